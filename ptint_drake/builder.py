@@ -1,0 +1,96 @@
+"""Wire the prescribed-time interceptor into an existing DiagramBuilder.
+
+``AddPrescribedTimeInterceptor`` is to this package what
+``AddMultibodyPlantSceneGraph`` is to Drake: give it a builder, a (finalized)
+MultibodyPlant already added to that builder, the frame whose origin must
+intercept, the schedule and one target per segment, and it adds
+
+    TargetSource ─┐
+    TimeBaseGenerator ─┼─> SlidingSurface ─> SlidingModeController ─> plant actuation
+    plant state ─> TaskSpaceKinematics ─┘                ↑ J
+
+returning the handles of every block so the caller can log, export or
+re-wire their ports.  Every actuated joint of the plant is driven; the plant
+must actuate each of its velocities (nv = nu).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+from ptint_drake.controller import SlidingModeController
+from ptint_drake.kinematics import TaskSpaceKinematics
+from ptint_drake.schedule import Schedule
+from ptint_drake.sliding_surface import SlidingSurface
+from ptint_drake.targets import TargetSource
+from ptint_drake.tbg import TimeBaseGenerator
+
+
+@dataclass(frozen=True)
+class ControllerGains:
+    """The paper's gains (section 3.1) as defaults; K, Lambda scalars or diagonals."""
+
+    K: object = 50.0
+    Lambda: object = 5.0
+    k: float = 3.0
+    epsilon: float = 1.0e-6
+    delta: float = 1.0e-6
+    alpha_hold: float = 0.0
+    switching: str = "tanh"
+    phi: float = 0.01
+    sigma_policy: str = "keep"
+
+
+@dataclass(frozen=True)
+class InterceptorHandles:
+    """The systems that ``AddPrescribedTimeInterceptor`` added."""
+
+    tbg: TimeBaseGenerator
+    targets: TargetSource
+    kinematics: TaskSpaceKinematics
+    surface: SlidingSurface
+    controller: SlidingModeController
+    schedule: Schedule
+
+
+def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
+                                 targets: Sequence, gains: ControllerGains = ControllerGains(),
+                                 connect_actuation: bool = True,
+                                 name: str = "interceptor") -> InterceptorHandles:
+    """Add the interceptor's blocks to ``builder`` and connect them to ``plant``.
+
+    With ``connect_actuation=False`` the controller's ``u`` port is left for the
+    caller (e.g. to add saturation or a disturbance before the plant).
+    """
+    if not plant.is_finalized():
+        raise ValueError("plant: must be finalized before adding the interceptor")
+    nv = plant.num_velocities()
+    if plant.num_actuated_dofs() != nv:
+        raise ValueError(
+            f"robot.model: the plant must actuate every velocity (nv = {nv}, "
+            f"actuated = {plant.num_actuated_dofs()})")
+    if nv < 3:
+        raise ValueError(f"robot.model: at least 3 joints are needed for 3-D interception, got {nv}")
+
+    tbg = builder.AddNamedSystem(f"{name}_tbg", TimeBaseGenerator(
+        schedule, gains.epsilon, gains.delta, gains.alpha_hold))
+    source = builder.AddNamedSystem(f"{name}_target", TargetSource(schedule, targets))
+    kin = builder.AddNamedSystem(f"{name}_kinematics", TaskSpaceKinematics(plant, frame))
+    surface = builder.AddNamedSystem(f"{name}_surface", SlidingSurface(
+        schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy))
+    ctrl = builder.AddNamedSystem(f"{name}_controller", SlidingModeController(
+        nv, gains.K, plant.MakeActuationMatrix()))
+
+    builder.Connect(plant.get_state_output_port(), kin.get_state_input_port())
+    builder.Connect(kin.GetOutputPort("x"), surface.GetInputPort("x"))
+    builder.Connect(kin.GetOutputPort("xdot"), surface.GetInputPort("xdot"))
+    builder.Connect(source.GetOutputPort("x_r"), surface.GetInputPort("x_r"))
+    builder.Connect(source.GetOutputPort("xdot_r"), surface.GetInputPort("xdot_r"))
+    builder.Connect(tbg.GetOutputPort("alpha"), surface.GetInputPort("alpha"))
+    builder.Connect(tbg.GetOutputPort("segment"), surface.GetInputPort("segment"))
+    builder.Connect(surface.GetOutputPort("s_x"), ctrl.GetInputPort("s_x"))
+    builder.Connect(kin.GetOutputPort("J"), ctrl.GetInputPort("J"))
+    if connect_actuation:
+        builder.Connect(ctrl.GetOutputPort("u"), plant.get_actuation_input_port())
+    return InterceptorHandles(tbg, source, kin, surface, ctrl, schedule)

@@ -1,0 +1,52 @@
+"""Second-order sliding-mode controller τ = −K J⁺(q) s_x  (SPEC section 2.3, paper eq. 18).
+
+Model-free: the only robot knowledge it takes is the Jacobian J (kinematics).
+For a square J the pseudoinverse product J⁺ s_x is a linear solve; for a
+redundant arm (more joints than 3) it is the minimum-norm solution
+Jᵀ (J Jᵀ)⁻¹ s_x.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from ptint_drake.cache import DeclareVectorCache
+
+
+class SlidingModeController(LeafSystem):
+    """Inputs ``s_x`` (3) and ``J`` (3·nv, row-major); output ``tau`` (nv joint torques).
+
+    ``K`` is a scalar or a length-nv diagonal (N·m·s/rad).  The output is in
+    generalized-velocity order; ``actuation_matrix`` (the plant's B, nv × nu)
+    maps it to the plant's actuation input order: u = Bᵀ τ.
+    """
+
+    def __init__(self, nv: int, K=50.0, actuation_matrix=None):
+        super().__init__()
+        self._nv = nv
+        self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
+        self._BT = None if actuation_matrix is None else np.asarray(actuation_matrix).T
+        nu = nv if actuation_matrix is None else self._BT.shape[0]
+        self._s_x_in = self.DeclareVectorInputPort("s_x", 3)
+        self._J_in = self.DeclareVectorInputPort("J", 3 * nv)
+        deps = {self.all_input_ports_ticket()}
+        self._eval = DeclareVectorCache(self, "tau", nv, self._tau, deps)
+        self.DeclareVectorOutputPort(
+            "tau", nv, lambda c, o: o.SetFromVector(self._eval(c)), prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort(
+            "u", nu, lambda c, o: o.SetFromVector(
+                self._eval(c) if self._BT is None else self._BT @ self._eval(c)),
+            prerequisites_of_calc=deps)
+
+    def torque(self, s_x: np.ndarray, J: np.ndarray) -> np.ndarray:
+        """τ = −K J⁺ s_x for a 3 × nv Jacobian J."""
+        if J.shape[1] == 3:
+            qdot_s = np.linalg.solve(J, s_x)
+        else:
+            qdot_s = J.T @ np.linalg.solve(J @ J.T, s_x)
+        return -self._K * qdot_s
+
+    def _tau(self, context) -> np.ndarray:
+        J = self._J_in.Eval(context).reshape(3, self._nv)
+        return self.torque(self._s_x_in.Eval(context), J)

@@ -1,0 +1,242 @@
+"""Scenario files (SPEC section 5.2): a typed schema, loading and validation.
+
+A scenario is one YAML mapping loaded with Drake's ``yaml_load_typed`` into
+``Scenario``; unknown keys are rejected.  ``simulator`` is Drake's own
+``SimulatorConfig``.  ``load_scenario`` accepts a bundled name (see
+``bundled_scenarios``) or a file path, and raises ``ScenarioError`` with a
+one-line message that names the offending field.
+
+Defaults are the paper's: gains K = 50, Λ = 5, k = 3, ϵ = δ = 1e-6 (section
+3.1), the RV-M1 start pose θ = (22.5°, 45°, 30°).  Choices the paper leaves
+open, with their defaults:
+
+- ``controller.switching``: ``tanh`` boundary layer of width ``phi`` = 0.01 m/s
+  (``sign`` reproduces the paper exactly but slowly);
+- ``controller.sigma_policy``: ``keep`` σ across segments (torque stays
+  continuous, the learned gravity load is kept);
+- ``controller.alpha_hold``: 0 s⁻¹ after tf, as in the paper;
+- ``plant``: scale factors for link masses/inertias and joint damping, used
+  to show that the model-free controller needs no retuning (all 1 by default).
+"""
+
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import List, Optional
+
+from pydrake.common.yaml import yaml_load_typed
+from pydrake.systems.analysis import SimulatorConfig
+
+from ptint_drake.schedule import Schedule, Segment
+from ptint_drake.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
+from ptint_drake.targets import LinearTarget, SinusoidTarget
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be run; the message names the field."""
+
+
+@dataclass
+class RobotConfig:
+    model: str = "rvm1"  # a bundled model name or a path to a URDF/SDFormat file
+    end_effector: str = "tool"  # frame whose origin is the interception point
+    initial_q_deg: List[float] = field(default_factory=lambda: [22.5, 45.0, 30.0])
+
+
+@dataclass
+class ControllerConfig:
+    K: float = 50.0
+    Lambda: float = 5.0
+    k: float = 3.0
+    epsilon: float = 1.0e-6
+    delta: float = 1.0e-6
+    alpha_hold: float = 0.0
+    switching: str = "tanh"
+    phi: float = 0.01
+    sigma_policy: str = "keep"
+
+
+@dataclass
+class SinusoidConfig:
+    center: List[float] = field(default_factory=list)
+    amplitude: List[float] = field(default_factory=list)
+    omega: float = 0.0
+    phase: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+@dataclass
+class LinearConfig:
+    start: List[float] = field(default_factory=list)
+    velocity: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+@dataclass
+class TargetConfig:
+    sinusoid: Optional[SinusoidConfig] = None
+    linear: Optional[LinearConfig] = None
+
+
+@dataclass
+class InterceptionConfig:
+    start: float = 0.0
+    tf: float = 1.5
+    beta: float = 0.75
+    target: TargetConfig = field(default_factory=TargetConfig)
+
+
+@dataclass
+class PlantConfig:
+    mass_scale: float = 1.0  # every link's mass and inertia × this
+    damping_scale: float = 1.0  # every joint's viscous damping × this
+
+
+def _default_simulator() -> SimulatorConfig:
+    return SimulatorConfig(integration_scheme="runge_kutta3", accuracy=1.0e-4,
+                           max_step_size=0.1, use_error_control=True)
+
+
+@dataclass
+class Scenario:
+    duration: float = 3.0
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    controller: ControllerConfig = field(default_factory=ControllerConfig)
+    interceptions: List[InterceptionConfig] = field(default_factory=list)
+    plant: PlantConfig = field(default_factory=PlantConfig)
+    simulator: SimulatorConfig = field(default_factory=_default_simulator)
+    name: str = ""
+
+    def schedule(self) -> Schedule:
+        return Schedule([Segment(i.start, i.tf, i.beta) for i in self.interceptions])
+
+    def targets(self) -> list:
+        return [make_target(i.target) for i in self.interceptions]
+
+
+def make_target(config: TargetConfig):
+    if config.sinusoid is not None:
+        s = config.sinusoid
+        return SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
+    return LinearTarget(config.linear.start, config.linear.velocity)
+
+
+def bundled_scenarios() -> "list[str]":
+    return sorted(p.name[:-5] for p in resources.files("ptint_drake.scenarios").iterdir()
+                  if p.name.endswith(".yaml"))
+
+
+def scenario_text(name_or_file: str) -> "tuple[str, str]":
+    """(name, YAML text) of a bundled scenario name or a scenario file."""
+    if name_or_file in bundled_scenarios():
+        return name_or_file, resources.files("ptint_drake.scenarios").joinpath(
+            f"{name_or_file}.yaml").read_text()
+    path = Path(name_or_file)
+    if not path.is_file():
+        raise ScenarioError(
+            f"scenario: {name_or_file!r} is neither a bundled scenario "
+            f"({', '.join(bundled_scenarios())}) nor a file")
+    return path.stem, path.read_text()
+
+
+def load_scenario(name_or_file: str) -> Scenario:
+    name, text = scenario_text(name_or_file)
+    return parse_scenario(text, name)
+
+
+def parse_scenario(text: str, name: str = "scenario") -> Scenario:
+    """Parse and validate YAML text; raises ScenarioError naming the field."""
+    try:
+        scenario = yaml_load_typed(schema=Scenario, data=text)
+    except Exception as exc:  # yaml_load_typed raises several types; keep one line
+        msg = " ".join(str(exc).split())
+        raise ScenarioError(f"scenario YAML: {msg}") from None
+    if not scenario.name:
+        scenario.name = name
+    validate(scenario)
+    return scenario
+
+
+def _vector3(value, where: str):
+    if len(value) != 3:
+        raise ScenarioError(f"{where}: must have 3 entries, got {len(value)}")
+    if not all(math.isfinite(v) for v in value):
+        raise ScenarioError(f"{where}: must be finite, got {list(value)}")
+
+
+def _positive(value: float, where: str):
+    if not (math.isfinite(value) and value > 0.0):
+        raise ScenarioError(f"{where}: must be > 0, got {value}")
+
+
+def validate(s: Scenario) -> None:
+    """Checks that need no robot model (the model-dependent ones live in simulation)."""
+    _positive(s.duration, "duration")
+    c = s.controller
+    for name in ("K", "Lambda", "k", "epsilon", "delta"):
+        _positive(getattr(c, name), f"controller.{name}")
+    if not (math.isfinite(c.alpha_hold) and c.alpha_hold >= 0.0):
+        raise ScenarioError(f"controller.alpha_hold: must be >= 0, got {c.alpha_hold}")
+    if c.switching not in SWITCHING_LAWS:
+        raise ScenarioError(f"controller.switching: must be one of {', '.join(SWITCHING_LAWS)}, got {c.switching!r}")
+    if c.switching != "sign":
+        _positive(c.phi, "controller.phi")
+    if c.sigma_policy not in SIGMA_POLICIES:
+        raise ScenarioError(f"controller.sigma_policy: must be one of {', '.join(SIGMA_POLICIES)}, got {c.sigma_policy!r}")
+    _positive(s.plant.mass_scale, "plant.mass_scale")
+    if not (math.isfinite(s.plant.damping_scale) and s.plant.damping_scale >= 0.0):
+        raise ScenarioError(f"plant.damping_scale: must be >= 0, got {s.plant.damping_scale}")
+    _positive(s.simulator.accuracy, "simulator.accuracy")
+    _positive(s.simulator.max_step_size, "simulator.max_step_size")
+    if s.simulator.start_time != 0.0:
+        raise ScenarioError(f"simulator.start_time: must be 0 (scenario times are absolute), got {s.simulator.start_time}")
+    if not s.interceptions:
+        raise ScenarioError("interceptions: at least one interception is needed")
+    for i, ic in enumerate(s.interceptions):
+        where = f"interceptions[{i}]"
+        if not (0.0 < ic.beta < 1.0):
+            raise ScenarioError(f"{where}.beta: must be in (0, 1), got {ic.beta}")
+        _positive(ic.tf, f"{where}.tf")
+        if not (math.isfinite(ic.start) and ic.start >= 0.0):
+            raise ScenarioError(f"{where}.start: must be >= 0, got {ic.start}")
+        if i == 0 and ic.start != 0.0:
+            raise ScenarioError(f"{where}.start: the first interception must start at 0, got {ic.start}")
+        if i > 0:
+            prev = s.interceptions[i - 1]
+            if ic.start < prev.start + prev.tf:
+                raise ScenarioError(
+                    f"{where}.start: {ic.start} s is before interceptions[{i - 1}] "
+                    f"intercepts at {prev.start + prev.tf} s (segments must be in time order "
+                    f"and may not overlap)")
+        if ic.start + ic.tf > s.duration + 1e-12:
+            raise ScenarioError(
+                f"{where}.tf: interception time {ic.start + ic.tf} s is after the end "
+                f"of the simulation (duration {s.duration} s)")
+        t = ic.target
+        kinds = [k for k in ("sinusoid", "linear") if getattr(t, k) is not None]
+        if len(kinds) != 1:
+            raise ScenarioError(
+                f"{where}.target: exactly one of sinusoid, linear is needed, got "
+                f"{', '.join(kinds) if kinds else 'none'}")
+        if t.sinusoid is not None:
+            for name in ("center", "amplitude", "phase"):
+                _vector3(getattr(t.sinusoid, name), f"{where}.target.sinusoid.{name}")
+            if not math.isfinite(t.sinusoid.omega):
+                raise ScenarioError(f"{where}.target.sinusoid.omega: must be finite")
+        else:
+            _vector3(t.linear.start, f"{where}.target.linear.start")
+            _vector3(t.linear.velocity, f"{where}.target.linear.velocity")
+
+
+def dump_dataclass(obj) -> dict:
+    """A plain dict of a scenario (SimulatorConfig included), for reports."""
+    if dataclasses.is_dataclass(obj):
+        return {f.name: dump_dataclass(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, SimulatorConfig):
+        return {k: getattr(obj, k) for k in (
+            "integration_scheme", "max_step_size", "accuracy", "use_error_control",
+            "start_time", "target_realtime_rate", "publish_every_time_step")}
+    if isinstance(obj, list):
+        return [dump_dataclass(v) for v in obj]
+    return obj

@@ -1,0 +1,128 @@
+"""Sliding surface with a prescribed-time gain (SPEC section 2.3, paper eqs. 11-17).
+
+    e   = x − x_r,  ė = ẋ − ẋ_r                         (11)
+    s   = ė + α(t) e                                      (16)
+    s_d = s(t0) exp(−k (t − t0))                          s(t0) captured at the segment start
+    s_x = s − s_d + Λ σ,   σ̇ = switch(s − s_d)            (17)
+
+``switch`` is the paper's ``sign`` or a boundary layer of width φ (m/s):
+``tanh`` → tanh(w/φ), ``sat`` → clip(w/φ, −1, 1).  The boundary layer is the
+default because an error-controlled integrator crawls through a discontinuous
+right-hand side (SPEC section 7); ``tests/test_switching.py`` measures how
+closely it reproduces ``sign``.
+
+Segment switches are Drake events: a timed (periodic, one-shot) unrestricted
+update at every segment start, plus one at initialization, stores s(t0) and
+the segment index.  At the instant of a switch, before its event is handled,
+s_d is taken as the current s, which is exactly the value the event stores, so
+every output is continuous from the right.  σ is kept across segments by
+default (``sigma_policy="keep"``): it holds the integral of the switching term,
+i.e. the learned gravity load, so the torque does not jump; ``"reset"`` sets it
+to 0 at each new segment.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from ptint_drake.cache import DeclareVectorCache
+from ptint_drake.schedule import Schedule
+
+SWITCHING_LAWS = ("sign", "tanh", "sat")
+SIGMA_POLICIES = ("keep", "reset")
+# One-shot timed events are periodic events whose period exceeds any simulation.
+_ONE_SHOT_PERIOD = 1.0e9
+
+
+def switching_function(w: np.ndarray, law: str, phi: float) -> np.ndarray:
+    """σ̇ = switch(w): ``sign`` (paper), ``tanh(w/φ)`` or ``sat(w/φ)``."""
+    if law == "sign":
+        return np.sign(w)
+    if law == "tanh":
+        return np.tanh(w / phi)
+    if law == "sat":
+        return np.clip(w / phi, -1.0, 1.0)
+    raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
+
+
+class SlidingSurface(LeafSystem):
+    """Inputs ``x``, ``xdot`` (robot point), ``x_r``, ``xdot_r`` (target), ``alpha`` (from the
+    TBG) and ``segment`` ([index, t0, ...] from the TBG).
+
+    Outputs ``s_x`` (what the controller uses), and for inspection ``e``, ``edot``,
+    ``s``, ``s_d`` and ``sigma``.  Continuous state σ (3); discrete state
+    [captured segment index, s(t0)] (4).
+    """
+
+    def __init__(self, schedule: Schedule, Lambda=5.0, k: float = 3.0,
+                 switching: str = "tanh", phi: float = 0.01, sigma_policy: str = "keep"):
+        super().__init__()
+        switching_function(np.zeros(1), switching, phi)  # validates the law
+        if sigma_policy not in SIGMA_POLICIES:
+            raise ValueError(f"controller.sigma_policy: use one of {SIGMA_POLICIES}, got {sigma_policy!r}")
+        if switching != "sign" and not phi > 0.0:
+            raise ValueError(f"controller.phi: must be > 0, got {phi}")
+        self._Lambda = np.broadcast_to(np.asarray(Lambda, dtype=float), (3,)).copy()
+        self._k = float(k)
+        self._law = switching
+        self._phi = float(phi)
+        self._reset_sigma = sigma_policy == "reset"
+
+        self._x_in = self.DeclareVectorInputPort("x", 3)
+        self._xdot_in = self.DeclareVectorInputPort("xdot", 3)
+        self._x_r_in = self.DeclareVectorInputPort("x_r", 3)
+        self._xdot_r_in = self.DeclareVectorInputPort("xdot_r", 3)
+        self._alpha_in = self.DeclareVectorInputPort("alpha", 1)
+        self._segment_in = self.DeclareVectorInputPort("segment", 5)
+        self._sigma_index = self.DeclareContinuousState(3)
+        self._capture_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0, 0.0]))
+
+        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
+        self._eval = DeclareVectorCache(self, "surface", 18, self._calc, deps)
+        for name, lo in (("s_x", 0), ("e", 3), ("edot", 6), ("s", 9), ("s_d", 12)):
+            self.DeclareVectorOutputPort(
+                name, 3, lambda c, o, lo=lo: o.SetFromVector(self._eval(c)[lo:lo + 3]),
+                prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort(
+            "sigma", 3, lambda c, o: o.SetFromVector(c.get_continuous_state_vector().CopyToVector()),
+            prerequisites_of_calc={self.xc_ticket()})
+
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._capture)
+        for start in schedule.starts:
+            if start > 0.0:
+                self.DeclarePeriodicUnrestrictedUpdateEvent(_ONE_SHOT_PERIOD, start, self._capture)
+
+    def _calc(self, context) -> np.ndarray:
+        x = self._x_in.Eval(context)
+        xdot = self._xdot_in.Eval(context)
+        e = x - self._x_r_in.Eval(context)
+        edot = xdot - self._xdot_r_in.Eval(context)
+        alpha = self._alpha_in.Eval(context)[0]
+        segment = self._segment_in.Eval(context)
+        s = edot + alpha * e
+        captured = context.get_discrete_state_vector().value()
+        if segment[0] < 0 or captured[0] != segment[0]:
+            s_d = s.copy()  # at the switch instant s(t0) is s itself
+        else:
+            s_d = captured[1:4] * np.exp(-self._k * (context.get_time() - segment[1]))
+        sigma = context.get_continuous_state_vector().CopyToVector()
+        w = s - s_d
+        s_x = w + self._Lambda * sigma
+        return np.concatenate([s_x, e, edot, s, s_d, switching_function(w, self._law, self._phi)])
+
+    def _capture(self, context, state):
+        segment = self._segment_in.Eval(context)
+        if segment[0] < 0:
+            return
+        s = self._eval(context)[9:12]
+        state.get_mutable_discrete_state().get_mutable_vector().SetFromVector(
+            np.concatenate([[segment[0]], s]))
+        if self._reset_sigma:
+            state.get_mutable_continuous_state().get_mutable_vector().SetZero()
+
+    def DoCalcTimeDerivatives(self, context, derivatives):
+        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[15:18])
+
+    def get_s_x_output_port(self):
+        return self.GetOutputPort("s_x")

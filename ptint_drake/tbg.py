@@ -1,0 +1,139 @@
+"""Time base generator (TBG), SPEC section 2.1 (paper eqs. 6-10).
+
+    ξ̇ = −γ (ξ(1−ξ))^β,  ξ(t0) = 1,  γ = B(1−β, 1−β) / tf
+
+has the exact solution ξ(t) = I⁻¹(1−β, 1−β; 1 − τ/tf), τ = t − t0, where I⁻¹
+is the inverse regularized incomplete beta function.  ξ reaches 0 exactly at
+τ = tf and stays 0 afterwards.  Near ξ ≈ 1 the complement η = 1 − ξ is
+computed directly (η = I⁻¹(1−β, 1−β; τ/tf)) because for β ≳ 0.6 it falls below
+double precision next to 1.0; every derivative is written in terms of the
+product ξη so that no precision is lost at either end.
+
+The same closed form gives the prescribed-time gain of SPEC section 2.2,
+
+    α(t) = −α0 ξ̇ / (ξ + δ),  α0 = 1 + ϵ,
+
+and, after tf, the hold gain ``alpha_hold`` (0 in the paper).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+from scipy.special import beta as beta_function
+from scipy.special import betaincinv
+
+from ptint_drake.cache import DeclareVectorCache
+from ptint_drake.schedule import Schedule
+
+
+def gamma_gain(tf: float, beta: float) -> float:
+    """γ = Γ(1−β)² / (tf Γ(2−2β)) = B(1−β, 1−β) / tf  (paper eq. 8)."""
+    return float(beta_function(1.0 - beta, 1.0 - beta)) / tf
+
+
+def tbg_profile(tau, tf: float, beta: float):
+    """ξ, ξ̇, ξ̈, ξ⃛ at times τ = t − t0 since the segment start (scalars or arrays).
+
+    For τ ≤ 0 the TBG sits at ξ = 1 (not yet started); for τ ≥ tf it is 0.
+    Returns a tuple of four arrays of the shape of ``tau`` (floats for scalars).
+    """
+    tau_arr = np.asarray(tau, dtype=float)
+    u = np.clip(tau_arr / tf, 0.0, 1.0)
+    a = 1.0 - beta
+    xi = betaincinv(a, a, 1.0 - u)
+    eta = betaincinv(a, a, u)  # 1 − ξ, computed directly
+    g = gamma_gain(tf, beta)
+    p = xi * eta  # ξ(1−ξ)
+    inside = (u > 0.0) & (u < 1.0)
+    safe_p = np.where(inside, p, 1.0)
+    xi_d = np.where(inside, -g * safe_p**beta, 0.0)
+    xi_dd = np.where(inside, g**2 * beta * (1.0 - 2.0 * xi) * safe_p ** (2.0 * beta - 1.0), 0.0)
+    xi_ddd = np.where(
+        inside,
+        -g**3 * beta * safe_p ** (3.0 * beta - 2.0)
+        * ((2.0 * beta - 1.0) * (1.0 - 2.0 * xi) ** 2 - 2.0 * p),
+        0.0)
+    xi = np.where(u >= 1.0, 0.0, xi)
+    out = (xi, xi_d, xi_dd, xi_ddd)
+    if tau_arr.ndim == 0:
+        return tuple(float(v) for v in out)
+    return out
+
+
+def alpha_gain(xi, xi_dot, epsilon: float = 1e-6, delta: float = 1e-6):
+    """α = −(1 + ϵ) ξ̇ / (ξ + δ)  (paper eq. 13), ≥ 0 during the segment."""
+    return -(1.0 + epsilon) * np.asarray(xi_dot) / (np.asarray(xi) + delta)
+
+
+def alpha_peak(tf: float, beta: float, epsilon: float = 1e-6, delta: float = 1e-6) -> float:
+    """Peak of α over a segment, found on a log-spaced grid just before tf."""
+    tau = tf * (1.0 - np.logspace(-14, 0, 4000))
+    xi, xi_d, _, _ = tbg_profile(tau, tf, beta)
+    return float(np.max(alpha_gain(xi, xi_d, epsilon, delta)))
+
+
+class TimeBaseGenerator(LeafSystem):
+    """The TBG of the active segment as a Drake system (paper eqs. 6-10, 13).
+
+    Stateless: the closed form is exact, so restarting the TBG at a new segment
+    is a matter of time alone.  Output ports (all functions of time only):
+
+    - ``xi``: [ξ, ξ̇, ξ̈, ξ⃛] of the active segment (ξ = 1 before the first start);
+    - ``alpha``: [α], the prescribed-time gain, ``alpha_hold`` after tf;
+    - ``segment``: [index, t0, tf, β, phase] with phase 0 before the first
+      segment, 1 while converging, 2 while holding after tf.
+    """
+
+    def __init__(self, schedule: Schedule, epsilon: float = 1e-6, delta: float = 1e-6,
+                 alpha_hold: float = 0.0):
+        super().__init__()
+        self._schedule = schedule
+        self._epsilon = epsilon
+        self._delta = delta
+        self._alpha_hold = alpha_hold
+        time_only = {self.time_ticket()}
+        self._eval = DeclareVectorCache(
+            self, "tbg", 10, lambda c: self.evaluate(c.get_time()), time_only)
+        self._xi_out = self.DeclareVectorOutputPort(
+            "xi", 4, lambda c, o: o.SetFromVector(self._eval(c)[0:4]),
+            prerequisites_of_calc=time_only)
+        self._alpha_out = self.DeclareVectorOutputPort(
+            "alpha", 1, lambda c, o: o.SetFromVector(self._eval(c)[4:5]),
+            prerequisites_of_calc=time_only)
+        self._segment_out = self.DeclareVectorOutputPort(
+            "segment", 5, lambda c, o: o.SetFromVector(self._eval(c)[5:10]),
+            prerequisites_of_calc=time_only)
+
+    @property
+    def schedule(self) -> Schedule:
+        return self._schedule
+
+    def evaluate(self, t: float) -> np.ndarray:
+        """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] at absolute time t."""
+        out = np.zeros(10)
+        i = self._schedule.active(t)
+        if i < 0:
+            out[0] = 1.0
+            out[5] = -1.0
+            return out
+        seg = self._schedule[i]
+        tau = t - seg.start
+        out[5:9] = (i, seg.start, seg.tf, seg.beta)
+        if tau < seg.tf:
+            out[0:4] = tbg_profile(tau, seg.tf, seg.beta)
+            out[4] = alpha_gain(out[0], out[1], self._epsilon, self._delta)
+            out[9] = 1.0
+        else:
+            out[4] = self._alpha_hold
+            out[9] = 2.0
+        return out
+
+    def get_xi_output_port(self):
+        return self._xi_out
+
+    def get_alpha_output_port(self):
+        return self._alpha_out
+
+    def get_segment_output_port(self):
+        return self._segment_out
