@@ -40,6 +40,7 @@ class ControllerGains:
     switching: str = "tanh"
     phi: float = 0.01
     sigma_policy: str = "keep"
+    k_hold: float = 50.0
 
 
 @dataclass(frozen=True)
@@ -78,7 +79,7 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     source = builder.AddNamedSystem(f"{name}_target", TargetSource(schedule, targets))
     kin = builder.AddNamedSystem(f"{name}_kinematics", TaskSpaceKinematics(plant, frame))
     surface = builder.AddNamedSystem(f"{name}_surface", SlidingSurface(
-        schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy))
+        schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy, gains.k_hold))
     ctrl = builder.AddNamedSystem(f"{name}_controller", SlidingModeController(
         nv, gains.K, plant.MakeActuationMatrix()))
 

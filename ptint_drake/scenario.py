@@ -15,6 +15,8 @@ open, with their defaults:
 - ``controller.sigma_policy``: ``keep`` σ across segments (torque stays
   continuous, the learned gravity load is kept);
 - ``controller.alpha_hold``: 0 s⁻¹ after tf, as in the paper;
+- ``controller.k_hold``: 50 s⁻¹, the decay rate of s_d after tf (``k_hold = k``
+  is the paper's formula; see ``sliding_surface`` for why the hold needs it);
 - ``plant``: scale factors for link masses/inertias and joint damping, used
   to show that the model-free controller needs no retuning (all 1 by default).
 """
@@ -28,7 +30,7 @@ from pathlib import Path
 from typing import List, Optional
 
 from pydrake.common.yaml import yaml_load_typed
-from pydrake.systems.analysis import SimulatorConfig
+from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from ptint_drake.schedule import Schedule, Segment
 from ptint_drake.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
@@ -57,6 +59,7 @@ class ControllerConfig:
     switching: str = "tanh"
     phi: float = 0.01
     sigma_policy: str = "keep"
+    k_hold: float = 50.0
 
 
 @dataclass
@@ -150,12 +153,73 @@ def parse_scenario(text: str, name: str = "scenario") -> Scenario:
     try:
         scenario = yaml_load_typed(schema=Scenario, data=text)
     except Exception as exc:  # yaml_load_typed raises several types; keep one line
-        msg = " ".join(str(exc).split())
-        raise ScenarioError(f"scenario YAML: {msg}") from None
+        raise ScenarioError(_yaml_error(text, Scenario, exc)) from None
     if not scenario.name:
         scenario.name = name
     validate(scenario)
     return scenario
+
+
+def _yaml_error(text: str, schema, exc: Exception) -> str:
+    """One line for a YAML load failure, naming the field where it can be located."""
+    import yaml  # noqa: PLC0415
+
+    try:
+        raw = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        return f"scenario YAML: malformed{where}: {getattr(err, 'problem', None) or err}"
+    found = _locate(raw, schema, "")
+    detail = " ".join(str(exc).split())
+    return f"{found}" if found else f"scenario YAML: {detail}"
+
+
+def _locate(raw, schema, path: str) -> Optional[str]:
+    """Walk raw YAML data against a dataclass schema; describe the first mismatch."""
+    import typing  # noqa: PLC0415
+
+    if dataclasses.is_dataclass(schema):
+        if not isinstance(raw, dict):
+            return f"{path or 'scenario'}: expected a mapping, got {raw!r}"
+        hints = typing.get_type_hints(schema)
+        for key, value in raw.items():
+            where = f"{path}.{key}" if path else str(key)
+            if key not in hints:
+                return f"{where}: unknown field (known: {', '.join(hints)})"
+            found = _locate(value, hints[key], where)
+            if found:
+                return found
+        return None
+    origin = typing.get_origin(schema)
+    if origin is typing.Union:
+        inner = [a for a in typing.get_args(schema) if a is not type(None)][0]
+        return None if raw is None else _locate(raw, inner, path)
+    if origin in (list, List):
+        if not isinstance(raw, list):
+            return f"{path}: expected a list, got {raw!r}"
+        item = typing.get_args(schema)[0]
+        for i, v in enumerate(raw):
+            found = _locate(v, item, f"{path}[{i}]")
+            if found:
+                return found
+        return None
+    if schema is float:
+        if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+            try:
+                float(raw)
+            except (TypeError, ValueError):
+                return f"{path}: expected a number, got {raw!r}"
+    if schema is str and not isinstance(raw, str):
+        return f"{path}: expected a string, got {raw!r}"
+    if schema is SimulatorConfig and not isinstance(raw, dict):
+        return f"{path}: expected a mapping, got {raw!r}"
+    if schema is SimulatorConfig:
+        known = dump_dataclass(SimulatorConfig()).keys()
+        for key in raw:
+            if key not in known:
+                return f"{path}.{key}: unknown field (known: {', '.join(known)})"
+    return None
 
 
 def _vector3(value, where: str):
@@ -174,7 +238,7 @@ def validate(s: Scenario) -> None:
     """Checks that need no robot model (the model-dependent ones live in simulation)."""
     _positive(s.duration, "duration")
     c = s.controller
-    for name in ("K", "Lambda", "k", "epsilon", "delta"):
+    for name in ("K", "Lambda", "k", "k_hold", "epsilon", "delta"):
         _positive(getattr(c, name), f"controller.{name}")
     if not (math.isfinite(c.alpha_hold) and c.alpha_hold >= 0.0):
         raise ScenarioError(f"controller.alpha_hold: must be >= 0, got {c.alpha_hold}")
@@ -187,6 +251,11 @@ def validate(s: Scenario) -> None:
     _positive(s.plant.mass_scale, "plant.mass_scale")
     if not (math.isfinite(s.plant.damping_scale) and s.plant.damping_scale >= 0.0):
         raise ScenarioError(f"plant.damping_scale: must be >= 0, got {s.plant.damping_scale}")
+    schemes = GetIntegrationSchemes()
+    if s.simulator.integration_scheme not in schemes:
+        raise ScenarioError(
+            f"simulator.integration_scheme: unknown {s.simulator.integration_scheme!r} "
+            f"(one of {', '.join(schemes)})")
     _positive(s.simulator.accuracy, "simulator.accuracy")
     _positive(s.simulator.max_step_size, "simulator.max_step_size")
     if s.simulator.start_time != 0.0:
@@ -240,3 +309,14 @@ def dump_dataclass(obj) -> dict:
     if isinstance(obj, list):
         return [dump_dataclass(v) for v in obj]
     return obj
+
+
+def parse_with_overrides(text: str, overrides: str, name: str = "scenario") -> Scenario:
+    """Parse ``text``, then merge the YAML mapping ``overrides`` over it, then validate."""
+    base = parse_scenario(text, name)
+    try:
+        scenario = yaml_load_typed(schema=Scenario, data=overrides, defaults=base)
+    except Exception as exc:
+        raise ScenarioError("--set " + _yaml_error(overrides, Scenario, exc)) from None
+    validate(scenario)
+    return scenario

@@ -138,7 +138,7 @@ def build(scenario: Scenario) -> Built:
     plant = builder.AddNamedSystem("plant", make_plant(scenario))
     c = scenario.controller
     gains = ControllerGains(c.K, c.Lambda, c.k, c.epsilon, c.delta, c.alpha_hold,
-                            c.switching, c.phi, c.sigma_policy)
+                            c.switching, c.phi, c.sigma_policy, c.k_hold)
     handles = AddPrescribedTimeInterceptor(
         builder, plant, plant.GetFrameByName(scenario.robot.end_effector),
         scenario.schedule(), scenario.targets(), gains)
@@ -229,7 +229,7 @@ def compute_metrics(scenario: Scenario, samples: dict, series: dict) -> dict:
         e_half, _ = samples[seg.start + 0.5 * seg.tf]
         e_tf, edot_tf = samples[seg.end]
         t_end = schedule.hold_end(i, scenario.duration)
-        hold = (t >= seg.end) & (t <= t_end)
+        hold = (t >= seg.end) & (t < t_end)
         hold_max = max(float(np.max(e_norm[hold])) if hold.any() else 0.0,
                        float(np.linalg.norm(e_tf)))
         segments.append({

@@ -2,7 +2,8 @@
 
     e   = x − x_r,  ė = ẋ − ẋ_r                         (11)
     s   = ė + α(t) e                                      (16)
-    s_d = s(t0) exp(−k (t − t0))                          s(t0) captured at the segment start
+    s_d = s(t0) exp(−k (t − t0))          t < t0 + tf,   s(t0) captured at the segment start
+    s_d = s_d(t0 + tf) exp(−k_hold (t − t0 − tf))   after tf (hold)
     s_x = s − s_d + Λ σ,   σ̇ = switch(s − s_d)            (17)
 
 ``switch`` is the paper's ``sign`` or a boundary layer of width φ (m/s):
@@ -19,6 +20,14 @@ every output is continuous from the right.  σ is kept across segments by
 default (``sigma_policy="keep"``): it holds the integral of the switching term,
 i.e. the learned gravity load, so the torque does not jump; ``"reset"`` sets it
 to 0 at each new segment.
+
+The hold after tf is a choice the paper leaves open.  Its α is 0 there, so the
+surface only matches velocities: s → s_d means ė → s_d and the position drifts
+by ∫ s_d dt.  With the paper's s_d that drift is |s(t0)| e^(−k tf) / k, which is
+4.4 mm for the first assembly segment (tf = 0.5 s, k = 3, object at 0.1 m/s).
+The hold therefore lets s_d decay at its own rate ``k_hold`` (default 50 s⁻¹,
+drift ≤ s_d(tf)/k_hold); s_d stays continuous, and ``k_hold = k`` is exactly the
+paper's formula.  ``alpha_hold`` (TBG) adds position feedback in the hold.
 """
 
 from __future__ import annotations
@@ -56,7 +65,8 @@ class SlidingSurface(LeafSystem):
     """
 
     def __init__(self, schedule: Schedule, Lambda=5.0, k: float = 3.0,
-                 switching: str = "tanh", phi: float = 0.01, sigma_policy: str = "keep"):
+                 switching: str = "tanh", phi: float = 0.01, sigma_policy: str = "keep",
+                 k_hold: float = 50.0):
         super().__init__()
         switching_function(np.zeros(1), switching, phi)  # validates the law
         if sigma_policy not in SIGMA_POLICIES:
@@ -65,6 +75,7 @@ class SlidingSurface(LeafSystem):
             raise ValueError(f"controller.phi: must be > 0, got {phi}")
         self._Lambda = np.broadcast_to(np.asarray(Lambda, dtype=float), (3,)).copy()
         self._k = float(k)
+        self._k_hold = float(k_hold)
         self._law = switching
         self._phi = float(phi)
         self._reset_sigma = sigma_policy == "reset"
@@ -105,7 +116,11 @@ class SlidingSurface(LeafSystem):
         if segment[0] < 0 or captured[0] != segment[0]:
             s_d = s.copy()  # at the switch instant s(t0) is s itself
         else:
-            s_d = captured[1:4] * np.exp(-self._k * (context.get_time() - segment[1]))
+            tau, tf = context.get_time() - segment[1], segment[2]
+            if tau < tf:
+                s_d = captured[1:4] * np.exp(-self._k * tau)
+            else:
+                s_d = captured[1:4] * np.exp(-self._k * tf - self._k_hold * (tau - tf))
         sigma = context.get_continuous_state_vector().CopyToVector()
         w = s - s_d
         s_x = w + self._Lambda * sigma

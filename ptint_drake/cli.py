@@ -1,0 +1,150 @@
+"""The ``ptint`` command line (SPEC section 5.1).
+
+    ptint list                              bundled scenarios
+    ptint run NAME_OR_FILE [--out DIR]      one scenario: metrics.json, series.npz, figures, replay.html
+    ptint paper [--out DIR]                 every paper scenario + TBG figures + index.html
+    ptint diagram NAME_OR_FILE [--out DIR]  the built diagram as Graphviz .dot and .svg
+
+``--set key=value`` (repeatable) overrides a scenario field, e.g.
+``--set controller.switching=sign --set simulator.accuracy=1e-6``; values are
+YAML.  Bad input ends with one line ``ptint: error: FIELD: ...`` and exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ptint_drake.scenario import ScenarioError, bundled_scenarios, scenario_text
+
+
+def _parse_overrides(pairs) -> str:
+    """``a.b=v`` pairs as one nested YAML mapping (text)."""
+    import yaml  # noqa: PLC0415  (PyYAML ships with drake's dependencies)
+
+    tree: dict = {}
+    for pair in pairs or []:
+        if "=" not in pair:
+            raise ScenarioError(f"--set: expected key=value, got {pair!r}")
+        key, value = pair.split("=", 1)
+        node = tree
+        parts = key.strip().split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        try:
+            node[parts[-1]] = yaml.safe_load(value)
+        except yaml.YAMLError:
+            raise ScenarioError(f"--set {key}: value {value!r} is not valid YAML") from None
+    return yaml.safe_dump(tree) if tree else ""
+
+
+def load(name_or_file: str, overrides=None):
+    from ptint_drake.scenario import parse_scenario, parse_with_overrides  # noqa: PLC0415
+
+    name, text = scenario_text(name_or_file)
+    extra = _parse_overrides(overrides)
+    if extra:
+        return parse_with_overrides(text, extra, name)
+    return parse_scenario(text, name)
+
+
+def _progress(label: str):
+    def report(t, duration):
+        width = 30
+        done = int(width * t / duration)
+        sys.stderr.write(f"\r{label:<18} [{'#' * done}{'.' * (width - done)}] {t:5.2f}/{duration:.2f} s")
+        if t >= duration:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+    return report
+
+
+def cmd_list(args) -> int:
+    for name in bundled_scenarios():
+        _, text = scenario_text(name)
+        first = text.splitlines()[0].lstrip("# ").strip() if text.startswith("#") else ""
+        print(f"{name:<18} {first}")
+    return 0
+
+
+def cmd_run(args) -> int:
+    from ptint_drake.report import run_and_write  # noqa: PLC0415
+
+    scenario = load(args.scenario, args.set)
+    out = Path(args.out) if args.out else Path("out") / scenario.name
+    metrics = run_and_write(scenario, out, replay=not args.no_replay,
+                            figures=not args.no_figures,
+                            progress=None if args.quiet else _progress(scenario.name))
+    for i, seg in enumerate(metrics["segments"]):
+        print(f"{scenario.name} segment {i}: e0 = {seg['e0_norm'] * 1e3:.2f} mm, "
+              f"e(tf/2) = {seg['e_half_norm'] * 1e3:.2f} mm, e(tf) = {seg['e_tf_norm'] * 1e3:.4f} mm, "
+              f"hold max = {seg['e_hold_max_norm'] * 1e3:.3f} mm")
+    sim = metrics["sim"]
+    print(f"realtime factor {sim['realtime_factor']:.2f}, {sim['steps']} steps, "
+          f"{sim['derivative_evaluations']} derivative evaluations; wrote {out}/")
+    return 0
+
+
+def cmd_diagram(args) -> int:
+    from ptint_drake.report import write_diagram  # noqa: PLC0415
+
+    scenario = load(args.scenario, args.set)
+    out = Path(args.out) if args.out else Path("out") / scenario.name
+    paths = write_diagram(scenario, out)
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0
+
+
+def cmd_paper(args) -> int:
+    from ptint_drake.report import write_paper  # noqa: PLC0415
+
+    index = write_paper(Path(args.out), progress_factory=None if args.quiet else _progress)
+    print(f"wrote {index}")
+    return 0
+
+
+def make_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="ptint", description=__doc__.split("\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="names of the bundled scenarios").set_defaults(func=cmd_list)
+
+    run = sub.add_parser("run", help="run one scenario and write its outputs")
+    run.add_argument("scenario", help="a bundled scenario name or a YAML file")
+    run.add_argument("--out", help="output folder (default out/NAME)")
+    run.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario field")
+    run.add_argument("--no-replay", action="store_true", help="skip replay.html")
+    run.add_argument("--no-figures", action="store_true", help="skip the figures")
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.set_defaults(func=cmd_run)
+
+    diagram = sub.add_parser("diagram", help="write the built diagram as .dot and .svg")
+    diagram.add_argument("scenario")
+    diagram.add_argument("--out", help="output folder (default out/NAME)")
+    diagram.add_argument("--set", action="append", metavar="KEY=VALUE")
+    diagram.set_defaults(func=cmd_diagram)
+
+    paper = sub.add_parser("paper", help="reproduce the paper: every scenario, figures, index.html")
+    paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")
+    paper.add_argument("--quiet", action="store_true")
+    paper.set_defaults(func=cmd_paper)
+    return parser
+
+
+def main(argv=None) -> int:
+    args = make_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except ScenarioError as exc:
+        print(f"ptint: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("\nptint: interrupted; no partial output was kept", file=sys.stderr)
+        return 130
+    except RuntimeError as exc:  # Drake's simulation errors
+        print(f"ptint: error: simulation failed: {' '.join(str(exc).split())[:400]}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,162 @@
+"""Matplotlib figures of a run and of the TBG families (paper Figs. 2-4, 6-19).
+
+Every figure is written as PNG and SVG, with units, legends and the prescribed
+interception time(s) marked by dashed vertical lines.  Robot accelerations and
+jerks are finite differences of the logged Cartesian velocity resampled on a
+uniform 1 ms grid (the integrator's own steps are not uniform).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ptint_drake.tbg import alpha_gain, tbg_profile  # noqa: E402
+
+AXES = ("X", "Y", "Z")
+FORMATS = ("png", "svg")
+
+
+def save(fig, out_dir: Path, stem: str) -> list[Path]:
+    """Write ``stem.png`` and ``stem.svg`` in ``out_dir``; returns the paths."""
+    paths = []
+    for ext in FORMATS:
+        path = Path(out_dir) / f"{stem}.{ext}"
+        fig.savefig(path, dpi=120 if ext == "png" else None, bbox_inches="tight")
+        paths.append(path)
+    plt.close(fig)
+    return paths
+
+
+def _mark_times(ax, times):
+    for i, t in enumerate(times):
+        ax.axvline(t, color="k", ls="--", lw=0.8, label="prescribed time $t_f$" if i == 0 else None)
+
+
+def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3):
+    """(t_u, ẋ, ẍ, x⃛) on a uniform grid from per-step samples of ẋ."""
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    t, xdot = t[keep], xdot[keep]
+    t_u = np.arange(t[0], t[-1], dt)
+    v = np.column_stack([np.interp(t_u, t, xdot[:, j]) for j in range(xdot.shape[1])])
+    a = np.gradient(v, dt, axis=0)
+    j = np.gradient(a, dt, axis=0)
+    return t_u, v, a, j
+
+
+def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2000):
+    """ξ, ξ̇, ξ̈, ξ⃛ and α(t) for a list of (tf, β) settings (paper Figs. 2-4).
+
+    Returns the sampled data {label: dict(t, xi, xi_dot, xi_ddot, xi_dddot, alpha)}.
+    """
+    fig, axes = plt.subplots(5, 1, figsize=(7, 11), sharex=True)
+    data = {}
+    t_max = max(tf for tf, _ in settings) * 1.15
+    for tf, beta in settings:
+        t = np.linspace(0.0, t_max, n)
+        xi, xd, xdd, xddd = tbg_profile(t, tf, beta)
+        alpha = np.where(t < tf, alpha_gain(xi, xd), 0.0)
+        label = f"β = {beta}, $t_f$ = {tf} s"
+        data[label] = dict(t=t, xi=xi, xi_dot=xd, xi_ddot=xdd, xi_dddot=xddd, alpha=alpha, tf=tf, beta=beta)
+        for ax, y in zip(axes, (xi, xd, xdd, xddd, alpha)):
+            ax.plot(t, y, label=label)
+    names = ("ξ [-]", "ξ̇ [1/s]", "ξ̈ [1/s²]", "ξ⃛ [1/s³]", "α [1/s]")
+    for ax, name in zip(axes, names):
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    for ax in axes[2:]:
+        ax.set_yscale("symlog", linthresh=10.0)
+    _mark_times(axes[0], sorted({tf for tf, _ in settings}))
+    axes[0].legend(fontsize=7)
+    axes[-1].set_xlabel("time since segment start [s]")
+    fig.suptitle(title)
+    save(fig, out_dir, stem)
+    return data
+
+
+def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[str]:
+    """Per-axis robot vs target (position, velocity, acceleration, jerk), the error and
+    torques, and the 3D paths.  Returns the stems written."""
+    t = series["t"]
+    tfs = [s["start"] + s["tf"] for s in metrics["segments"]]
+    stems = []
+
+    t_u, v, a, j = uniform_derivatives(t, series["xdot"])
+    x_u = np.column_stack([np.interp(t_u, t, series["x"][:, k]) for k in range(3)])
+    xr_u = np.column_stack([np.interp(t_u, t, series["x_r"][:, k]) for k in range(3)])
+    _, vr, ar, jr = uniform_derivatives(t, series["xdot_r"])
+    fig, axes = plt.subplots(4, 3, figsize=(12, 10), sharex=True)
+    rows = (("position [m]", x_u, xr_u), ("velocity [m/s]", v, vr),
+            ("acceleration [m/s²]", a, ar), ("jerk [m/s³]", j, jr))
+    for r, (name, robot, target) in enumerate(rows):
+        for k in range(3):
+            ax = axes[r, k]
+            ax.plot(t_u, robot[:, k], label="robot")
+            ax.plot(t_u, target[:, k], "--", label="target")
+            _mark_times(ax, tfs)
+            ax.grid(alpha=0.3)
+            if r == 0:
+                ax.set_title(AXES[k])
+            if k == 0:
+                ax.set_ylabel(name)
+            if r >= 2:
+                ax.set_yscale("symlog", linthresh=1.0)
+    for k in range(3):
+        axes[-1, k].set_xlabel("time [s]")
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle(f"{title}: robot vs target per axis")
+    save(fig, out_dir, "axes")
+    stems.append("axes")
+
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    axes[0].semilogy(t, np.maximum(np.linalg.norm(series["e"], axis=1), 1e-9), label="|e|")
+    axes[0].axhline(1e-3, color="r", lw=0.8, label="1 mm")
+    axes[0].set_ylabel("|e| [m]")
+    axes[1].plot(t, np.linalg.norm(series["edot"], axis=1), label="|ė|")
+    axes[1].set_ylabel("|ė| [m/s]")
+    for k in range(series["tau"].shape[1]):
+        axes[2].plot(t, series["tau"][:, k], label=f"τ{k + 1}")
+    axes[2].set_ylabel("torque [N·m]")
+    axes[2].set_xlabel("time [s]")
+    for ax in axes:
+        _mark_times(ax, tfs)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"{title}: interception error, velocity error, torques")
+    save(fig, out_dir, "errors")
+    stems.append("errors")
+
+    fig, axes = plt.subplots(series["q"].shape[1], 1, figsize=(8, 7), sharex=True)
+    for k, ax in enumerate(np.atleast_1d(axes)):
+        ax.plot(t, np.degrees(series["q"][:, k]))
+        ax.set_ylabel(f"θ{k + 1} [deg]")
+        _mark_times(ax, tfs)
+        ax.grid(alpha=0.3)
+    np.atleast_1d(axes)[-1].set_xlabel("time [s]")
+    fig.suptitle(f"{title}: joint trajectories (model angles θ)")
+    save(fig, out_dir, "joints")
+    stems.append("joints")
+
+    fig = plt.figure(figsize=(7, 6))
+    ax = fig.add_subplot(projection="3d")
+    ax.plot(*series["x"].T, label="robot")
+    objects = series["objects"].reshape(len(t), -1, 3)
+    for i in range(objects.shape[1]):
+        ax.plot(*objects[:, i, :].T, "--", label=f"target {i + 1}" if objects.shape[1] > 1 else "target")
+    for s, tf in zip(metrics["segments"], tfs):
+        k = min(np.searchsorted(t, tf), len(t) - 1)
+        ax.scatter(*series["x"][k], color="r", s=30)
+    ax.scatter(*series["x"][0], color="k", s=20, label="start")
+    ax.set_xlabel("X [m]")
+    ax.set_ylabel("Y [m]")
+    ax.set_zlabel("Z [m]")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{title}: 3D paths, red dots at the prescribed times")
+    save(fig, out_dir, "paths3d")
+    stems.append("paths3d")
+    return stems

@@ -1,0 +1,65 @@
+"""Writing a run's files into an output folder without ever leaving it half-written.
+
+Everything is written into a hidden temporary folder beside the final files
+and moved in with ``os.replace`` only when complete; ``metrics.json`` is moved
+last, and the previous run's ``metrics.json`` is removed first, so a folder
+whose ``metrics.json`` exists always holds one complete run.  An interrupted
+run leaves the folder as it was, minus the old ``metrics.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+METRICS = "metrics.json"
+SERIES = "series.npz"
+
+
+def write_json_atomic(path: Path, data) -> None:
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as f:
+            json.dump(data, f, indent=2)
+            f.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+@contextmanager
+def staged_output(out_dir: Path):
+    """Yield a temporary folder; on success its files replace those in ``out_dir``.
+
+    ``metrics.json`` (if staged) is moved last.  On any failure (or Ctrl-C) the
+    temporary folder is deleted and ``out_dir`` keeps no new file.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".ptint-stage-", dir=out_dir))
+    try:
+        yield stage
+        (out_dir / METRICS).unlink(missing_ok=True)
+        names = sorted(p.name for p in stage.iterdir())
+        for name in sorted(names, key=lambda n: n == METRICS):
+            target = out_dir / name
+            if target.is_dir() and not (stage / name).is_dir():
+                shutil.rmtree(target)
+            elif (stage / name).is_dir() and target.exists():
+                shutil.rmtree(target) if target.is_dir() else target.unlink()
+            os.replace(stage / name, target)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def save_series(path: Path, series: dict) -> None:
+    """The logged time series (t, q, v, tau, x, x_r, e, edot, xi, alpha, s_x, ...) as .npz."""
+    np.savez_compressed(path, **series)

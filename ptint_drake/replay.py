@@ -1,0 +1,139 @@
+"""Standalone HTML replays of a run: a Meshcat recording saved with ``StaticHtml()``.
+
+The simulation runs without any visualizer (no publish period caps its steps).
+Afterwards the logged joint trajectory is replayed at a fixed frame rate into a
+separate diagram (plant + SceneGraph + MeshcatVisualizer), while the moving
+objects, the target's path, the gripper's trail and the interception markers
+are animated with ``Meshcat.SetTransform(..., time_in_recording=t)``.
+
+Objects: one sphere per segment target.  Until its segment's prescribed time
+an object follows its own path (rides its conveyor); from then on it is held:
+it moves with the gripper point for the rest of the run (the arm carries it).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from pydrake.geometry import (Box, Meshcat, MeshcatParams, MeshcatVisualizer,
+                              MeshcatVisualizerParams, Rgba, Role, Sphere)
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
+_MESHCAT = None
+COLORS = (Rgba(0.85, 0.15, 0.15, 1), Rgba(0.15, 0.55, 0.9, 1), Rgba(0.2, 0.7, 0.25, 1),
+          Rgba(0.8, 0.6, 0.1, 1), Rgba(0.6, 0.3, 0.8, 1))
+
+
+def shared_meshcat() -> Meshcat:
+    """One Meshcat per process (each holds a port until the process exits)."""
+    global _MESHCAT
+    if _MESHCAT is None:
+        logger = logging.getLogger("drake")
+        level = logger.level
+        logger.setLevel(logging.WARNING)  # not "listening at http://..." (replays are files)
+        try:
+            _MESHCAT = Meshcat(MeshcatParams(host="localhost"))
+        finally:
+            logger.setLevel(level)
+    return _MESHCAT
+
+
+def held_object_index(t: float, starts, ends) -> int:
+    """Index of the object the gripper holds at time t (-1 if none).
+
+    Object i is caught at its segment's prescribed time ``ends[i]``; the gripper
+    holds the most recently caught object.
+    """
+    held = -1
+    for i, end in enumerate(ends):
+        if t >= end:
+            held = i
+    return held
+
+
+def object_positions(series: dict, starts, ends) -> np.ndarray:
+    """(N, n_objects, 3): each object on its own path until caught, then with the gripper.
+
+    An object caught earlier and released when the next segment starts stays where
+    it was released (the arm put it down), which is what the assembly task shows.
+    """
+    t = series["t"]
+    objs = series["objects"].reshape(len(t), -1, 3).copy()
+    x = series["x"]
+    n = objs.shape[1]
+    for i in range(n):
+        release = starts[i + 1] if i + 1 < n else np.inf
+        carried = (t >= ends[i]) & (t < release)
+        objs[carried, i, :] = x[carried]
+        after = t >= release
+        if after.any() and carried.any():
+            objs[after, i, :] = x[np.nonzero(carried)[0][-1]]
+    return objs
+
+
+def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
+                 conveyors=None) -> int:
+    """Write a standalone replay HTML to ``path``; returns its size in bytes.
+
+    ``conveyors``: optional list of (start_xyz, end_xyz) belts to draw as boxes.
+    """
+    meshcat = shared_meshcat()
+    meshcat.Delete()
+    meshcat.DeleteRecording()
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    Parser(plant).AddModels(str(model_file))
+    plant.Finalize()
+    viz = MeshcatVisualizer.AddToBuilder(
+        builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+
+    t = series["t"]
+    starts = [s["start"] for s in metrics["segments"]]
+    ends = [s["start"] + s["tf"] for s in metrics["segments"]]
+    objs = object_positions(series, starts, ends)
+    n_obj = objs.shape[1]
+
+    raw = series["objects"].reshape(len(t), -1, 3)
+    for i in range(n_obj):
+        color = COLORS[i % len(COLORS)]
+        meshcat.SetLine(f"paths/target_{i}", raw[:, i, :].T.copy(), 2.0,
+                        Rgba(color.r(), color.g(), color.b(), 0.6))
+        meshcat.SetObject(f"objects/object_{i}", Sphere(0.018), color)
+        meshcat.SetObject(f"intercepts/point_{i}", Sphere(0.01), Rgba(1, 0.9, 0, 1))
+        k = min(np.searchsorted(t, ends[i]), len(t) - 1)
+        meshcat.SetTransform(f"intercepts/point_{i}", RigidTransform(series["x"][k]))
+    meshcat.SetLine("paths/gripper_trail", series["x"].T.copy(), 3.0, Rgba(0.1, 0.1, 0.1, 0.9))
+    for j, (a, b) in enumerate(conveyors or []):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        length = float(np.linalg.norm(b - a))
+        meshcat.SetObject(f"conveyors/belt_{j}", Box(0.06, length, 0.01), Rgba(0.3, 0.3, 0.3, 1))
+        meshcat.SetTransform(f"conveyors/belt_{j}", RigidTransform(0.5 * (a + b) - [0, 0, 0.025]))
+    meshcat.SetCameraPose(np.array([0.9, -0.9, 0.75]), np.array([0.2, 0.0, 0.25]))
+
+    meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
+    frames = np.arange(t[0], t[-1] + 0.5 / fps, 1.0 / fps)
+    nq = plant.num_positions()
+    for tf_ in frames:
+        q = np.array([np.interp(tf_, t, series["q"][:, j]) for j in range(nq)])
+        plant.SetPositions(plant_context, q)
+        context.SetTime(tf_)
+        viz.ForcedPublish(viz.GetMyContextFromRoot(context))
+        for i in range(n_obj):
+            p = np.array([np.interp(tf_, t, objs[:, i, k]) for k in range(3)])
+            meshcat.SetTransform(f"objects/object_{i}", RigidTransform(p), time_in_recording=tf_)
+            meshcat.SetProperty(f"intercepts/point_{i}", "visible", bool(tf_ >= ends[i]),
+                                time_in_recording=tf_)
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    html = meshcat.StaticHtml()
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(html)
+    meshcat.DeleteRecording()
+    return len(html)
