@@ -1,0 +1,41 @@
+"""Shared helpers: scenario runs cached per session (a run is deterministic)."""
+
+from __future__ import annotations
+
+import functools
+
+import pytest
+
+from ptint_drake.scenario import load_scenario, parse_with_overrides, scenario_text
+from ptint_drake.simulation import simulate
+
+CURVES = ["curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12",
+          "curve_b075_tf19"]
+
+
+@functools.lru_cache(maxsize=None)
+def run_cached(name: str, overrides: str = ""):
+    """simulate() of a bundled scenario, with an optional YAML override mapping."""
+    if overrides:
+        _, text = scenario_text(name)
+        scenario = parse_with_overrides(text, overrides, name)
+    else:
+        scenario = load_scenario(name)
+    return simulate(scenario)
+
+
+def assert_prescribed_time(metrics: dict, label: str = "") -> None:
+    """SPEC section 6 on every segment of a run's metrics."""
+    for i, seg in enumerate(metrics["segments"]):
+        where = f"{label} segment {i}"
+        assert seg["e_tf_norm"] <= 1e-3, f"{where}: |e(tf)| = {seg['e_tf_norm']} m > 1 mm"
+        if seg["e0_norm"] >= 1e-2:
+            assert seg["e_half_norm"] >= 0.25 * seg["e0_norm"], (
+                f"{where}: arrived early, |e(tf/2)| = {seg['e_half_norm']} < |e0|/4 = "
+                f"{0.25 * seg['e0_norm']}")
+        assert seg["e_hold_max_norm"] <= 3e-3, f"{where}: hold max {seg['e_hold_max_norm']} m > 3 mm"
+
+
+@pytest.fixture
+def run():
+    return run_cached

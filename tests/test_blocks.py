@@ -1,0 +1,139 @@
+"""Each LeafSystem with fixed inputs against its equation (SPEC section 2.3)."""
+
+import numpy as np
+import pytest
+
+from ptint_drake.controller import SlidingModeController
+from ptint_drake.schedule import Schedule, Segment
+from ptint_drake.sliding_surface import SlidingSurface, switching_function
+from ptint_drake.targets import LinearTarget, SinusoidTarget, TargetSource
+from ptint_drake.tbg import TimeBaseGenerator
+
+SCHED = Schedule([Segment(0.0, 1.5, 0.75), Segment(2.0, 1.0, 0.5)])
+
+
+def _surface_context(surface, t, x, xdot, x_r, xdot_r, alpha, segment, sigma, captured):
+    ctx = surface.CreateDefaultContext()
+    ctx.SetTime(t)
+    for name, value in (("x", x), ("xdot", xdot), ("x_r", x_r), ("xdot_r", xdot_r),
+                        ("alpha", [alpha]), ("segment", segment)):
+        surface.GetInputPort(name).FixValue(ctx, np.asarray(value, dtype=float))
+    ctx.SetContinuousState(sigma)
+    ctx.SetDiscreteState(np.asarray(captured, dtype=float))
+    return ctx
+
+
+def test_surface_outputs_follow_equations():
+    surface = SlidingSurface(SCHED, Lambda=5.0, k=3.0, switching="sign")
+    x, xdot = np.array([0.2, 0.1, 0.3]), np.array([0.05, -0.02, 0.01])
+    x_r, xdot_r = np.array([0.24, 0.0, 0.3]), np.array([0.15, 0.0, 0.15])
+    alpha, sigma, s0 = 2.5, np.array([0.1, -0.2, 0.3]), np.array([-0.15, 0.0, -0.15])
+    t = 0.7
+    ctx = _surface_context(surface, t, x, xdot, x_r, xdot_r, alpha, [0, 0.0, 1.5, 0.75, 1],
+                           sigma, [0, *s0])
+    e, edot = x - x_r, xdot - xdot_r
+    s = edot + alpha * e
+    s_d = s0 * np.exp(-3.0 * t)
+    np.testing.assert_allclose(surface.GetOutputPort("e").Eval(ctx), e)
+    np.testing.assert_allclose(surface.GetOutputPort("edot").Eval(ctx), edot)
+    np.testing.assert_allclose(surface.GetOutputPort("s").Eval(ctx), s)
+    np.testing.assert_allclose(surface.GetOutputPort("s_d").Eval(ctx), s_d)
+    np.testing.assert_allclose(surface.GetOutputPort("s_x").Eval(ctx), s - s_d + 5.0 * sigma)
+    deriv = surface.EvalTimeDerivatives(ctx).CopyToVector()
+    np.testing.assert_allclose(deriv, np.sign(s - s_d))
+
+
+def test_surface_hold_decay_and_capture_instant():
+    surface = SlidingSurface(SCHED, k=3.0, k_hold=50.0)
+    s0 = np.array([0.1, 0.0, -0.1])
+    args = ([0.2, 0.1, 0.3], [0, 0, 0], [0.2, 0.1, 0.3], [0, 0, 0], 0.0)
+    ctx = _surface_context(surface, 1.7, *args, [0, 0.0, 1.5, 0.75, 2], np.zeros(3), [0, *s0])
+    np.testing.assert_allclose(surface.GetOutputPort("s_d").Eval(ctx),
+                               s0 * np.exp(-3.0 * 1.5 - 50.0 * 0.2))
+    # at a new segment's start, before its event: s_d is s itself, so s_x = Λσ exactly
+    ctx = _surface_context(surface, 2.0, [0.2, 0.1, 0.3], [0.1, 0, 0], [0.25, 0.0, 0.3],
+                           [0, 0.1, 0], 0.0, [1, 2.0, 1.0, 0.5, 1], np.array([1.0, 2, 3]), [0, *s0])
+    np.testing.assert_allclose(surface.GetOutputPort("s_x").Eval(ctx), 5.0 * np.array([1.0, 2, 3]))
+
+
+@pytest.mark.parametrize("law", ["sign", "tanh", "sat"])
+def test_switching_laws(law):
+    w = np.array([-1.0, -1e-3, 0.0, 1e-3, 1.0])
+    out = switching_function(w, law, 0.01)
+    assert out[0] == -1.0 or out[0] == pytest.approx(-1.0)
+    assert out[-1] == pytest.approx(1.0)
+    assert out[2] == 0.0
+    assert np.all(np.diff(out) >= 0)
+    if law != "sign":  # a boundary layer is continuous: small w, small σ̇
+        assert abs(out[3]) < 0.2
+
+
+def test_controller_is_minus_K_Jpinv_s():
+    ctrl = SlidingModeController(3, K=50.0)
+    ctx = ctrl.CreateDefaultContext()
+    rng = np.random.default_rng(0)
+    J = rng.normal(size=(3, 3))
+    s_x = rng.normal(size=3)
+    ctrl.GetInputPort("J").FixValue(ctx, J.ravel())
+    ctrl.GetInputPort("s_x").FixValue(ctx, s_x)
+    np.testing.assert_allclose(ctrl.GetOutputPort("tau").Eval(ctx), -50.0 * np.linalg.pinv(J) @ s_x)
+
+
+def test_controller_redundant_is_minimum_norm():
+    ctrl = SlidingModeController(5, K=[1, 2, 3, 4, 5])
+    ctx = ctrl.CreateDefaultContext()
+    rng = np.random.default_rng(1)
+    J = rng.normal(size=(3, 5))
+    s_x = rng.normal(size=3)
+    ctrl.GetInputPort("J").FixValue(ctx, J.ravel())
+    ctrl.GetInputPort("s_x").FixValue(ctx, s_x)
+    expected = -np.array([1, 2, 3, 4, 5]) * (np.linalg.pinv(J) @ s_x)
+    np.testing.assert_allclose(ctrl.GetOutputPort("tau").Eval(ctx), expected, atol=1e-12)
+
+
+def test_controller_uses_kinematics_only():
+    """Model-free: the controller's only inputs are s_x and J; it holds no plant."""
+    ctrl = SlidingModeController(3)
+    assert sorted(ctrl.get_input_port(i).get_name() for i in range(ctrl.num_input_ports())) == ["J", "s_x"]
+    assert not any("plant" in k.lower() for k in vars(ctrl))
+
+
+def test_targets_derivatives():
+    targets = [SinusoidTarget([0.24, 0, 0.3], [0.1] * 3, 1.5, [0, np.pi / 2, 0]),
+               LinearTarget([0.3, -0.15, 0.15], [0, 0.1, 0])]
+    h = 1e-5
+    for tg in targets:
+        for t in (0.0, 0.4, 1.3):
+            f = [tg.evaluate(t + k * h) for k in (-1, 0, 1)]
+            for d in range(3):
+                np.testing.assert_allclose(f[1][3 * (d + 1):3 * (d + 2)],
+                                           (f[2][3 * d:3 * (d + 1)] - f[0][3 * d:3 * (d + 1)]) / (2 * h),
+                                           atol=1e-6)
+    # the paper's curve (eq. 28)
+    t = 0.9
+    np.testing.assert_allclose(targets[0].evaluate(t)[0:6], [
+        0.24 + 0.1 * np.sin(1.5 * t), 0.1 * np.cos(1.5 * t), 0.3 + 0.1 * np.sin(1.5 * t),
+        0.15 * np.cos(1.5 * t), -0.15 * np.sin(1.5 * t), 0.15 * np.cos(1.5 * t)], atol=1e-15)
+
+
+def test_target_source_switches_with_segments():
+    targets = [LinearTarget([0.3, -0.15, 0.15], [0, 0.1, 0]), LinearTarget([0.2, -0.23, 0.25], [0, 0.1, 0])]
+    src = TargetSource(SCHED, targets)
+    ctx = src.CreateDefaultContext()
+    ctx.SetTime(1.99)
+    np.testing.assert_allclose(src.GetOutputPort("x_r").Eval(ctx), [0.3, -0.15 + 0.199, 0.15])
+    ctx.SetTime(2.0)
+    np.testing.assert_allclose(src.GetOutputPort("x_r").Eval(ctx), [0.2, -0.23 + 0.2, 0.25])
+    np.testing.assert_allclose(src.GetOutputPort("objects").Eval(ctx),
+                               [0.3, 0.05, 0.15, 0.2, -0.03, 0.25])
+    with pytest.raises(ValueError, match="one target per segment"):
+        TargetSource(SCHED, targets[:1])
+
+
+def test_schedule_validation():
+    with pytest.raises(ValueError, match=r"interceptions\[1\].start"):
+        Schedule([Segment(0.0, 1.0, 0.5), Segment(0.5, 1.0, 0.5)])
+    with pytest.raises(ValueError, match="beta"):
+        Schedule([Segment(0.0, 1.0, 1.0)])
+    assert SCHED.active(-0.1) == -1 and SCHED.active(0.0) == 0 and SCHED.active(2.0) == 1
+    assert TimeBaseGenerator(SCHED).schedule is SCHED
