@@ -52,26 +52,41 @@ def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3):
 def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2000):
     """ξ, ξ̇, ξ̈, ξ⃛ and α(t) for a list of (tf, β) settings (paper Figs. 2-4).
 
-    Returns the sampled data {label: dict(t, xi, xi_dot, xi_ddot, xi_dddot, alpha)}.
+    The time grid is refined geometrically towards each tf, where α peaks.  ξ̈ is
+    unbounded for β < 1/2 and ξ⃛ for β < 2/3: their axes are scaled to the bounded
+    curves and the unbounded ones run off the plot (as in the paper).
+    Returns the sampled data {label: dict(t, xi, xi_dot, xi_ddot, xi_dddot, alpha, tf, beta)}.
     """
     fig, axes = plt.subplots(5, 1, figsize=(7, 11), sharex=True)
     data = {}
     t_max = max(tf for tf, _ in settings) * 1.15
+    limits = {2: [0.0], 3: [0.0]}
     for tf, beta in settings:
-        t = np.linspace(0.0, t_max, n)
+        t = np.unique(np.concatenate([np.linspace(0.0, t_max, n),
+                                      tf * (1.0 - np.logspace(-12, 0, n))]))
         xi, xd, xdd, xddd = tbg_profile(t, tf, beta)
         alpha = np.where(t < tf, alpha_gain(xi, xd), 0.0)
         label = f"β = {beta}, $t_f$ = {tf} s"
         data[label] = dict(t=t, xi=xi, xi_dot=xd, xi_ddot=xdd, xi_dddot=xddd, alpha=alpha, tf=tf, beta=beta)
         for ax, y in zip(axes, (xi, xd, xdd, xddd, alpha)):
             ax.plot(t, y, label=label)
+        if beta >= 0.5:
+            limits[2].append(np.max(np.abs(xdd)))
+        if beta >= 2.0 / 3.0:
+            limits[3].append(np.max(np.abs(xddd)))
     names = ("ξ [-]", "ξ̇ [1/s]", "ξ̈ [1/s²]", "ξ⃛ [1/s³]", "α [1/s]")
     for ax, name in zip(axes, names):
         ax.set_ylabel(name)
         ax.grid(alpha=0.3)
-    for ax in axes[2:]:
-        ax.set_yscale("symlog", linthresh=10.0)
+    for k in (2, 3):
+        if max(limits[k]) > 0:
+            axes[k].set_ylim(-1.3 * max(limits[k]), 1.3 * max(limits[k]))
+    axes[4].set_yscale("log")
+    alpha_max = max(float(np.max(d["alpha"])) for d in data.values())
+    axes[4].set_ylim(1e-2, 3.0 * alpha_max)
     _mark_times(axes[0], sorted({tf for tf, _ in settings}))
+    for ax in axes[1:]:
+        _mark_times(ax, sorted({tf for tf, _ in settings}))
     axes[0].legend(fontsize=7)
     axes[-1].set_xlabel("time since segment start [s]")
     fig.suptitle(title)

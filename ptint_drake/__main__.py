@@ -1,0 +1,7 @@
+"""``python -m ptint_drake`` is the ``ptint`` command."""
+
+import sys
+
+from ptint_drake.cli import main
+
+sys.exit(main())

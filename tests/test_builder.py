@@ -1,0 +1,96 @@
+"""AddPrescribedTimeInterceptor composed by hand into diagrams of robots that are not the RV-M1."""
+
+import numpy as np
+import pytest
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
+
+from ptint_drake.builder import AddPrescribedTimeInterceptor, ControllerGains
+from ptint_drake.schedule import Schedule, Segment
+from ptint_drake.targets import LinearTarget
+
+
+def _link(name, mass, com, size):
+    return f"""
+  <link name="{name}">
+    <inertial><origin xyz="{com}"/><mass value="{mass}"/>
+      <inertia ixx="{size}" ixy="0" ixz="0" iyy="{size}" iyz="0" izz="{size}"/></inertial>
+  </link>"""
+
+
+def _joint(name, parent, child, xyz, axis):
+    return f"""
+  <joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>
+    <origin xyz="{xyz}"/><axis xyz="{axis}"/><limit effort="100" lower="-3" upper="3" velocity="5"/>
+    <dynamics damping="0.5"/></joint>
+  <transmission type="SimpleTransmission" name="{name}_t">
+    <actuator name="{name}_m"/><joint name="{name}"/><mechanicalReduction>1</mechanicalReduction>
+  </transmission>"""
+
+
+# A 3-DOF arm with a shoulder offset and other lengths and masses, and a 4-DOF redundant arm.
+OFFSET_ARM = ("""<?xml version="1.0"?><robot name="offset_arm">""" + _link("base", 5, "0 0 0", 0.05)
+              + """<joint name="weld" type="fixed"><parent link="world"/><child link="base"/></joint>"""
+              + _link("l1", 2.0, "0 0 0.1", 0.01) + _joint("j1", "base", "l1", "0 0 0.4", "0 0 1")
+              + _link("l2", 2.5, "0 0 0.17", 0.02) + _joint("j2", "l1", "l2", "0 0.06 0", "0 1 0")
+              + _link("l3", 1.5, "0.15 0 0", 0.01) + _joint("j3", "l2", "l3", "0 0 0.35", "0 1 0")
+              + """<link name="hand"/><joint name="hand_fix" type="fixed"><parent link="l3"/>
+                 <child link="hand"/><origin xyz="0.3 0 0"/></joint></robot>""")
+REDUNDANT_ARM = OFFSET_ARM.replace("offset_arm", "redundant_arm").replace(
+    """<link name="hand"/><joint name="hand_fix" type="fixed"><parent link="l3"/>
+                 <child link="hand"/><origin xyz="0.3 0 0"/></joint>""",
+    _link("l4", 0.5, "0.05 0 0", 0.002) + _joint("j4", "l3", "l4", "0.2 0 0", "0 1 0")
+    + """<link name="hand"/><joint name="hand_fix" type="fixed"><parent link="l4"/>
+         <child link="hand"/><origin xyz="0.1 0 0"/></joint>""")
+
+
+@pytest.mark.parametrize("urdf, q0", [(OFFSET_ARM, [0.3, 0.5, 1.2]),
+                                      (REDUNDANT_ARM, [0.3, 0.5, 1.0, 0.4])])
+def test_interceptor_composes_with_another_robot(urdf, q0):
+    builder = DiagramBuilder()
+    # a user's own diagram: plant with SceneGraph, the interceptor added on top
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    Parser(plant).AddModelsFromString(urdf, "urdf")
+    plant.Finalize()
+    hand = plant.GetFrameByName("hand")
+    ctx0 = plant.CreateDefaultContext()
+    plant.SetPositions(ctx0, q0)
+    x0 = hand.CalcPoseInWorld(ctx0).translation()
+    target = LinearTarget(x0 + [0.06, -0.08, -0.05], [0.0, 0.1, 0.0])
+    tf = 1.0
+    schedule = Schedule([Segment(0.0, tf, 0.75)])
+    h = AddPrescribedTimeInterceptor(builder, plant, hand, schedule, [target], ControllerGains())
+    log = LogVectorOutput(h.surface.GetOutputPort("e"), builder, publish_period=0.0)
+    diagram = builder.Build()
+    sim = Simulator(diagram)
+    sim.get_mutable_integrator().set_target_accuracy(1e-4)
+    context = sim.get_mutable_context()
+    plant.SetPositions(plant.GetMyMutableContextFromRoot(context), q0)
+    e_port = h.surface.GetOutputPort("e")
+    sc = h.surface.GetMyContextFromRoot(context)
+    e0 = np.linalg.norm(e_port.Eval(sc))
+    sim.AdvanceTo(0.5 * tf)
+    e_half = np.linalg.norm(e_port.Eval(sc))
+    sim.AdvanceTo(tf)
+    e_tf = np.linalg.norm(e_port.Eval(sc))
+    sim.AdvanceTo(1.5 * tf)
+    data = log.FindLog(context)
+    e_after = np.linalg.norm(data.data()[:, data.sample_times() >= tf], axis=0)
+    assert e0 > 0.1
+    assert e_tf < 1e-3, f"|e(tf)| = {e_tf}"
+    assert e_half >= 0.25 * e0, f"arrived early: {e_half} vs e0 {e0}"
+    assert np.max(e_after) < 3e-3
+
+
+def test_rejects_plants_it_cannot_drive():
+    from pydrake.multibody.plant import MultibodyPlant
+
+    builder = DiagramBuilder()
+    plant = builder.AddSystem(MultibodyPlant(0.0))
+    Parser(plant).AddModelsFromString(OFFSET_ARM, "urdf")
+    with pytest.raises(ValueError, match="finalized"):
+        AddPrescribedTimeInterceptor(builder, plant, plant.world_frame(),
+                                     Schedule([Segment(0, 1, 0.5)]), [LinearTarget([0, 0, 0], [0, 0, 0])])
