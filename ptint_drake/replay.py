@@ -45,14 +45,15 @@ def shared_meshcat() -> Meshcat:
 def held_object_index(t: float, starts, ends) -> int:
     """Index of the object the gripper holds at time t (-1 if none).
 
-    Object i is caught at its segment's prescribed time ``ends[i]``; the gripper
-    holds the most recently caught object.
+    Object i is caught at its segment's prescribed time ``ends[i]`` and held until
+    the next segment starts (then it is put down where it is); the last object is
+    held to the end of the run.
     """
-    held = -1
     for i, end in enumerate(ends):
-        if t >= end:
-            held = i
-    return held
+        release = starts[i + 1] if i + 1 < len(starts) else np.inf
+        if end <= t < release:
+            return i
+    return -1
 
 
 def object_positions(series: dict, starts, ends) -> np.ndarray:
@@ -65,9 +66,10 @@ def object_positions(series: dict, starts, ends) -> np.ndarray:
     objs = series["objects"].reshape(len(t), -1, 3).copy()
     x = series["x"]
     n = objs.shape[1]
+    held = np.array([held_object_index(tk, starts, ends) for tk in t])
     for i in range(n):
         release = starts[i + 1] if i + 1 < n else np.inf
-        carried = (t >= ends[i]) & (t < release)
+        carried = held == i
         objs[carried, i, :] = x[carried]
         after = t >= release
         if after.any() and carried.any():

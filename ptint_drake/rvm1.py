@@ -20,14 +20,21 @@ START_THETA_DEG = (22.5, 45.0, 30.0)
 END_EFFECTOR = "tool"
 
 
+def _models_dir() -> Path:
+    """The bundled models: ``ptint_drake.models`` when installed, else the source tree's models/."""
+    try:
+        return Path(str(resources.files("ptint_drake.models")))
+    except ModuleNotFoundError:
+        return Path(__file__).resolve().parent.parent / "models"
+
+
 def model_path(name: str = "rvm1") -> Path:
     """Path of a bundled model file (installed with the package as ptint_drake.models)."""
-    return Path(str(resources.files("ptint_drake.models").joinpath(f"{name}.urdf")))
+    return _models_dir() / f"{name}.urdf"
 
 
 def bundled_models() -> list[str]:
-    return sorted(p.name[:-5] for p in resources.files("ptint_drake.models").iterdir()
-                  if p.name.endswith(".urdf"))
+    return sorted(p.name[:-5] for p in _models_dir().iterdir() if p.name.endswith(".urdf"))
 
 
 def theta_from_q(q) -> np.ndarray:

@@ -29,5 +29,6 @@ else
   .venv/bin/python -m pip install -q --force-reinstall --no-deps . 2>&1 | grep -v "^WARNING: Location" || true
   .venv/bin/python -m pip install -q ".[test]" 2>&1 | grep -v "^WARNING: Location" || true
 fi
-.venv/bin/python -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file()"
+# check the installed package (from outside the source tree) finds its bundled model
+(cd / && "$OLDPWD/.venv/bin/python" -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
 echo "setup: ready (.venv/bin/ptint)" >&2
