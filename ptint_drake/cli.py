@@ -50,12 +50,17 @@ def load(name_or_file: str, overrides=None):
 
 
 def _progress(label: str):
+    """A progress line on stderr: redrawn in place on a terminal, one line at the end otherwise."""
+    tty = sys.stderr.isatty()
+
     def report(t, duration):
+        if not tty and t < duration:
+            return
         width = 30
-        done = int(width * t / duration)
-        sys.stderr.write(f"\r{label:<18} [{'#' * done}{'.' * (width - done)}] {t:5.2f}/{duration:.2f} s")
-        if t >= duration:
-            sys.stderr.write("\n")
+        done = int(width * min(t / duration, 1.0))
+        end = "\n" if t >= duration else ""
+        sys.stderr.write(f"\r{label:<18} [{'#' * done}{'.' * (width - done)}] "
+                         f"{t:5.2f}/{duration:.2f} s simulated{end}")
         sys.stderr.flush()
     return report
 

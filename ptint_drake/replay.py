@@ -42,6 +42,28 @@ def shared_meshcat() -> Meshcat:
     return _MESHCAT
 
 
+# A three-quarter view from the front right (world, z up); meshcat's orbit target stays at the
+# world origin, the robot's base.
+CAMERA = (0.6, -0.5, 0.45)
+_DEFAULT_VIEW = 'viewer.set_property([\'Cameras\', \'default\', \'rotated\', \'<object>\'],\n                        "position", [0.0, 1.0, 3.0])'
+
+
+def with_camera(html: str, camera) -> str:
+    """Replace the page's initial camera position (the page sets it after the recorded
+    scene loads, so a recorded ``SetCameraPose`` is overridden) by ``camera``.
+
+    ``camera`` is in Drake's z-up world; three.js is y-up: (x, y, z) → (x, z, −y).
+    """
+    def three(p):
+        return f"[{p[0]}, {p[2]}, {-p[1]}]"
+
+    if _DEFAULT_VIEW not in html:
+        return html  # another meshcat page layout: keep its own view
+    view = (f'viewer.set_property([\'Cameras\', \'default\', \'rotated\', \'<object>\'], '
+            f'"position", {three(camera)})')
+    return html.replace(_DEFAULT_VIEW, view)
+
+
 def held_object_index(t: float, starts, ends) -> int:
     """Index of the object the gripper holds at time t (-1 if none).
 
@@ -115,9 +137,8 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
     for j, (a, b) in enumerate(conveyors or []):
         a, b = np.asarray(a, float), np.asarray(b, float)
         length = float(np.linalg.norm(b - a))
-        meshcat.SetObject(f"conveyors/belt_{j}", Box(0.06, length, 0.01), Rgba(0.3, 0.3, 0.3, 1))
+        meshcat.SetObject(f"conveyors/belt_{j}", Box(0.04, length, 0.01), Rgba(0.3, 0.3, 0.3, 1))
         meshcat.SetTransform(f"conveyors/belt_{j}", RigidTransform(0.5 * (a + b) - [0, 0, 0.025]))
-    meshcat.SetCameraPose(np.array([0.9, -0.9, 0.75]), np.array([0.2, 0.0, 0.25]))
 
     meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
     frames = np.arange(t[0], t[-1] + 0.5 / fps, 1.0 / fps)
@@ -134,7 +155,7 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
                                 time_in_recording=tf_)
     meshcat.StopRecording()
     meshcat.PublishRecording()
-    html = meshcat.StaticHtml()
+    html = with_camera(meshcat.StaticHtml(), CAMERA)
     with open(path, "w", encoding="utf-8") as f:
         f.write(html)
     meshcat.DeleteRecording()

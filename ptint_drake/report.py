@@ -8,6 +8,7 @@ metrics.json last) through ``outputs.staged_output``.
 from __future__ import annotations
 
 import html
+import re
 import shutil
 import subprocess
 import time
@@ -68,13 +69,29 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
     return metrics
 
 
+def normalize_graphviz_ids(text: str) -> str:
+    """Renumber Drake's system ids (a process-wide counter) in order of appearance.
+
+    The same diagram then exports to the same text in any process, so the
+    committed ``diagrams/`` can be compared with a fresh export.
+    """
+    mapping: dict = {}
+
+    def renumber(match):
+        key = match.group(2)
+        mapping.setdefault(key, str(len(mapping)))
+        return match.group(1) + mapping[key]
+
+    return re.sub(r"(\bs|\b_|cluster)(\d+)", renumber, text)
+
+
 def write_diagram(scenario: Scenario, out_dir: Path) -> list[Path]:
     """The built diagram as ``NAME.dot`` and ``NAME.svg`` (Graphviz's ``dot``)."""
     dot_exe = shutil.which("dot")
     if dot_exe is None:
         raise ScenarioError("diagram: Graphviz's `dot` is not installed (apt-get install graphviz)")
-    diagram = build(scenario).diagram
-    text = diagram.GetGraphvizString(max_depth=1)
+    diagram = build(scenario, log=False).diagram
+    text = normalize_graphviz_ids(diagram.GetGraphvizString(max_depth=1))
     out_dir = Path(out_dir)
     with staged_output(out_dir) as stage:
         dot_path = stage / f"{scenario.name}.dot"

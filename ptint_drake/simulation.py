@@ -22,7 +22,7 @@ from pydrake.multibody.tree import (BodyIndex, JointIndex, PrismaticJoint, Revol
                                     SpatialInertia)
 from pydrake.solvers import Solve
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.framework import DiagramBuilder, EventStatus
 from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.builder import AddPrescribedTimeInterceptor, ControllerGains, InterceptorHandles
@@ -132,8 +132,8 @@ class Built:
     loggers: dict
 
 
-def build(scenario: Scenario) -> Built:
-    """The scenario's diagram: continuous plant + interceptor + per-step loggers."""
+def build(scenario: Scenario, log: bool = True) -> Built:
+    """The scenario's diagram: continuous plant + interceptor (+ per-step loggers if ``log``)."""
     builder = DiagramBuilder()
     plant = builder.AddNamedSystem("plant", make_plant(scenario))
     c = scenario.controller
@@ -143,7 +143,7 @@ def build(scenario: Scenario) -> Built:
         builder, plant, plant.GetFrameByName(scenario.robot.end_effector),
         scenario.schedule(), scenario.targets(), gains)
     loggers = {}
-    for name, (owner, port) in _LOGGED.items():
+    for name, (owner, port) in (_LOGGED.items() if log else ()):
         system = plant if owner == "plant" else getattr(handles, owner)
         source = plant.get_state_output_port() if owner == "plant" else system.GetOutputPort(port)
         loggers[name] = LogVectorOutput(source, builder, publish_period=0.0)
@@ -183,6 +183,17 @@ def simulate(scenario: Scenario, check: bool = True, progress=None) -> RunResult
         stops.update({seg.start, seg.start + 0.5 * seg.tf, seg.end})
     samples = {}
     wall = 0.0
+    if progress is not None:
+        last = [0.0]
+
+        def monitor(ctx):
+            now = time.perf_counter()
+            if now - last[0] > 0.2:
+                last[0] = now
+                progress(ctx.get_time(), scenario.duration)
+            return EventStatus.Succeeded()
+
+        simulator.set_monitor(monitor)
     simulator.Initialize()
     for t_stop in sorted(stops):
         if t_stop > context.get_time():
@@ -191,9 +202,9 @@ def simulate(scenario: Scenario, check: bool = True, progress=None) -> RunResult
             wall += time.perf_counter() - t0
         samples[t_stop] = (h.surface.GetOutputPort("e").Eval(surface_context).copy(),
                            h.surface.GetOutputPort("edot").Eval(surface_context).copy())
-        if progress is not None:
-            progress(t_stop, scenario.duration)
 
+    if progress is not None:
+        progress(scenario.duration, scenario.duration)
     series = {}
     for name, logger in built.loggers.items():
         log = logger.FindLog(context)

@@ -1,0 +1,113 @@
+"""Replays in a real headless browser, figure data, and the `ptint paper` report."""
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+
+from ptint_drake.figures import tbg_family_figure, uniform_derivatives
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+BROWSER_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                "--no-first-run"]
+
+
+@pytest.fixture(scope="module")
+def paper_dir(tmp_path_factory):
+    """One `ptint paper` run shared by the tests below (about 25 s)."""
+    out = tmp_path_factory.mktemp("paper")
+    done = subprocess.run([sys.executable, "-m", "ptint_drake", "paper", "--out", str(out), "--quiet"],
+                          capture_output=True, text=True, timeout=900,
+                          cwd=Path(__file__).parent)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+def _orange_pixels(png: Path) -> int:
+    img = mpimg.imread(png)[..., :3]
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    return int(np.sum((r > 0.75) & (g > 0.35) & (g < 0.7) & (b < 0.3)))
+
+
+def test_replay_renders_in_headless_chromium(paper_dir, tmp_path):
+    from playwright.sync_api import sync_playwright
+
+    if not Path(CHROMIUM).exists():
+        pytest.fail("chromium is missing: run scripts/setup.sh")
+    page_file = paper_dir / "assembly" / "replay.html"
+    messages = []
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=BROWSER_ARGS)
+        page = browser.new_page(viewport={"width": 1000, "height": 700})
+        page.on("console", lambda m: messages.append((m.type, m.text)))
+        page.on("pageerror", lambda e: messages.append(("pageerror", str(e))))
+        page.goto(page_file.as_uri())
+        page.wait_for_timeout(1500)
+        first = tmp_path / "first.png"
+        page.screenshot(path=str(first))
+        page.wait_for_timeout(2500)
+        later = tmp_path / "later.png"
+        page.screenshot(path=str(later))
+        browser.close()
+    errors = [m for m in messages if m[0] in ("error", "pageerror")]
+    assert not errors, errors
+    # the scene is drawn: the RV-M1's orange waist covers a visible patch of the image
+    assert _orange_pixels(first) > 500
+    img = mpimg.imread(first)[..., :3]
+    assert len(np.unique((img * 255).astype(np.uint8).reshape(-1, 3), axis=0)) > 200
+    # and it is animated: the arm and the objects move between the two screenshots
+    diff = np.abs(mpimg.imread(first)[..., :3] - mpimg.imread(later)[..., :3]).sum(axis=2)
+    assert np.sum(diff > 0.1) > 500
+
+
+def test_paper_report_has_every_scenario(paper_dir):
+    index = (paper_dir / "index.html").read_text()
+    names = ["curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12",
+             "curve_b075_tf19", "assembly"]
+    for name in names:
+        assert f"{name}/replay.html" in index
+        assert (paper_dir / name / "replay.html").stat().st_size > 1_000_000
+        for fig in ("axes", "errors", "joints", "paths3d"):
+            assert (paper_dir / name / f"{fig}.png").stat().st_size > 10_000
+            assert (paper_dir / name / f"{fig}.svg").is_file()
+    # 5 curve rows + 3 assembly rows, every one meeting SPEC section 6
+    rows = re.findall(r"<td>(yes|NO)</td>", index)
+    assert rows == ["yes"] * 8
+    for stem in ("fig2_tbg_beta", "fig3_tbg_tf"):
+        assert (paper_dir / "tbg" / f"{stem}.png").stat().st_size > 10_000
+        assert f"tbg/{stem}.png" in index
+
+
+def test_tbg_figure_data(tmp_path):
+    """Figs. 2-4: each ξ reaches 0 at its tf, is 1/2 at tf/2, and α peaks just before tf."""
+    data = tbg_family_figure([(1.5, b) for b in (0.25, 0.5, 0.75, 0.9)] + [(1.2, 0.7), (1.9, 0.7)],
+                             tmp_path, "fam", "test")
+    assert (tmp_path / "fam.png").is_file() and (tmp_path / "fam.svg").is_file()
+    for label, d in data.items():
+        t, tf = d["t"], d["tf"]
+        assert np.all(d["xi"][t >= tf] == 0.0), label
+        k_half = np.argmin(np.abs(t - 0.5 * tf))
+        assert d["xi"][k_half] == pytest.approx(0.5, abs=2e-3), label
+        k_peak = int(np.argmax(d["alpha"]))
+        assert 0.75 * tf < t[k_peak] < tf, label
+        assert d["alpha"][0] == 0.0
+    # larger β: smoother (smaller peak α); shorter tf: larger peak α (paper section 2.3)
+    peaks = {(d["tf"], d["beta"]): np.max(d["alpha"]) for d in data.values()}
+    assert peaks[(1.5, 0.25)] > peaks[(1.5, 0.5)] > peaks[(1.5, 0.75)] > peaks[(1.5, 0.9)]
+    assert peaks[(1.2, 0.7)] > peaks[(1.9, 0.7)]
+
+
+def test_uniform_derivatives_of_a_known_signal():
+    t = np.sort(np.random.default_rng(0).uniform(0, 2, 3000))
+    t[0], t[-1] = 0.0, 2.0
+    v = np.column_stack([np.sin(3 * t), np.cos(2 * t)])
+    t_u, v_u, a_u, j_u = uniform_derivatives(t, v)
+    inner = slice(50, -50)
+    np.testing.assert_allclose(a_u[inner, 0], 3 * np.cos(3 * t_u[inner]), atol=5e-2)
+    np.testing.assert_allclose(j_u[inner, 1], -8 * np.cos(2 * t_u[inner]), atol=0.3)
