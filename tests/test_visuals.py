@@ -109,5 +109,5 @@ def test_uniform_derivatives_of_a_known_signal():
     v = np.column_stack([np.sin(3 * t), np.cos(2 * t)])
     t_u, v_u, a_u, j_u = uniform_derivatives(t, v)
     inner = slice(50, -50)
-    np.testing.assert_allclose(a_u[inner, 0], 3 * np.cos(3 * t_u[inner]), atol=5e-2)
-    np.testing.assert_allclose(j_u[inner, 1], -8 * np.cos(2 * t_u[inner]), atol=0.3)
+    np.testing.assert_allclose(a_u[inner, 0], 3 * np.cos(3 * t_u[inner]), atol=1e-4)
+    np.testing.assert_allclose(j_u[inner, 1], -4 * np.cos(2 * t_u[inner]), atol=1e-3)
