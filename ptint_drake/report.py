@@ -70,7 +70,8 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
 
 
 def normalize_graphviz_ids(text: str) -> str:
-    """Renumber Drake's system ids (a process-wide counter) in order of appearance.
+    """Renumber Drake's system ids (a process-wide counter) in order of appearance and
+    sort each run of edge lines (Drake emits them in an order that varies by process).
 
     The same diagram then exports to the same text in any process, so the
     committed ``diagrams/`` can be compared with a fresh export.
@@ -82,7 +83,16 @@ def normalize_graphviz_ids(text: str) -> str:
         mapping.setdefault(key, str(len(mapping)))
         return match.group(1) + mapping[key]
 
-    return re.sub(r"(\bs|\b_|cluster)(\d+)", renumber, text)
+    lines = re.sub(r"(\bs|\b_|cluster)(\d+)", renumber, text).split("\n")
+    out, edges = [], []
+    for line in lines + [""]:
+        if " -> " in line:
+            edges.append(line)
+            continue
+        out.extend(sorted(edges))
+        edges = []
+        out.append(line)
+    return "\n".join(out[:-1])
 
 
 def write_diagram(scenario: Scenario, out_dir: Path) -> list[Path]:
