@@ -17,9 +17,10 @@ must actuate each of its velocities (nv = nu).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Optional, Sequence
 
 from ptint_drake.controller import SlidingModeController
+from ptint_drake.interceptor import PrescribedTimeInterceptor
 from ptint_drake.kinematics import TaskSpaceKinematics
 from ptint_drake.schedule import Schedule
 from ptint_drake.sliding_surface import SlidingSurface
@@ -45,24 +46,28 @@ class ControllerGains:
 
 @dataclass(frozen=True)
 class InterceptorHandles:
-    """The systems that ``AddPrescribedTimeInterceptor`` added."""
+    """The systems that ``AddPrescribedTimeInterceptor`` added: the five blocks, or
+    (``fused=True``) the single ``PrescribedTimeInterceptor`` in ``fused``."""
 
-    tbg: TimeBaseGenerator
-    targets: TargetSource
-    kinematics: TaskSpaceKinematics
-    surface: SlidingSurface
-    controller: SlidingModeController
     schedule: Schedule
+    tbg: Optional[TimeBaseGenerator] = None
+    targets: Optional[TargetSource] = None
+    kinematics: Optional[TaskSpaceKinematics] = None
+    surface: Optional[SlidingSurface] = None
+    controller: Optional[SlidingModeController] = None
+    fused: Optional[PrescribedTimeInterceptor] = None
 
 
 def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
                                  targets: Sequence, gains: ControllerGains = ControllerGains(),
                                  connect_actuation: bool = True,
-                                 name: str = "interceptor") -> InterceptorHandles:
+                                 name: str = "interceptor", fused: bool = False) -> InterceptorHandles:
     """Add the interceptor's blocks to ``builder`` and connect them to ``plant``.
 
     With ``connect_actuation=False`` the controller's ``u`` port is left for the
     caller (e.g. to add saturation or a disturbance before the plant).
+    ``fused=True`` adds the same computation as one ``PrescribedTimeInterceptor``
+    system (several times faster to simulate; fewer ports to inspect).
     """
     if not plant.is_finalized():
         raise ValueError("plant: must be finalized before adding the interceptor")
@@ -73,6 +78,16 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
             f"actuated = {plant.num_actuated_dofs()})")
     if nv < 3:
         raise ValueError(f"robot.model: at least 3 joints are needed for 3-D interception, got {nv}")
+
+    if fused:
+        system = builder.AddNamedSystem(name, PrescribedTimeInterceptor(
+            plant, frame, schedule, targets, gains.K, gains.Lambda, gains.k, gains.epsilon,
+            gains.delta, gains.alpha_hold, gains.switching, gains.phi, gains.sigma_policy,
+            gains.k_hold))
+        builder.Connect(plant.get_state_output_port(), system.GetInputPort("state"))
+        if connect_actuation:
+            builder.Connect(system.GetOutputPort("u"), plant.get_actuation_input_port())
+        return InterceptorHandles(schedule, fused=system)
 
     tbg = builder.AddNamedSystem(f"{name}_tbg", TimeBaseGenerator(
         schedule, gains.epsilon, gains.delta, gains.alpha_hold))
@@ -94,4 +109,4 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     builder.Connect(kin.GetOutputPort("J"), ctrl.GetInputPort("J"))
     if connect_actuation:
         builder.Connect(ctrl.GetOutputPort("u"), plant.get_actuation_input_port())
-    return InterceptorHandles(tbg, source, kin, surface, ctrl, schedule)
+    return InterceptorHandles(schedule, tbg, source, kin, surface, ctrl)

@@ -17,6 +17,33 @@ from pydrake.systems.framework import LeafSystem
 from ptint_drake.cache import DeclareVectorCache
 
 
+_ORIGIN = np.zeros(3)
+
+
+class FrameKinematics:
+    """x, ẋ, J of one frame's origin, computed on a private plant context."""
+
+    def __init__(self, plant, frame):
+        self._plant = plant
+        self._frame = frame
+        self._world = plant.world_frame()
+        self._plant_context = plant.CreateDefaultContext()
+
+    def compute(self, q, v):
+        """(x, ẋ, J) at joint positions q and velocities v."""
+        plant, pc = self._plant, self._plant_context
+        plant.SetPositions(pc, q)
+        x = self._frame.CalcPoseInWorld(pc).translation()
+        J = plant.CalcJacobianTranslationalVelocity(
+            pc, JacobianWrtVariable.kV, self._frame, _ORIGIN, self._world, self._world)
+        return x, J @ v, J
+
+    def evaluate(self, q, v) -> np.ndarray:
+        """[x, ẋ, vec(J)] (row-major J, 3 × nv) at joint positions q and velocities v."""
+        x, xdot, J = self.compute(q, v)
+        return np.concatenate([x, xdot, J.ravel()])
+
+
 class TaskSpaceKinematics(LeafSystem):
     """Input ``state`` = [q; v] of the plant; outputs ``x`` (3), ``xdot`` (3), ``J`` (3·nv, row-major).
 
@@ -26,10 +53,7 @@ class TaskSpaceKinematics(LeafSystem):
 
     def __init__(self, plant, frame):
         super().__init__()
-        self._plant = plant
-        self._frame = frame
-        self._world = plant.world_frame()
-        self._plant_context = plant.CreateDefaultContext()
+        self._kinematics = FrameKinematics(plant, frame)
         nq, nv = plant.num_positions(), plant.num_velocities()
         self._nq, self._nv = nq, nv
         self._state_in = self.DeclareVectorInputPort("state", nq + nv)
@@ -52,12 +76,7 @@ class TaskSpaceKinematics(LeafSystem):
 
     def evaluate(self, q, v) -> np.ndarray:
         """[x, ẋ, vec(J)] at joint positions q and velocities v."""
-        plant, pc = self._plant, self._plant_context
-        plant.SetPositions(pc, q)
-        x = self._frame.CalcPoseInWorld(pc).translation()
-        J = plant.CalcJacobianTranslationalVelocity(
-            pc, JacobianWrtVariable.kV, self._frame, np.zeros(3), self._world, self._world)
-        return np.concatenate([x, J @ v, J.ravel()])
+        return self._kinematics.evaluate(q, v)
 
     def get_state_input_port(self):
         return self._state_in

@@ -17,6 +17,8 @@ open, with their defaults:
 - ``controller.alpha_hold``: 0 s⁻¹ after tf, as in the paper;
 - ``controller.k_hold``: 50 s⁻¹, the decay rate of s_d after tf (``k_hold = k``
   is the paper's formula; see ``sliding_surface`` for why the hold needs it);
+- ``controller.implementation``: ``fused`` (one LeafSystem, the fast default) or
+  ``blocks`` (the five wired blocks); both compute the same thing;
 - ``plant``: scale factors for link masses/inertias and joint damping, used
   to show that the model-free controller needs no retuning (all 1 by default).
 """
@@ -35,6 +37,9 @@ from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 from ptint_drake.schedule import Schedule, Segment
 from ptint_drake.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.targets import LinearTarget, SinusoidTarget
+
+
+IMPLEMENTATIONS = ("fused", "blocks")
 
 
 class ScenarioError(ValueError):
@@ -60,6 +65,7 @@ class ControllerConfig:
     phi: float = 0.01
     sigma_policy: str = "keep"
     k_hold: float = 50.0
+    implementation: str = "fused"  # "fused": one LeafSystem; "blocks": the five wired blocks
 
 
 @dataclass
@@ -246,6 +252,9 @@ def validate(s: Scenario) -> None:
         raise ScenarioError(f"controller.switching: must be one of {', '.join(SWITCHING_LAWS)}, got {c.switching!r}")
     if c.switching != "sign":
         _positive(c.phi, "controller.phi")
+    if c.implementation not in IMPLEMENTATIONS:
+        raise ScenarioError(f"controller.implementation: must be one of {', '.join(IMPLEMENTATIONS)}, "
+                            f"got {c.implementation!r}")
     if c.sigma_policy not in SIGMA_POLICIES:
         raise ScenarioError(f"controller.sigma_policy: must be one of {', '.join(SIGMA_POLICIES)}, got {c.sigma_policy!r}")
     _positive(s.plant.mass_scale, "plant.mass_scale")

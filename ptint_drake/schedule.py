@@ -14,6 +14,8 @@ import bisect
 from dataclasses import dataclass
 from typing import Sequence
 
+from scipy.special import beta as beta_function
+
 
 @dataclass(frozen=True)
 class Segment:
@@ -46,12 +48,18 @@ class Schedule:
                     f"segment's interception time {segments[i - 1].end}")
         self.segments = tuple(segments)
         self.starts = tuple(s.start for s in segments)
+        # γ of each segment (paper eq. 8), computed once
+        self._gammas = tuple(float(beta_function(1.0 - s.beta, 1.0 - s.beta)) / s.tf for s in segments)
 
     def __len__(self) -> int:
         return len(self.segments)
 
     def __getitem__(self, i: int) -> Segment:
         return self.segments[i]
+
+    def gamma(self, i: int) -> float:
+        """γ = B(1−β, 1−β)/tf of segment i."""
+        return self._gammas[i]
 
     def active(self, t: float) -> int:
         """Index of the segment active at time t; -1 before the first start."""

@@ -139,11 +139,17 @@ def build(scenario: Scenario, log: bool = True) -> Built:
     c = scenario.controller
     gains = ControllerGains(c.K, c.Lambda, c.k, c.epsilon, c.delta, c.alpha_hold,
                             c.switching, c.phi, c.sigma_policy, c.k_hold)
+    fused = c.implementation == "fused"
     handles = AddPrescribedTimeInterceptor(
         builder, plant, plant.GetFrameByName(scenario.robot.end_effector),
-        scenario.schedule(), scenario.targets(), gains)
+        scenario.schedule(), scenario.targets(), gains, fused=fused)
     loggers = {}
-    for name, (owner, port) in (_LOGGED.items() if log else ()):
+    if log and fused:  # states only: telemetry is recomputed afterwards (see interceptor.py)
+        loggers["state"] = LogVectorOutput(plant.get_state_output_port(), builder, publish_period=0.0)
+        for port in ("sigma", "captured"):
+            loggers[port] = LogVectorOutput(handles.fused.GetOutputPort(port), builder,
+                                            publish_period=0.0)
+    for name, (owner, port) in (_LOGGED.items() if log and not fused else ()):
         system = plant if owner == "plant" else getattr(handles, owner)
         source = plant.get_state_output_port() if owner == "plant" else system.GetOutputPort(port)
         loggers[name] = LogVectorOutput(source, builder, publish_period=0.0)
@@ -175,7 +181,20 @@ def simulate(scenario: Scenario, check: bool = True, progress=None) -> RunResult
     scale_masses(plant, plant_context, scenario.plant.mass_scale)
     plant.SetPositions(plant_context, np.radians(scenario.robot.initial_q_deg))
     plant.SetVelocities(plant_context, np.zeros(plant.num_velocities()))
-    surface_context = h.surface.GetMyContextFromRoot(context)
+    if h.fused is not None:
+        telemetry = h.fused.GetOutputPort("telemetry")
+        fused_context = h.fused.GetMyContextFromRoot(context)
+        layout = h.fused.layout
+
+        def error_now():
+            value = telemetry.Eval(fused_context)
+            return value[layout["e"]].copy(), value[layout["edot"]].copy()
+    else:
+        surface_context = h.surface.GetMyContextFromRoot(context)
+
+        def error_now():
+            return (h.surface.GetOutputPort("e").Eval(surface_context).copy(),
+                    h.surface.GetOutputPort("edot").Eval(surface_context).copy())
 
     schedule = h.schedule
     stops = {scenario.duration}
@@ -200,8 +219,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None) -> RunResult
             t0 = time.perf_counter()
             simulator.AdvanceTo(t_stop)
             wall += time.perf_counter() - t0
-        samples[t_stop] = (h.surface.GetOutputPort("e").Eval(surface_context).copy(),
-                           h.surface.GetOutputPort("edot").Eval(surface_context).copy())
+        samples[t_stop] = error_now()
 
     if progress is not None:
         progress(scenario.duration, scenario.duration)
@@ -210,6 +228,14 @@ def simulate(scenario: Scenario, check: bool = True, progress=None) -> RunResult
         log = logger.FindLog(context)
         series[name] = log.data().T.copy()
         series["t"] = log.sample_times().copy()
+    if h.fused is not None:
+        telemetry = h.fused.telemetry_at(series["t"], series["state"], series.pop("sigma"),
+                                         series.pop("captured"))
+        for name, part in h.fused.layout.items():
+            series[name] = telemetry[:, part]
+        targets = scenario.targets()
+        series["objects"] = np.array([np.concatenate([tg.evaluate(tk)[0:3] for tg in targets])
+                                      for tk in series["t"]])
     nq = plant.num_positions()
     series["q"] = series["state"][:, :nq]
     series["v"] = series["state"][:, nq:]

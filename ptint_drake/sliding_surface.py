@@ -55,6 +55,80 @@ def switching_function(w: np.ndarray, law: str, phi: float) -> np.ndarray:
     raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
 
 
+class SurfaceLaw:
+    """The surface equations above as plain numpy, shared by ``SlidingSurface`` and the
+    fused ``PrescribedTimeInterceptor`` so both compute exactly the same thing."""
+
+    def __init__(self, Lambda=5.0, k: float = 3.0, switching: str = "tanh", phi: float = 0.01,
+                 sigma_policy: str = "keep", k_hold: float = 50.0):
+        switching_function(np.zeros(1), switching, phi)  # validates the law
+        if sigma_policy not in SIGMA_POLICIES:
+            raise ValueError(f"controller.sigma_policy: use one of {SIGMA_POLICIES}, got {sigma_policy!r}")
+        if switching != "sign" and not phi > 0.0:
+            raise ValueError(f"controller.phi: must be > 0, got {phi}")
+        self.Lambda = np.broadcast_to(np.asarray(Lambda, dtype=float), (3,)).copy()
+        self.k = float(k)
+        self.k_hold = float(k_hold)
+        self.law = switching
+        self.phi = float(phi)
+        self.reset_sigma = sigma_policy == "reset"
+
+    def terms(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma) -> np.ndarray:
+        """[s_x, e, ė, s, s_d, σ̇] (18 values); see ``parts``."""
+        return np.concatenate(self.parts(t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma))
+
+    def parts(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma):
+        """(s_x, e, ė, s, s_d, σ̇).
+
+        ``segment`` = [index, t0, tf, ...] of the active segment (TBG output),
+        ``captured`` = [index, s(t0)] (the discrete state), ``sigma`` = σ.
+        """
+        e = x - x_r
+        edot = xdot - xdot_r
+        s = edot + alpha * e
+        if segment[0] < 0 or captured[0] != segment[0]:
+            s_d = s.copy()  # at the switch instant s(t0) is s itself
+        else:
+            tau, tf = t - segment[1], segment[2]
+            if tau < tf:
+                s_d = captured[1:4] * np.exp(-self.k * tau)
+            else:
+                s_d = captured[1:4] * np.exp(-self.k * tf - self.k_hold * (tau - tf))
+        w = s - s_d
+        s_x = w + self.Lambda * sigma
+        return s_x, e, edot, s, s_d, self.switch(w)
+
+    def switch(self, w: np.ndarray) -> np.ndarray:
+        """σ̇ = switch(s − s_d) with this law's switching function."""
+        return switching_function(w, self.law, self.phi)
+
+
+def DeclareSegmentCapture(system, schedule: Schedule, law: SurfaceLaw, segment_and_s):
+    """Declare on ``system`` the continuous state σ (3), the discrete state [index, s(t0)]
+    and the events that store s(t0) at initialization and at every later segment start.
+
+    ``segment_and_s(context)`` returns (active segment vector, current s).
+    Returns the (ContinuousStateIndex, DiscreteStateIndex) of σ and [index, s(t0)].
+    """
+    sigma_index = system.DeclareContinuousState(3)
+    capture_index = system.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0, 0.0]))
+
+    def capture(context, state):
+        segment, s = segment_and_s(context)
+        if segment[0] < 0:
+            return
+        state.get_mutable_discrete_state().get_mutable_vector().SetFromVector(
+            np.concatenate([[segment[0]], s]))
+        if law.reset_sigma:
+            state.get_mutable_continuous_state().get_mutable_vector().SetZero()
+
+    system.DeclareInitializationUnrestrictedUpdateEvent(capture)
+    for start in schedule.starts:
+        if start > 0.0:
+            system.DeclarePeriodicUnrestrictedUpdateEvent(_ONE_SHOT_PERIOD, start, capture)
+    return sigma_index, capture_index
+
+
 class SlidingSurface(LeafSystem):
     """Inputs ``x``, ``xdot`` (robot point), ``x_r``, ``xdot_r`` (target), ``alpha`` (from the
     TBG) and ``segment`` ([index, t0, ...] from the TBG).
@@ -68,26 +142,15 @@ class SlidingSurface(LeafSystem):
                  switching: str = "tanh", phi: float = 0.01, sigma_policy: str = "keep",
                  k_hold: float = 50.0):
         super().__init__()
-        switching_function(np.zeros(1), switching, phi)  # validates the law
-        if sigma_policy not in SIGMA_POLICIES:
-            raise ValueError(f"controller.sigma_policy: use one of {SIGMA_POLICIES}, got {sigma_policy!r}")
-        if switching != "sign" and not phi > 0.0:
-            raise ValueError(f"controller.phi: must be > 0, got {phi}")
-        self._Lambda = np.broadcast_to(np.asarray(Lambda, dtype=float), (3,)).copy()
-        self._k = float(k)
-        self._k_hold = float(k_hold)
-        self._law = switching
-        self._phi = float(phi)
-        self._reset_sigma = sigma_policy == "reset"
-
+        self._law = SurfaceLaw(Lambda, k, switching, phi, sigma_policy, k_hold)
         self._x_in = self.DeclareVectorInputPort("x", 3)
         self._xdot_in = self.DeclareVectorInputPort("xdot", 3)
         self._x_r_in = self.DeclareVectorInputPort("x_r", 3)
         self._xdot_r_in = self.DeclareVectorInputPort("xdot_r", 3)
         self._alpha_in = self.DeclareVectorInputPort("alpha", 1)
         self._segment_in = self.DeclareVectorInputPort("segment", 5)
-        self._sigma_index = self.DeclareContinuousState(3)
-        self._capture_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0, 0.0]))
+        DeclareSegmentCapture(self, schedule, self._law,
+                              lambda c: (self._segment_in.Eval(c), self._eval(c)[9:12]))
 
         deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         self._eval = DeclareVectorCache(self, "surface", 18, self._calc, deps)
@@ -99,42 +162,13 @@ class SlidingSurface(LeafSystem):
             "sigma", 3, lambda c, o: o.SetFromVector(c.get_continuous_state_vector().CopyToVector()),
             prerequisites_of_calc={self.xc_ticket()})
 
-        self.DeclareInitializationUnrestrictedUpdateEvent(self._capture)
-        for start in schedule.starts:
-            if start > 0.0:
-                self.DeclarePeriodicUnrestrictedUpdateEvent(_ONE_SHOT_PERIOD, start, self._capture)
-
     def _calc(self, context) -> np.ndarray:
-        x = self._x_in.Eval(context)
-        xdot = self._xdot_in.Eval(context)
-        e = x - self._x_r_in.Eval(context)
-        edot = xdot - self._xdot_r_in.Eval(context)
-        alpha = self._alpha_in.Eval(context)[0]
-        segment = self._segment_in.Eval(context)
-        s = edot + alpha * e
-        captured = context.get_discrete_state_vector().value()
-        if segment[0] < 0 or captured[0] != segment[0]:
-            s_d = s.copy()  # at the switch instant s(t0) is s itself
-        else:
-            tau, tf = context.get_time() - segment[1], segment[2]
-            if tau < tf:
-                s_d = captured[1:4] * np.exp(-self._k * tau)
-            else:
-                s_d = captured[1:4] * np.exp(-self._k * tf - self._k_hold * (tau - tf))
-        sigma = context.get_continuous_state_vector().CopyToVector()
-        w = s - s_d
-        s_x = w + self._Lambda * sigma
-        return np.concatenate([s_x, e, edot, s, s_d, switching_function(w, self._law, self._phi)])
-
-    def _capture(self, context, state):
-        segment = self._segment_in.Eval(context)
-        if segment[0] < 0:
-            return
-        s = self._eval(context)[9:12]
-        state.get_mutable_discrete_state().get_mutable_vector().SetFromVector(
-            np.concatenate([[segment[0]], s]))
-        if self._reset_sigma:
-            state.get_mutable_continuous_state().get_mutable_vector().SetZero()
+        return self._law.terms(
+            context.get_time(), self._x_in.Eval(context), self._xdot_in.Eval(context),
+            self._x_r_in.Eval(context), self._xdot_r_in.Eval(context),
+            self._alpha_in.Eval(context)[0], self._segment_in.Eval(context),
+            context.get_discrete_state_vector().value(),
+            context.get_continuous_state_vector().CopyToVector())
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._eval(context)[15:18])

@@ -30,13 +30,16 @@ class SinusoidTarget:
     def __post_init__(self):
         for name in ("center", "amplitude", "phase"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
+        a, w = self.amplitude, self.omega
+        # the k-th derivative of a sin(ωt + φ) is a ωᵏ sin(ωt + φ + kπ/2): one sin call for all 12
+        object.__setattr__(self, "_offset", np.concatenate([self.center, np.zeros(9)]))
+        object.__setattr__(self, "_gain", np.concatenate([a, a * w, a * w**2, a * w**3]))
+        object.__setattr__(self, "_shift", np.concatenate(
+            [self.phase + k * np.pi / 2 for k in range(4)]))
 
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
-        arg = self.omega * t + self.phase
-        s, c = np.sin(arg), np.cos(arg)
-        a, w = self.amplitude, self.omega
-        return np.concatenate([self.center + a * s, a * w * c, -a * w**2 * s, -a * w**3 * c])
+        return self._offset + self._gain * np.sin(self.omega * t + self._shift)
 
 
 @dataclass(frozen=True)
@@ -47,11 +50,17 @@ class LinearTarget:
     def __post_init__(self):
         for name in ("start", "velocity"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
+        object.__setattr__(self, "_offset", np.concatenate([self.start, self.velocity, np.zeros(6)]))
+        object.__setattr__(self, "_rate", np.concatenate([self.velocity, np.zeros(9)]))
 
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
-        z = np.zeros(3)
-        return np.concatenate([self.start + self.velocity * t, self.velocity, z, z])
+        return self._offset + self._rate * t
+
+
+def active_target_state(schedule: Schedule, targets: Sequence, t: float) -> np.ndarray:
+    """[x_r, ẋ_r, ẍ_r, x⃛_r] of the target of the segment active at t (the first before it)."""
+    return targets[max(schedule.active(t), 0)].evaluate(t)
 
 
 class TargetSource(LeafSystem):
@@ -95,7 +104,7 @@ class TargetSource(LeafSystem):
 
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] of the target active at absolute time t."""
-        return self._targets[max(self._schedule.active(t), 0)].evaluate(t)
+        return active_target_state(self._schedule, self._targets, t)
 
     def get_x_r_output_port(self):
         return self._x_out

@@ -61,6 +61,27 @@ def tbg_profile(tau, tf: float, beta: float):
     return out
 
 
+def tbg_profile_scalar(tau: float, tf: float, beta: float, g: float):
+    """``tbg_profile`` for one time, in plain floats (the per-derivative fast path).
+
+    ``g`` is ``gamma_gain(tf, beta)``, passed in so that it is computed once per segment.
+    """
+    u = tau / tf
+    if u <= 0.0:
+        return 1.0, 0.0, 0.0, 0.0
+    if u >= 1.0:
+        return 0.0, 0.0, 0.0, 0.0
+    a = 1.0 - beta
+    xi = float(betaincinv(a, a, 1.0 - u))
+    eta = float(betaincinv(a, a, u))  # 1 − ξ, computed directly
+    p = xi * eta
+    one_m_2xi = 1.0 - 2.0 * xi
+    xi_d = -g * p**beta
+    xi_dd = g * g * beta * one_m_2xi * p ** (2.0 * beta - 1.0)
+    xi_ddd = -g**3 * beta * p ** (3.0 * beta - 2.0) * ((2.0 * beta - 1.0) * one_m_2xi**2 - 2.0 * p)
+    return xi, xi_d, xi_dd, xi_ddd
+
+
 def alpha_gain(xi, xi_dot, epsilon: float = 1e-6, delta: float = 1e-6):
     """α = −(1 + ϵ) ξ̇ / (ξ + δ)  (paper eq. 13), ≥ 0 during the segment."""
     return -(1.0 + epsilon) * np.asarray(xi_dot) / (np.asarray(xi) + delta)
@@ -71,6 +92,31 @@ def alpha_peak(tf: float, beta: float, epsilon: float = 1e-6, delta: float = 1e-
     tau = tf * (1.0 - np.logspace(-14, 0, 4000))
     xi, xi_d, _, _ = tbg_profile(tau, tf, beta)
     return float(np.max(alpha_gain(xi, xi_d, epsilon, delta)))
+
+
+def tbg_state(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float = 1e-6,
+              alpha_hold: float = 0.0) -> np.ndarray:
+    """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] of the segment active at absolute time t.
+
+    phase: 0 before the first segment, 1 while converging, 2 while holding after tf.
+    """
+    out = np.zeros(10)
+    i = schedule.active(t)
+    if i < 0:
+        out[0] = 1.0
+        out[5] = -1.0
+        return out
+    seg = schedule[i]
+    tau = t - seg.start
+    out[5:9] = (i, seg.start, seg.tf, seg.beta)
+    if tau < seg.tf:
+        xi, xi_d, xi_dd, xi_ddd = tbg_profile_scalar(tau, seg.tf, seg.beta, schedule.gamma(i))
+        out[0:5] = (xi, xi_d, xi_dd, xi_ddd, -(1.0 + epsilon) * xi_d / (xi + delta))
+        out[9] = 1.0
+    else:
+        out[4] = alpha_hold
+        out[9] = 2.0
+    return out
 
 
 class TimeBaseGenerator(LeafSystem):
@@ -111,23 +157,7 @@ class TimeBaseGenerator(LeafSystem):
 
     def evaluate(self, t: float) -> np.ndarray:
         """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] at absolute time t."""
-        out = np.zeros(10)
-        i = self._schedule.active(t)
-        if i < 0:
-            out[0] = 1.0
-            out[5] = -1.0
-            return out
-        seg = self._schedule[i]
-        tau = t - seg.start
-        out[5:9] = (i, seg.start, seg.tf, seg.beta)
-        if tau < seg.tf:
-            out[0:4] = tbg_profile(tau, seg.tf, seg.beta)
-            out[4] = alpha_gain(out[0], out[1], self._epsilon, self._delta)
-            out[9] = 1.0
-        else:
-            out[4] = self._alpha_hold
-            out[9] = 2.0
-        return out
+        return tbg_state(self._schedule, t, self._epsilon, self._delta, self._alpha_hold)
 
     def get_xi_output_port(self):
         return self._xi_out

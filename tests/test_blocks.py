@@ -137,3 +137,24 @@ def test_schedule_validation():
         Schedule([Segment(0.0, 1.0, 1.0)])
     assert SCHED.active(-0.1) == -1 and SCHED.active(0.0) == 0 and SCHED.active(2.0) == 1
     assert TimeBaseGenerator(SCHED).schedule is SCHED
+
+
+def test_solve3_matches_numpy_and_survives_singular():
+    from ptint_drake.controller import solve3
+
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        J = rng.normal(size=(3, 3))
+        b = rng.normal(size=3)
+        np.testing.assert_allclose(solve3(J, b), np.linalg.solve(J, b), rtol=1e-9, atol=1e-9)
+    singular = np.array([[1.0, 2, 3], [2, 4, 6], [0, 1, 1]])
+    assert np.all(np.isfinite(solve3(singular, np.ones(3))))
+
+
+def test_scalar_tbg_matches_vector_form():
+    from ptint_drake.tbg import gamma_gain, tbg_profile, tbg_profile_scalar
+
+    for beta in (0.25, 0.5, 0.75, 0.9):
+        for tau in (-0.1, 0.0, 1e-6, 0.3, 0.75, 1.4999, 1.5, 2.0):
+            np.testing.assert_allclose(tbg_profile_scalar(tau, 1.5, beta, gamma_gain(1.5, beta)),
+                                       tbg_profile(tau, 1.5, beta), rtol=1e-12, atol=1e-300)

@@ -1,0 +1,120 @@
+"""The whole interceptor in one LeafSystem: the fast path for simulation.
+
+``PrescribedTimeInterceptor`` computes exactly what the five blocks wired by
+``AddPrescribedTimeInterceptor(fused=False)`` compute — it calls the same
+functions (``tbg_state``, ``active_target_state``, ``FrameKinematics``,
+``SurfaceLaw``, ``smc_torque``) — but as one cache entry per context, so each
+derivative evaluation crosses from C++ into Python three times instead of about
+sixteen.  Its ``telemetry`` port carries every intermediate signal (layout in
+``telemetry_layout``).  Logging it at every step would cost one more full
+evaluation per step, so a run logs only states (the plant's, and ``sigma`` and
+``captured`` here, all C++ state ports) and ``telemetry_at`` recomputes the
+telemetry of each logged sample afterwards — the same function on the same
+state, so the values are identical.
+
+Model-free like the blocks: it reads the plant's state and kinematics only.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from ptint_drake.cache import DeclareVectorCache
+from ptint_drake.controller import smc_torque
+from ptint_drake.kinematics import FrameKinematics
+from ptint_drake.schedule import Schedule
+from ptint_drake.sliding_surface import DeclareSegmentCapture, SurfaceLaw
+from ptint_drake.targets import active_target_state
+from ptint_drake.tbg import tbg_state
+
+
+def telemetry_layout(nv: int) -> dict:
+    """name -> slice of the ``telemetry`` vector."""
+    sizes = [("x", 3), ("xdot", 3), ("x_r", 3), ("xdot_r", 3), ("xddot_r", 3), ("xi", 4),
+             ("alpha", 1), ("s_x", 3), ("e", 3), ("edot", 3), ("s", 3), ("s_d", 3),
+             ("sigma", 3), ("tau", nv)]
+    layout, lo = {}, 0
+    for name, n in sizes:
+        layout[name] = slice(lo, lo + n)
+        lo += n
+    return layout
+
+
+class PrescribedTimeInterceptor(LeafSystem):
+    """Input ``state`` ([q; v] of the plant); outputs ``u`` (actuation), ``tau`` (joint
+    torques) and ``telemetry``.  State: σ (continuous, 3), [index, s(t0)] (discrete)."""
+
+    def __init__(self, plant, frame, schedule: Schedule, targets: Sequence, K=50.0, Lambda=5.0,
+                 k: float = 3.0, epsilon: float = 1e-6, delta: float = 1e-6,
+                 alpha_hold: float = 0.0, switching: str = "tanh", phi: float = 0.01,
+                 sigma_policy: str = "keep", k_hold: float = 50.0):
+        super().__init__()
+        if len(targets) != len(schedule):
+            raise ValueError(f"targets: one target per segment is needed, got {len(targets)} "
+                             f"for {len(schedule)} segments")
+        nq, nv = plant.num_positions(), plant.num_velocities()
+        self._nq, self._nv = nq, nv
+        self._schedule = schedule
+        self._targets = tuple(targets)
+        self._tbg_args = (epsilon, delta, alpha_hold)
+        self._kinematics = FrameKinematics(plant, frame)
+        self._law = SurfaceLaw(Lambda, k, switching, phi, sigma_policy, k_hold)
+        self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
+        self._BT = plant.MakeActuationMatrix().T
+        self.layout = telemetry_layout(nv)
+        size = self.layout["tau"].stop
+
+        self._state_in = self.DeclareVectorInputPort("state", nq + nv)
+        sigma_index, capture_index = DeclareSegmentCapture(
+            self, schedule, self._law, lambda c: (self._eval(c)[-5:], self._eval(c)[self.layout["s"]]))
+        self.DeclareStateOutputPort("sigma", sigma_index)
+        self.DeclareStateOutputPort("captured", capture_index)
+        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self._state_in.ticket()}
+        # telemetry followed by the active segment vector (5)
+        self._eval = DeclareVectorCache(self, "interceptor", size + 5, self._calc, deps)
+        tau = self.layout["tau"]
+        self.DeclareVectorOutputPort("u", self._BT.shape[0],
+                                     lambda c, o: o.SetFromVector(self._BT @ self._eval(c)[tau]),
+                                     prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("tau", nv, lambda c, o: o.SetFromVector(self._eval(c)[tau]),
+                                     prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("telemetry", size,
+                                     lambda c, o: o.SetFromVector(self._eval(c)[:size]),
+                                     prerequisites_of_calc=deps)
+
+    def _calc(self, context) -> np.ndarray:
+        t = context.get_time()
+        qv = self._state_in.Eval(context)
+        x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
+        target = active_target_state(self._schedule, self._targets, t)
+        tbg = tbg_state(self._schedule, t, *self._tbg_args)
+        sigma = context.get_continuous_state_vector().CopyToVector()
+        s_x, e, edot, s, s_d, _ = self._law.parts(
+            t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
+            context.get_discrete_state_vector().value(), sigma)
+        tau = smc_torque(self._K, J, s_x)
+        return np.concatenate([x, xdot, target[0:9], tbg[0:5], s_x, e, edot, s, s_d, sigma, tau,
+                               tbg[5:10]])
+
+    def telemetry_at(self, t: np.ndarray, plant_state: np.ndarray, sigma: np.ndarray,
+                     captured: np.ndarray) -> np.ndarray:
+        """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0)])."""
+        context = self.CreateDefaultContext()
+        port = self._state_in
+        size = self.layout["tau"].stop
+        rows = np.empty((len(t), size))
+        for k in range(len(t)):
+            context.SetTime(t[k])
+            context.SetContinuousState(sigma[k])
+            context.SetDiscreteState(captured[k])
+            port.FixValue(context, plant_state[k])
+            rows[k] = self._eval(context)[:size]
+        return rows
+
+    def DoCalcTimeDerivatives(self, context, derivatives):
+        value = self._eval(context)
+        w = value[self.layout["s"]] - value[self.layout["s_d"]]
+        derivatives.get_mutable_vector().SetFromVector(self._law.switch(w))
