@@ -4,6 +4,8 @@
     ptint run NAME_OR_FILE [--out DIR]      one scenario: metrics.json, series.npz, figures, replay.html
     ptint paper [--out DIR]                 every paper scenario + TBG figures + index.html
     ptint diagram NAME_OR_FILE [--out DIR]  the built diagram as Graphviz .dot and .svg
+    ptint sweep NAME_OR_FILE --beta B,.. --tf T,.. [--workers N] [--out DIR]   grid → sweep.csv
+    ptint bench [SCENARIO ...]              speed and accuracy benchmark, JSON on stdout
 
 ``--set key=value`` (repeatable) overrides a scenario field, e.g.
 ``--set controller.switching=sign --set simulator.accuracy=1e-6``; values are
@@ -109,6 +111,48 @@ def cmd_paper(args) -> int:
     return 0
 
 
+def _floats(text: str, flag: str) -> list:
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ScenarioError(f"{flag}: expected comma-separated numbers, got {text!r}") from None
+    if not values:
+        raise ScenarioError(f"{flag}: no values given")
+    return values
+
+
+def cmd_sweep(args) -> int:
+    from ptint_drake import sweep  # noqa: PLC0415
+    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+
+    betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
+    for b in betas:
+        if not 0.0 < b < 1.0:
+            raise ScenarioError(f"--beta: every value must be in (0, 1), got {b}")
+    for tf in tfs:
+        if not tf > 0.0:
+            raise ScenarioError(f"--tf: every value must be > 0, got {tf}")
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
+    scenario = load(args.scenario)  # validates the base scenario before any worker starts
+    name, text = scenario_text(args.scenario)
+    out = Path(args.out) if args.out else Path("out") / f"sweep_{scenario.name}"
+    report = None if args.quiet else (lambda i, n: print(f"sweep: {i}/{n} runs done", file=sys.stderr))
+    rows = sweep.run_sweep(text, name, betas, tfs, workers=args.workers, progress=report)
+    with staged_output(out) as stage:
+        sweep.heatmaps(rows, betas, tfs, stage, f"{scenario.name}: β × tf sweep")
+        sweep.write_csv(rows, stage / "sweep.csv")
+    ok = sum(1 for r in rows if r.get("ok"))
+    print(f"{len(rows)} runs, {ok} meet the prescribed-time property; wrote {out}/sweep.csv")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from ptint_drake.benchmark import main as bench_main  # noqa: PLC0415
+
+    return bench_main(args.rest)
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="ptint", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -128,6 +172,20 @@ def make_parser() -> argparse.ArgumentParser:
     diagram.add_argument("--out", help="output folder (default out/NAME)")
     diagram.add_argument("--set", action="append", metavar="KEY=VALUE")
     diagram.set_defaults(func=cmd_diagram)
+
+    sw = sub.add_parser("sweep", help="β × tf grid in parallel worker processes")
+    sw.add_argument("scenario")
+    sw.add_argument("--beta", default="0.25,0.5,0.75", help="comma-separated β values")
+    sw.add_argument("--tf", default="1.2,1.5,1.9", help="comma-separated tf values (s)")
+    sw.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
+    sw.add_argument("--out", help="output folder (default out/sweep_NAME)")
+    sw.add_argument("--quiet", action="store_true")
+    sw.set_defaults(func=cmd_sweep)
+
+    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (see --help there)",
+                           add_help=False)
+    bench.add_argument("rest", nargs=argparse.REMAINDER)
+    bench.set_defaults(func=cmd_bench)
 
     paper = sub.add_parser("paper", help="reproduce the paper: every scenario, figures, index.html")
     paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install everything ptint_drake needs on a fresh Debian machine, idempotently:
 #   system tools: graphviz (`ptint diagram`), chromium (the replay browser test)
-#   a virtual environment .venv with the package and its test extra.
+#   a virtual environment .venv with the package and its test and cluster (Dask) extras.
 # PTINT_EDITABLE=1 installs the package in editable mode (for development).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,10 +24,10 @@ PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip 2>&1 | grep -v "^WARNING: Location" || true
 if [ "${PTINT_EDITABLE:-0}" = 1 ]; then
-  .venv/bin/python -m pip install -q -e ".[test]" 2>&1 | grep -v "^WARNING: Location" || true
+  .venv/bin/python -m pip install -q -e ".[test,cluster]" 2>&1 | grep -v "^WARNING: Location" || true
 else
   .venv/bin/python -m pip install -q --force-reinstall --no-deps . 2>&1 | grep -v "^WARNING: Location" || true
-  .venv/bin/python -m pip install -q ".[test]" 2>&1 | grep -v "^WARNING: Location" || true
+  .venv/bin/python -m pip install -q ".[test,cluster]" 2>&1 | grep -v "^WARNING: Location" || true
 fi
 # check the installed package (from outside the source tree) finds its bundled model
 (cd / && "$OLDPWD/.venv/bin/python" -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file(), r.model_path()")

@@ -1,0 +1,137 @@
+"""Parameter sweeps over (β, tf) in parallel worker processes (``ptint sweep``).
+
+Each grid point is one simulation of the scenario with every segment's β and tf
+replaced, run by a worker that builds its own diagram from the scenario *text*
+(Drake diagrams do not pickle).  ``run_sweep`` takes any
+``concurrent.futures.Executor``: a ``ProcessPoolExecutor`` (the default, forked
+on Linux so workers start without re-importing Drake), or e.g. a Dask cluster's
+``Client.get_executor()``.  When a point makes the last interception fall after
+the scenario's end, the duration is extended to the last start + 2 tf.
+"""
+
+from __future__ import annotations
+
+import csv
+import multiprocessing
+import os
+import time
+from concurrent.futures import Executor, ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+# Imported here, not in the worker function: forked workers then inherit them ready.
+from ptint_drake.figures import plt, save, uniform_derivatives
+from ptint_drake.scenario import ScenarioError, parse_scenario, validate
+from ptint_drake.simulation import simulate
+
+COLUMNS = ("beta", "tf", "e0", "e_tf", "e_half", "hold", "peak_torque", "peak_jerk",
+           "realtime_factor", "steps", "ok", "error")
+
+
+def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
+    """Simulate one grid point; returns a row of ``COLUMNS`` (``error`` set if it failed)."""
+    row = {"beta": beta, "tf": tf, "error": ""}
+    try:
+        scenario = parse_scenario(text, name)
+        for ic in scenario.interceptions:
+            ic.beta, ic.tf = beta, tf
+        last = scenario.interceptions[-1]
+        scenario.duration = max(scenario.duration, last.start + 2.0 * tf)
+        validate(scenario)
+        result = simulate(scenario)
+    except (ScenarioError, RuntimeError) as exc:
+        row["error"] = " ".join(str(exc).split())[:200]
+        row["ok"] = False
+        return row
+    m = result.metrics
+    segs = m["segments"]
+    _, _, _, jerk = uniform_derivatives(result.series["t"], result.series["xdot"])
+    row.update({
+        "e0": max(s["e0_norm"] for s in segs),
+        "e_tf": max(s["e_tf_norm"] for s in segs),
+        "e_half": min(s["e_half_norm"] for s in segs),
+        "hold": max(s["e_hold_max_norm"] for s in segs),
+        "peak_torque": float(np.max(m["torque_peak"])),
+        "peak_jerk": float(np.max(np.linalg.norm(jerk, axis=1))),
+        "realtime_factor": m["sim"]["realtime_factor"],
+        "steps": m["sim"]["steps"],
+        "ok": all(s["e_tf_norm"] <= 1e-3 and s["e_hold_max_norm"] <= 3e-3
+                  and (s["e0_norm"] < 1e-2 or s["e_half_norm"] >= 0.25 * s["e0_norm"])
+                  for s in segs),
+    })
+    return row
+
+
+def default_executor(workers: int) -> Executor:
+    """Worker processes: forked on Linux (fast start), spawned elsewhere."""
+    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+
+
+def run_sweep(text: str, name: str, betas, tfs, executor: Executor = None, workers: int = None,
+              progress=None) -> list[dict]:
+    """Rows for the grid betas × tfs, in grid order.  ``executor`` is used as given and
+    left open; without one, a process pool of ``workers`` (default: CPU count) is used."""
+    points = [(float(b), float(tf)) for b in betas for tf in tfs]
+    own = executor is None
+    if own:
+        executor = default_executor(workers or os.cpu_count() or 1)
+    try:
+        futures = [executor.submit(sweep_point, text, name, b, tf) for b, tf in points]
+        rows = []
+        for i, future in enumerate(futures):
+            rows.append(future.result())
+            if progress:
+                progress(i + 1, len(points))
+        return rows
+    finally:
+        if own:
+            executor.shutdown()
+
+
+def write_csv(rows, path: Path) -> None:
+    tmp = Path(path).with_suffix(".csv.tmp")
+    with open(tmp, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: row.get(k, "") for k in COLUMNS})
+    os.replace(tmp, path)
+
+
+def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
+    """One heat map per metric over (tf, β); returns the stems written."""
+    metrics = (("e_tf", "|e(tf)| [mm]", 1e3), ("hold", "hold max |e| [mm]", 1e3),
+               ("peak_torque", "peak |τ| [N·m]", 1.0), ("peak_jerk", "peak |jerk| [m/s³]", 1.0),
+               ("realtime_factor", "realtime factor", 1.0))
+    fig, axes = plt.subplots(1, len(metrics), figsize=(4.2 * len(metrics), 3.8))
+    lookup = {(r["beta"], r["tf"]): r for r in rows}
+    for ax, (key, label, scale) in zip(axes, metrics):
+        grid = np.full((len(betas), len(tfs)), np.nan)
+        for i, b in enumerate(betas):
+            for j, tf in enumerate(tfs):
+                r = lookup.get((float(b), float(tf)))
+                if r and not r.get("error"):
+                    grid[i, j] = r[key] * scale
+        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
+        ax.set_xticks(range(len(tfs)), [f"{tf:g}" for tf in tfs])
+        ax.set_yticks(range(len(betas)), [f"{b:g}" for b in betas])
+        ax.set_xlabel("tf [s]")
+        ax.set_ylabel("β")
+        ax.set_title(label, fontsize=9)
+        for i in range(len(betas)):
+            for j in range(len(tfs)):
+                if np.isfinite(grid[i, j]):
+                    ax.text(j, i, f"{grid[i, j]:.3g}", ha="center", va="center", color="w", fontsize=7)
+        fig.colorbar(im, ax=ax, shrink=0.8)
+    fig.suptitle(title)
+    save(fig, out_dir, "sweep")
+    return ["sweep"]
+
+
+def timed_sweep(text: str, name: str, betas, tfs, workers: int) -> float:
+    """Wall seconds of a whole sweep with ``workers`` processes (pool start-up included)."""
+    t0 = time.perf_counter()
+    run_sweep(text, name, betas, tfs, workers=workers)
+    return time.perf_counter() - t0
