@@ -42,6 +42,7 @@ class ControllerGains:
     phi: float = 0.01
     sigma_policy: str = "keep"
     k_hold: float = 50.0
+    pinv_damping: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
         system = builder.AddNamedSystem(name, PrescribedTimeInterceptor(
             plant, frame, schedule, targets, gains.K, gains.Lambda, gains.k, gains.epsilon,
             gains.delta, gains.alpha_hold, gains.switching, gains.phi, gains.sigma_policy,
-            gains.k_hold))
+            gains.k_hold, gains.pinv_damping))
         builder.Connect(plant.get_state_output_port(), system.GetInputPort("state"))
         if connect_actuation:
             builder.Connect(system.GetOutputPort("u"), plant.get_actuation_input_port())
@@ -96,7 +97,7 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     surface = builder.AddNamedSystem(f"{name}_surface", SlidingSurface(
         schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy, gains.k_hold))
     ctrl = builder.AddNamedSystem(f"{name}_controller", SlidingModeController(
-        nv, gains.K, plant.MakeActuationMatrix()))
+        nv, gains.K, plant.MakeActuationMatrix(), gains.pinv_damping))
 
     builder.Connect(plant.get_state_output_port(), kin.get_state_input_port())
     builder.Connect(kin.GetOutputPort("x"), surface.GetInputPort("x"))

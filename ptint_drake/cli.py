@@ -5,6 +5,7 @@
     ptint paper [--out DIR]                 every paper scenario + TBG figures + index.html
     ptint diagram NAME_OR_FILE [--out DIR]  the built diagram as Graphviz .dot and .svg
     ptint sweep NAME_OR_FILE --beta B,.. --tf T,.. [--workers N] [--out DIR]   grid → sweep.csv
+    ptint robust NAME_OR_FILE --samples N [--seed S] [--workers W] [--out DIR]   Monte Carlo
     ptint bench [SCENARIO ...]              speed and accuracy benchmark, JSON on stdout
 
 ``--set key=value`` (repeatable) overrides a scenario field, e.g.
@@ -83,13 +84,21 @@ def cmd_run(args) -> int:
     metrics = run_and_write(scenario, out, replay=not args.no_replay,
                             figures=not args.no_figures,
                             progress=None if args.quiet else _progress(scenario.name))
+    for warning in metrics["warnings"]:
+        print(f"ptint: warning: {warning}", file=sys.stderr)
+    mm = lambda v: "n/a" if v is None else f"{v * 1e3:.4g} mm"  # noqa: E731
     for i, seg in enumerate(metrics["segments"]):
-        print(f"{scenario.name} segment {i}: e0 = {seg['e0_norm'] * 1e3:.2f} mm, "
-              f"e(tf/2) = {seg['e_half_norm'] * 1e3:.2f} mm, e(tf) = {seg['e_tf_norm'] * 1e3:.4f} mm, "
-              f"hold max = {seg['e_hold_max_norm'] * 1e3:.3f} mm")
+        print(f"{scenario.name} segment {i}: e0 = {mm(seg['e0_norm'])}, e(tf/2) = "
+              f"{mm(seg['e_half_norm'])}, e(tf) = {mm(seg['e_tf_norm'])}, hold max = "
+              f"{mm(seg['e_hold_max_norm'])}")
     sim = metrics["sim"]
     print(f"realtime factor {sim['realtime_factor']:.2f}, {sim['steps']} steps, "
-          f"{sim['derivative_evaluations']} derivative evaluations; wrote {out}/")
+          f"{sim['derivative_evaluations']} derivative evaluations, saturated "
+          f"{100 * metrics['saturated_fraction']:.1f} % of the time; wrote {out}/")
+    if metrics["status"] == "failed":
+        print(f"ptint: error: run failed: {metrics['failure']['message']} "
+              f"(outputs up to then are in {out}/, metrics.json says status: failed)", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -147,6 +156,37 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_robust(args) -> int:
+    from ptint_drake import robust  # noqa: PLC0415
+
+    if args.samples < 1:
+        raise ScenarioError(f"--samples: must be >= 1, got {args.samples}")
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
+    ranges = dict(robust.RANGES)
+    for pair in args.range or []:
+        key, _, value = pair.partition("=")
+        if key not in ranges:
+            raise ScenarioError(f"--range: unknown parameter {key!r} (one of {', '.join(ranges)})")
+        lo_hi = _floats(value, f"--range {key}")
+        if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or lo_hi[0] < 0:
+            raise ScenarioError(f"--range {key}: expected LOW,HIGH with 0 <= LOW <= HIGH, got {value!r}")
+        ranges[key] = tuple(lo_hi)
+    scenario = load(args.scenario)
+    name, text = scenario_text(args.scenario)
+    out = Path(args.out) if args.out else Path("out") / f"robust_{scenario.name}"
+    report = None if args.quiet else (
+        lambda i, n: print(f"robust: {i}/{n} samples", file=sys.stderr) if i % 10 == 0 or i == n else None)
+    result = robust.run_robust(text, name, args.samples, args.seed, args.workers, ranges=ranges,
+                               progress=report)
+    robust.write_robust(result, out)
+    p = result["e_tf_percentiles"]
+    print(f"{result['samples']} samples, success rate {100 * result['success_rate']:.1f} %, "
+          f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, max {p.get('max', float('nan')) * 1e3:.4f} mm; "
+          f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
+    return 0
+
+
 def cmd_bench(args) -> int:
     from ptint_drake.benchmark import main as bench_main  # noqa: PLC0415
 
@@ -181,6 +221,18 @@ def make_parser() -> argparse.ArgumentParser:
     sw.add_argument("--out", help="output folder (default out/sweep_NAME)")
     sw.add_argument("--quiet", action="store_true")
     sw.set_defaults(func=cmd_sweep)
+
+    rb = sub.add_parser("robust", help="Monte Carlo study over unknown dynamics and disturbances")
+    rb.add_argument("scenario")
+    rb.add_argument("--samples", type=int, default=100)
+    rb.add_argument("--seed", type=int, default=0, help="sample i uses seed + i")
+    rb.add_argument("--workers", type=int, help="worker processes (default 1)")
+    rb.add_argument("--range", action="append", metavar="NAME=LOW,HIGH",
+                    help="override a parameter range (mass, friction, coulomb, payload, "
+                         "disturbance, noise, latency)")
+    rb.add_argument("--out", help="output folder (default out/robust_NAME)")
+    rb.add_argument("--quiet", action="store_true")
+    rb.set_defaults(func=cmd_robust)
 
     bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (see --help there)",
                            add_help=False)

@@ -33,9 +33,15 @@ def solve3(J: np.ndarray, b: np.ndarray) -> np.ndarray:
     ]) / det
 
 
-def smc_torque(K: np.ndarray, J: np.ndarray, s_x: np.ndarray) -> np.ndarray:
-    """τ = −K J⁺ s_x: a linear solve for square J, the minimum-norm solution otherwise."""
-    if J.shape[1] == 3:
+def smc_torque(K: np.ndarray, J: np.ndarray, s_x: np.ndarray, damping: float = 0.0) -> np.ndarray:
+    """τ = −K J⁺ s_x: a linear solve for square J, the minimum-norm solution otherwise.
+
+    With ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which
+    stays bounded through singular configurations at the cost of a small bias near them.
+    """
+    if damping > 0.0:
+        qdot_s = J.T @ solve3(J @ J.T + damping * damping * np.eye(3), s_x)
+    elif J.shape[1] == 3:
         qdot_s = solve3(J, s_x)
     else:
         qdot_s = J.T @ np.linalg.solve(J @ J.T, s_x)
@@ -50,9 +56,10 @@ class SlidingModeController(LeafSystem):
     maps it to the plant's actuation input order: u = Bᵀ τ.
     """
 
-    def __init__(self, nv: int, K=50.0, actuation_matrix=None):
+    def __init__(self, nv: int, K=50.0, actuation_matrix=None, pinv_damping: float = 0.0):
         super().__init__()
         self._nv = nv
+        self._damping = float(pinv_damping)
         self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
         self._BT = None if actuation_matrix is None else np.asarray(actuation_matrix).T
         nu = nv if actuation_matrix is None else self._BT.shape[0]
@@ -69,7 +76,7 @@ class SlidingModeController(LeafSystem):
 
     def torque(self, s_x: np.ndarray, J: np.ndarray) -> np.ndarray:
         """τ = −K J⁺ s_x for a 3 × nv Jacobian J."""
-        return smc_torque(self._K, J, s_x)
+        return smc_torque(self._K, J, s_x, self._damping)
 
     def _tau(self, context) -> np.ndarray:
         J = self._J_in.Eval(context).reshape(3, self._nv)

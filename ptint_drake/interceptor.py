@@ -50,7 +50,7 @@ class PrescribedTimeInterceptor(LeafSystem):
     def __init__(self, plant, frame, schedule: Schedule, targets: Sequence, K=50.0, Lambda=5.0,
                  k: float = 3.0, epsilon: float = 1e-6, delta: float = 1e-6,
                  alpha_hold: float = 0.0, switching: str = "tanh", phi: float = 0.01,
-                 sigma_policy: str = "keep", k_hold: float = 50.0):
+                 sigma_policy: str = "keep", k_hold: float = 50.0, pinv_damping: float = 0.0):
         super().__init__()
         if len(targets) != len(schedule):
             raise ValueError(f"targets: one target per segment is needed, got {len(targets)} "
@@ -63,6 +63,7 @@ class PrescribedTimeInterceptor(LeafSystem):
         self._kinematics = FrameKinematics(plant, frame)
         self._law = SurfaceLaw(Lambda, k, switching, phi, sigma_policy, k_hold)
         self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
+        self._damping = float(pinv_damping)
         self._BT = plant.MakeActuationMatrix().T
         self.layout = telemetry_layout(nv)
         size = self.layout["tau"].stop
@@ -76,9 +77,11 @@ class PrescribedTimeInterceptor(LeafSystem):
         # telemetry followed by the active segment vector (5)
         self._eval = DeclareVectorCache(self, "interceptor", size + 5, self._calc, deps)
         tau = self.layout["tau"]
-        self.DeclareVectorOutputPort("u", self._BT.shape[0],
-                                     lambda c, o: o.SetFromVector(self._BT @ self._eval(c)[tau]),
-                                     prerequisites_of_calc=deps)
+        if self._BT.shape[0] == nv and np.array_equal(self._BT, np.eye(nv)):
+            calc_u = lambda c, o: o.SetFromVector(self._eval(c)[tau])  # noqa: E731
+        else:
+            calc_u = lambda c, o: o.SetFromVector(self._BT @ self._eval(c)[tau])  # noqa: E731
+        self.DeclareVectorOutputPort("u", self._BT.shape[0], calc_u, prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("tau", nv, lambda c, o: o.SetFromVector(self._eval(c)[tau]),
                                      prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("telemetry", size,
@@ -95,7 +98,7 @@ class PrescribedTimeInterceptor(LeafSystem):
         s_x, e, edot, s, s_d, _ = self._law.parts(
             t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
             context.get_discrete_state_vector().value(), sigma)
-        tau = smc_torque(self._K, J, s_x)
+        tau = smc_torque(self._K, J, s_x, self._damping)
         return np.concatenate([x, xdot, target[0:9], tbg[0:5], s_x, e, edot, s, s_d, sigma, tau,
                                tbg[5:10]])
 

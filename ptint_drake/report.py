@@ -20,7 +20,8 @@ from ptint_drake import figures
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.replay import write_replay
 from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass, load_scenario
-from ptint_drake.simulation import build, resolve_model, simulate
+from ptint_drake.robot import resolve_model
+from ptint_drake.simulation import build, simulate
 
 PAPER_SCENARIOS = {
     "curve_b025_tf15": ("Figs. 6-7", "β = 0.25: intercepts almost linearly; discontinuous velocity, "

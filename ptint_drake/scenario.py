@@ -66,6 +66,7 @@ class ControllerConfig:
     sigma_policy: str = "keep"
     k_hold: float = 50.0
     implementation: str = "fused"  # "fused": one LeafSystem; "blocks": the five wired blocks
+    pinv_damping: float = 0.0  # m/rad: λ of the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹; 0 = exact
 
 
 @dataclass
@@ -97,9 +98,51 @@ class InterceptionConfig:
 
 
 @dataclass
+class DisturbanceConfig:
+    """External joint torque d(t) = amplitude ⊙ sin(2π f t + phase) + step ⊙ [t ≥ step_time]."""
+
+    amplitude: List[float] = field(default_factory=list)  # N·m per joint (empty: none)
+    frequency_hz: float = 1.0
+    phase: List[float] = field(default_factory=list)  # rad per joint (empty: zeros)
+    step: List[float] = field(default_factory=list)  # N·m per joint (empty: none)
+    step_time: float = 0.0  # s
+
+
+@dataclass
 class PlantConfig:
+    """How the simulated robot differs from its model file (the controller never knows)."""
+
     mass_scale: float = 1.0  # every link's mass and inertia × this
     damping_scale: float = 1.0  # every joint's viscous damping × this
+    payload_kg: float = 0.0  # point-like mass (sphere r 3 cm) welded at the end effector
+    coulomb: List[float] = field(default_factory=list)  # N·m per joint: −F tanh(v / coulomb_speed)
+    coulomb_speed: float = 0.01  # rad/s, smoothing of the Coulomb law
+    disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
+
+
+@dataclass
+class MeasurementConfig:
+    """How the controller sees the target (the paper's cameras); metrics use the true target.
+
+    Measured x_r(t) = x_r(t − latency) + n(t), n piecewise linear between Gaussian samples
+    (std ``noise_std`` per axis) drawn at ``rate_hz`` from ``seed``.  With
+    ``compensate_latency`` the delayed position is extrapolated with the known velocity and
+    acceleration of the target's profile.
+    """
+
+    noise_std: float = 0.0  # m
+    rate_hz: float = 30.0
+    latency: float = 0.0  # s
+    compensate_latency: bool = False
+    seed: int = 0
+
+
+@dataclass
+class LimitsConfig:
+    saturate: bool = True  # clamp torques to the model's effort limits (Drake Saturation)
+    max_error: float = 0.5  # m: |e| beyond this stops the run as diverged
+    max_joint_speed: float = 50.0  # rad/s (or m/s): beyond this stops the run as diverged
+    singular_value_warning: float = 0.02  # m/rad: warn when J's smallest singular value drops below
 
 
 def _default_simulator() -> SimulatorConfig:
@@ -114,6 +157,8 @@ class Scenario:
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     interceptions: List[InterceptionConfig] = field(default_factory=list)
     plant: PlantConfig = field(default_factory=PlantConfig)
+    measurement: MeasurementConfig = field(default_factory=MeasurementConfig)
+    limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)
     name: str = ""
 
@@ -164,6 +209,13 @@ def parse_scenario(text: str, name: str = "scenario") -> Scenario:
         scenario.name = name
     validate(scenario)
     return scenario
+
+
+def dump_yaml(scenario: "Scenario") -> str:
+    """The scenario as YAML text that ``parse_scenario`` reads back to the same scenario."""
+    import yaml  # noqa: PLC0415
+
+    return yaml.safe_dump(dump_dataclass(scenario), sort_keys=False)
 
 
 def _yaml_error(text: str, schema, exc: Exception) -> str:
@@ -235,6 +287,11 @@ def _vector3(value, where: str):
         raise ScenarioError(f"{where}: must be finite, got {list(value)}")
 
 
+def _nonnegative(value: float, where: str):
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ScenarioError(f"{where}: must be >= 0, got {value}")
+
+
 def _positive(value: float, where: str):
     if not (math.isfinite(value) and value > 0.0):
         raise ScenarioError(f"{where}: must be > 0, got {value}")
@@ -258,8 +315,25 @@ def validate(s: Scenario) -> None:
     if c.sigma_policy not in SIGMA_POLICIES:
         raise ScenarioError(f"controller.sigma_policy: must be one of {', '.join(SIGMA_POLICIES)}, got {c.sigma_policy!r}")
     _positive(s.plant.mass_scale, "plant.mass_scale")
-    if not (math.isfinite(s.plant.damping_scale) and s.plant.damping_scale >= 0.0):
-        raise ScenarioError(f"plant.damping_scale: must be >= 0, got {s.plant.damping_scale}")
+    for name in ("damping_scale", "payload_kg"):
+        _nonnegative(getattr(s.plant, name), f"plant.{name}")
+    _positive(s.plant.coulomb_speed, "plant.coulomb_speed")
+    for v in s.plant.coulomb:
+        _nonnegative(v, "plant.coulomb")
+    d = s.plant.disturbance
+    for name in ("amplitude", "phase", "step"):
+        if not all(math.isfinite(v) for v in getattr(d, name)):
+            raise ScenarioError(f"plant.disturbance.{name}: must be finite")
+    _positive(d.frequency_hz, "plant.disturbance.frequency_hz")
+    m = s.measurement
+    for name in ("noise_std", "latency"):
+        _nonnegative(getattr(m, name), f"measurement.{name}")
+    _positive(m.rate_hz, "measurement.rate_hz")
+    if c.pinv_damping < 0 or not math.isfinite(c.pinv_damping):
+        raise ScenarioError(f"controller.pinv_damping: must be >= 0, got {c.pinv_damping}")
+    for name in ("max_error", "max_joint_speed"):
+        _positive(getattr(s.limits, name), f"limits.{name}")
+    _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")
     schemes = GetIntegrationSchemes()
     if s.simulator.integration_scheme not in schemes:
         raise ScenarioError(

@@ -72,8 +72,13 @@ def tbg_profile_scalar(tau: float, tf: float, beta: float, g: float):
     if u >= 1.0:
         return 0.0, 0.0, 0.0, 0.0
     a = 1.0 - beta
-    xi = float(betaincinv(a, a, 1.0 - u))
-    eta = float(betaincinv(a, a, u))  # 1 − ξ, computed directly
+    # one inverse per call: the smaller of ξ and η = 1 − ξ directly, the other as 1 − it
+    if u < 0.5:
+        eta = float(betaincinv(a, a, u))
+        xi = 1.0 - eta
+    else:
+        xi = float(betaincinv(a, a, 1.0 - u))
+        eta = 1.0 - xi
     p = xi * eta
     one_m_2xi = 1.0 - 2.0 * xi
     xi_d = -g * p**beta

@@ -1,4 +1,6 @@
-"""Regenerate diagrams/: the built Drake diagrams of a curve scenario and of the assembly task.
+"""Regenerate diagrams/: the built Drake diagrams of a curve scenario and of the assembly task,
+as they run (NAME.dot/.svg, the fused interceptor) and with the five wired blocks
+(NAME_blocks.dot/.svg, controller.implementation = blocks).
 
     .venv/bin/python scripts/export_diagrams.py
 
@@ -8,12 +10,20 @@ tests/test_diagrams.py fails when the committed .dot files no longer match a fre
 from pathlib import Path
 
 from ptint_drake.report import write_diagram
-from ptint_drake.scenario import load_scenario
+from ptint_drake.scenario import load_scenario, parse_with_overrides, scenario_text
 
 DIAGRAM_SCENARIOS = ("curve_b075_tf15", "assembly")
 OUT = Path(__file__).resolve().parent.parent / "diagrams"
 
+def diagram_scenarios(name):
+    """The scenario as bundled, and its blocks variant named NAME_blocks."""
+    blocks = parse_with_overrides(scenario_text(name)[1], "controller: {implementation: blocks}", name)
+    blocks.name = f"{name}_blocks"
+    return [load_scenario(name), blocks]
+
+
 if __name__ == "__main__":
     for name in DIAGRAM_SCENARIOS:
-        for path in write_diagram(load_scenario(name), OUT):
-            print(f"wrote {path}")
+        for scenario in diagram_scenarios(name):
+            for path in write_diagram(scenario, OUT):
+                print(f"wrote {path}")
