@@ -35,12 +35,17 @@ def write_json_atomic(path: Path, data) -> None:
         raise
 
 
+MANIFEST = ".ptint-manifest.json"
+
+
 @contextmanager
 def staged_output(out_dir: Path):
     """Yield a temporary folder; on success its files replace those in ``out_dir``.
 
-    ``metrics.json`` (if staged) is moved last.  On any failure (or Ctrl-C) the
-    temporary folder is deleted and ``out_dir`` keeps no new file.
+    ``metrics.json`` (if staged) is moved last.  Files that the previous run in
+    ``out_dir`` wrote (listed in its manifest) and this one did not are removed,
+    so two runs never mix.  On any failure (or Ctrl-C) the temporary folder is
+    deleted and ``out_dir`` keeps no new file.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -48,14 +53,23 @@ def staged_output(out_dir: Path):
     try:
         yield stage
         (out_dir / METRICS).unlink(missing_ok=True)
-        names = sorted(p.name for p in stage.iterdir())
-        for name in sorted(names, key=lambda n: n == METRICS):
+        names = sorted((p.name for p in stage.iterdir()), key=lambda n: n == METRICS)
+        for name in names:
             target = out_dir / name
-            if target.is_dir() and not (stage / name).is_dir():
+            if target.is_dir():
                 shutil.rmtree(target)
-            elif (stage / name).is_dir() and target.exists():
-                shutil.rmtree(target) if target.is_dir() else target.unlink()
             os.replace(stage / name, target)
+        try:
+            previous = set(json.loads((out_dir / MANIFEST).read_text()))
+        except (OSError, ValueError):
+            previous = set()
+        for name in previous - set(names):
+            stale = out_dir / name
+            if stale.is_dir():
+                shutil.rmtree(stale, ignore_errors=True)
+            elif "/" not in name and stale.exists():
+                stale.unlink()
+        write_json_atomic(out_dir / MANIFEST, names)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 

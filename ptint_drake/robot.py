@@ -177,24 +177,28 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int =
 
 
 def singularity_warnings(plant: MultibodyPlant, scenario: Scenario, series: dict) -> list:
-    """A warning at the first logged time where J's smallest singular value drops below
-    ``limits.singular_value_warning`` (time, configuration, value)."""
+    """A warning when J's smallest singular value drops below ``limits.singular_value_warning``:
+    when it first did, and the time and configuration where it was smallest."""
     threshold = scenario.limits.singular_value_warning
     if threshold <= 0 or len(series["t"]) == 0:
         return []
     frame = plant.GetFrameByName(scenario.robot.end_effector)
     context = plant.CreateDefaultContext()
-    for t, q in zip(series["t"], series["q"]):
+    smallest = np.empty(len(series["t"]))
+    for k, q in enumerate(series["q"]):
         plant.SetPositions(context, q)
         J = plant.CalcJacobianTranslationalVelocity(
             context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(),
             plant.world_frame())
-        smallest = np.linalg.svd(J, compute_uv=False)[-1]
-        if smallest < threshold:
-            deg = ", ".join(f"{v:.1f}" for v in np.degrees(q))
-            damped = scenario.controller.pinv_damping
-            advice = (f"the damped pseudoinverse (λ = {damped:g}) keeps the torques bounded" if damped
-                      else "consider controller.pinv_damping (e.g. 0.01) for a damped pseudoinverse")
-            return [f"near-singular Jacobian at t = {t:.3f} s, q = ({deg}) deg: smallest "
-                    f"singular value {smallest:.2e} m/rad < {threshold:g}; {advice}"]
-    return []
+        smallest[k] = np.linalg.svd(J, compute_uv=False)[-1]
+    below = np.nonzero(smallest < threshold)[0]
+    if len(below) == 0:
+        return []
+    k = int(np.argmin(smallest))
+    deg = ", ".join(f"{v:.1f}" for v in np.degrees(series["q"][k]))
+    damped = scenario.controller.pinv_damping
+    advice = (f"the damped pseudoinverse (λ = {damped:g} m/rad) keeps the torques bounded" if damped
+              else "consider controller.pinv_damping (e.g. 0.01) for a damped pseudoinverse")
+    return [f"near-singular Jacobian from t = {series['t'][below[0]]:.3f} s; smallest singular value "
+            f"{smallest[k]:.2e} m/rad (< {threshold:g}) at t = {series['t'][k]:.3f} s, q = ({deg}) deg; "
+            f"{advice}"]
