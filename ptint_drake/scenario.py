@@ -34,6 +34,7 @@ from typing import List, Optional
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
+from ptint_drake.builder import ControllerGains
 from ptint_drake.schedule import Schedule, Segment
 from ptint_drake.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.targets import LinearTarget, SinusoidTarget
@@ -54,19 +55,8 @@ class RobotConfig:
 
 
 @dataclass
-class ControllerConfig:
-    K: float = 50.0
-    Lambda: float = 5.0
-    k: float = 3.0
-    epsilon: float = 1.0e-6
-    delta: float = 1.0e-6
-    alpha_hold: float = 0.0
-    switching: str = "tanh"
-    phi: float = 0.01
-    sigma_policy: str = "keep"
-    k_hold: float = 50.0
+class ControllerConfig(ControllerGains):
     implementation: str = "fused"  # "fused": one LeafSystem; "blocks": the five wired blocks
-    pinv_damping: float = 0.0  # m/rad: λ of the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹; 0 = exact
 
 
 @dataclass

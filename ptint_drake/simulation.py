@@ -10,6 +10,7 @@ interpolated.  Every block's outputs are logged once per integrator step
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -83,8 +84,7 @@ def build(scenario: Scenario, log: bool = True) -> Built:
     builder = DiagramBuilder()
     plant = builder.AddNamedSystem("plant", make_plant(scenario))
     c = scenario.controller
-    gains = ControllerGains(c.K, c.Lambda, c.k, c.epsilon, c.delta, c.alpha_hold,
-                            c.switching, c.phi, c.sigma_policy, c.k_hold, c.pinv_damping)
+    gains = ControllerGains(**{f.name: getattr(c, f.name) for f in dataclasses.fields(ControllerGains)})
     fused = c.implementation == "fused"
     handles = AddPrescribedTimeInterceptor(
         builder, plant, plant.GetFrameByName(scenario.robot.end_effector),
