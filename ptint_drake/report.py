@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake import figures
+from ptint_drake.figures import run_figures, tbg_family_figure
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.replay import write_replay
 from ptint_drake.robust import meets_spec
@@ -52,17 +52,16 @@ def conveyor_belts(scenario: Scenario):
     return belts
 
 
-def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figures_: bool = True,
-                  progress=None, **kwargs) -> dict:
+def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figures: bool = True,
+                  progress=None) -> dict:
     """Simulate ``scenario`` and write its outputs into ``out_dir``; returns the metrics."""
-    figures_ = kwargs.pop("figures", figures_)
     result = simulate(scenario, progress=progress)
     metrics = dict(result.metrics)
     metrics["scenario_config"] = dump_dataclass(scenario)
     with staged_output(out_dir) as stage:
         save_series(stage / SERIES, result.series)
-        if figures_:
-            metrics["figures"] = [f"{s}.png" for s in figures.run_figures(
+        if figures:
+            metrics["figures"] = [f"{s}.png" for s in run_figures(
                 result.series, result.metrics, stage, scenario.name)]
         if replay:
             write_replay(result.series, result.metrics, resolve_model(scenario.robot.model),
@@ -134,7 +133,7 @@ def write_paper(out_dir: Path, progress_factory=None) -> Path:
     (out_dir / "index.html").unlink(missing_ok=True)
     with staged_output(out_dir / "tbg") as stage:
         for stem, (settings, title) in TBG_FIGURES.items():
-            figures.tbg_family_figure(settings, stage, stem, title)
+            tbg_family_figure(settings, stage, stem, title)
     rows, sections = [], []
     for name, (figs, claim) in PAPER_SCENARIOS.items():
         scenario = load_scenario(name)

@@ -4,8 +4,11 @@ The plant is continuous (``time_step = 0``) so that the scenario's
 ``SimulatorConfig`` (error-controlled by default) integrates the whole loop.
 The simulator is stopped at exactly every segment's start, start + tf/2 and
 start + tf (SPEC section 5.3): ``AdvanceTo`` lands on those times, no log is
-interpolated.  Every block's outputs are logged once per integrator step
-(per-step logging adds no step-size cap).
+interpolated.  Logging is per integrator step (it adds no step-size cap): with
+the fused interceptor (default) only C++ state ports are logged and the
+telemetry is recomputed from them after the run; with the wired blocks every
+block's outputs are logged.  Metrics use the error against the *true* target
+(the controller may see a measured one, ``measurement``).
 """
 
 from __future__ import annotations
