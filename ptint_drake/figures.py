@@ -106,8 +106,9 @@ def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2
 
 
 def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[str]:
-    """Per-axis robot vs target (position, velocity, acceleration, jerk), the error and
-    torques, and the 3D paths.  Returns the stems written."""
+    """Per-axis robot vs target (position, velocity, acceleration, jerk), the error
+    (against the true target), the per-axis velocity error (Fig. 16), torques, joint
+    trajectories and the 3D paths.  Returns the stems written."""
     t = series["t"]
     tfs = [s["start"] + s["tf"] for s in metrics["segments"]]
     stems = []
@@ -140,11 +141,12 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     stems.append("axes")
 
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    axes[0].semilogy(t, np.maximum(np.linalg.norm(series["e"], axis=1), 1e-9), label="|e|")
+    axes[0].semilogy(t, np.maximum(np.linalg.norm(series["e_true"], axis=1), 1e-9), label="|e|")
     axes[0].axhline(1e-3, color="r", lw=0.8, label="1 mm")
     axes[0].set_ylabel("|e| [m]")
-    axes[1].plot(t, np.linalg.norm(series["edot"], axis=1), label="|ė|")
-    axes[1].set_ylabel("|ė| [m/s]")
+    for k, axis in enumerate(AXES):  # per axis, as the paper's Fig. 16
+        axes[1].plot(t, series["edot_true"][:, k], label=f"ė_{axis.lower()}")
+    axes[1].set_ylabel("ė [m/s]")
     for k in range(series["tau"].shape[1]):
         axes[2].plot(t, series["tau"][:, k], label=f"τ{k + 1}")
     axes[2].set_ylabel("torque [N·m]")
