@@ -104,6 +104,17 @@ def check_reachable(plant: MultibodyPlant, scenario: Scenario, samples_per_hold:
 
 
 
+def actuator_effort_limits(plant: MultibodyPlant) -> np.ndarray:
+    """Effort limit of each actuator, in the plant's actuation-input order."""
+    return np.array([plant.get_joint_actuator(i).effort_limit()
+                     for i in plant.GetJointActuatorIndices()])
+
+
+def effort_limits(plant: MultibodyPlant) -> np.ndarray:
+    """Effort limit of each generalized velocity's actuator (in velocity order)."""
+    return np.abs(plant.MakeActuationMatrix()) @ actuator_effort_limits(plant)
+
+
 def _ik(plant, frame, x, guess):
     ik = InverseKinematics(plant, with_joint_limits=True)
     ik.AddPositionConstraint(frame, np.zeros(3), plant.world_frame(), x - 1e-3, x + 1e-3)
@@ -128,9 +139,7 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int =
 
     frame = plant.GetFrameByName(scenario.robot.end_effector)
     context = plant.CreateDefaultContext()
-    limits_u = np.array([plant.get_joint_actuator(i).effort_limit()
-                         for i in plant.GetJointActuatorIndices()])
-    limits = np.abs(plant.MakeActuationMatrix()) @ limits_u
+    limits = effort_limits(plant)
     q_prev = np.radians(scenario.robot.initial_q_deg)
     plant.SetPositions(context, q_prev)
     x_prev = frame.CalcPoseInWorld(context).translation()

@@ -27,8 +27,8 @@ from pydrake.systems.primitives import LogVectorOutput, Saturation
 from ptint_drake.builder import AddPrescribedTimeInterceptor, ControllerGains, InterceptorHandles
 from ptint_drake.disturbance import JointDisturbance
 from ptint_drake.measurement import MeasuredTarget
-from ptint_drake.robot import (check_reachable, make_plant, scale_masses, singularity_warnings,
-                               torque_feasibility)
+from ptint_drake.robot import (actuator_effort_limits, check_reachable, effort_limits, make_plant,
+                               scale_masses, singularity_warnings, torque_feasibility)
 from ptint_drake.scenario import Scenario, ScenarioError
 from ptint_drake.targets import active_target_state
 
@@ -63,14 +63,6 @@ class Built:
     effort_limits: np.ndarray  # per generalized velocity (inf where none)
 
 
-def effort_limits(plant: MultibodyPlant) -> np.ndarray:
-    """Effort limit of each generalized velocity's actuator (in velocity order)."""
-    B = plant.MakeActuationMatrix()  # nv × nu
-    limits = np.array([plant.get_joint_actuator(index).effort_limit()
-                       for index in plant.GetJointActuatorIndices()])
-    return np.abs(B) @ limits
-
-
 def controller_targets(scenario: Scenario) -> list:
     """What the controller is given: the true targets, or their camera measurement."""
     targets = scenario.targets()
@@ -96,8 +88,7 @@ def build(scenario: Scenario, log: bool = True) -> Built:
     u = (handles.fused or handles.controller).GetOutputPort("u")
     limits = effort_limits(plant)
     if scenario.limits.saturate:
-        actuator_limits = np.array([plant.get_joint_actuator(i).effort_limit()
-                                    for i in plant.GetJointActuatorIndices()])
+        actuator_limits = actuator_effort_limits(plant)
         saturation = builder.AddNamedSystem("saturation", Saturation(-actuator_limits, actuator_limits))
         builder.Connect(u, saturation.get_input_port())
         builder.Connect(saturation.get_output_port(), plant.get_actuation_input_port())
