@@ -69,13 +69,16 @@ class PrescribedTimeInterceptor(LeafSystem):
         size = self.layout["tau"].stop
 
         self._state_in = self.DeclareVectorInputPort("state", nq + nv)
+        # the cache holds the telemetry, then the active segment (5), then σ̇ (3)
+        self._segment = slice(size, size + 5)
+        self._sigma_dot = slice(size + 5, size + 8)
         sigma_index, capture_index = DeclareSegmentCapture(
-            self, schedule, self._law, lambda c: (self._eval(c)[-5:], self._eval(c)[self.layout["s"]]))
+            self, schedule, self._law,
+            lambda c: (self._eval(c)[self._segment], self._eval(c)[self.layout["s"]]))
         self.DeclareStateOutputPort("sigma", sigma_index)
         self.DeclareStateOutputPort("captured", capture_index)
         deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self._state_in.ticket()}
-        # telemetry followed by the active segment vector (5)
-        self._eval = DeclareVectorCache(self, "interceptor", size + 5, self._calc, deps)
+        self._eval = DeclareVectorCache(self, "interceptor", size + 8, self._calc, deps)
         tau = self.layout["tau"]
         if self._BT.shape[0] == nv and np.array_equal(self._BT, np.eye(nv)):
             calc_u = lambda c, o: o.SetFromVector(self._eval(c)[tau])  # noqa: E731
@@ -95,12 +98,12 @@ class PrescribedTimeInterceptor(LeafSystem):
         target = active_target_state(self._schedule, self._targets, t)
         tbg = tbg_state(self._schedule, t, *self._tbg_args)
         sigma = context.get_continuous_state_vector().CopyToVector()
-        s_x, e, edot, s, s_d, _ = self._law.parts(
+        s_x, e, edot, s, s_d, sigma_dot = self._law.parts(
             t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
             context.get_discrete_state_vector().value(), sigma)
         tau = smc_torque(self._K, J, s_x, self._damping)
         return np.concatenate([x, xdot, target[0:9], tbg[0:5], s_x, e, edot, s, s_d, sigma, tau,
-                               tbg[5:10]])
+                               tbg[5:10], sigma_dot])
 
     def telemetry_at(self, t: np.ndarray, plant_state: np.ndarray, sigma: np.ndarray,
                      captured: np.ndarray) -> np.ndarray:
@@ -118,6 +121,4 @@ class PrescribedTimeInterceptor(LeafSystem):
         return rows
 
     def DoCalcTimeDerivatives(self, context, derivatives):
-        value = self._eval(context)
-        w = value[self.layout["s"]] - value[self.layout["s_d"]]
-        derivatives.get_mutable_vector().SetFromVector(self._law.switch(w))
+        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self._sigma_dot])
