@@ -68,26 +68,17 @@ def test_switching_laws(law):
         assert abs(out[3]) < 0.2
 
 
-def test_controller_is_minus_K_Jpinv_s():
-    ctrl = SlidingModeController(3, K=50.0)
+@pytest.mark.parametrize("nv, K, seed", [(3, 50.0, 0), (5, [1, 2, 3, 4, 5], 1)])
+def test_controller_is_minus_K_Jpinv_s(nv, K, seed):
+    """Square J: a solve; redundant J (5 joints): the minimum-norm solution."""
+    ctrl = SlidingModeController(nv, K=K)
     ctx = ctrl.CreateDefaultContext()
-    rng = np.random.default_rng(0)
-    J = rng.normal(size=(3, 3))
+    rng = np.random.default_rng(seed)
+    J = rng.normal(size=(3, nv))
     s_x = rng.normal(size=3)
     ctrl.GetInputPort("J").FixValue(ctx, J.ravel())
     ctrl.GetInputPort("s_x").FixValue(ctx, s_x)
-    np.testing.assert_allclose(ctrl.GetOutputPort("tau").Eval(ctx), -50.0 * np.linalg.pinv(J) @ s_x)
-
-
-def test_controller_redundant_is_minimum_norm():
-    ctrl = SlidingModeController(5, K=[1, 2, 3, 4, 5])
-    ctx = ctrl.CreateDefaultContext()
-    rng = np.random.default_rng(1)
-    J = rng.normal(size=(3, 5))
-    s_x = rng.normal(size=3)
-    ctrl.GetInputPort("J").FixValue(ctx, J.ravel())
-    ctrl.GetInputPort("s_x").FixValue(ctx, s_x)
-    expected = -np.array([1, 2, 3, 4, 5]) * (np.linalg.pinv(J) @ s_x)
+    expected = -np.broadcast_to(np.asarray(K, dtype=float), (nv,)) * (np.linalg.pinv(J) @ s_x)
     np.testing.assert_allclose(ctrl.GetOutputPort("tau").Eval(ctx), expected, atol=1e-12)
 
 
