@@ -20,7 +20,6 @@ Default ranges (uniform; ``--set``-style overrides through ``RANGES`` keys):
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 

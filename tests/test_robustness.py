@@ -1,7 +1,6 @@
 """Issue: robust and safe — disturbances, measurement, limits, singularities, divergence, outputs."""
 
 import json
-import os
 import signal
 import subprocess
 import sys
