@@ -131,7 +131,7 @@ def _floats(text: str, flag: str) -> list:
 
 
 def cmd_sweep(args) -> int:
-    from ptint_drake import sweep  # noqa: PLC0415
+    from ptint_drake.studies import sweep  # noqa: PLC0415
     from ptint_drake.outputs import staged_output  # noqa: PLC0415
 
     betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
@@ -157,7 +157,7 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_robust(args) -> int:
-    from ptint_drake import robust  # noqa: PLC0415
+    from ptint_drake.studies import robust  # noqa: PLC0415
 
     if args.samples < 1:
         raise ScenarioError(f"--samples: must be >= 1, got {args.samples}")
@@ -188,7 +188,7 @@ def cmd_robust(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from ptint_drake.benchmark import main as bench_main  # noqa: PLC0415
+    from ptint_drake.studies.benchmark import main as bench_main  # noqa: PLC0415
 
     return bench_main(args.rest)
 

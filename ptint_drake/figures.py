@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 from scipy.interpolate import CubicSpline  # noqa: E402
 from scipy.signal import savgol_filter  # noqa: E402
 
-from ptint_drake.tbg import alpha_gain, tbg_profile  # noqa: E402
+from ptint_drake.systems.tbg import alpha_gain, tbg_profile  # noqa: E402
 
 AXES = ("X", "Y", "Z")
 FORMATS = ("png", "svg")

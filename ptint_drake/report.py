@@ -19,7 +19,7 @@ import numpy as np
 from ptint_drake.figures import run_figures, tbg_family_figure
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.replay import write_replay
-from ptint_drake.robust import meets_spec
+from ptint_drake.studies.robust import meets_spec
 from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass, load_scenario
 from ptint_drake.robot import resolve_model
 from ptint_drake.simulation import build, simulate

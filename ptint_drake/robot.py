@@ -135,7 +135,7 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int =
     gives the suggested tf.  e0 is taken from the start pose for the first
     segment and from the previous target for later ones.
     """
-    from ptint_drake.tbg import tbg_profile  # noqa: PLC0415
+    from ptint_drake.systems.tbg import tbg_profile  # noqa: PLC0415
 
     frame = plant.GetFrameByName(scenario.robot.end_effector)
     context = plant.CreateDefaultContext()

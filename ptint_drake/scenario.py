@@ -34,10 +34,10 @@ from typing import List, Optional
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
-from ptint_drake.builder import ControllerGains
-from ptint_drake.schedule import Schedule, Segment
-from ptint_drake.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
-from ptint_drake.targets import LinearTarget, SinusoidTarget
+from ptint_drake.systems.builder import ControllerGains
+from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
+from ptint_drake.systems.targets import LinearTarget, SinusoidTarget
 
 
 IMPLEMENTATIONS = ("fused", "blocks")

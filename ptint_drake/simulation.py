@@ -23,13 +23,13 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder, EventStatus
 from pydrake.systems.primitives import LogVectorOutput, Saturation
 
-from ptint_drake.builder import AddPrescribedTimeInterceptor, ControllerGains, InterceptorHandles
-from ptint_drake.disturbance import JointDisturbance
-from ptint_drake.measurement import MeasuredTarget
+from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains, InterceptorHandles
+from ptint_drake.systems.disturbance import JointDisturbance
+from ptint_drake.systems.measurement import MeasuredTarget
 from ptint_drake.robot import (actuator_effort_limits, check_reachable, effort_limits, make_plant,
                                scale_masses, singularity_warnings, torque_feasibility)
 from ptint_drake.scenario import Scenario, ScenarioError
-from ptint_drake.targets import active_target_state
+from ptint_drake.systems.targets import active_target_state
 
 # Logged signals: name -> (system attribute of the handles or "plant", output port name).
 _LOGGED = {

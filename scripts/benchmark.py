@@ -5,7 +5,7 @@
 
 import sys
 
-from ptint_drake.benchmark import main
+from ptint_drake.studies.benchmark import main
 
 if __name__ == "__main__":
     sys.exit(main())

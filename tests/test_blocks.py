@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from ptint_drake.controller import SlidingModeController
-from ptint_drake.schedule import Schedule, Segment
-from ptint_drake.sliding_surface import SlidingSurface, switching_function
-from ptint_drake.targets import LinearTarget, SinusoidTarget, TargetSource
-from ptint_drake.tbg import TimeBaseGenerator
+from ptint_drake.systems.controller import SlidingModeController
+from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.sliding_surface import SlidingSurface, switching_function
+from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, TargetSource
+from ptint_drake.systems.tbg import TimeBaseGenerator
 
 SCHED = Schedule([Segment(0.0, 1.5, 0.75), Segment(2.0, 1.0, 0.5)])
 
@@ -131,7 +131,7 @@ def test_schedule_validation():
 
 
 def test_solve3_matches_numpy_and_survives_singular():
-    from ptint_drake.controller import solve3
+    from ptint_drake.systems.controller import solve3
 
     rng = np.random.default_rng(5)
     for _ in range(200):
@@ -143,7 +143,7 @@ def test_solve3_matches_numpy_and_survives_singular():
 
 
 def test_scalar_tbg_matches_vector_form():
-    from ptint_drake.tbg import gamma_gain, tbg_profile, tbg_profile_scalar
+    from ptint_drake.systems.tbg import gamma_gain, tbg_profile, tbg_profile_scalar
 
     for beta in (0.25, 0.5, 0.75, 0.9):
         for tau in (-0.1, 0.0, 1e-6, 0.3, 0.75, 1.4999, 1.5, 2.0):

@@ -8,9 +8,9 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from ptint_drake.builder import AddPrescribedTimeInterceptor, ControllerGains
-from ptint_drake.schedule import Schedule, Segment
-from ptint_drake.targets import LinearTarget
+from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
+from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.targets import LinearTarget
 
 
 def _link(name, mass, com, size):

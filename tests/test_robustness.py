@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from conftest import assert_prescribed_time, run_cached
-from ptint_drake.disturbance import JointDisturbance
-from ptint_drake.measurement import MeasuredTarget
-from ptint_drake.robust import RANGES, sample_scenario
+from ptint_drake.systems.disturbance import JointDisturbance
+from ptint_drake.systems.measurement import MeasuredTarget
+from ptint_drake.studies.robust import RANGES, sample_scenario
 from ptint_drake.scenario import parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
-from ptint_drake.targets import LinearTarget
+from ptint_drake.systems.targets import LinearTarget
 
 HERE = Path(__file__).parent
 NAME, TEXT = scenario_text("curve_b075_tf15")

@@ -11,7 +11,7 @@ import pytest
 
 from ptint_drake.scenario import parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
-from ptint_drake.sweep import run_sweep, sweep_point
+from ptint_drake.studies.sweep import run_sweep, sweep_point
 
 NAME, TEXT = scenario_text("curve_b075_tf15")
 

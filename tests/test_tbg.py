@@ -5,8 +5,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.special import betaincinv, gamma
 
-from ptint_drake.schedule import Schedule, Segment
-from ptint_drake.tbg import TimeBaseGenerator, alpha_gain, alpha_peak, gamma_gain, tbg_profile
+from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.tbg import TimeBaseGenerator, alpha_gain, alpha_peak, gamma_gain, tbg_profile
 
 
 @pytest.mark.parametrize("beta", [0.25, 0.5, 0.75, 0.9])

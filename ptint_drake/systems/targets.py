@@ -16,8 +16,8 @@ from typing import Sequence
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.cache import DeclareVectorCache
-from ptint_drake.schedule import Schedule
+from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.schedule import Schedule
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ import numpy as np
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.cache import DeclareVectorCache
+from ptint_drake.systems.cache import DeclareVectorCache
 
 
 _ORIGIN = np.zeros(3)

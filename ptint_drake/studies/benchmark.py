@@ -74,7 +74,7 @@ def benchmark(names=None, configs=("default", "blocks", "sign"), reference: bool
 def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
                     tfs=(1.2, 1.5, 1.9), workers=(1, 2)) -> dict:
     """Wall time of a 3 × 3 ``ptint sweep`` grid with 1 and 2 worker processes."""
-    from ptint_drake.sweep import timed_sweep
+    from ptint_drake.studies.sweep import timed_sweep
 
     _, text = scenario_text(name)
     walls = {w: timed_sweep(text, name, betas, tfs, w) for w in workers}

@@ -23,8 +23,8 @@ from pydrake.systems.framework import LeafSystem
 from scipy.special import beta as beta_function
 from scipy.special import betaincinv
 
-from ptint_drake.cache import DeclareVectorCache
-from ptint_drake.schedule import Schedule
+from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.schedule import Schedule
 
 
 def gamma_gain(tf: float, beta: float) -> float:

@@ -17,13 +17,13 @@ must actuate each of its velocities (nv = nu).
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
-from ptint_drake.controller import SlidingModeController
-from ptint_drake.interceptor import PrescribedTimeInterceptor
-from ptint_drake.kinematics import TaskSpaceKinematics
-from ptint_drake.schedule import Schedule
-from ptint_drake.sliding_surface import SlidingSurface
-from ptint_drake.targets import TargetSource
-from ptint_drake.tbg import TimeBaseGenerator
+from ptint_drake.systems.controller import SlidingModeController
+from ptint_drake.systems.interceptor import PrescribedTimeInterceptor
+from ptint_drake.systems.kinematics import TaskSpaceKinematics
+from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.sliding_surface import SlidingSurface
+from ptint_drake.systems.targets import TargetSource
+from ptint_drake.systems.tbg import TimeBaseGenerator
 
 
 @dataclass

@@ -35,8 +35,8 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.cache import DeclareVectorCache
-from ptint_drake.schedule import Schedule
+from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.schedule import Schedule
 
 SWITCHING_LAWS = ("sign", "tanh", "sat")
 SIGMA_POLICIES = ("keep", "reset")

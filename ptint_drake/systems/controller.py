@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.cache import DeclareVectorCache
+from ptint_drake.systems.cache import DeclareVectorCache
 
 
 def solve3(J: np.ndarray, b: np.ndarray) -> np.ndarray:

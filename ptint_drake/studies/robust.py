@@ -28,7 +28,7 @@ import numpy as np
 from ptint_drake.figures import plt, save
 from ptint_drake.scenario import ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.simulation import simulate
-from ptint_drake.sweep import default_executor
+from ptint_drake.studies.sweep import default_executor
 
 RANGES = {
     "mass": (0.7, 1.5),

@@ -22,13 +22,13 @@ from typing import Sequence
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.cache import DeclareVectorCache
-from ptint_drake.controller import smc_torque
-from ptint_drake.kinematics import FrameKinematics
-from ptint_drake.schedule import Schedule
-from ptint_drake.sliding_surface import DeclareSegmentCapture, SurfaceLaw
-from ptint_drake.targets import active_target_state
-from ptint_drake.tbg import tbg_state
+from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.controller import smc_torque
+from ptint_drake.systems.kinematics import FrameKinematics
+from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.sliding_surface import DeclareSegmentCapture, SurfaceLaw
+from ptint_drake.systems.targets import active_target_state
+from ptint_drake.systems.tbg import tbg_state
 
 
 def telemetry_layout(nv: int) -> dict:
