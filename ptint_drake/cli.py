@@ -76,29 +76,47 @@ def cmd_list(args) -> int:
     return 0
 
 
+def _mm(value) -> str:
+    return "n/a" if value is None else f"{value * 1e3:.4g} mm"
+
+
+def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
+    from ptint_drake.metrics import segment_reasons  # noqa: PLC0415
+
+    reasons = segment_reasons(seg, criteria)
+    return (f"{name} segment {i}: e0 = {_mm(seg['e0_norm'])}, e(tf/2) = {_mm(seg['e_half_norm'])}, "
+            f"e(tf) = {_mm(seg['e_tf_norm'])}, hold max = {_mm(seg['e_hold_max_norm'])}: "
+            + (f"MISSED ({', '.join(reasons)})" if reasons else "ok"))
+
+
 def cmd_run(args) -> int:
     from ptint_drake.report import run_and_write  # noqa: PLC0415
 
     scenario = load(args.scenario, args.set)
     out = Path(args.out) if args.out else Path("out") / scenario.name
+    warn = lambda message: print(f"ptint: warning: {message}", file=sys.stderr)  # noqa: E731
     metrics = run_and_write(scenario, out, replay=not args.no_replay,
                             figures=not args.no_figures,
-                            progress=None if args.quiet else _progress(scenario.name))
-    for warning in metrics["warnings"]:
-        print(f"ptint: warning: {warning}", file=sys.stderr)
-    mm = lambda v: "n/a" if v is None else f"{v * 1e3:.4g} mm"  # noqa: E731
+                            progress=None if args.quiet else _progress(scenario.name), warn=warn)
+    for note in metrics["controller"]["notes"]:
+        print(note)
     for i, seg in enumerate(metrics["segments"]):
-        print(f"{scenario.name} segment {i}: e0 = {mm(seg['e0_norm'])}, e(tf/2) = "
-              f"{mm(seg['e_half_norm'])}, e(tf) = {mm(seg['e_tf_norm'])}, hold max = "
-              f"{mm(seg['e_hold_max_norm'])}")
+        print(_segment_line(scenario.name, i, seg, scenario.criteria))
     sim = metrics["sim"]
-    print(f"realtime factor {sim['realtime_factor']:.2f}, {sim['steps']} steps, "
+    print(f"realtime factor {sim['realtime_factor']:.2f} end to end, {sim['steps']} steps, "
           f"{sim['derivative_evaluations']} derivative evaluations, saturated "
           f"{100 * metrics['saturated_fraction']:.1f} % of the time; wrote {out}/")
+    for message in metrics["warnings"][metrics["warnings_before_run"]:]:
+        warn(message)
     if metrics["status"] == "failed":
         print(f"ptint: error: run failed: {metrics['failure']['message']} "
               f"(outputs up to then are in {out}/, metrics.json says status: failed)", file=sys.stderr)
         return 1
+    if metrics["status"] == "missed":
+        print(f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])}); the gains may not fit "
+              f"this arm or tf: try `ptint tune {args.scenario}`")
+        return 1
+    print(f"{scenario.name}: ok (every segment meets the criteria)")
     return 0
 
 

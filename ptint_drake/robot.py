@@ -62,9 +62,13 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
 
 
 def scale_masses(plant: MultibodyPlant, plant_context, scale: float) -> None:
-    """Every link's mass and rotational inertia × scale (rotor inertias and payload unchanged)."""
+    """Every link's mass and rotational inertia and every actuator's rotor inertia × scale
+    (the ``mass_xF`` plant variant); the payload is unchanged."""
     if scale == 1.0:
         return
+    for index in plant.GetJointActuatorIndices():
+        actuator = plant.get_joint_actuator(index)
+        actuator.SetRotorInertia(plant_context, actuator.default_rotor_inertia() * scale)
     for index in range(1, plant.num_bodies()):
         body = plant.get_body(BodyIndex(index))
         if body.name() == "payload":
@@ -211,3 +215,22 @@ def singularity_warnings(plant: MultibodyPlant, scenario: Scenario, series: dict
     return [f"near-singular Jacobian from t = {series['t'][below[0]]:.3f} s; smallest singular value "
             f"{smallest[k]:.2e} m/rad (< {threshold:g}) at t = {series['t'][k]:.3f} s, q = ({deg}) deg; "
             f"{advice}"]
+
+
+def joint_limit_warnings(plant: MultibodyPlant, series: dict) -> list[str]:
+    """Warnings for joints that went beyond the model's position or speed limits during the
+    run (a continuous plant does not enforce them): which joint, how far, and when."""
+    warnings = []
+    for kind, values, lower, upper, unit in (
+            ("position", series["q"], plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits(), "rad"),
+            ("speed", series["v"], plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits(), "rad/s")):
+        for j in range(values.shape[1]):
+            over = np.maximum(values[:, j] - upper[j], lower[j] - values[:, j])
+            k = int(np.argmax(over))
+            if len(over) and over[k] > 1e-9:
+                first = float(series["t"][int(np.argmax(over > 1e-9))])
+                limit = upper[j] if values[k, j] > upper[j] else lower[j]
+                warnings.append(
+                    f"joint {j + 1} {kind} {values[k, j]:.3g} {unit} at t = {series['t'][k]:.3f} s is "
+                    f"beyond the model's limit {limit:.3g} {unit} (first beyond it at t = {first:.3f} s)")
+    return warnings

@@ -24,6 +24,7 @@ open, with their defaults:
 """
 
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass, field
@@ -34,13 +35,15 @@ from typing import List, Optional
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
-from ptint_drake.systems.builder import ControllerGains
+from ptint_drake.metrics import Criteria, validate_criteria
+from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import LinearTarget, SinusoidTarget
 
 
 IMPLEMENTATIONS = ("fused", "blocks")
+CONTROLLER_TYPES = ("ptsmc",)  # the slot's controllers (controllers.py); ptsmc = the paper's
 
 
 class ScenarioError(ValueError):
@@ -56,7 +59,10 @@ class RobotConfig:
 
 @dataclass
 class ControllerConfig(ControllerGains):
-    implementation: str = "fused"  # "fused": one LeafSystem; "blocks": the five wired blocks
+    """The paper's gains (shared by ``smc``) and which controller runs (``type``)."""
+
+    type: str = "ptsmc"  # the controller in the slot: ptsmc (the paper's) | pd | smc | ct_quintic
+    implementation: str = "fused"  # ptsmc: "fused" one LeafSystem, or "blocks" (the five wired blocks)
 
 
 @dataclass
@@ -150,6 +156,7 @@ class Scenario:
     measurement: MeasurementConfig = field(default_factory=MeasurementConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)
+    criteria: Criteria = field(default_factory=Criteria)
     name: str = ""
 
     def schedule(self) -> Schedule:
@@ -299,6 +306,12 @@ def validate(s: Scenario) -> None:
         raise ScenarioError(f"controller.switching: must be one of {', '.join(SWITCHING_LAWS)}, got {c.switching!r}")
     if c.switching != "sign":
         _positive(c.phi, "controller.phi")
+    if c.type not in CONTROLLER_TYPES:
+        raise ScenarioError(f"controller.type: must be one of {', '.join(CONTROLLER_TYPES)}, got {c.type!r}")
+    try:
+        validate_criteria(s.criteria)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
     if c.implementation not in IMPLEMENTATIONS:
         raise ScenarioError(f"controller.implementation: must be one of {', '.join(IMPLEMENTATIONS)}, "
                             f"got {c.implementation!r}")
@@ -369,6 +382,33 @@ def validate(s: Scenario) -> None:
         else:
             _vector3(t.linear.start, f"{where}.target.linear.start")
             _vector3(t.linear.velocity, f"{where}.target.linear.velocity")
+
+
+VARIANT_FORMS = "nominal, mass_xF (e.g. mass_x1.5), payload_Mkg (e.g. payload_0.5kg)"
+
+
+def apply_variant(scenario: Scenario, variant: str) -> Scenario:
+    """The scenario on a plant variant (one definition for compare, tune and tests):
+    ``nominal`` as is; ``mass_xF``: every link's mass and rotational inertia and every rotor
+    inertia × F (friction unchanged); ``payload_Mkg``: a point mass of M kg at the end
+    effector.  Returns a copy; ScenarioError naming the variant if it is not one of those."""
+    out = copy.deepcopy(scenario)
+    try:
+        if variant == "nominal":
+            return out
+        if variant.startswith("mass_x"):
+            factor = float(variant[len("mass_x"):])
+            if factor > 0 and math.isfinite(factor):
+                out.plant.mass_scale *= factor
+                return out
+        elif variant.startswith("payload_") and variant.endswith("kg"):
+            mass = float(variant[len("payload_"):-2])
+            if mass >= 0 and math.isfinite(mass):
+                out.plant.payload_kg += mass
+                return out
+    except ValueError:
+        pass
+    raise ScenarioError(f"variant: unknown plant variant {variant!r} (use {VARIANT_FORMS})")
 
 
 def dump_dataclass(obj) -> dict:

@@ -106,12 +106,14 @@ interceptions:
 """)
     out = ptint("run", str(scenario), "--out", str(tmp_path / "out"), "--quiet", "--no-replay",
                 "--no-figures")
-    assert out.returncode == 0, out.stderr
+    assert out.returncode == 1, out.stderr  # a miss: exit 1
+    assert "MISSED (late, hold)" in out.stdout and "ptint tune" in out.stdout
     warning = [line for line in out.stderr.splitlines() if line.startswith("ptint: warning:")]
     assert warning and "interceptions[0].tf = 0.2 s looks too short" in warning[0]
     assert "tf ≥" in warning[0] and "would fit" in warning[0]
     m = json.loads((tmp_path / "out" / "metrics.json").read_text())
-    assert m["status"] == "ok" and m["saturated_fraction"] > 0.05
+    assert m["status"] == "missed" and m["reasons"] == ["segment 0: late", "segment 0: hold"]
+    assert m["saturated_fraction"] > 0.05
     assert all(p <= lim + 1e-9 for p, lim in zip(m["torque_peak"], m["effort_limits"]))
     series = np.load(tmp_path / "out" / "series.npz")
     assert np.all(np.isfinite(series["q"])) and np.max(np.abs(series["v"])) < 50

@@ -17,13 +17,14 @@ Model-free like the blocks: it reads the plant's state and kinematics only.
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.controller import smc_torque
+from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.sliding_surface import DeclareSegmentCapture, SurfaceLaw
@@ -45,30 +46,36 @@ def telemetry_layout(nv: int) -> dict:
 
 class PrescribedTimeInterceptor(LeafSystem):
     """Input ``state`` ([q; v] of the plant); outputs ``u`` (actuation), ``tau`` (joint
-    torques) and ``telemetry``.  State: σ (continuous, 3), [index, s(t0)] (discrete)."""
+    torques) and ``telemetry``.  State: σ (continuous, 3), [index, s(t0)] (discrete).
 
-    def __init__(self, plant, frame, schedule: Schedule, targets: Sequence, K=50.0, Lambda=5.0,
-                 k: float = 3.0, epsilon: float = 1e-6, delta: float = 1e-6,
-                 alpha_hold: float = 0.0, switching: str = "tanh", phi: float = 0.01,
-                 sigma_policy: str = "keep", k_hold: float = 50.0, pinv_damping: float = 0.0):
+    With ``targets`` (one per segment, ``evaluate(t)`` → [x, ẋ, ẍ, …]) the target is
+    computed inside (the fast path for analytic targets); with ``targets=None`` the
+    system has an input port ``target`` (9: [x_r, ẋ_r, ẍ_r] of the active segment,
+    e.g. a Kalman filter's estimate) and holds no target object at all.
+    """
+
+    def __init__(self, *, plant, frame, schedule: Schedule, gains: ControllerGains,
+                 targets: Optional[Sequence] = None):
         super().__init__()
-        if len(targets) != len(schedule):
+        if targets is not None and len(targets) != len(schedule):
             raise ValueError(f"targets: one target per segment is needed, got {len(targets)} "
                              f"for {len(schedule)} segments")
         nq, nv = plant.num_positions(), plant.num_velocities()
         self._nq, self._nv = nq, nv
         self._schedule = schedule
-        self._targets = tuple(targets)
-        self._tbg_args = (epsilon, delta, alpha_hold)
+        self._targets = None if targets is None else tuple(targets)
+        self._tbg_args = (gains.epsilon, gains.delta, gains.alpha_hold)
         self._kinematics = FrameKinematics(plant, frame)
-        self._law = SurfaceLaw(Lambda, k, switching, phi, sigma_policy, k_hold)
-        self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
-        self._damping = float(pinv_damping)
+        self._law = SurfaceLaw(gains.Lambda, gains.k, gains.switching, gains.phi,
+                               gains.sigma_policy, gains.k_hold)
+        self._K = np.broadcast_to(np.asarray(gains.K, dtype=float), (nv,)).copy()
+        self._damping = float(gains.pinv_damping)
         self._BT = plant.MakeActuationMatrix().T
         self.layout = telemetry_layout(nv)
         size = self.layout["tau"].stop
 
         self._state_in = self.DeclareVectorInputPort("state", nq + nv)
+        self._target_in = None if targets is not None else self.DeclareVectorInputPort("target", 9)
         # the cache holds the telemetry, then the active segment (5), then σ̇ (3)
         self._segment = slice(size, size + 5)
         self._sigma_dot = slice(size + 5, size + 8)
@@ -77,7 +84,7 @@ class PrescribedTimeInterceptor(LeafSystem):
             lambda c: (self._eval(c)[self._segment], self._eval(c)[self.layout["s"]]))
         self.DeclareStateOutputPort("sigma", sigma_index)
         self.DeclareStateOutputPort("captured", capture_index)
-        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self._state_in.ticket()}
+        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         self._eval = DeclareVectorCache(self, "interceptor", size + 8, self._calc, deps)
         tau = self.layout["tau"]
         if self._BT.shape[0] == nv and np.array_equal(self._BT, np.eye(nv)):
@@ -91,11 +98,18 @@ class PrescribedTimeInterceptor(LeafSystem):
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
                                      prerequisites_of_calc=deps)
 
+    @property
+    def has_target_input(self) -> bool:
+        return self._target_in is not None
+
     def _calc(self, context) -> np.ndarray:
         t = context.get_time()
         qv = self._state_in.Eval(context)
         x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
-        target = active_target_state(self._schedule, self._targets, t)
+        if self._targets is None:
+            target = self._target_in.Eval(context)
+        else:
+            target = active_target_state(self._schedule, self._targets, t)
         tbg = tbg_state(self._schedule, t, *self._tbg_args)
         sigma = context.get_continuous_state_vector().CopyToVector()
         s_x, e, edot, s, s_d, sigma_dot = self._law.parts(
@@ -106,8 +120,9 @@ class PrescribedTimeInterceptor(LeafSystem):
                                tbg[5:10], sigma_dot])
 
     def telemetry_at(self, t: np.ndarray, plant_state: np.ndarray, sigma: np.ndarray,
-                     captured: np.ndarray) -> np.ndarray:
-        """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0)])."""
+                     captured: np.ndarray, target: Optional[np.ndarray] = None) -> np.ndarray:
+        """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0)], and the
+        ``target`` input's value when the system has that port)."""
         context = self.CreateDefaultContext()
         port = self._state_in
         size = self.layout["tau"].stop
@@ -117,6 +132,8 @@ class PrescribedTimeInterceptor(LeafSystem):
             context.SetContinuousState(sigma[k])
             context.SetDiscreteState(captured[k])
             port.FixValue(context, plant_state[k])
+            if self._target_in is not None:
+                self._target_in.FixValue(context, target[k])
             rows[k] = self._eval(context)[:size]
         return rows
 

@@ -66,7 +66,8 @@ def active_target_state(schedule: Schedule, targets: Sequence, t: float) -> np.n
 class TargetSource(LeafSystem):
     """x_r, ẋ_r, ẍ_r of the target of the active segment (one target per segment).
 
-    Output ports ``x_r``, ``xdot_r``, ``xddot_r`` (3 each) depend on time only.
+    Output ports ``x_r``, ``xdot_r``, ``xddot_r`` (3 each) and ``target`` (the three
+    stacked, 9) depend on time only.
     Before the first segment starts, the first target is emitted.  Output port
     ``objects`` (3 × number of segments) gives every target's position at t,
     which a replay uses to draw the objects that are not being chased.
@@ -91,6 +92,9 @@ class TargetSource(LeafSystem):
             prerequisites_of_calc=time_only)
         self._xddot_out = self.DeclareVectorOutputPort(
             "xddot_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[6:9]),
+            prerequisites_of_calc=time_only)
+        self._target_out = self.DeclareVectorOutputPort(
+            "target", 9, lambda c, o: o.SetFromVector(self._eval(c)[0:9]),
             prerequisites_of_calc=time_only)
         self._objects_out = self.DeclareVectorOutputPort(
             "objects", 3 * len(targets),

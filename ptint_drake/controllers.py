@@ -1,0 +1,145 @@
+"""The controller slot: the scenario's ``controller.type`` chosen and wired to the station.
+
+Every controller connects to the station's ports the same way — ``state`` in,
+a target in, ``u`` out to ``actuation`` — and declares its own telemetry: the
+ports to log at every integrator step and a function that turns those logs
+into named signals (at least ``x``, ``xdot``, ``tau``).
+
+What the controller sees of the target (``target_view``): with
+``measurement.estimator: none`` the analytic target (or its legacy noisy/delayed
+version, ``measurement.noise_std``/``latency``); with an estimator, only what a
+camera and a Kalman filter make of the true objects.  The station's true
+target never reaches a controller directly.
+
+Controllers (``CONTROLLERS``): ``ptsmc``, the paper's interceptor (model-free).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+from pydrake.systems.framework import DiagramBuilder, OutputPort
+
+from ptint_drake.scenario import Scenario
+from ptint_drake.station import Station
+from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, InterceptorHandles
+from ptint_drake.systems.gains import ControllerGains
+from ptint_drake.systems.measurement import MeasuredTarget
+from ptint_drake.systems.targets import TargetSource
+
+# Logged signals of the wired blocks: name -> (handle attribute, output port name).
+_BLOCK_PORTS = {
+    "x": ("kinematics", "x"), "xdot": ("kinematics", "xdot"),
+    "x_r": ("surface", None), "xi": ("tbg", "xi"), "alpha": ("tbg", "alpha"),
+    "e": ("surface", "e"), "edot": ("surface", "edot"), "s": ("surface", "s"),
+    "s_d": ("surface", "s_d"), "s_x": ("surface", "s_x"), "sigma": ("surface", "sigma"),
+    "tau": ("controller", "tau"),
+}
+
+
+@dataclass
+class ControllerHandles:
+    """What the slot added: the ports to log every step, how to turn those logs into
+    telemetry (a dict of arrays, rows = samples), and lines for the run's output."""
+
+    name: str
+    log_ports: dict
+    telemetry: Callable[[dict], dict]
+    notes: list = field(default_factory=list)
+    model_based: bool = False
+    system: object = None
+
+
+def controller_targets(scenario: Scenario) -> list:
+    """The analytic view: the true targets, or their legacy noisy/delayed measurement."""
+    targets = scenario.targets()
+    m = scenario.measurement
+    if m.noise_std == 0.0 and m.latency == 0.0:
+        return targets
+    return [MeasuredTarget(tg, scenario.duration, m.noise_std, m.rate_hz, m.latency,
+                           m.compensate_latency, m.seed + i) for i, tg in enumerate(targets)]
+
+
+def target_view(builder: DiagramBuilder, station_system, scenario: Scenario) -> OutputPort:
+    """The port that carries [x_r, ẋ_r, ẍ_r] of the active segment as the controller sees it."""
+    source = builder.AddNamedSystem("target_view", TargetSource(
+        scenario.schedule(), controller_targets(scenario)))
+    return source.GetOutputPort("target")
+
+
+def gains_of(scenario: Scenario) -> ControllerGains:
+    c = scenario.controller
+    return ControllerGains(**{name: getattr(c, name) for name in ControllerGains.__dataclass_fields__})
+
+
+def _add_ptsmc(builder, station_system, station: Station, scenario: Scenario) -> ControllerHandles:
+    plant = station.plant
+    frame = plant.GetFrameByName(scenario.robot.end_effector)
+    fused = scenario.controller.implementation == "fused"
+    analytic = uses_analytic_targets(scenario)
+    h = AddPrescribedTimeInterceptor(
+        builder, plant, frame, scenario.schedule(),
+        controller_targets(scenario) if analytic and fused else None, gains_of(scenario),
+        connect_actuation=False, fused=fused, state_port=station_system.GetOutputPort("state"))
+    system = h.fused or h.controller
+    builder.Connect(system.GetOutputPort("u"), station_system.GetInputPort("actuation"))
+    target = None
+    if h.target_input is not None:
+        target = target_view(builder, station_system, scenario) if analytic else None
+        builder.Connect(target, h.target_input)
+    notes = [f"ptsmc: K = {scenario.controller.K:g}, Λ = {scenario.controller.Lambda:g}, "
+             f"k = {scenario.controller.k:g}, {scenario.controller.switching} law"]
+    if fused:
+        return _fused_handles(h, target, notes)
+    return _block_handles(h, target, notes)
+
+
+def _fused_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -> ControllerHandles:
+    """The fused system logs only state ports; its telemetry is recomputed afterwards."""
+    system = h.fused
+    ports = {"sigma": system.GetOutputPort("sigma"), "captured": system.GetOutputPort("captured")}
+    if target is not None:
+        ports["target"] = target
+
+    def telemetry(logs: dict) -> dict:
+        rows = system.telemetry_at(logs["t"], logs["state"], logs["sigma"], logs["captured"],
+                                   logs.get("target"))
+        return {name: rows[:, part] for name, part in system.layout.items()}
+
+    return ControllerHandles("ptsmc", ports, telemetry, notes, system=system)
+
+
+def _block_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -> ControllerHandles:
+    ports = {}
+    for name, (owner, port) in _BLOCK_PORTS.items():
+        if port is not None:
+            ports[name] = getattr(h, owner).GetOutputPort(port)
+    if h.target_input is None:
+        ports["target"] = h.targets.GetOutputPort("target")
+    else:
+        ports["target"] = target
+
+    def telemetry(logs: dict) -> dict:
+        out = {name: logs[name] for name in ports}
+        target_log = out.pop("target")
+        out["x_r"], out["xdot_r"], out["xddot_r"] = np.split(target_log, 3, axis=1)
+        return out
+
+    return ControllerHandles("ptsmc", ports, telemetry, notes, system=h.controller)
+
+
+def uses_analytic_targets(scenario: Scenario) -> bool:
+    """True unless a camera and an estimator are in the loop."""
+    return getattr(scenario.measurement, "estimator", "none") == "none"
+
+
+_REGISTRY = {"ptsmc": _add_ptsmc}
+CONTROLLERS = tuple(_REGISTRY)
+
+
+def AddController(builder: DiagramBuilder, station_system, station: Station,
+                  scenario: Scenario) -> ControllerHandles:
+    """Add ``scenario.controller.type`` to ``builder`` and wire it to the station."""
+    return _REGISTRY[scenario.controller.type](builder, station_system, station, scenario)

@@ -1,0 +1,167 @@
+"""What a run achieved and whether it intercepted: one definition for every command.
+
+(No postponed annotations here: Drake's ``yaml_load_typed`` reads ``Criteria``'s field types.)
+
+Everything here is measured against the *true* target from the plant's state
+alone — the controller may have seen a measured or estimated target, and its
+own telemetry is not trusted for the verdict.
+
+The metrics of one segment (README "Outputs"):
+
+- ``e0_norm`` |e| at the segment start, ``e_half_norm`` at start + tf/2,
+  ``e_tf_norm`` and ``edot_tf_norm`` at exactly start + tf (the simulator stops
+  there), from the exact stops;
+- ``e_hold_max_norm``: the largest |e| from start + tf to the next segment's
+  start (or the end), last sample included;
+- ``t_arrive``: the first time after the start at which |e| ≤ 1 mm (None if never).
+
+The verdict (paper's prescribed-time property, README "What works means"):
+a segment is ``late`` when |e(tf)| > ``criteria.e_tf``, ``early`` when it was
+already closer than ``half_fraction`` |e0| at tf/2 (only when |e0| ≥ ``min_e0``:
+a segment that starts on its target cannot arrive early), and ``hold`` when the
+hold exceeds ``criteria.hold``.  A run is ``ok`` when every segment passes,
+``missed`` otherwise, and ``failed`` when the divergence watchdog stopped it.
+"""
+
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+ARRIVAL_TOLERANCE = 1.0e-3  # m: t_arrive is the first time |e| is within this
+STARTUP_FRACTION = 0.05  # peaks "after start-up" skip the first 5 % of each segment's tf
+
+
+@dataclass
+class Criteria:
+    """Pass criteria of a scenario (defaults: the paper's property as this project states it)."""
+
+    e_tf: float = 1.0e-3  # m: |e(start + tf)| at most this ("late" otherwise)
+    hold: float = 3.0e-3  # m: |e| while holding at most this ("hold" otherwise)
+    half_fraction: float = 0.25  # |e(tf/2)| at least this × |e0| ("early" otherwise)
+    min_e0: float = 1.0e-2  # m: the early check applies only when |e0| is at least this
+
+
+def validate_criteria(c: Criteria) -> None:
+    """ValueError naming the field of a criterion that is not a positive number."""
+    for name in ("e_tf", "hold", "half_fraction", "min_e0"):
+        value = getattr(c, name)
+        if not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"criteria.{name}: must be > 0, got {value}")
+    if c.half_fraction >= 1.0:
+        raise ValueError(f"criteria.half_fraction: must be < 1, got {c.half_fraction}")
+
+
+def segment_reasons(seg: dict, criteria: Criteria, margin: float = 1.0) -> list[str]:
+    """The criteria a segment's metrics fail: a subset of ``late``, ``early``, ``hold``.
+
+    ``margin`` M tightens the bounds to e_tf / M and hold / M (used by tuning).
+    A segment the run never reached is ``late``.
+    """
+    if seg.get("e_tf_norm") is None:
+        return ["late"]
+    reasons = []
+    if seg["e_tf_norm"] > criteria.e_tf / margin:
+        reasons.append("late")
+    e0, half = seg.get("e0_norm"), seg.get("e_half_norm")
+    if e0 is not None and half is not None and e0 >= criteria.min_e0 and half < criteria.half_fraction * e0:
+        reasons.append("early")
+    if (seg.get("e_hold_max_norm") or 0.0) > criteria.hold / margin:
+        reasons.append("hold")
+    return reasons
+
+
+def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str, list[str]]:
+    """(status, reasons) of a run: ``ok``, ``missed`` (reasons like ``segment 0: late``) or
+    ``failed`` (the divergence watchdog stopped it; its message is the reason)."""
+    if metrics.get("failure"):
+        return "failed", [metrics["failure"]["message"]]
+    reasons = [f"segment {i}: {r}" for i, seg in enumerate(metrics["segments"])
+               for r in segment_reasons(seg, criteria, margin)]
+    return ("missed" if reasons else "ok"), reasons
+
+
+def is_ok(metrics: dict, criteria: Criteria, margin: float = 1.0) -> bool:
+    return verdict(metrics, criteria, margin)[0] == "ok"
+
+
+def _peak(values: np.ndarray, t: np.ndarray, mask: Optional[np.ndarray] = None) -> dict:
+    """Per-column peak of |values| and the time it happens (over ``mask`` rows if given)."""
+    if mask is not None:
+        values, t = values[mask], t[mask]
+    if len(t) == 0:
+        return {"value": [0.0] * values.shape[1], "time": [None] * values.shape[1]}
+    k = np.argmax(np.abs(values), axis=0)
+    cols = np.arange(values.shape[1])
+    return {"value": np.abs(values[k, cols]).tolist(), "time": t[k].tolist()}
+
+
+def after_startup(t: np.ndarray, segments) -> np.ndarray:
+    """Rows outside the first ``STARTUP_FRACTION`` of every segment's tf: the peaks a
+    sweep over tf should compare (at a segment start the surface is not zero because
+    the object moves while the arm is at rest, so the first step dominates the peak)."""
+    keep = np.ones(len(t), dtype=bool)
+    for seg in segments:
+        keep &= ~((t >= seg.start) & (t < seg.start + STARTUP_FRACTION * seg.tf))
+    return keep
+
+
+def segment_metrics(schedule, duration: float, samples: dict, t: np.ndarray, x: np.ndarray,
+                    objects: np.ndarray) -> list[dict]:
+    """Per-segment metrics from the exact stops (``samples``: time → (e, ė) against the
+    true target active then) and the per-sample gripper point ``x`` (N × 3) and true object
+    positions ``objects`` (N × 3·segments): segment i is measured against object i only,
+    so its hold includes the instant the next segment starts."""
+    rows = []
+    for i, seg in enumerate(schedule.segments):
+        t_end = schedule.hold_end(i, duration)
+        e_norm = np.linalg.norm(x - objects[:, 3 * i:3 * i + 3], axis=1)
+        row = {"start": seg.start, "tf": seg.tf, "beta": seg.beta, "hold_end": t_end}
+        for key, at, which in (("e0_norm", seg.start, 0), ("e_half_norm", seg.start + 0.5 * seg.tf, 0),
+                               ("e_tf_norm", seg.end, 0), ("edot_tf_norm", seg.end, 1)):
+            row[key] = float(np.linalg.norm(samples[at][which])) if at in samples else None
+        hold = (t >= seg.end) & (t <= t_end)
+        if row["e_tf_norm"] is None:
+            row["e_hold_max_norm"] = None
+        else:
+            row["e_hold_max_norm"] = max(float(np.max(e_norm[hold])) if hold.any() else 0.0,
+                                         row["e_tf_norm"])
+        inside = np.nonzero((t >= seg.start) & (t <= t_end) & (e_norm <= ARRIVAL_TOLERANCE))[0]
+        row["t_arrive"] = float(t[inside[0]]) if len(inside) else None
+        rows.append(row)
+    return rows
+
+
+def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> dict:
+    """The metrics of a run (README "Outputs"): segments, torque and joint-speed peaks with
+    their times, the peaks after start-up, and the fraction of time the actuators saturate.
+
+    ``series`` holds ``t``, ``x`` (gripper point from the plant state), ``objects`` (true
+    positions), ``v`` (joint speeds), ``tau`` (commanded) and ``tau_applied`` (saturated).
+    """
+    schedule = scenario.schedule()
+    t = series["t"]
+    tau, applied = series["tau"], series["tau_applied"]
+    over = np.any(np.abs(tau) > limits * (1.0 + 1e-9), axis=1)
+    dt = np.diff(t, append=t[-1]) if len(t) else np.zeros(0)
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    steady = after_startup(t, schedule.segments)
+    torque, torque_late = _peak(applied, t), _peak(applied, t, steady)
+    speed = _peak(series["v"], t)
+    return {
+        "scenario": scenario.name,
+        "duration": scenario.duration,
+        "segments": segment_metrics(schedule, scenario.duration, samples, t, series["x"],
+                                    series["objects"]),
+        "torque_peak": torque["value"],
+        "torque_peak_time": torque["time"],
+        "torque_peak_after_startup": torque_late["value"],
+        "torque_peak_after_startup_time": torque_late["time"],
+        "torque_command_peak": np.max(np.abs(tau), axis=0).tolist() if len(t) else [],
+        "joint_speed_peak": speed["value"],
+        "joint_speed_peak_time": speed["time"],
+        "effort_limits": limits.tolist(),
+        "saturated_fraction": float(np.sum(dt[over]) / span) if span > 0 else 0.0,
+    }

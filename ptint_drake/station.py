@@ -1,0 +1,77 @@
+"""The simulated world of a scenario as one Drake diagram with exported ports.
+
+In the spirit of a hardware station: ``MakeStation`` builds everything the
+controller does *not* decide — the continuous plant with the scenario's
+deviations (``plant``: masses, damping, payload, friction, disturbance), the
+torque saturation at the model's effort limits, and the true moving objects —
+and exports the ports a controller (or a user's own diagram) connects to:
+
+=================  ======  ================================================
+port               size    meaning
+=================  ======  ================================================
+``actuation``      nu      input: commanded actuation (saturated if
+                           ``limits.saturate``), in the plant's actuator order
+``state``          nq+nv   output: the plant's [q; v]
+``target``         9       output: true [x_r, ẋ_r, ẍ_r] of the active segment's object
+``objects``        3·n     output: true position of every object
+=================  ======  ================================================
+
+The station may use the model (it *is* the model); the model-free controllers
+only see ``state`` (through the kinematics) and a target.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import Saturation
+
+from ptint_drake.robot import actuator_effort_limits, effort_limits, make_plant
+from ptint_drake.scenario import Scenario, ScenarioError
+from ptint_drake.systems.disturbance import JointDisturbance
+from ptint_drake.systems.targets import TargetSource
+
+
+@dataclass
+class Station:
+    """The station diagram and what a builder of the rest needs to know about it."""
+
+    diagram: Diagram
+    plant: MultibodyPlant
+    true_targets: list
+    effort_limits: np.ndarray  # per generalized velocity (inf where none)
+    saturate: bool
+
+
+def MakeStation(scenario: Scenario) -> Station:
+    """The station of ``scenario`` (see the module docstring for its ports)."""
+    builder = DiagramBuilder()
+    plant = builder.AddNamedSystem("plant", make_plant(scenario))
+    if scenario.limits.saturate:
+        limits = actuator_effort_limits(plant)
+        saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
+        builder.Connect(saturation.get_output_port(), plant.get_actuation_input_port())
+        builder.ExportInput(saturation.get_input_port(), "actuation")
+    else:
+        builder.ExportInput(plant.get_actuation_input_port(), "actuation")
+    if JointDisturbance.needed(scenario.plant):
+        p, d = scenario.plant, scenario.plant.disturbance
+        try:
+            disturbance = builder.AddNamedSystem("disturbance", JointDisturbance(
+                plant.num_positions(), plant.num_velocities(), d.amplitude, d.frequency_hz,
+                d.phase, d.step, d.step_time, p.coulomb, p.coulomb_speed))
+        except ValueError as exc:
+            raise ScenarioError(str(exc)) from None
+        builder.Connect(plant.get_state_output_port(), disturbance.get_input_port())
+        builder.Connect(disturbance.get_output_port(), plant.get_applied_generalized_force_input_port())
+    targets = scenario.targets()
+    truth = builder.AddNamedSystem("objects", TargetSource(scenario.schedule(), targets))
+    builder.ExportOutput(plant.get_state_output_port(), "state")
+    builder.ExportOutput(truth.GetOutputPort("target"), "target")
+    builder.ExportOutput(truth.GetOutputPort("objects"), "objects")
+    diagram = builder.Build()
+    diagram.set_name("station")
+    return Station(diagram, plant, targets, effort_limits(plant), scenario.limits.saturate)

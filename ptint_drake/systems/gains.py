@@ -1,0 +1,26 @@
+"""The gains of the paper's controller and the choices it leaves open (paper section 3.1)."""
+
+from dataclasses import dataclass
+
+
+@dataclass
+class ControllerGains:
+    """The paper's gains (section 3.1) as defaults, and the choices it leaves open.
+
+    K (N·m·s/rad) and Lambda may also be given as diagonals (sequences) from Python;
+    the scenario schema (``scenario.ControllerConfig``, which extends this class)
+    takes scalars.  Annotations are real types (no postponed evaluation in this
+    module) because Drake's ``yaml_load_typed`` reads them.
+    """
+
+    K: float = 50.0
+    Lambda: float = 5.0
+    k: float = 3.0  # 1/s, decay of s_d
+    epsilon: float = 1.0e-6
+    delta: float = 1.0e-6
+    alpha_hold: float = 0.0  # 1/s, α after tf
+    switching: str = "tanh"  # sign | tanh | sat
+    phi: float = 0.01  # m/s, boundary-layer width
+    sigma_policy: str = "keep"  # keep | reset σ at a new segment
+    k_hold: float = 50.0  # 1/s, decay of s_d after tf
+    pinv_damping: float = 0.0  # m/rad: λ of the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹; 0 = exact
