@@ -37,7 +37,7 @@ the time the estimate refers to: continuous in t between updates (for ``cv`` â 
 with ``compensate_latency`` Δt includes the latency, so the prediction removes the
 lag of a delayed sample.  Zeros until the first sample is seen.
 Output ``covariance`` (n²): P predicted to t (F(Δt) P F(Δt)ᵀ + Q(Δt)), row-major,
-for figures (P[0, 0] is the variance of each axis' position).
+for figures (P[0, 0] is the variance of each axis' position; P₀ before the first sample).
 
 Discrete state, three groups: ``meta`` = [initialised, t_est, last stamp consumed,
 t of the last update], ``estimate`` = χ as n×3 row-major ([p_xyz, v_xyz(, a_xyz)]),
@@ -69,7 +69,6 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
 
-from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.camera import (
     TIME_TOL,
     Camera,
@@ -146,13 +145,13 @@ class TargetKalmanFilter(LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
 
         state_and_time = {self.time_ticket(), self.xd_ticket()}
-        self._prediction = DeclareVectorCache(
-            self, "prediction", 9 + n * n, self._predict_output, state_and_time)
+        # ``target`` is read at every derivative evaluation; ``covariance`` (figures) only
+        # costs when someone evaluates it
         self._target_out = self.DeclareVectorOutputPort(
-            "target", 9, lambda c, o: o.SetFromVector(self._prediction(c)[:9]),
+            "target", 9, lambda c, o: o.SetFromVector(self._predict_target(c)),
             prerequisites_of_calc=state_and_time)
         self._covariance_out = self.DeclareVectorOutputPort(
-            "covariance", n * n, lambda c, o: o.SetFromVector(self._prediction(c)[9:]),
+            "covariance", n * n, lambda c, o: o.SetFromVector(self._predict_covariance(c)),
             prerequisites_of_calc=state_and_time)
 
     @property
@@ -224,19 +223,28 @@ class TargetKalmanFilter(LeafSystem):
         discrete_state.get_mutable_vector(self._estimate).SetFromVector(X.ravel())
         discrete_state.get_mutable_vector(self._covariance).SetFromVector(P.ravel())
 
-    def _predict_output(self, context) -> np.ndarray:
-        n = self._n
+    def _predict_target(self, context) -> np.ndarray:
+        """[p + vΔt + aΔt²/2, v + aΔt, a], Δt = t − t_est (zeros before the first sample)."""
         meta = context.get_discrete_state(self._meta).value()
         if meta[0] < 0.5:
-            return np.zeros(9 + n * n)
+            return np.zeros(9)
         dt = context.get_time() - meta[1]
-        X = context.get_discrete_state(self._estimate).value().reshape(n, 3)
+        X = context.get_discrete_state(self._estimate).value()
+        if self._n == 2:
+            return np.concatenate([X[0:3] + dt * X[3:6], X[3:6], np.zeros(3)])
+        a = X[6:9]
+        return np.concatenate([X[0:3] + dt * X[3:6] + (0.5 * dt * dt) * a, X[3:6] + dt * a, a])
+
+    def _predict_covariance(self, context) -> np.ndarray:
+        """F(Δt) P F(Δt)ᵀ + Q(Δt), row-major (P₀ before the first sample)."""
+        n = self._n
+        meta = context.get_discrete_state(self._meta).value()
         P = context.get_discrete_state(self._covariance).value().reshape(n, n)
+        if meta[0] < 0.5:
+            return P.ravel().copy()
+        dt = context.get_time() - meta[1]
         F = transition(self._model, dt)
-        out = np.zeros(9 + n * n)
-        out[:3 * n] = (F @ X).ravel()
-        out[9:] = (F @ P @ F.T + process_covariance(self._model, dt, self._q)).ravel()
-        return out
+        return (F @ P @ F.T + process_covariance(self._model, dt, self._q)).ravel()
 
 
 class ActiveTargetSelector(LeafSystem):
