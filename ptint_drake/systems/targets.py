@@ -5,16 +5,19 @@ Both kinds are functions of absolute time t:
 - ``SinusoidTarget``: x_r = center + amplitude ⊙ sin(ω t + phase)
   (the paper's curve, eq. 28, is center (0.24, 0, 0.3), amplitude 0.1,
   ω = 1.5, phase (0, π/2, 0));
-- ``LinearTarget``: x_r = start + velocity · t (an object on a conveyor).
+- ``LinearTarget``: x_r = start + velocity · t (an object on a conveyor);
+- ``WaypointTarget``: a C² cubic spline through recorded samples (SPEC 5.4 ``waypoints``).
 """
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
+from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
@@ -121,3 +124,86 @@ class TargetSource(LeafSystem):
 
     def get_objects_output_port(self):
         return self._objects_out
+
+
+class WaypointTarget:
+    """A target through recorded samples: x_r(time[i]) = position[i] exactly.
+
+    Between the first and the last sample: Drake's
+    ``PiecewisePolynomial.CubicWithContinuousSecondDerivatives`` with the not-a-knot end
+    condition (C² everywhere; it reproduces any cubic, so samples on a line give that
+    line exactly).  With two samples it is the straight line between them (Drake needs
+    three for a cubic spline; a line is C^∞).  Before the first and after the last sample
+    the target moves on with the spline's end velocity: x_r = x(t_end) + ẋ(t_end)(t − t_end),
+    ẍ_r = x⃛_r = 0 (so x_r is C¹ there, its acceleration jumps to 0: an object that
+    keeps going, not one that stops or bounces).
+
+    ``evaluate`` does not call Drake: at construction every piece (the spline's, and the
+    two extrapolations) is stored as a 4 × 12 matrix M with
+    [x, ẋ, ẍ, x⃛](t) = [1, τ, τ², τ³] M,  τ = t − (start of the piece),
+    so an evaluation is a bisection and one small product.
+    """
+
+    def __init__(self, time: Sequence[float], position: Sequence[Sequence[float]]):
+        t = np.asarray(time, dtype=float)
+        if t.ndim != 1 or len(t) < 2:
+            raise ValueError(f"time: at least 2 sample times are needed, got {len(np.atleast_1d(t))}")
+        if not np.all(np.isfinite(t)):
+            raise ValueError("time: must be finite")
+        if not np.all(np.diff(t) > 0.0):
+            raise ValueError("time: must be strictly increasing")
+        try:
+            x = np.asarray(position, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError("position: must be a list of [x, y, z] samples") from None
+        if x.ndim != 2 or x.shape[1] != 3:
+            raise ValueError(f"position: each sample must be [x, y, z], got shape {x.shape}")
+        if len(x) != len(t):
+            raise ValueError(f"position: one sample per time is needed, got {len(x)} for {len(t)} times")
+        if not np.all(np.isfinite(x)):
+            raise ValueError("position: must be finite")
+        self.time = t
+        self.position = x
+        if len(t) == 2:
+            spline = PiecewisePolynomial.FirstOrderHold(t, x.T)
+        else:
+            spline = PiecewisePolynomial.CubicWithContinuousSecondDerivatives(t, x.T, False)
+        self.trajectory = spline
+
+        def derivatives(tau: float) -> np.ndarray:
+            return np.array([spline.EvalDerivative(tau, k)[:, 0] for k in range(4)])
+
+        pieces = []
+        for i in range(len(t) - 1):
+            # Taylor coefficients c_j = x^(j)(t_i) / j! of the cubic on [t_i, t_i+1)
+            d = derivatives(t[i])
+            d[0] = x[i]
+            pieces.append(self._piece(d[0], d[1], d[2] / 2.0, d[3] / 6.0))
+        v_start = spline.EvalDerivative(t[0], 1)[:, 0]
+        v_end = spline.EvalDerivative(t[-1], 1)[:, 0]
+        zero = np.zeros(3)
+        before = self._piece(x[0], v_start, zero, zero)  # τ measured from t_0 (negative)
+        after = self._piece(x[-1], v_end, zero, zero)
+        # piece j covers [time[j-1], time[j]): piece 0 is before time[0], the last after time[-1]
+        self._starts = [float(ti) for ti in t]
+        self._pieces = [before, *pieces, after]
+        self._tau_powers = np.ones(4)
+
+    @staticmethod
+    def _piece(c0, c1, c2, c3) -> np.ndarray:
+        """M such that [1, τ, τ², τ³] M = [x, ẋ, ẍ, x⃛] for x = c0 + c1 τ + c2 τ² + c3 τ³."""
+        z = np.zeros(3)
+        return np.array([np.concatenate([c0, c1, 2.0 * c2, 6.0 * c3]),
+                         np.concatenate([c1, 2.0 * c2, 6.0 * c3, z]),
+                         np.concatenate([c2, 3.0 * c3, z, z]),
+                         np.concatenate([c3, z, z, z])])
+
+    def evaluate(self, t: float) -> np.ndarray:
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
+        j = bisect.bisect_right(self._starts, t)  # 0 before time[0]; len(time) from time[-1] on
+        tau = t - self._starts[max(j - 1, 0)]
+        p = self._tau_powers
+        p[1] = tau
+        p[2] = tau * tau
+        p[3] = p[2] * tau
+        return p @ self._pieces[j]

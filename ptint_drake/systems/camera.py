@@ -1,0 +1,223 @@
+"""A camera that reports one object's position: sampled, noisy, late, sometimes missing.
+
+What it models (``Camera``, one per object):
+
+- sampling at a fixed rate: sample k is taken at t_k = k / rate_hz, k = 0, 1, …
+  (a periodic discrete update; the first sample is at t = 0);
+- measurement noise: z_k = x_true(t_k) + n_k, n_k ~ N(0, noise_std² I₃) i.i.d.,
+  drawn from ``numpy.random.default_rng(seed + seed_offset)``; n_k depends only
+  on k, so a run is reproducible and does not depend on how often the output is
+  evaluated (nor on the dropouts: sample k always carries the same n_k);
+- a fixed latency L: sample k becomes visible at t_k + L;
+- dropouts: a sample whose time falls in a window ``from ≤ t_k < to`` is never
+  delivered (the output keeps holding the last delivered sample).
+
+The output ``measurement`` = [stamp, x, y, z, valid] is the newest sample visible
+at time t, held between samples (zero-order hold); ``stamp`` = t_k is the time it
+was taken, ``valid`` = 0 until the first sample is visible (then [0, 0, 0, 0, 0]).
+
+What it does not model: the optics (projection, field of view, occlusion by the
+arm, calibration or hand–eye bias), noise that is correlated in time or
+between axes, outliers, jitter of the sample times or of the latency, rolling
+shutter and motion blur, and data association (each camera sees exactly one,
+known object).
+
+Timing (the point of the design).  The delay buffer — the last N delivered
+samples, N = ⌈L·rate⌉ + 2, newest first — is the system's discrete state; the
+output is computed from it and the time, so sample k appears exactly at
+t_k + L.  A downstream discrete system updating at t_k + L (period 1/rate,
+offset L, as ``TargetKalmanFilter`` does) reads the output *before* any update
+at that instant and still sees sample k: for L > 0 sample k was stored by the
+camera's update at t_k < t_k + L; for L = 0 (both updates at t_k) the output
+computes the not-yet-stored sample k from the input ``x_true`` (direct
+feedthrough, only when L = 0).  Event times are computed by Drake as
+offset + k·period, so "visible at t" is tested as stamp + L ≤ t + TIME_TOL with
+TIME_TOL = 1e-9 s, which absorbs round-off (≈1e-14 s at t = 100 s) and is far
+below any sample period; latencies below TIME_TOL count as 0.  For L > 0 a no-op
+periodic publish event at offset L makes the simulator stop at every t_k + L, so
+no integration step straddles a change of the output.
+"""
+
+# No ``from __future__ import annotations``: yaml_load_typed needs real annotations.
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+ESTIMATORS = ("none", "kalman_cv", "kalman_ca")
+# Tolerance (s) on event times: a sample is visible at t when stamp + latency <= t + TIME_TOL.
+TIME_TOL = 1.0e-9
+# Size of the blocks of noise drawn at once (noise of sample k = row k of one stream).
+_NOISE_BLOCK = 1024
+
+
+@dataclass
+class MeasurementConfig:
+    """How the target is observed (scenario key ``measurement``).
+
+    ``process_noise`` is the spectral density q of the white noise that drives the
+    filter's motion model: white acceleration for ``kalman_cv`` (m²/s³), white jerk
+    for ``kalman_ca`` (m²/s⁵).  The default 0.01 gave the smallest tracking error of
+    both models on the paper's curve at 30 Hz with 0.1–0.5 mm noise (``kalman``'s
+    docstring has the numbers); ``ptint`` scenarios may tune it.
+    """
+
+    noise_std: float = 0.0  # m, per axis
+    rate_hz: float = 30.0  # samples per second
+    latency: float = 0.0  # s, from taking a sample to seeing it
+    compensate_latency: bool = False  # the filter predicts over the latency
+    dropouts: list[list[float]] = field(default_factory=list)  # [from, to] windows, s
+    seed: int = 0
+    estimator: str = "none"  # none | kalman_cv | kalman_ca
+    process_noise: float = 0.01  # q: m²/s³ (kalman_cv) or m²/s⁵ (kalman_ca)
+
+
+def _field_error(name: str, message: str) -> ValueError:
+    return ValueError(f"measurement.{name}: {message}")
+
+
+def validate_measurement(m: MeasurementConfig) -> None:
+    """Raise ``ValueError`` with a one-line message naming the first bad field."""
+    def number(name: str) -> float:
+        value = getattr(m, name)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise _field_error(name, f"must be a number, got {value!r}")
+        return float(value)
+
+    rate = number("rate_hz")
+    if not (math.isfinite(rate) and rate > 0.0):
+        raise _field_error("rate_hz", f"must be > 0, got {m.rate_hz}")
+    for name in ("noise_std", "latency", "process_noise"):
+        value = number(name)
+        if not (math.isfinite(value) and value >= 0.0):
+            raise _field_error(name, f"must be >= 0 and finite, got {getattr(m, name)}")
+    if m.estimator not in ESTIMATORS:
+        raise _field_error("estimator", f"must be one of {', '.join(ESTIMATORS)}, got {m.estimator!r}")
+    if isinstance(m.seed, bool) or not isinstance(m.seed, int) or m.seed < 0:
+        raise _field_error("seed", f"must be an integer >= 0, got {m.seed!r}")
+    windows = []
+    for i, window in enumerate(m.dropouts):
+        where = f"dropouts[{i}]"
+        if not isinstance(window, (list, tuple)) or len(window) != 2:
+            raise _field_error(where, f"must be a [from, to] pair, got {window!r}")
+        try:
+            lo, hi = (float(v) for v in window)
+        except (TypeError, ValueError):
+            raise _field_error(where, f"must be two numbers, got {window!r}") from None
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise _field_error(where, f"must be finite, got {list(window)}")
+        if not lo < hi:
+            raise _field_error(where, f"from must be < to, got [{lo}, {hi}]")
+        windows.append((lo, hi, i))
+    windows.sort()
+    for (lo0, hi0, i0), (lo1, hi1, i1) in itertools.pairwise(windows):
+        if lo1 < hi0:
+            first, second = sorted((i0, i1))
+            raise _field_error(f"dropouts[{second}]", f"overlaps dropouts[{first}] "
+                               f"([{lo1}, {hi1}] and [{lo0}, {hi0}])")
+
+
+class _NoiseTable:
+    """n_k for k = 0, 1, …: row k of one N(0, std²) stream from ``default_rng(seed)``.
+
+    Rows are drawn in blocks as needed; sequential draws from one generator equal one
+    large draw, so n_k depends on k only (not on when or how often it is asked for).
+    """
+
+    def __init__(self, std: float, seed: int):
+        self._std = float(std)
+        self._rng = np.random.default_rng(seed)
+        self._rows = np.zeros((0, 3))
+
+    def __call__(self, k: int) -> np.ndarray:
+        if self._std == 0.0:
+            return np.zeros(3)
+        while k >= len(self._rows):
+            self._rows = np.vstack([self._rows, self._rng.normal(0.0, self._std, (_NOISE_BLOCK, 3))])
+        return self._rows[k]
+
+
+class Camera(LeafSystem):
+    """One object's camera (see the module docstring).
+
+    Input port ``x_true`` (3): the object's true position.
+    Output port ``measurement`` (5): [stamp, x, y, z, valid] of the newest visible sample.
+    Discrete state (one group, 5·N): N slots [stamp, x, y, z, valid], newest first, of
+    the last N delivered samples (``valid`` = 0 marks an empty slot).
+    """
+
+    def __init__(self, *, config: MeasurementConfig, seed_offset: int = 0):
+        super().__init__()
+        validate_measurement(config)
+        self._config = config
+        self._period = 1.0 / config.rate_hz
+        self._latency = float(config.latency) if config.latency > TIME_TOL else 0.0
+        self._windows = [(float(a), float(b)) for a, b in config.dropouts]
+        self._noise = _NoiseTable(config.noise_std, config.seed + seed_offset)
+        self._slots = math.ceil(self._latency * config.rate_hz - TIME_TOL) + 2
+
+        self._x_in = self.DeclareVectorInputPort("x_true", 3)
+        self._buffer_index = self.DeclareDiscreteState(np.zeros(5 * self._slots))
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._take_sample)
+        if self._latency > 0.0:
+            # no-op: only makes the simulator stop where the output changes
+            self.DeclarePeriodicPublishEvent(self._period, self._latency, lambda context: None)
+            prerequisites = {self.time_ticket(), self.xd_ticket()}
+        else:
+            prerequisites = {self.time_ticket(), self.xd_ticket(), self._x_in.ticket()}
+        self._measurement_out = self.DeclareVectorOutputPort(
+            "measurement", 5, lambda c, o: o.SetFromVector(self._visible(c)),
+            prerequisites_of_calc=prerequisites)
+
+    @property
+    def config(self) -> MeasurementConfig:
+        return self._config
+
+    @property
+    def buffer_slots(self) -> int:
+        """N, the number of samples the delay buffer holds."""
+        return self._slots
+
+    def get_x_true_input_port(self):
+        return self._x_in
+
+    def get_measurement_output_port(self):
+        return self._measurement_out
+
+    def dropped(self, t: float) -> bool:
+        """Whether a sample taken at t falls in a dropout window [from, to)."""
+        return any(lo - TIME_TOL <= t < hi - TIME_TOL for lo, hi in self._windows)
+
+    def sample(self, k: int, x_true: np.ndarray) -> np.ndarray:
+        """z_k = x_true + n_k (3 values); n_k is fixed by k and the seed."""
+        return np.asarray(x_true, dtype=float) + self._noise(k)
+
+    def _sample_index(self, t: float) -> int:
+        return round(t * self._config.rate_hz)
+
+    def _take_sample(self, context, discrete_state) -> None:
+        t = context.get_time()
+        if self.dropped(t):
+            return
+        z = self.sample(self._sample_index(t), self._x_in.Eval(context))
+        buffer = discrete_state.get_mutable_vector(self._buffer_index)
+        old = context.get_discrete_state(self._buffer_index).value()
+        buffer.SetFromVector(np.concatenate([[t], z, [1.0], old[:-5]]))
+
+    def _visible(self, context) -> np.ndarray:
+        t = context.get_time()
+        slots = context.get_discrete_state(self._buffer_index).value().reshape(self._slots, 5)
+        if self._latency == 0.0:
+            # the sample taken now is visible now, even before this instant's update stores it
+            k = self._sample_index(t)
+            t_k = k * self._period
+            newest = slots[0]
+            stored = newest[4] > 0.5 and newest[0] >= t_k - TIME_TOL
+            if abs(t - t_k) <= TIME_TOL and not stored and not self.dropped(t_k):
+                return np.concatenate([[t], self.sample(k, self._x_in.Eval(context)), [1.0]])
+        for slot in slots:
+            if slot[4] > 0.5 and slot[0] + self._latency <= t + TIME_TOL:
+                return slot.copy()
+        return np.zeros(5)
