@@ -21,11 +21,13 @@ from typing import Callable, Optional
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder, OutputPort
+from pydrake.systems.primitives import Demultiplexer
 
 from ptint_drake.scenario import Scenario
 from ptint_drake.station import Station
 from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, InterceptorHandles
 from ptint_drake.systems.gains import ControllerGains
+from ptint_drake.systems.kalman import AddCameraEstimators
 from ptint_drake.systems.measurement import MeasuredTarget
 from ptint_drake.systems.targets import TargetSource
 
@@ -63,10 +65,18 @@ def controller_targets(scenario: Scenario) -> list:
 
 
 def target_view(builder: DiagramBuilder, station_system, scenario: Scenario) -> OutputPort:
-    """The port that carries [x_r, ẋ_r, ẍ_r] of the active segment as the controller sees it."""
-    source = builder.AddNamedSystem("target_view", TargetSource(
-        scenario.schedule(), controller_targets(scenario)))
-    return source.GetOutputPort("target")
+    """The port that carries [x_r, ẋ_r, ẍ_r] of the active segment as the controller sees it:
+    the analytic targets (``estimator: none``), or one camera + Kalman filter per object
+    fed by the station's true object positions (``kalman_cv`` / ``kalman_ca``)."""
+    if uses_analytic_targets(scenario):
+        source = builder.AddNamedSystem("target_view", TargetSource(
+            scenario.schedule(), controller_targets(scenario)))
+        return source.GetOutputPort("target")
+    n = len(scenario.interceptions)
+    split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
+    builder.Connect(station_system.GetOutputPort("objects"), split.get_input_port())
+    return AddCameraEstimators(builder, true_position_ports=[split.get_output_port(i) for i in range(n)],
+                               schedule=scenario.schedule(), config=scenario.measurement).target_port
 
 
 def gains_of(scenario: Scenario) -> ControllerGains:
@@ -87,7 +97,7 @@ def _add_ptsmc(builder, station_system, station: Station, scenario: Scenario) ->
     builder.Connect(system.GetOutputPort("u"), station_system.GetInputPort("actuation"))
     target = None
     if h.target_input is not None:
-        target = target_view(builder, station_system, scenario) if analytic else None
+        target = target_view(builder, station_system, scenario)
         builder.Connect(target, h.target_input)
     notes = [f"ptsmc: K = {scenario.controller.K:g}, Λ = {scenario.controller.Lambda:g}, "
              f"k = {scenario.controller.k:g}, {scenario.controller.switching} law"]
@@ -132,7 +142,7 @@ def _block_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -
 
 def uses_analytic_targets(scenario: Scenario) -> bool:
     """True unless a camera and an estimator are in the loop."""
-    return getattr(scenario.measurement, "estimator", "none") == "none"
+    return scenario.measurement.estimator == "none"
 
 
 _REGISTRY = {"ptsmc": _add_ptsmc}

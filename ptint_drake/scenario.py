@@ -36,10 +36,11 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from ptint_drake.metrics import Criteria, validate_criteria
+from ptint_drake.systems.camera import MeasurementConfig, validate_measurement
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
-from ptint_drake.systems.targets import LinearTarget, SinusoidTarget
+from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
 
 
 IMPLEMENTATIONS = ("fused", "blocks")
@@ -80,9 +81,21 @@ class LinearConfig:
 
 
 @dataclass
+class WaypointsConfig:
+    """A recorded path: positions (m) at increasing times (s), interpolated C² (cubic spline)."""
+
+    time: List[float] = field(default_factory=list)
+    position: List[List[float]] = field(default_factory=list)
+
+
+TARGET_KINDS = ("sinusoid", "linear", "waypoints")
+
+
+@dataclass
 class TargetConfig:
     sinusoid: Optional[SinusoidConfig] = None
     linear: Optional[LinearConfig] = None
+    waypoints: Optional[WaypointsConfig] = None
 
 
 @dataclass
@@ -114,23 +127,6 @@ class PlantConfig:
     coulomb: List[float] = field(default_factory=list)  # N·m per joint: −F tanh(v / coulomb_speed)
     coulomb_speed: float = 0.01  # rad/s, smoothing of the Coulomb law
     disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
-
-
-@dataclass
-class MeasurementConfig:
-    """How the controller sees the target (the paper's cameras); metrics use the true target.
-
-    Measured x_r(t) = x_r(t − latency) + n(t), n piecewise linear between Gaussian samples
-    (std ``noise_std`` per axis) drawn at ``rate_hz`` from ``seed``.  With
-    ``compensate_latency`` the delayed position is extrapolated with the known velocity and
-    acceleration of the target's profile.
-    """
-
-    noise_std: float = 0.0  # m
-    rate_hz: float = 30.0
-    latency: float = 0.0  # s
-    compensate_latency: bool = False
-    seed: int = 0
 
 
 @dataclass
@@ -170,6 +166,8 @@ def make_target(config: TargetConfig):
     if config.sinusoid is not None:
         s = config.sinusoid
         return SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
+    if config.waypoints is not None:
+        return WaypointTarget(config.waypoints.time, config.waypoints.position)
     return LinearTarget(config.linear.start, config.linear.velocity)
 
 
@@ -328,10 +326,10 @@ def validate(s: Scenario) -> None:
         if not all(math.isfinite(v) for v in getattr(d, name)):
             raise ScenarioError(f"plant.disturbance.{name}: must be finite")
     _positive(d.frequency_hz, "plant.disturbance.frequency_hz")
-    m = s.measurement
-    for name in ("noise_std", "latency"):
-        _nonnegative(getattr(m, name), f"measurement.{name}")
-    _positive(m.rate_hz, "measurement.rate_hz")
+    try:
+        validate_measurement(s.measurement)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
     if c.pinv_damping < 0 or not math.isfinite(c.pinv_damping):
         raise ScenarioError(f"controller.pinv_damping: must be >= 0, got {c.pinv_damping}")
     for name in ("max_error", "max_joint_speed"):
@@ -369,16 +367,21 @@ def validate(s: Scenario) -> None:
                 f"{where}.tf: interception time {ic.start + ic.tf} s is after the end "
                 f"of the simulation (duration {s.duration} s)")
         t = ic.target
-        kinds = [k for k in ("sinusoid", "linear") if getattr(t, k) is not None]
+        kinds = [k for k in TARGET_KINDS if getattr(t, k) is not None]
         if len(kinds) != 1:
             raise ScenarioError(
-                f"{where}.target: exactly one of sinusoid, linear is needed, got "
+                f"{where}.target: exactly one of {', '.join(TARGET_KINDS)} is needed, got "
                 f"{', '.join(kinds) if kinds else 'none'}")
         if t.sinusoid is not None:
             for name in ("center", "amplitude", "phase"):
                 _vector3(getattr(t.sinusoid, name), f"{where}.target.sinusoid.{name}")
             if not math.isfinite(t.sinusoid.omega):
                 raise ScenarioError(f"{where}.target.sinusoid.omega: must be finite")
+        elif t.waypoints is not None:
+            try:
+                WaypointTarget(t.waypoints.time, t.waypoints.position)
+            except ValueError as exc:
+                raise ScenarioError(f"{where}.target.waypoints.{exc}") from None
         else:
             _vector3(t.linear.start, f"{where}.target.linear.start")
             _vector3(t.linear.velocity, f"{where}.target.linear.velocity")
