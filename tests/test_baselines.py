@@ -12,7 +12,11 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from ptint_drake import rvm1
 from ptint_drake.systems.builder import ControllerGains
-from ptint_drake.systems.ct_quintic import CtQuinticConfig, CtQuinticController, quintic_eval
+from ptint_drake.systems.ct_quintic import (
+    CtQuinticConfig,
+    CtQuinticController,
+    quintic_eval,
+)
 from ptint_drake.systems.pd import PDConfig, PDController
 from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
@@ -158,11 +162,25 @@ def test_ct_quintic_plan_at_start(predicted):
     np.testing.assert_allclose(tel[ct.layout["q_d"]], THETA0, atol=1e-12)
 
 
-def test_ct_quintic_unreachable_target_names_the_segment():
-    ct = _make("ct", _plant(), Schedule([Segment(0.0, 1.0, 0.75)]))
+def test_ct_quintic_unreachable_target():
+    """"raise": a ValueError naming the segment; "nearest": the reachable point closest to it."""
+    plant = _plant()
+    frame = plant.GetFrameByName(rvm1.END_EFFECTOR)
+    schedule = Schedule([Segment(0.0, 1.0, 0.75)])
     far = np.concatenate([[2.0, 0.0, 0.3], np.zeros(6)])
+    ct = CtQuinticController(plant=plant, frame=frame, schedule=schedule, nominal_plant=_plant(),
+                             config=CtQuinticConfig(on_ik_failure="raise"))
     with pytest.raises(ValueError, match="segment 0"):
         _fixed(ct, 0.0, THETA0, np.zeros(3), far)
+    ct = _make("ct", plant, schedule)
+    ctx = _fixed(ct, 0.0, THETA0, np.zeros(3), far)
+    plan = ct.reference.plan(ct.reference.GetMyContextFromRoot(ctx))
+    assert not plan["reached"]
+    assert ct.GetOutputPort("telemetry").Eval(ctx)[ct.layout["reached"]] == [0.0]
+    x_f = _hand_kinematics(plan["q_f"], np.zeros(3))[0]
+    # the arm stretched towards it: 0.41 m is the reach of the 0.25 + 0.16 m arms from the shoulder
+    np.testing.assert_allclose(np.linalg.norm(x_f - [0, 0, 0.3]), 0.41, atol=1e-3)
+    assert x_f[0] > 0.4
 
 
 class _CurveSource(LeafSystem):
@@ -214,7 +232,7 @@ def test_closed_loop_reaches_static_target(kind):
 
 def test_ct_quintic_intercepts_the_curve_at_tf():
     """The paper's curve from t = 0, tf = 1.5, exact model and exact predictor: |e(tf)| ≤ 1 mm."""
-    predict = lambda i, t, target: CURVE.evaluate(t)[0:6]  # noqa: E731
+    predict = lambda i, t, target: CURVE.evaluate(t)[0:6]
     sim, ctrl, cctx = _closed_loop("ct", Schedule([Segment(0.0, 1.5, 0.75)]), CURVE, predict)
     sim.AdvanceTo(1.5)
     assert _error(ctrl, cctx) <= 1e-3
@@ -268,6 +286,7 @@ def test_model_free_controllers_never_evaluate_dynamics(kind, monkeypatch):
     calls.clear()
     sim, ctrl, cctx = _closed_loop(kind, Schedule([Segment(0.0, 1.0, 0.75)]), CURVE)
     sim.AdvanceTo(1.0)
+    assert _error(ctrl, cctx) < 0.01  # it did chase the target
     assert calls == []
 
 

@@ -24,7 +24,10 @@ With an exact model the joint error obeys ë + 2ωė + ω²e = 0, so the arm is 
 and reaches x_f at t1 exactly when the prediction is exact; in the hold the task error
 obeys ë + (k_x + 2ω) ė + 2ω k_x e = 0.  ω = 20 rad/s is well above the plan's bandwidth.
 
-If IK finds no solution the event raises ValueError naming the segment.  The default
+If IK finds no q_f within the tolerance (the predicted point is outside the workspace) the
+plan goes to the reachable point nearest to x_f (``on_ik_failure = "nearest"``, the default:
+the run goes on, a miss is a result, and the differential IK chases the target after t1) or
+the event raises ValueError naming the segment (``"raise"``).  The default
 ``predict`` (None) extrapolates the ``target`` input at constant acceleration:
 x_f = x_r + ẋ_r Δ + ½ ẍ_r Δ², ẋ_f = ẋ_r + ẍ_r Δ, Δ = t1 − t0.
 The quintic's coefficients live in the context's discrete state, not in Python attributes.
@@ -64,10 +67,13 @@ class CtQuinticConfig:
     ki: float = 0.0  # 1/s³, integral gain of the InverseDynamicsController
     k_x: float = 20.0  # 1/s, task-space position gain of the differential IK after tf
     ik_tolerance: float = 1.0e-6  # m, |f(q_f) − x_f|∞ allowed by the IK
+    on_ik_failure: str = "nearest"  # nearest (closest reachable point) | raise (ValueError)
 
     def validate(self) -> None:
         if not (self.omega > 0.0 and self.k_x >= 0.0 and self.ki >= 0.0 and self.ik_tolerance > 0.0):
             raise ValueError("ct_quintic: omega and ik_tolerance must be > 0, k_x and ki ≥ 0")
+        if self.on_ik_failure not in ("nearest", "raise"):
+            raise ValueError(f"ct_quintic.on_ik_failure: use nearest or raise, got {self.on_ik_failure!r}")
 
 
 def quintic_coefficients(q0, v0, a0, qf, vf, af, T: float) -> np.ndarray:
@@ -100,14 +106,15 @@ def constant_acceleration_predict(target: np.ndarray, dt: float) -> np.ndarray:
 def ct_reference_layout(nq: int) -> dict:
     """name -> slice of ``QuinticReference``'s telemetry (``tau`` is appended by the diagram).
 
-    ``x_f``: the planned interception point; ``mode``: 0 on the quintic, 1 following after t1."""
+    ``x_f``: the predicted interception point; ``reached``: 1 if the IK met it, 0 if the plan
+    goes to the nearest reachable point; ``mode``: 0 on the quintic, 1 following after t1."""
     return make_layout([("x", 3), ("xdot", 3), ("e", 3), ("edot", 3), ("x_f", 3),
-                        ("mode", 1), ("q_d", nq), ("v_d", nq), ("a_d", nq)])
+                        ("reached", 1), ("mode", 1), ("q_d", nq), ("v_d", nq), ("a_d", nq)])
 
 
 class QuinticReference(LeafSystem):
     """Inputs ``state``, ``target``; outputs ``desired_state`` ([q_d; v_d]), ``desired_acceleration``
-    (a_d) and ``telemetry``.  Discrete state: [segment, t0, t1, x_f(3), q_f, v_f, c (6·nq)]."""
+    (a_d) and ``telemetry``.  Discrete state: [segment, t0, t1, reached, x_f(3), q_f, v_f, c (6·nq)]."""
 
     def __init__(self, *, plant, frame, schedule: Schedule, config: CtQuinticConfig,
                  predict: Predictor | None = None):
@@ -123,7 +130,7 @@ class QuinticReference(LeafSystem):
         self.layout = ct_reference_layout(nq)
         self._state_in = self.DeclareVectorInputPort("state", 2 * nq)
         self._target_in = self.DeclareVectorInputPort("target", TARGET_SIZE)
-        self._plan_index = self.DeclareDiscreteState(np.zeros(6 + 2 * nq + 6 * nq))
+        self._plan_index = self.DeclareDiscreteState(np.concatenate([[-1.0], np.zeros(6 + 8 * nq)]))
         DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
         deps = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         size = layout_size(self.layout)
@@ -141,30 +148,41 @@ class QuinticReference(LeafSystem):
             "telemetry", size, lambda c, o: o.SetFromVector(self._eval(c)), prerequisites_of_calc=deps)
 
     def plan(self, context) -> dict:
-        """The stored plan: segment, t0, t1 (s), x_f (m), q_f (rad), v_f (rad/s), c (6 × nq)."""
+        """The stored plan: segment, t0, t1 (s), reached (IK met x_f), x_f (m), q_f (rad),
+        v_f (rad/s), c (6 × nq)."""
         p, n = context.get_discrete_state(self._plan_index).value(), self._n
-        return {"segment": int(p[0]), "t0": p[1], "t1": p[2], "x_f": p[3:6], "q_f": p[6:6 + n],
-                "v_f": p[6 + n:6 + 2 * n], "c": p[6 + 2 * n:].reshape(6, n)}
+        return {"segment": int(p[0]), "t0": p[1], "t1": p[2], "reached": bool(p[3]), "x_f": p[4:7],
+                "q_f": p[7:7 + n], "v_f": p[7 + n:7 + 2 * n], "c": p[7 + 2 * n:].reshape(6, n)}
 
     def _predicted(self, i: int, t0: float, t1: float, target: np.ndarray) -> np.ndarray:
         if self._predict is None:
             return constant_acceleration_predict(target, t1 - t0)
         return np.asarray(self._predict(i, t1, target), dtype=float)
 
-    def solve_ik(self, x_f: np.ndarray, q_seed: np.ndarray, segment: int) -> np.ndarray:
-        """q_f with the frame within ik_tolerance of x_f, nearest to q_seed; ValueError if none."""
-        tol = self._config.ik_tolerance
-        ik = InverseKinematics(self._plant, with_joint_limits=True)
-        ik.AddPositionConstraint(self._frame, np.zeros(3), self._plant.world_frame(),
-                                 x_f - tol, x_f + tol)
+    def solve_ik(self, x_f: np.ndarray, q_seed: np.ndarray, segment: int) -> tuple:
+        """(q_f, reached): q_f within ik_tolerance of x_f, nearest to q_seed (reached = True).
+
+        When no such q_f exists: ValueError naming the segment (``on_ik_failure = "raise"``), or
+        (``"nearest"``) the q_f within the joint limits whose frame is closest to x_f (reached = False).
+        """
+        tol, plant = self._config.ik_tolerance, self._plant
+        ik = InverseKinematics(plant, with_joint_limits=True)
+        ik.AddPositionConstraint(self._frame, np.zeros(3), plant.world_frame(), x_f - tol, x_f + tol)
         ik.prog().AddQuadraticErrorCost(np.eye(self._n), q_seed, ik.q())
         ik.prog().SetInitialGuess(ik.q(), q_seed)
         result = Solve(ik.prog())
-        if not result.is_success():
+        if result.is_success():
+            return result.GetSolution(ik.q()), True
+        if self._config.on_ik_failure == "raise":
             raise ValueError(
                 f"ct_quintic: segment {segment}: inverse kinematics found no joint position within "
                 f"the joint limits for the predicted target {np.round(x_f, 4).tolist()} m")
-        return result.GetSolution(ik.q())
+        nearest = InverseKinematics(plant, with_joint_limits=True)
+        nearest.AddPositionCost(self._frame, np.zeros(3), plant.world_frame(), x_f, np.eye(3))
+        nearest.prog().AddQuadraticErrorCost(1e-6 * np.eye(self._n), q_seed, nearest.q())
+        nearest.prog().SetInitialGuess(nearest.q(), q_seed)
+        result = Solve(nearest.prog())
+        return (result.GetSolution(nearest.q()) if result.is_success() else q_seed.copy()), False
 
     def _on_segment_start(self, context, state) -> None:
         t0 = context.get_time()
@@ -173,14 +191,14 @@ class QuinticReference(LeafSystem):
         qv = self._state_in.Eval(context)
         q0, v0 = qv[: self._n], qv[self._n:]
         goal = self._predicted(i, t0, t1, self._target_in.Eval(context))
-        q_f = self.solve_ik(goal[0:3], q0, i)
+        q_f, reached = self.solve_ik(goal[0:3], q0, i)
         _, _, J_f = self._kinematics.compute(q_f, np.zeros(self._n))
         v_f = pinv_apply(J_f, goal[3:6])
         zero = np.zeros(self._n)
         c = quintic_coefficients(q0, v0, zero, q_f, v_f, zero, t1 - t0) if t1 > t0 else \
             np.zeros((6, self._n))
         state.get_mutable_discrete_state(self._plan_index).SetFromVector(
-            np.concatenate([[i, t0, t1], goal[0:3], q_f, v_f, c.ravel()]))
+            np.concatenate([[i, t0, t1, float(reached)], goal[0:3], q_f, v_f, c.ravel()]))
 
     def _calc(self, context) -> np.ndarray:
         t = context.get_time()
@@ -196,7 +214,7 @@ class QuinticReference(LeafSystem):
             mode = 1.0
             q_d, v_d, a_d = self._follow(q, v, x, xdot, J, target)
         return np.concatenate([x, xdot, x - target[0:3], xdot - target[3:6], plan["x_f"],
-                               [mode], q_d, v_d, a_d])
+                               [float(plan["reached"]), mode], q_d, v_d, a_d])
 
     def _follow(self, q, v, x, xdot, J, target):
         """Differential IK after t1: (q_d, v_d, a_d) = (q, J⁺(ẋ_r + k_x(x_r − x)), ...)."""
