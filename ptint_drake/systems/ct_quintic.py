@@ -9,11 +9,12 @@ At every segment start t0 (a Drake event; i = the segment, t1 = t0 + tf):
     q_f  = IK(x_f)                                          Drake InverseKinematics, joint limits on,
                                                             |f(q_f) − x_f|∞ ≤ ik_tolerance, seeded
                                                             from q(t0), cost |q_f − q(t0)|²
-    v_f  = J⁺(q_f) ẋ_f                                      (rad/s)
+    v_f  = J⁺(q_f) ẋ_f                                      (rad/s; J⁺ damped, see below)
     q_d(t) = Σ_k c_k (t − t0)^k, k = 0..5                   quintic with q_d, v_d, a_d =
                                                             (q, v, 0) at t0 and (q_f, v_f, 0) at t1
 
-For t ≥ t1 it follows the target by differential IK (k_x in 1/s):
+For t ≥ t1 it follows the target by differential IK (k_x in 1/s; J⁺ is the damped
+pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, λ = pinv_damping, so a stretched arm gets bounded commands):
 
     v_d = J⁺(q) (ẋ_r + k_x (x_r − x)),  q_d = q,  a_d = J⁺(q) (ẍ_r + k_x (ẋ_r − ẋ) − J̇q̇)
 
@@ -25,9 +26,10 @@ and reaches x_f at t1 exactly when the prediction is exact; in the hold the task
 obeys ë + (k_x + 2ω) ė + 2ω k_x e = 0.  ω = 20 rad/s is well above the plan's bandwidth.
 
 If IK finds no q_f within the tolerance (the predicted point is outside the workspace) the
-plan goes to the reachable point nearest to x_f (``on_ik_failure = "nearest"``, the default:
-the run goes on, a miss is a result, and the differential IK chases the target after t1) or
-the event raises ValueError naming the segment (``"raise"``).  The default
+plan goes to the target's present position x_r(t0) if reachable, else to the reachable point
+nearest to x_f (``on_ik_failure = "nearest"``, the default: the run goes on, a miss is a
+result, and the differential IK chases the target after t1; ``reached`` = 0 in the plan and
+the telemetry), or the event raises ValueError naming the segment (``"raise"``).  The default
 ``predict`` (None) extrapolates the ``target`` input at constant acceleration:
 x_f = x_r + ẋ_r Δ + ½ ẍ_r Δ², ẋ_f = ẋ_r + ẍ_r Δ, Δ = t1 − t0.
 The quintic's coefficients live in the context's discrete state, not in Python attributes.
@@ -68,10 +70,13 @@ class CtQuinticConfig:
     k_x: float = 20.0  # 1/s, task-space position gain of the differential IK after tf
     ik_tolerance: float = 1.0e-6  # m, |f(q_f) − x_f|∞ allowed by the IK
     on_ik_failure: str = "nearest"  # nearest (closest reachable point) | raise (ValueError)
+    pinv_damping: float = 0.01  # m/rad: J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ in v_f and the differential IK; 0 = exact
 
     def validate(self) -> None:
-        if not (self.omega > 0.0 and self.k_x >= 0.0 and self.ki >= 0.0 and self.ik_tolerance > 0.0):
-            raise ValueError("ct_quintic: omega and ik_tolerance must be > 0, k_x and ki ≥ 0")
+        if not (self.omega > 0.0 and self.ik_tolerance > 0.0
+                and min(self.k_x, self.ki, self.pinv_damping) >= 0.0):
+            raise ValueError("ct_quintic: omega and ik_tolerance must be > 0, k_x, ki and "
+                             "pinv_damping ≥ 0")
         if self.on_ik_failure not in ("nearest", "raise"):
             raise ValueError(f"ct_quintic.on_ik_failure: use nearest or raise, got {self.on_ik_failure!r}")
 
@@ -159,24 +164,37 @@ class QuinticReference(LeafSystem):
             return constant_acceleration_predict(target, t1 - t0)
         return np.asarray(self._predict(i, t1, target), dtype=float)
 
-    def solve_ik(self, x_f: np.ndarray, q_seed: np.ndarray, segment: int) -> tuple:
-        """(q_f, reached): q_f within ik_tolerance of x_f, nearest to q_seed (reached = True).
-
-        When no such q_f exists: ValueError naming the segment (``on_ik_failure = "raise"``), or
-        (``"nearest"``) the q_f within the joint limits whose frame is closest to x_f (reached = False).
-        """
+    def _ik(self, x_f: np.ndarray, q_seed: np.ndarray):
+        """q within ik_tolerance of x_f (joint limits on) nearest to q_seed, or None."""
         tol, plant = self._config.ik_tolerance, self._plant
         ik = InverseKinematics(plant, with_joint_limits=True)
         ik.AddPositionConstraint(self._frame, np.zeros(3), plant.world_frame(), x_f - tol, x_f + tol)
         ik.prog().AddQuadraticErrorCost(np.eye(self._n), q_seed, ik.q())
         ik.prog().SetInitialGuess(ik.q(), q_seed)
         result = Solve(ik.prog())
-        if result.is_success():
-            return result.GetSolution(ik.q()), True
+        return result.GetSolution(ik.q()) if result.is_success() else None
+
+    def solve_ik(self, x_f: np.ndarray, q_seed: np.ndarray, segment: int,
+                 x_now: np.ndarray | None = None) -> tuple:
+        """(q_f, reached): q_f within ik_tolerance of x_f, nearest to q_seed (reached = True).
+
+        When x_f is out of reach: ValueError naming the segment (``on_ik_failure = "raise"``), or
+        (``"nearest"``) a pose at ``x_now`` (the target's position now) if that is reachable, else
+        the pose within the joint limits whose frame is closest to x_f (reached = False).  The
+        target's present position is preferred because the point closest to an unreachable one
+        is on the workspace boundary, a singular stretched arm the differential IK cannot leave.
+        """
+        q_f = self._ik(x_f, q_seed)
+        if q_f is not None:
+            return q_f, True
         if self._config.on_ik_failure == "raise":
             raise ValueError(
                 f"ct_quintic: segment {segment}: inverse kinematics found no joint position within "
                 f"the joint limits for the predicted target {np.round(x_f, 4).tolist()} m")
+        q_f = None if x_now is None else self._ik(x_now, q_seed)
+        if q_f is not None:
+            return q_f, False
+        plant = self._plant
         nearest = InverseKinematics(plant, with_joint_limits=True)
         nearest.AddPositionCost(self._frame, np.zeros(3), plant.world_frame(), x_f, np.eye(3))
         nearest.prog().AddQuadraticErrorCost(1e-6 * np.eye(self._n), q_seed, nearest.q())
@@ -190,10 +208,11 @@ class QuinticReference(LeafSystem):
         t1 = max(self._schedule[i].end, t0)
         qv = self._state_in.Eval(context)
         q0, v0 = qv[: self._n], qv[self._n:]
-        goal = self._predicted(i, t0, t1, self._target_in.Eval(context))
-        q_f, reached = self.solve_ik(goal[0:3], q0, i)
+        target = self._target_in.Eval(context)
+        goal = self._predicted(i, t0, t1, target)
+        q_f, reached = self.solve_ik(goal[0:3], q0, i, target[0:3])
         _, _, J_f = self._kinematics.compute(q_f, np.zeros(self._n))
-        v_f = pinv_apply(J_f, goal[3:6])
+        v_f = pinv_apply(J_f, goal[3:6], self._config.pinv_damping)
         zero = np.zeros(self._n)
         c = quintic_coefficients(q0, v0, zero, q_f, v_f, zero, t1 - t0) if t1 > t0 else \
             np.zeros((6, self._n))
@@ -224,8 +243,9 @@ class QuinticReference(LeafSystem):
         Jdot_v = plant.CalcBiasTranslationalAcceleration(
             pc, JacobianWrtVariable.kV, self._frame, np.zeros(3), plant.world_frame(),
             plant.world_frame()).ravel()
-        v_d = pinv_apply(J, target[3:6] + k_x * (target[0:3] - x))
-        a_d = pinv_apply(J, target[6:9] + k_x * (target[3:6] - xdot) - Jdot_v)
+        lam = self._config.pinv_damping
+        v_d = pinv_apply(J, target[3:6] + k_x * (target[0:3] - x), lam)
+        a_d = pinv_apply(J, target[6:9] + k_x * (target[3:6] - xdot) - Jdot_v, lam)
         return q, v_d, a_d
 
 
