@@ -1,0 +1,128 @@
+"""Model-free second-order sliding-mode baseline: the paper's controller without the TBG.
+
+    e   = x − x_r ,  ė = ẋ − ẋ_r                  (m, m/s)
+    s   = ė + λ e ,   λ = lambda_factor / tf        (m/s; λ in 1/s, constant per segment)
+    s_x = s + Λ σ ,   σ̇ = switch(s)                 (σ in m; switch = sign | tanh(·/φ) | sat(·/φ))
+    τ   = −K J⁺(q) s_x                              (N·m; K in N·m·s/rad)
+
+On the surface s = 0 the error decays as e(t0) e^(−λ(t − t0)); lambda_factor = 4 leaves
+e^(−4) ≈ 2 % of e(t0) at t0 + tf ("settles in about tf") but arrives whenever λ says — no
+prescribed time.  There is no s_d term: the loop does not start on the surface.  K, Λ, the
+switching law, φ, pinv_damping and the σ policy are the paper controller's (defaults
+K = 50, Λ = 5, tanh, φ = 0.01 m/s, σ kept across segments); ``SMCConfig.from_gains``
+copies them from a ``ControllerGains``.  At every segment start (a Drake event) λ of the
+new segment is stored in the discrete state and, with ``sigma_policy = "reset"``, σ is
+zeroed.
+
+Model-free: only the frame's position and Jacobian are evaluated (``FrameKinematics``),
+never the mass matrix, Coriolis, gravity or inverse dynamics.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from ptint_drake.systems.baseline_common import (
+    TARGET_SIZE,
+    DeclareControllerOutputs,
+    DeclareSegmentStartEvents,
+    layout_size,
+    make_layout,
+    segment_index,
+)
+from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.controller import smc_torque
+from ptint_drake.systems.kinematics import FrameKinematics
+from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, switching_function
+
+_SHARED = ("K", "Lambda", "switching", "phi", "sigma_policy", "pinv_damping")
+
+
+@dataclass
+class SMCConfig:
+    """First-order-surface SMC parameters (units in the module docstring)."""
+
+    lambda_factor: float = 4.0  # λ = lambda_factor / tf (1/s)
+    K: float = 50.0  # N·m·s/rad
+    Lambda: float = 5.0  # 1/s, weight of σ in s_x
+    switching: str = "tanh"  # sign | tanh | sat
+    phi: float = 0.01  # m/s, boundary-layer width
+    sigma_policy: str = "keep"  # keep | reset σ at a new segment
+    pinv_damping: float = 0.0  # m/rad, damped pseudoinverse; 0 = exact
+
+    @classmethod
+    def from_gains(cls, gains, lambda_factor: float = 4.0) -> "SMCConfig":
+        """The fields shared with the paper controller copied from a ``ControllerGains``."""
+        return cls(lambda_factor=lambda_factor, **{k: getattr(gains, k) for k in _SHARED})
+
+    def validate(self) -> None:
+        switching_function(np.zeros(1), self.switching, self.phi)
+        if self.switching != "sign" and not self.phi > 0.0:
+            raise ValueError(f"smc.phi: must be > 0, got {self.phi}")
+        if self.sigma_policy not in SIGMA_POLICIES:
+            raise ValueError(f"smc.sigma_policy: use one of {SIGMA_POLICIES}, got {self.sigma_policy!r}")
+        if not self.lambda_factor > 0.0:
+            raise ValueError(f"smc.lambda_factor: must be > 0, got {self.lambda_factor}")
+
+
+def smc_layout(nv: int) -> dict:
+    """name -> slice of the SMC baseline's ``telemetry``."""
+    return make_layout([("x", 3), ("xdot", 3), ("e", 3), ("edot", 3), ("lambda", 1), ("s", 3),
+                        ("s_x", 3), ("sigma", 3), ("tau", nv)])
+
+
+class FirstOrderSMC(LeafSystem):
+    """Inputs ``state`` (nq + nv), ``target`` (9); outputs ``u`` (nu), ``tau`` (nv),
+    ``telemetry`` (``layout``).  State: σ (continuous, 3), [segment, λ] (discrete)."""
+
+    def __init__(self, *, plant, frame, schedule: Schedule, config: SMCConfig):
+        super().__init__()
+        config.validate()
+        self._config = config
+        self._schedule = schedule
+        self._nq, self._nv = plant.num_positions(), plant.num_velocities()
+        self._K = np.broadcast_to(np.asarray(config.K, dtype=float), (self._nv,)).copy()
+        self._Lambda = np.broadcast_to(np.asarray(config.Lambda, dtype=float), (3,)).copy()
+        self._kinematics = FrameKinematics(plant, frame)
+        self.layout = smc_layout(self._nv)
+        self._state_in = self.DeclareVectorInputPort("state", self._nq + self._nv)
+        self._target_in = self.DeclareVectorInputPort("target", TARGET_SIZE)
+        self._sigma_index = self.DeclareContinuousState(3)
+        self._lambda_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
+        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(),
+                self.all_input_ports_ticket()}
+        size = layout_size(self.layout)
+        # the cache holds the telemetry, then σ̇ (3)
+        self._sigma_dot = slice(size, size + 3)
+        self._eval = DeclareVectorCache(self, "smc", size + 3, self._calc, deps)
+        DeclareControllerOutputs(self, plant, self.layout, self._eval, deps)
+
+    def lambda_for(self, tf: float) -> float:
+        """λ (1/s) on a segment of duration tf (s)."""
+        return self._config.lambda_factor / tf
+
+    def _on_segment_start(self, context, state) -> None:
+        i = segment_index(self._schedule, context.get_time())
+        state.get_mutable_discrete_state(self._lambda_index).SetFromVector(
+            [i, self.lambda_for(self._schedule[i].tf)])
+        if self._config.sigma_policy == "reset":
+            state.get_mutable_continuous_state().get_mutable_vector().SetZero()
+
+    def _calc(self, context) -> np.ndarray:
+        qv = self._state_in.Eval(context)
+        target = self._target_in.Eval(context)
+        x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
+        e, edot = x - target[0:3], xdot - target[3:6]
+        lam = context.get_discrete_state(self._lambda_index).value()[1]
+        sigma = context.get_continuous_state_vector().CopyToVector()
+        s = edot + lam * e
+        s_x = s + self._Lambda * sigma
+        tau = smc_torque(self._K, J, s_x, self._config.pinv_damping)
+        sigma_dot = switching_function(s, self._config.switching, self._config.phi)
+        return np.concatenate([x, xdot, e, edot, [lam], s, s_x, sigma, tau, sigma_dot])
+
+    def DoCalcTimeDerivatives(self, context, derivatives):
+        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self._sigma_dot])
