@@ -11,11 +11,15 @@ version, ``measurement.noise_std``/``latency``); with an estimator, only what a
 camera and a Kalman filter make of the true objects.  The station's true
 target never reaches a controller directly.
 
-Controllers (``CONTROLLERS``): ``ptsmc``, the paper's interceptor (model-free).
+Controllers (``CONTROLLERS``): ``ptsmc``, the paper's interceptor (model-free);
+``pd`` (task-space PID) and ``smc`` (first-order sliding mode, no TBG), both
+model-free; ``ct_quintic`` (quintic joint plan tracked by inverse dynamics of the
+*nominal* model, given the target's future) — the model-based reference.
 """
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
@@ -23,11 +27,15 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder, OutputPort
 from pydrake.systems.primitives import Demultiplexer
 
-from ptint_drake.scenario import Scenario
+from ptint_drake.robot import make_plant
+from ptint_drake.scenario import PlantConfig, Scenario
 from ptint_drake.station import Station
 from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, InterceptorHandles
 from ptint_drake.systems.gains import ControllerGains
+from ptint_drake.systems.ct_quintic import CtQuinticController
 from ptint_drake.systems.kalman import AddCameraEstimators
+from ptint_drake.systems.pd import PDController
+from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
 from ptint_drake.systems.measurement import MeasuredTarget
 from ptint_drake.systems.targets import TargetSource
 
@@ -145,7 +153,76 @@ def uses_analytic_targets(scenario: Scenario) -> bool:
     return scenario.measurement.estimator == "none"
 
 
-_REGISTRY = {"ptsmc": _add_ptsmc}
+def _baseline_handles(name: str, system, target: OutputPort, notes, model_based=False) -> ControllerHandles:
+    """Baselines log their telemetry port (and the target they saw) at every step."""
+    ports = {"telemetry": system.GetOutputPort("telemetry"), "target": target}
+    layout = system.layout
+
+    def telemetry(logs: dict) -> dict:
+        out = {key: logs["telemetry"][:, part] for key, part in layout.items()}
+        out["x_r"], out["xdot_r"], out["xddot_r"] = np.split(logs["target"], 3, axis=1)
+        return out
+
+    return ControllerHandles(name, ports, telemetry, notes, model_based, system)
+
+
+def _wire(builder, station_system, system, scenario) -> OutputPort:
+    builder.Connect(station_system.GetOutputPort("state"), system.GetInputPort("state"))
+    builder.Connect(system.GetOutputPort("u"), station_system.GetInputPort("actuation"))
+    target = target_view(builder, station_system, scenario)
+    builder.Connect(target, system.GetInputPort("target"))
+    return target
+
+
+def _common(station: Station, scenario: Scenario) -> dict:
+    plant = station.plant
+    return {"plant": plant, "frame": plant.GetFrameByName(scenario.robot.end_effector),
+            "schedule": scenario.schedule()}
+
+
+def _add_pd(builder, station_system, station: Station, scenario: Scenario) -> ControllerHandles:
+    config = scenario.controller.pd
+    system = builder.AddNamedSystem("pd", PDController(**_common(station, scenario), config=config))
+    target = _wire(builder, station_system, system, scenario)
+    notes = []
+    for i, ic in enumerate(scenario.interceptions):
+        g = config.gains_for(ic.tf)
+        notes.append(f"pd segment {i}: Kp = {g['Kp']:.4g} N/m, Kd = {g['Kd']:.4g} N·s/m, "
+                     f"Ki = {g['Ki']:.4g} N/(m·s) (triple pole at −{g['omega']:.3g} rad/s for "
+                     f"{config.mass:g} kg)")
+    return _baseline_handles("pd", system, target, notes)
+
+
+def _add_smc(builder, station_system, station: Station, scenario: Scenario) -> ControllerHandles:
+    config = SMCConfig.from_gains(gains_of(scenario), lambda_factor=scenario.controller.smc.lambda_factor)
+    system = builder.AddNamedSystem("smc", FirstOrderSMC(**_common(station, scenario), config=config))
+    target = _wire(builder, station_system, system, scenario)
+    notes = [f"smc segment {i}: λ = {config.lambda_factor:g}/tf = {config.lambda_factor / ic.tf:.3g} 1/s, "
+             f"K = {config.K:g}, Λ = {config.Lambda:g}" for i, ic in enumerate(scenario.interceptions)]
+    return _baseline_handles("smc", system, target, notes)
+
+
+def _add_ct_quintic(builder, station_system, station: Station, scenario: Scenario) -> ControllerHandles:
+    """Model-based: the nominal model (the file's, without the scenario's plant deviations)
+    and, for analytic targets, their exact future."""
+    nominal = copy.deepcopy(scenario)
+    nominal.plant = PlantConfig()
+    predict = None
+    if uses_analytic_targets(scenario):
+        seen = controller_targets(scenario)
+
+        def predict(i, t1, _target, seen=seen):
+            return seen[i].evaluate(t1)[0:6]
+    config = scenario.controller.ct_quintic
+    system = builder.AddNamedSystem("ct_quintic", CtQuinticController(
+        **_common(station, scenario), config=config, nominal_plant=make_plant(nominal), predict=predict))
+    target = _wire(builder, station_system, system, scenario)
+    notes = [f"ct_quintic: inverse dynamics of the nominal model, ω = {config.omega:g} rad/s, "
+             f"target future {'exact (analytic)' if predict else 'extrapolated from the estimate'}"]
+    return _baseline_handles("ct_quintic", system, target, notes, model_based=True)
+
+
+_REGISTRY = {"ptsmc": _add_ptsmc, "pd": _add_pd, "smc": _add_smc, "ct_quintic": _add_ct_quintic}
 CONTROLLERS = tuple(_REGISTRY)
 
 

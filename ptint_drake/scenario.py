@@ -37,14 +37,16 @@ from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from ptint_drake.metrics import Criteria, validate_criteria
 from ptint_drake.systems.camera import MeasurementConfig, validate_measurement
+from ptint_drake.systems.ct_quintic import CtQuinticConfig
 from ptint_drake.systems.gains import ControllerGains
+from ptint_drake.systems.pd import PDConfig
 from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
 
 
 IMPLEMENTATIONS = ("fused", "blocks")
-CONTROLLER_TYPES = ("ptsmc",)  # the slot's controllers (controllers.py); ptsmc = the paper's
+CONTROLLER_TYPES = ("ptsmc", "pd", "smc", "ct_quintic")  # the slot's (controllers.py); ptsmc: the paper's
 
 
 class ScenarioError(ValueError):
@@ -59,11 +61,21 @@ class RobotConfig:
 
 
 @dataclass
+class SmcOptions:
+    lambda_factor: float = 4.0  # smc: constant λ = lambda_factor / tf (1/s); 4 settles in about tf
+
+
+@dataclass
 class ControllerConfig(ControllerGains):
-    """The paper's gains (shared by ``smc``) and which controller runs (``type``)."""
+    """The paper's gains (shared by ``smc``), which controller runs (``type``; a plain
+    field rather than a tagged YAML variant so that ``--set controller.type=pd`` works and
+    an untagged mapping stays the paper's controller), and each baseline's own settings."""
 
     type: str = "ptsmc"  # the controller in the slot: ptsmc (the paper's) | pd | smc | ct_quintic
     implementation: str = "fused"  # ptsmc: "fused" one LeafSystem, or "blocks" (the five wired blocks)
+    pd: PDConfig = field(default_factory=PDConfig)
+    smc: SmcOptions = field(default_factory=SmcOptions)
+    ct_quintic: CtQuinticConfig = field(default_factory=CtQuinticConfig)
 
 
 @dataclass
@@ -310,6 +322,12 @@ def validate(s: Scenario) -> None:
         validate_criteria(s.criteria)
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
+    _positive(c.smc.lambda_factor, "controller.smc.lambda_factor")
+    for sub in (c.pd, c.ct_quintic):
+        try:
+            sub.validate()  # messages name the field from "pd." / "ct_quintic." on
+        except ValueError as exc:
+            raise ScenarioError(f"controller.{exc}") from None
     if c.implementation not in IMPLEMENTATIONS:
         raise ScenarioError(f"controller.implementation: must be one of {', '.join(IMPLEMENTATIONS)}, "
                             f"got {c.implementation!r}")
