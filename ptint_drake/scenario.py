@@ -32,7 +32,7 @@ from importlib import resources
 from pathlib import Path
 from typing import List, Optional
 
-from pydrake.common.yaml import yaml_load_typed
+from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from ptint_drake.metrics import Criteria, validate_criteria
@@ -219,10 +219,28 @@ def parse_scenario(text: str, name: str = "scenario") -> Scenario:
 
 
 def dump_yaml(scenario: "Scenario") -> str:
-    """The scenario as YAML text that ``parse_scenario`` reads back to the same scenario."""
+    """The scenario as YAML text that ``parse_scenario`` reads back to the same scenario.
+
+    Written with Drake's ``yaml_dump_typed``, then made portable across the supported Drake
+    versions: a ``simulator`` field that only some of them have (``_VERSION_SPECIFIC_SIMULATOR``)
+    is left out while it holds the value that means "absent", so a file written under Drake 1.51
+    loads under 1.58 and back.  A non-default value is kept (it matters on this Drake); another
+    Drake then rejects it with a message naming the field.
+    """
     import yaml  # noqa: PLC0415
 
-    return yaml.safe_dump(dump_dataclass(scenario), sort_keys=False)
+    data = yaml.safe_load(yaml_dump_typed(scenario))
+    simulator = data.get("simulator", {})
+    for key, absent in _VERSION_SPECIFIC_SIMULATOR.items():
+        if key in simulator and simulator[key] == absent:
+            del simulator[key]
+
+    class Dumper(yaml.SafeDumper):  # Drake's layout: block mappings, flow lists of numbers
+        pass
+
+    Dumper.add_representer(list, lambda d, v: d.represent_sequence(
+        "tag:yaml.org,2002:seq", v, flow_style=not any(isinstance(x, (dict, list)) for x in v)))
+    return yaml.dump(data, Dumper=Dumper, sort_keys=False, width=100)
 
 
 def _yaml_error(text: str, schema, exc: Exception) -> str:
@@ -279,11 +297,13 @@ def _locate(raw, schema, path: str) -> Optional[str]:
         return f"{path}: expected a string, got {raw!r}"
     if schema is SimulatorConfig and not isinstance(raw, dict):
         return f"{path}: expected a mapping, got {raw!r}"
-    if schema is SimulatorConfig:
+    if schema is SimulatorConfig:  # the installed Drake's fields
         known = dump_dataclass(SimulatorConfig()).keys()
         for key in raw:
             if key not in known:
-                return f"{path}.{key}: unknown field (known: {', '.join(known)})"
+                hint = (f" (a field of other Drake versions, not of the installed {_drake_version()}: "
+                        f"delete it)" if key in _VERSION_SPECIFIC_SIMULATOR else "")
+                return f"{path}.{key}: unknown field{hint} (known: {', '.join(known)})"
     return None
 
 
@@ -432,14 +452,29 @@ def apply_variant(scenario: Scenario, variant: str) -> Scenario:
     raise ScenarioError(f"variant: unknown plant variant {variant!r} (use {VARIANT_FORMS})")
 
 
+# SimulatorConfig fields that only some supported Drake versions have, each with the value that
+# means the same as leaving it out (Drake 1.52 removed publish_every_time_step; false was the default).
+_VERSION_SPECIFIC_SIMULATOR = {"publish_every_time_step": False}
+
+
+def _drake_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
+
+    try:
+        return version("drake")
+    except PackageNotFoundError:  # a source build of pydrake
+        return "(unknown version)"
+
+
 def dump_dataclass(obj) -> dict:
-    """A plain dict of a scenario (SimulatorConfig included), for reports."""
+    """A plain dict of a scenario (SimulatorConfig included, with every field the installed
+    Drake has, through Drake's ``yaml_dump_typed``), for reports."""
     if dataclasses.is_dataclass(obj):
         return {f.name: dump_dataclass(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
     if isinstance(obj, SimulatorConfig):
-        return {k: getattr(obj, k) for k in (
-            "integration_scheme", "max_step_size", "accuracy", "use_error_control",
-            "start_time", "target_realtime_rate", "publish_every_time_step")}
+        import yaml  # noqa: PLC0415
+
+        return yaml.safe_load(yaml_dump_typed(obj))
     if isinstance(obj, list):
         return [dump_dataclass(v) for v in obj]
     return obj

@@ -7,6 +7,8 @@ as they run (NAME.dot/.svg, the fused interceptor) and with the five wired block
 tests/test_diagrams.py fails when the committed .dot files no longer match a fresh export.
 """
 
+import shutil
+import tempfile
 from pathlib import Path
 
 from ptint_drake.report import write_diagram
@@ -23,7 +25,11 @@ def diagram_scenarios(name):
 
 
 if __name__ == "__main__":
+    # each export goes through its own folder: write_diagram's staged output replaces the files
+    # that the previous export into the same folder wrote (its manifest), so only copy them in
     for name in DIAGRAM_SCENARIOS:
         for scenario in diagram_scenarios(name):
-            for path in write_diagram(scenario, OUT):
-                print(f"wrote {path}")
+            with tempfile.TemporaryDirectory() as tmp:
+                for path in write_diagram(scenario, Path(tmp)):
+                    shutil.copyfile(path, OUT / path.name)
+                    print(f"wrote {OUT / path.name}")
