@@ -56,9 +56,9 @@ def test_committed_diagrams_are_current(tmp_path, name):
     if shutil.which("dot") is None:
         pytest.fail("graphviz's dot is missing: run scripts/setup.sh")
     fused, blocks = export.diagram_scenarios(name)
-    for scenario, systems in ((fused, ("interceptor", "saturation", "plant")),
+    for scenario, systems in ((fused, ("interceptor", "station")),
                               (blocks, ("interceptor_tbg", "interceptor_target", "interceptor_kinematics",
-                                        "interceptor_surface", "interceptor_controller", "plant"))):
+                                        "interceptor_surface", "interceptor_controller", "station"))):
         dot, svg = write_diagram(scenario, tmp_path)
         committed = DIAGRAMS / dot.name
         assert committed.is_file(), f"{committed} is missing: run `.venv/bin/python scripts/export_diagrams.py`"
@@ -66,11 +66,11 @@ def test_committed_diagrams_are_current(tmp_path, name):
         assert structure(committed.read_text()) == fresh, (
             f"{committed} is stale: run `.venv/bin/python scripts/export_diagrams.py`")
         assert set(systems) <= set(fresh["systems"])
-        assert any(c.endswith(" -> plant.actuation") for c in fresh["connections"])
+        assert any(c.endswith(" -> station.actuation") for c in fresh["connections"])
         assert (DIAGRAMS / svg.name).is_file()
         text = svg.read_text()
         assert text.lstrip().startswith("<?xml") and "<svg" in text
-        for system in systems:  # every block appears, wired to the plant
+        for system in systems:  # every block appears, wired to the station
             assert system in text
 
 
