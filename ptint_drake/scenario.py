@@ -25,32 +25,27 @@ open, with their defaults:
 
 
 import copy
-import dataclasses
 import math
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import List, Optional
 
-from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
-from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
+from pydrake.common.yaml import yaml_load_typed
+from pydrake.systems.analysis import SimulatorConfig
 
-from ptint_drake.metrics import Criteria, validate_criteria
-from ptint_drake.systems.camera import MeasurementConfig, validate_measurement
+from ptint_drake.metrics import Criteria
+from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
+from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.ct_quintic import CtQuinticConfig
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.pd import PDConfig
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
+from ptint_drake.validation import CONTROLLER_TYPES, TARGET_KINDS, ScenarioError, validate
 
-
-IMPLEMENTATIONS = ("fused", "blocks")
-CONTROLLER_TYPES = ("ptsmc", "pd", "smc", "ct_quintic")  # the slot's (controllers.py); ptsmc: the paper's
-
-
-class ScenarioError(ValueError):
-    """A scenario that cannot be run; the message names the field."""
+__all__ = ["CONTROLLER_TYPES", "TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
+           "load_scenario", "parse_scenario", "parse_with_overrides", "apply_variant", "validate"]
 
 
 @dataclass
@@ -98,9 +93,6 @@ class WaypointsConfig:
 
     time: List[float] = field(default_factory=list)
     position: List[List[float]] = field(default_factory=list)
-
-
-TARGET_KINDS = ("sinusoid", "linear", "waypoints")
 
 
 @dataclass
@@ -211,218 +203,11 @@ def parse_scenario(text: str, name: str = "scenario") -> Scenario:
     try:
         scenario = yaml_load_typed(schema=Scenario, data=text)
     except Exception as exc:  # yaml_load_typed raises several types; keep one line
-        raise ScenarioError(_yaml_error(text, Scenario, exc)) from None
+        raise ScenarioError(yaml_error(text, Scenario, exc)) from None
     if not scenario.name:
         scenario.name = name
     validate(scenario)
     return scenario
-
-
-def dump_yaml(scenario: "Scenario") -> str:
-    """The scenario as YAML text that ``parse_scenario`` reads back to the same scenario.
-
-    Written with Drake's ``yaml_dump_typed``, then made portable across the supported Drake
-    versions: a ``simulator`` field that only some of them have (``_VERSION_SPECIFIC_SIMULATOR``)
-    is left out while it holds the value that means "absent", so a file written under Drake 1.51
-    loads under 1.58 and back.  A non-default value is kept (it matters on this Drake); another
-    Drake then rejects it with a message naming the field.
-    """
-    import yaml  # noqa: PLC0415
-
-    data = yaml.safe_load(yaml_dump_typed(scenario))
-    simulator = data.get("simulator", {})
-    for key, absent in _VERSION_SPECIFIC_SIMULATOR.items():
-        if key in simulator and simulator[key] == absent:
-            del simulator[key]
-
-    class Dumper(yaml.SafeDumper):  # Drake's layout: block mappings, flow lists of numbers
-        pass
-
-    Dumper.add_representer(list, lambda d, v: d.represent_sequence(
-        "tag:yaml.org,2002:seq", v, flow_style=not any(isinstance(x, (dict, list)) for x in v)))
-    return yaml.dump(data, Dumper=Dumper, sort_keys=False, width=100)
-
-
-def _yaml_error(text: str, schema, exc: Exception) -> str:
-    """One line for a YAML load failure, naming the field where it can be located."""
-    import yaml  # noqa: PLC0415
-
-    try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        return f"scenario YAML: malformed{where}: {getattr(err, 'problem', None) or err}"
-    found = _locate(raw, schema, "")
-    detail = " ".join(str(exc).split())
-    return f"{found}" if found else f"scenario YAML: {detail}"
-
-
-def _locate(raw, schema, path: str) -> Optional[str]:
-    """Walk raw YAML data against a dataclass schema; describe the first mismatch."""
-    import typing  # noqa: PLC0415
-
-    if dataclasses.is_dataclass(schema):
-        if not isinstance(raw, dict):
-            return f"{path or 'scenario'}: expected a mapping, got {raw!r}"
-        hints = typing.get_type_hints(schema)
-        for key, value in raw.items():
-            where = f"{path}.{key}" if path else str(key)
-            if key not in hints:
-                return f"{where}: unknown field (known: {', '.join(hints)})"
-            found = _locate(value, hints[key], where)
-            if found:
-                return found
-        return None
-    origin = typing.get_origin(schema)
-    if origin is typing.Union:
-        inner = [a for a in typing.get_args(schema) if a is not type(None)][0]
-        return None if raw is None else _locate(raw, inner, path)
-    if origin in (list, List):
-        if not isinstance(raw, list):
-            return f"{path}: expected a list, got {raw!r}"
-        item = typing.get_args(schema)[0]
-        for i, v in enumerate(raw):
-            found = _locate(v, item, f"{path}[{i}]")
-            if found:
-                return found
-        return None
-    if schema is float:
-        if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-            try:
-                float(raw)
-            except (TypeError, ValueError):
-                return f"{path}: expected a number, got {raw!r}"
-    if schema is str and not isinstance(raw, str):
-        return f"{path}: expected a string, got {raw!r}"
-    if schema is SimulatorConfig and not isinstance(raw, dict):
-        return f"{path}: expected a mapping, got {raw!r}"
-    if schema is SimulatorConfig:  # the installed Drake's fields
-        known = dump_dataclass(SimulatorConfig()).keys()
-        for key in raw:
-            if key not in known:
-                hint = (f" (a field of other Drake versions, not of the installed {_drake_version()}: "
-                        f"delete it)" if key in _VERSION_SPECIFIC_SIMULATOR else "")
-                return f"{path}.{key}: unknown field{hint} (known: {', '.join(known)})"
-    return None
-
-
-def _vector3(value, where: str):
-    if len(value) != 3:
-        raise ScenarioError(f"{where}: must have 3 entries, got {len(value)}")
-    if not all(math.isfinite(v) for v in value):
-        raise ScenarioError(f"{where}: must be finite, got {list(value)}")
-
-
-def _nonnegative(value: float, where: str):
-    if not (math.isfinite(value) and value >= 0.0):
-        raise ScenarioError(f"{where}: must be >= 0, got {value}")
-
-
-def _positive(value: float, where: str):
-    if not (math.isfinite(value) and value > 0.0):
-        raise ScenarioError(f"{where}: must be > 0, got {value}")
-
-
-def validate(s: Scenario) -> None:
-    """Checks that need no robot model (the model-dependent ones live in simulation)."""
-    _positive(s.duration, "duration")
-    c = s.controller
-    for name in ("K", "Lambda", "k", "k_hold", "epsilon", "delta"):
-        _positive(getattr(c, name), f"controller.{name}")
-    if not (math.isfinite(c.alpha_hold) and c.alpha_hold >= 0.0):
-        raise ScenarioError(f"controller.alpha_hold: must be >= 0, got {c.alpha_hold}")
-    if c.switching not in SWITCHING_LAWS:
-        raise ScenarioError(f"controller.switching: must be one of {', '.join(SWITCHING_LAWS)}, got {c.switching!r}")
-    if c.switching != "sign":
-        _positive(c.phi, "controller.phi")
-    if c.type not in CONTROLLER_TYPES:
-        raise ScenarioError(f"controller.type: must be one of {', '.join(CONTROLLER_TYPES)}, got {c.type!r}")
-    try:
-        validate_criteria(s.criteria)
-    except ValueError as exc:
-        raise ScenarioError(str(exc)) from None
-    _positive(c.smc.lambda_factor, "controller.smc.lambda_factor")
-    for sub in (c.pd, c.ct_quintic):
-        try:
-            sub.validate()  # messages name the field from "pd." / "ct_quintic." on
-        except ValueError as exc:
-            raise ScenarioError(f"controller.{exc}") from None
-    if c.implementation not in IMPLEMENTATIONS:
-        raise ScenarioError(f"controller.implementation: must be one of {', '.join(IMPLEMENTATIONS)}, "
-                            f"got {c.implementation!r}")
-    if c.sigma_policy not in SIGMA_POLICIES:
-        raise ScenarioError(f"controller.sigma_policy: must be one of {', '.join(SIGMA_POLICIES)}, got {c.sigma_policy!r}")
-    _positive(s.plant.mass_scale, "plant.mass_scale")
-    for name in ("damping_scale", "payload_kg"):
-        _nonnegative(getattr(s.plant, name), f"plant.{name}")
-    _positive(s.plant.coulomb_speed, "plant.coulomb_speed")
-    for v in s.plant.coulomb:
-        _nonnegative(v, "plant.coulomb")
-    d = s.plant.disturbance
-    for name in ("amplitude", "phase", "step"):
-        if not all(math.isfinite(v) for v in getattr(d, name)):
-            raise ScenarioError(f"plant.disturbance.{name}: must be finite")
-    _positive(d.frequency_hz, "plant.disturbance.frequency_hz")
-    try:
-        validate_measurement(s.measurement)
-    except ValueError as exc:
-        raise ScenarioError(str(exc)) from None
-    if c.pinv_damping < 0 or not math.isfinite(c.pinv_damping):
-        raise ScenarioError(f"controller.pinv_damping: must be >= 0, got {c.pinv_damping}")
-    for name in ("max_error", "max_joint_speed"):
-        _positive(getattr(s.limits, name), f"limits.{name}")
-    _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")
-    schemes = GetIntegrationSchemes()
-    if s.simulator.integration_scheme not in schemes:
-        raise ScenarioError(
-            f"simulator.integration_scheme: unknown {s.simulator.integration_scheme!r} "
-            f"(one of {', '.join(schemes)})")
-    _positive(s.simulator.accuracy, "simulator.accuracy")
-    _positive(s.simulator.max_step_size, "simulator.max_step_size")
-    if s.simulator.start_time != 0.0:
-        raise ScenarioError(f"simulator.start_time: must be 0 (scenario times are absolute), got {s.simulator.start_time}")
-    if not s.interceptions:
-        raise ScenarioError("interceptions: at least one interception is needed")
-    for i, ic in enumerate(s.interceptions):
-        where = f"interceptions[{i}]"
-        if not (0.0 < ic.beta < 1.0):
-            raise ScenarioError(f"{where}.beta: must be in (0, 1), got {ic.beta}")
-        _positive(ic.tf, f"{where}.tf")
-        if not (math.isfinite(ic.start) and ic.start >= 0.0):
-            raise ScenarioError(f"{where}.start: must be >= 0, got {ic.start}")
-        if i == 0 and ic.start != 0.0:
-            raise ScenarioError(f"{where}.start: the first interception must start at 0, got {ic.start}")
-        if i > 0:
-            prev = s.interceptions[i - 1]
-            if ic.start < prev.start + prev.tf:
-                raise ScenarioError(
-                    f"{where}.start: {ic.start} s is before interceptions[{i - 1}] "
-                    f"intercepts at {prev.start + prev.tf} s (segments must be in time order "
-                    f"and may not overlap)")
-        if ic.start + ic.tf > s.duration + 1e-12:
-            raise ScenarioError(
-                f"{where}.tf: interception time {ic.start + ic.tf} s is after the end "
-                f"of the simulation (duration {s.duration} s)")
-        t = ic.target
-        kinds = [k for k in TARGET_KINDS if getattr(t, k) is not None]
-        if len(kinds) != 1:
-            raise ScenarioError(
-                f"{where}.target: exactly one of {', '.join(TARGET_KINDS)} is needed, got "
-                f"{', '.join(kinds) if kinds else 'none'}")
-        if t.sinusoid is not None:
-            for name in ("center", "amplitude", "phase"):
-                _vector3(getattr(t.sinusoid, name), f"{where}.target.sinusoid.{name}")
-            if not math.isfinite(t.sinusoid.omega):
-                raise ScenarioError(f"{where}.target.sinusoid.omega: must be finite")
-        elif t.waypoints is not None:
-            try:
-                WaypointTarget(t.waypoints.time, t.waypoints.position)
-            except ValueError as exc:
-                raise ScenarioError(f"{where}.target.waypoints.{exc}") from None
-        else:
-            _vector3(t.linear.start, f"{where}.target.linear.start")
-            _vector3(t.linear.velocity, f"{where}.target.linear.velocity")
 
 
 VARIANT_FORMS = "nominal, mass_xF (e.g. mass_x1.5), payload_Mkg (e.g. payload_0.5kg)"
@@ -452,40 +237,12 @@ def apply_variant(scenario: Scenario, variant: str) -> Scenario:
     raise ScenarioError(f"variant: unknown plant variant {variant!r} (use {VARIANT_FORMS})")
 
 
-# SimulatorConfig fields that only some supported Drake versions have, each with the value that
-# means the same as leaving it out (Drake 1.52 removed publish_every_time_step; false was the default).
-_VERSION_SPECIFIC_SIMULATOR = {"publish_every_time_step": False}
-
-
-def _drake_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
-
-    try:
-        return version("drake")
-    except PackageNotFoundError:  # a source build of pydrake
-        return "(unknown version)"
-
-
-def dump_dataclass(obj) -> dict:
-    """A plain dict of a scenario (SimulatorConfig included, with every field the installed
-    Drake has, through Drake's ``yaml_dump_typed``), for reports."""
-    if dataclasses.is_dataclass(obj):
-        return {f.name: dump_dataclass(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
-    if isinstance(obj, SimulatorConfig):
-        import yaml  # noqa: PLC0415
-
-        return yaml.safe_load(yaml_dump_typed(obj))
-    if isinstance(obj, list):
-        return [dump_dataclass(v) for v in obj]
-    return obj
-
-
 def parse_with_overrides(text: str, overrides: str, name: str = "scenario") -> Scenario:
     """Parse ``text``, then merge the YAML mapping ``overrides`` over it, then validate."""
     base = parse_scenario(text, name)
     try:
         scenario = yaml_load_typed(schema=Scenario, data=overrides, defaults=base)
     except Exception as exc:
-        raise ScenarioError("--set " + _yaml_error(overrides, Scenario, exc)) from None
+        raise ScenarioError("--set " + yaml_error(overrides, Scenario, exc)) from None
     validate(scenario)
     return scenario

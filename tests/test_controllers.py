@@ -130,3 +130,35 @@ def test_unknown_controller_is_one_line_naming_the_field():
     with pytest.raises(ScenarioError, match=r"^controller\.type: must be one of ptsmc, pd, smc, "
                                             r"ct_quintic, got 'lqr'$"):
         parse_scenario(load_scenario_text().replace("controller: {", "controller: {type: lqr, "))
+
+
+DYNAMICS = ("CalcMassMatrix", "CalcMassMatrixViaInverseDynamics", "CalcBiasTerm",
+            "CalcGravityGeneralizedForces", "CalcInverseDynamics")
+
+
+@pytest.mark.parametrize("controller, implementation", [
+    ("ptsmc", "fused"), ("ptsmc", "blocks"), ("pd", "fused"), ("smc", "fused")])
+def test_model_free_controllers_never_evaluate_dynamics(controller, implementation, monkeypatch):
+    """Every Python call of a MultibodyPlant dynamics method during a whole run through the
+    slot is recorded (the controllers are Python systems: any use of the model goes through
+    these); the checks before the run, which may use the model, are off."""
+    from pydrake.multibody.plant import MultibodyPlant  # noqa: PLC0415
+
+    calls = []
+    for name in DYNAMICS:
+        original = getattr(MultibodyPlant, name)
+
+        def spy(self, *args, _name=name, _original=original, **kwargs):
+            calls.append(_name)
+            return _original(self, *args, **kwargs)
+        monkeypatch.setattr(MultibodyPlant, name, spy)
+    scenario = load_scenario("curve_b075_tf15")
+    probe = build(scenario, log=False).plant
+    probe.CalcGravityGeneralizedForces(probe.CreateDefaultContext())  # the spy works
+    assert calls == ["CalcGravityGeneralizedForces"]
+    calls.clear()
+    scenario.controller.type, scenario.controller.implementation = controller, implementation
+    scenario.duration = 1.5
+    result = simulate(scenario, check=False)
+    assert result.metrics["segments"][0]["e_tf_norm"] < 0.01  # it did chase the target
+    assert calls == []
