@@ -161,6 +161,7 @@ def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> di
         "torque_peak_after_startup_time": torque_late["time"],
         "torque_command_peak": np.max(np.abs(tau), axis=0).tolist() if len(t) else [],
         "joint_speed_peak": speed["value"],
+        "final_joint_speed": float(np.max(np.abs(series["v"][-1]))) if len(t) else 0.0,
         "joint_speed_peak_time": speed["time"],
         "effort_limits": limits.tolist(),
         "saturated_fraction": float(np.sum(dt[over]) / span) if span > 0 else 0.0,
