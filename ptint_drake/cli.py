@@ -23,7 +23,6 @@ from pathlib import Path
 
 from ptint_drake.scenario import ScenarioError, bundled_scenarios, scenario_text
 
-
 _PATH_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]|(\.)")
 
 
@@ -77,6 +76,19 @@ def _apply_override(tree: dict, key: str, value) -> None:
             node = node[part]
 
 
+def _yaml_loader():
+    """PyYAML's safe loader that also reads ``1e-6`` as a number (YAML 1.2, as Drake does)."""
+    import yaml  # noqa: PLC0415
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float", re.compile(r"^[-+]?(?:[0-9][0-9_]*)?(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+        list("-+0123456789."))
+    return Loader
+
+
 def override_text(text: str, overrides) -> str:
     """The scenario YAML ``text`` with each ``key=value`` of ``overrides`` applied.
 
@@ -88,8 +100,9 @@ def override_text(text: str, overrides) -> str:
 
     if not overrides:
         return text
+    loader = _yaml_loader()
     try:
-        tree = yaml.safe_load(text)
+        tree = yaml.load(text, Loader=loader)  # noqa: S506  (a SafeLoader subclass)
     except yaml.YAMLError:
         return text  # parse_scenario reports where the file is malformed
     if tree is None:
@@ -101,14 +114,14 @@ def override_text(text: str, overrides) -> str:
             raise ScenarioError(f"--set: expected key=value, got {pair!r}")
         key, raw = (v.strip() for v in pair.split("=", 1))
         try:
-            value = yaml.safe_load(raw)
+            value = yaml.load(raw, Loader=loader)  # noqa: S506
         except yaml.YAMLError:
             raise ScenarioError(f"--set {key}: value {raw!r} is not valid YAML") from None
         _apply_override(tree, key, value)
     return yaml.safe_dump(tree, sort_keys=False)
 
 
-def load_text(name_or_file: str, overrides=None) -> "tuple[str, str]":
+def load_text(name_or_file: str, overrides=None) -> tuple[str, str]:
     """(name, YAML text) of a scenario with the ``--set`` overrides applied."""
     name, text = scenario_text(name_or_file)
     return name, override_text(text, overrides)
@@ -233,8 +246,8 @@ def _floats(text: str, flag: str) -> list:
 
 
 def cmd_sweep(args) -> int:
-    from ptint_drake.studies import sweep  # noqa: PLC0415
     from ptint_drake.outputs import staged_output  # noqa: PLC0415
+    from ptint_drake.studies import sweep  # noqa: PLC0415
 
     betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
     for b in betas:
@@ -334,6 +347,7 @@ def make_parser() -> argparse.ArgumentParser:
     diagram.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     diagram.add_argument("--out", help="output folder (default out/NAME)")
     diagram.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
+    diagram.add_argument("--quiet", action="store_true", help="accepted like the other commands")
     diagram.set_defaults(func=cmd_diagram)
 
     sw = sub.add_parser(
