@@ -65,7 +65,8 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
                 result.series, result.metrics, stage, scenario.name)]
         if replay:
             write_replay(result.series, result.metrics, resolve_model(scenario.robot.model),
-                         stage / "replay.html", conveyors=conveyor_belts(scenario))
+                         stage / "replay.html", conveyors=conveyor_belts(scenario),
+                         end_effector=scenario.robot.end_effector)
         write_json_atomic(stage / METRICS, metrics)
     return metrics
 
