@@ -1,4 +1,4 @@
-"""The ``ptint`` command line (SPEC section 5.1).
+"""ptint: prescribed-time interception of moving objects with a robot arm (Drake).
 
     ptint list                              bundled scenarios
     ptint run NAME_OR_FILE [--out DIR]      one scenario: metrics.json, series.npz, figures, replay.html
@@ -8,62 +8,176 @@
     ptint robust NAME_OR_FILE --samples N [--seed S] [--workers W] [--out DIR]   Monte Carlo
     ptint bench [SCENARIO ...]              speed and accuracy benchmark, JSON on stdout
 
-``--set key=value`` (repeatable) overrides a scenario field, e.g.
-``--set controller.switching=sign --set simulator.accuracy=1e-6``; values are
-YAML.  Bad input ends with one line ``ptint: error: FIELD: ...`` and exit 2.
+``--set key=value`` (repeatable) overrides any scenario field, list items
+included, e.g. ``--set controller.switching=sign --set 'interceptions[0].tf=1.2'``;
+values are YAML.  Bad input ends with one line ``ptint: error: FIELD: ...`` and exit 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import re
 import sys
 from pathlib import Path
 
 from ptint_drake.scenario import ScenarioError, bundled_scenarios, scenario_text
 
+_PATH_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]|(\.)")
 
-def _parse_overrides(pairs) -> str:
-    """``a.b=v`` pairs as one nested YAML mapping (text)."""
+
+def _split_path(key: str) -> list:
+    """``interceptions[1].target.linear.velocity`` → ``['interceptions', 1, 'target', ...]``."""
+    parts, pos, expect_name = [], 0, True
+    while pos < len(key):
+        m = _PATH_TOKEN.match(key, pos)
+        if m is None or (m.group(1) and not expect_name) or (m.group(2) and expect_name) \
+                or (m.group(3) and expect_name):
+            raise ScenarioError(f"--set {key}: not a field path (expected e.g. "
+                                f"controller.K or interceptions[0].tf)")
+        if m.group(1):
+            parts.append(m.group(1))
+        elif m.group(2):
+            parts.append(int(m.group(2)))
+        expect_name = bool(m.group(3))
+        pos = m.end()
+    if not parts or expect_name:
+        raise ScenarioError(f"--set {key}: not a field path (expected e.g. "
+                            f"controller.K or interceptions[0].tf)")
+    return parts
+
+
+def _path_text(parts) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else p)
+                   for i, p in enumerate(parts))
+
+
+def _apply_override(tree: dict, key: str, value) -> None:
+    """Set ``value`` at the path ``key`` (dots and ``[i]``) in the plain YAML data ``tree``."""
+    parts = _split_path(key)
+    node = tree
+    for depth, part in enumerate(parts):
+        here = _path_text(parts[:depth]) or "the scenario"
+        last = depth == len(parts) - 1
+        if isinstance(part, int):
+            if not isinstance(node, list):
+                raise ScenarioError(f"--set {key}: {here} is not a list, it cannot be indexed")
+            if part >= len(node):
+                raise ScenarioError(f"--set {key}: index {part} out of range ({here} has "
+                                    f"{len(node)} item{'s' if len(node) != 1 else ''})")
+        elif not isinstance(node, dict):
+            kind = "a list (use [i])" if isinstance(node, list) else f"not a mapping ({node!r})"
+            raise ScenarioError(f"--set {key}: {here} is {kind}")
+        if last:
+            node[part] = value
+        else:
+            if isinstance(part, str) and node.get(part) is None:
+                node[part] = [] if isinstance(parts[depth + 1], int) else {}
+            node = node[part]
+
+
+def _yaml_loader():
+    """PyYAML's safe loader that also reads ``1e-6`` as a number (YAML 1.2, as Drake does)."""
+    import yaml  # noqa: PLC0415
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float", re.compile(r"^[-+]?(?:[0-9][0-9_]*)?(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+        list("-+0123456789."))
+    return Loader
+
+
+def override_text(text: str, overrides) -> str:
+    """The scenario YAML ``text`` with each ``key=value`` of ``overrides`` applied.
+
+    Keys are paths with dots and list indices (``interceptions[0].target.linear.start``);
+    values are YAML.  Field names are not checked here: ``parse_scenario`` reports
+    unknown ones with their path.
+    """
     import yaml  # noqa: PLC0415  (PyYAML ships with drake's dependencies)
 
-    tree: dict = {}
-    for pair in pairs or []:
+    if not overrides:
+        return text
+    loader = _yaml_loader()
+    try:
+        tree = yaml.load(text, Loader=loader)  # noqa: S506  (a SafeLoader subclass)
+    except yaml.YAMLError:
+        return text  # parse_scenario reports where the file is malformed
+    if tree is None:
+        tree = {}
+    if not isinstance(tree, dict):
+        return text  # parse_scenario reports "expected a mapping"
+    for pair in overrides:
         if "=" not in pair:
             raise ScenarioError(f"--set: expected key=value, got {pair!r}")
-        key, value = pair.split("=", 1)
-        node = tree
-        parts = key.strip().split(".")
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
+        key, raw = (v.strip() for v in pair.split("=", 1))
         try:
-            node[parts[-1]] = yaml.safe_load(value)
+            value = yaml.load(raw, Loader=loader)  # noqa: S506
         except yaml.YAMLError:
-            raise ScenarioError(f"--set {key}: value {value!r} is not valid YAML") from None
-    return yaml.safe_dump(tree) if tree else ""
+            raise ScenarioError(f"--set {key}: value {raw!r} is not valid YAML") from None
+        _apply_override(tree, key, value)
+    return yaml.safe_dump(tree, sort_keys=False)
+
+
+def load_text(name_or_file: str, overrides=None) -> tuple[str, str]:
+    """(name, YAML text) of a scenario with the ``--set`` overrides applied."""
+    name, text = scenario_text(name_or_file)
+    return name, override_text(text, overrides)
 
 
 def load(name_or_file: str, overrides=None):
-    from ptint_drake.scenario import parse_scenario, parse_with_overrides  # noqa: PLC0415
+    """The validated scenario ``name_or_file`` with the ``--set`` overrides applied."""
+    from ptint_drake.scenario import parse_scenario  # noqa: PLC0415
 
     name, text = scenario_text(name_or_file)
-    extra = _parse_overrides(overrides)
-    if extra:
-        return parse_with_overrides(text, extra, name)
-    return parse_scenario(text, name)
+    if not overrides:
+        return parse_scenario(text, name)
+    changed = override_text(text, overrides)
+    try:
+        return parse_scenario(changed, name)
+    except ScenarioError as exc:
+        parse_scenario(text, name)  # an error of the file itself is reported as such
+        raise ScenarioError(f"--set: {exc}") from None
+
+
+def _out_dir(value, default: Path) -> Path:
+    """The ``--out`` folder; a one-line error if it (or a parent) is an existing file."""
+    out = Path(value) if value else default
+    for p in (out, *out.parents):
+        if p.exists():
+            if not p.is_dir():
+                raise ScenarioError(f"--out: {p} is a file" if p == out
+                                    else f"--out: {p} (in {out}) is a file")
+            break
+    return out
 
 
 def _progress(label: str):
-    """A progress line on stderr: redrawn in place on a terminal, one line at the end otherwise."""
+    """Progress on stderr: a bar redrawn in place on a terminal; otherwise (a log file,
+    a pipe) one line per 10 % of simulated time.  The returned ``report(t, duration,
+    steps=None)`` adds the integrator's step count when the caller passes it."""
     tty = sys.stderr.isatty()
+    printed = [-1]  # the last tenth reported (non-tty)
 
-    def report(t, duration):
-        if not tty and t < duration:
+    def report(t, duration, steps=None):
+        frac = min(t / duration, 1.0) if duration > 0 else 1.0
+        extra = f", {steps} steps" if steps is not None else ""
+        if not tty:
+            tenth = int(frac * 10 + 1e-9)
+            if tenth <= printed[0]:
+                return
+            printed[0] = tenth
+            sys.stderr.write(f"{label}: {10 * tenth:3d} % ({t:.2f}/{duration:.2f} s simulated"
+                             f"{extra})\n")
+            sys.stderr.flush()
             return
         width = 30
-        done = int(width * min(t / duration, 1.0))
+        done = int(width * frac)
         end = "\n" if t >= duration else ""
         sys.stderr.write(f"\r{label:<18} [{'#' * done}{'.' * (width - done)}] "
-                         f"{t:5.2f}/{duration:.2f} s simulated{end}")
+                         f"{t:5.2f}/{duration:.2f} s simulated{extra}{end}")
         sys.stderr.flush()
     return report
 
@@ -92,8 +206,9 @@ def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
 def cmd_run(args) -> int:
     from ptint_drake.report import run_and_write  # noqa: PLC0415
 
+    _out_dir(args.out, Path("out"))  # an --out that is a file fails before the run
     scenario = load(args.scenario, args.set)
-    out = Path(args.out) if args.out else Path("out") / scenario.name
+    out = _out_dir(args.out, Path("out") / scenario.name)
     warn = lambda message: print(f"ptint: warning: {message}", file=sys.stderr)  # noqa: E731
     metrics = run_and_write(scenario, out, replay=not args.no_replay,
                             figures=not args.no_figures,
@@ -124,7 +239,7 @@ def cmd_diagram(args) -> int:
     from ptint_drake.report import write_diagram  # noqa: PLC0415
 
     scenario = load(args.scenario, args.set)
-    out = Path(args.out) if args.out else Path("out") / scenario.name
+    out = _out_dir(args.out, Path("out") / scenario.name)
     paths = write_diagram(scenario, out)
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0
@@ -133,7 +248,7 @@ def cmd_diagram(args) -> int:
 def cmd_paper(args) -> int:
     from ptint_drake.report import write_paper  # noqa: PLC0415
 
-    index = write_paper(Path(args.out), progress_factory=None if args.quiet else _progress)
+    index = write_paper(_out_dir(args.out, Path("out/paper")), progress_factory=None if args.quiet else _progress)
     print(f"wrote {index}")
     return 0
 
@@ -149,8 +264,8 @@ def _floats(text: str, flag: str) -> list:
 
 
 def cmd_sweep(args) -> int:
-    from ptint_drake.studies import sweep  # noqa: PLC0415
     from ptint_drake.outputs import staged_output  # noqa: PLC0415
+    from ptint_drake.studies import sweep  # noqa: PLC0415
 
     betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
     for b in betas:
@@ -161,9 +276,10 @@ def cmd_sweep(args) -> int:
             raise ScenarioError(f"--tf: every value must be > 0, got {tf}")
     if args.workers is not None and args.workers < 1:
         raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
-    scenario = load(args.scenario)  # validates the base scenario before any worker starts
-    name, text = scenario_text(args.scenario)
-    out = Path(args.out) if args.out else Path("out") / f"sweep_{scenario.name}"
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario, args.set)  # validates the base scenario before any worker starts
+    name, text = load_text(args.scenario, args.set)
+    out = _out_dir(args.out, Path("out") / f"sweep_{scenario.name}")
     report = None if args.quiet else (lambda i, n: print(f"sweep: {i}/{n} runs done", file=sys.stderr))
     rows = sweep.run_sweep(text, name, betas, tfs, workers=args.workers, progress=report)
     with staged_output(out) as stage:
@@ -190,9 +306,10 @@ def cmd_robust(args) -> int:
         if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or lo_hi[0] < 0:
             raise ScenarioError(f"--range {key}: expected LOW,HIGH with 0 <= LOW <= HIGH, got {value!r}")
         ranges[key] = tuple(lo_hi)
-    scenario = load(args.scenario)
-    name, text = scenario_text(args.scenario)
-    out = Path(args.out) if args.out else Path("out") / f"robust_{scenario.name}"
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario, args.set)
+    name, text = load_text(args.scenario, args.set)
+    out = _out_dir(args.out, Path("out") / f"robust_{scenario.name}")
     report = None if args.quiet else (
         lambda i, n: print(f"robust: {i}/{n} samples", file=sys.stderr) if i % 10 == 0 or i == n else None)
     result = robust.run_robust(text, name, args.samples, args.seed, args.workers, ranges=ranges,
@@ -211,61 +328,103 @@ def cmd_bench(args) -> int:
     return bench_main(args.rest)
 
 
-def make_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="ptint", description=__doc__.split("\n")[0])
-    sub = parser.add_subparsers(dest="command", required=True)
-    sub.add_parser("list", help="names of the bundled scenarios").set_defaults(func=cmd_list)
+SET_HELP = ("override a scenario field (repeatable); KEY is a path with dots and list "
+            "indices, VALUE is YAML, e.g. controller.K=40 or 'interceptions[0].tf=1.2' "
+            "(README: Scenario files)")
+RESULTS = "Criteria of an interception: README, Results (|e(tf)| <= 1 mm, hold <= 3 mm)."
 
-    run = sub.add_parser("run", help="run one scenario and write its outputs")
-    run.add_argument("scenario", help="a bundled scenario name or a YAML file")
+
+def make_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="ptint", description=__doc__.split("\n")[0],
+        epilog="Paper: Flores-Campos et al., Robotics 2024, 13(10), 145. "
+               "README: Command line, Scenario files.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="names of the bundled scenarios",
+                   description="The bundled scenarios (paper section 3, Table 1; README: "
+                               "Scenario files).").set_defaults(func=cmd_list)
+
+    run = sub.add_parser(
+        "run", help="run one scenario and write its outputs",
+        description="Simulate one scenario: the TBG (paper eqs. 6-10), the sliding surface "
+                    "(eqs. 11, 16, 17) and the controller (eq. 18) on the robot; writes "
+                    "metrics.json, series.npz, figures and replay.html. Exit 0 when it ran, "
+                    "1 when the run failed, 2 on bad input.", epilog=RESULTS)
+    run.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     run.add_argument("--out", help="output folder (default out/NAME)")
-    run.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario field")
+    run.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     run.add_argument("--no-replay", action="store_true", help="skip replay.html")
     run.add_argument("--no-figures", action="store_true", help="skip the figures")
-    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.add_argument("--quiet", action="store_true", help="no progress on stderr")
     run.set_defaults(func=cmd_run)
 
-    diagram = sub.add_parser("diagram", help="write the built diagram as .dot and .svg")
-    diagram.add_argument("scenario")
+    diagram = sub.add_parser(
+        "diagram", help="write the built diagram as .dot and .svg",
+        description="The scenario's Drake diagram (paper Fig. 1: TBG, targets, kinematics, "
+                    "surface, controller, plant) as Graphviz NAME.dot and NAME.svg.")
+    diagram.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     diagram.add_argument("--out", help="output folder (default out/NAME)")
-    diagram.add_argument("--set", action="append", metavar="KEY=VALUE")
+    diagram.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
+    diagram.add_argument("--quiet", action="store_true", help="accepted like the other commands")
     diagram.set_defaults(func=cmd_diagram)
 
-    sw = sub.add_parser("sweep", help="β × tf grid in parallel worker processes")
-    sw.add_argument("scenario")
-    sw.add_argument("--beta", default="0.25,0.5,0.75", help="comma-separated β values")
-    sw.add_argument("--tf", default="1.2,1.5,1.9", help="comma-separated tf values (s)")
+    sw = sub.add_parser(
+        "sweep", help="β × tf grid in parallel worker processes",
+        description="Run the scenario on a grid of TBG shapes β and prescribed times tf "
+                    "(paper eq. 6), every segment getting the grid's values; writes sweep.csv "
+                    "and heat maps (README: Sweeps).", epilog=RESULTS)
+    sw.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
+    sw.add_argument("--beta", default="0.25,0.5,0.75",
+                    help="comma-separated β values in (0, 1) (paper eq. 6; default %(default)s)")
+    sw.add_argument("--tf", default="1.2,1.5,1.9",
+                    help="comma-separated prescribed times tf in s (default %(default)s)")
     sw.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
+    sw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     sw.add_argument("--out", help="output folder (default out/sweep_NAME)")
-    sw.add_argument("--quiet", action="store_true")
+    sw.add_argument("--quiet", action="store_true", help="no progress on stderr")
     sw.set_defaults(func=cmd_sweep)
 
-    rb = sub.add_parser("robust", help="Monte Carlo study over unknown dynamics and disturbances")
-    rb.add_argument("scenario")
-    rb.add_argument("--samples", type=int, default=100)
+    rb = sub.add_parser(
+        "robust", help="Monte Carlo study over unknown dynamics and disturbances",
+        description="Monte Carlo over what the controller does not know: masses, friction, "
+                    "payload, the disturbance d of paper eq. 1, measurement noise (README: "
+                    "Robustness and safety); writes robust.json, samples.json, worst.yaml and "
+                    "a histogram.", epilog=RESULTS)
+    rb.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
+    rb.add_argument("--samples", type=int, default=100, help="number of samples (default 100)")
     rb.add_argument("--seed", type=int, default=0, help="sample i uses seed + i")
     rb.add_argument("--workers", type=int, help="worker processes (default 1)")
     rb.add_argument("--range", action="append", metavar="NAME=LOW,HIGH",
                     help="override a parameter range (mass, friction, coulomb, payload, "
                          "disturbance, noise, latency)")
+    rb.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     rb.add_argument("--out", help="output folder (default out/robust_NAME)")
-    rb.add_argument("--quiet", action="store_true")
+    rb.add_argument("--quiet", action="store_true", help="no progress on stderr")
     rb.set_defaults(func=cmd_robust)
 
-    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (see --help there)",
+    # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
+    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
                            add_help=False)
     bench.add_argument("rest", nargs=argparse.REMAINDER)
     bench.set_defaults(func=cmd_bench)
 
-    paper = sub.add_parser("paper", help="reproduce the paper: every scenario, figures, index.html")
+    paper = sub.add_parser(
+        "paper", help="reproduce the paper: every scenario, figures, index.html",
+        description="Run the five curve scenarios (paper Figs. 6-15) and the assembly task "
+                    "(Figs. 16-19), draw the TBG and α families (Figs. 2-4) and write "
+                    "DIR/index.html (README: Quick start).", epilog=RESULTS)
     paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")
-    paper.add_argument("--quiet", action="store_true")
+    paper.add_argument("--quiet", action="store_true", help="no progress on stderr")
     paper.set_defaults(func=cmd_paper)
     return parser
 
 
-def main(argv=None) -> int:
-    args = make_parser().parse_args(argv)
+def _run(argv) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["bench"]:  # everything after it, --help included, is the benchmark's
+        args = argparse.Namespace(func=cmd_bench, rest=argv[1:])
+    else:
+        args = make_parser().parse_args(argv)
     try:
         return args.func(args)
     except ScenarioError as exc:
@@ -274,8 +433,27 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("\nptint: interrupted; no partial output was kept", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        raise
+    except OSError as exc:  # e.g. an --out folder that cannot be written
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"ptint: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 1
     except RuntimeError as exc:  # Drake's simulation errors
         print(f"ptint: error: simulation failed: {' '.join(str(exc).split())[:400]}", file=sys.stderr)
+        return 1
+
+
+def main(argv=None) -> int:
+    try:
+        code = _run(argv)
+        sys.stdout.flush()  # a closed pipe shows up here, not at interpreter exit
+        return code
+    except BrokenPipeError:
+        # The reader went away (`ptint list | head -1`): stop quietly.  Python's
+        # documented recipe: point stdout at devnull so the flush at exit cannot fail again.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
         return 1
 
 

@@ -41,6 +41,40 @@ def _mark_times(ax, times):
         ax.axvline(t, color="k", ls="--", lw=0.8, label="prescribed time $t_f$" if i == 0 else None)
 
 
+def peak_of(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """(time, value) of the largest |y|."""
+    k = int(np.argmax(np.abs(y)))
+    return float(t[k]), float(y[k])
+
+
+def peak_label(name: str, t_peak: float, value: float, unit: str) -> str:
+    """``"τ1: peak −5.89 N·m at t = 0.178 s"`` (with a true minus sign, as on the axes)."""
+    return f"{name}peak {value:.3g} {unit} at t = {t_peak:.3f} s".replace("-", "−")
+
+
+def robust_limit(robot: np.ndarray, target: np.ndarray, spread: float = 3.0) -> float:
+    """A symmetric y limit that shows the curves, not one start-up spike.
+
+    The whole range when the robot's peak is within ``spread`` × its 99th percentile
+    (and the target's range); otherwise the latter, and the peak is marked off scale.
+    """
+    robot, target = np.abs(robot), np.abs(target)
+    whole = max(float(np.max(robot)), float(np.max(target)), 1e-12)
+    body = max(float(np.percentile(robot, 99)), float(np.max(target)), 1e-12)
+    return 1.08 * (whole if whole <= spread * body else body)
+
+
+def mark_peak(ax, t_peak: float, value: float, limit: float | None = None, **style):
+    """A marker at the peak; at the axis edge (pointing out) when it lies beyond ``limit``.
+    Returns the marker's handle, for a legend."""
+    off = limit is not None and abs(value) > limit
+    y = np.sign(value) * limit if off else value
+    marker = ("^" if value > 0 else "v") if off else "o"
+    (h,) = ax.plot([t_peak], [y], ls="none", marker=marker, ms=6, mfc="none", mew=1.5,
+                   clip_on=False, zorder=5, **style)
+    return h
+
+
 def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3, window_s: float = 0.021):
     """(t_u, ẋ, ẍ, x⃛) on a uniform grid from per-step samples of ẋ.
 
@@ -68,7 +102,7 @@ def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2
     curves and the unbounded ones run off the plot (as in the paper).
     Returns the sampled data {label: dict(t, xi, xi_dot, xi_ddot, xi_dddot, alpha, tf, beta)}.
     """
-    fig, axes = plt.subplots(5, 1, figsize=(7, 11), sharex=True)
+    fig, axes = plt.subplots(5, 1, figsize=(7, 11), sharex=True, layout="constrained")
     data = {}
     t_max = max(tf for tf, _ in settings) * 1.15
     limits = {2: [0.0], 3: [0.0]}
@@ -117,10 +151,10 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     x_u = np.column_stack([np.interp(t_u, t, series["x"][:, k]) for k in range(3)])
     xr_u = np.column_stack([np.interp(t_u, t, series["x_r"][:, k]) for k in range(3)])
     _, vr, ar, jr = uniform_derivatives(t, series["xdot_r"])
-    fig, axes = plt.subplots(4, 3, figsize=(12, 10), sharex=True)
-    rows = (("position [m]", x_u, xr_u), ("velocity [m/s]", v, vr),
-            ("acceleration [m/s²]", a, ar), ("jerk [m/s³]", j, jr))
-    for r, (name, robot, target) in enumerate(rows):
+    fig, axes = plt.subplots(4, 3, figsize=(12, 10.5), sharex=True, layout="constrained")
+    rows = (("position", "m", x_u, xr_u), ("velocity", "m/s", v, vr),
+            ("acceleration", "m/s²", a, ar), ("jerk", "m/s³", j, jr))
+    for r, (name, unit, robot, target) in enumerate(rows):
         for k in range(3):
             ax = axes[r, k]
             ax.plot(t_u, robot[:, k], label="robot")
@@ -130,47 +164,70 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
             if r == 0:
                 ax.set_title(AXES[k])
             if k == 0:
-                ax.set_ylabel(name)
-            if r >= 2:
-                ax.set_yscale("symlog", linthresh=1.0)
+                ax.set_ylabel(f"{name} [{unit}]")
+            if r >= 2:  # linear axes scaled to the curves; the robot's peak marked with its time
+                limit = robust_limit(robot[:, k], target[:, k])
+                ax.set_ylim(-limit, limit)
+                t_pk, val = peak_of(t_u, robot[:, k])
+                off = abs(val) > limit
+                h = mark_peak(ax, t_pk, val, limit, color="tab:red")
+                ax.legend([h], [peak_label("", t_pk, val, unit) + (" (off scale)" if off else "")],
+                          loc="best", fontsize=7, handletextpad=0.3, borderpad=0.3)
     for k in range(3):
         axes[-1, k].set_xlabel("time [s]")
-    axes[0, 0].legend(fontsize=8)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=9)
     fig.suptitle(f"{title}: robot vs target per axis")
     save(fig, out_dir, "axes")
     stems.append("axes")
 
-    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    axes[0].semilogy(t, np.maximum(np.linalg.norm(series["e_true"], axis=1), 1e-9), label="|e|")
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8.5), sharex=True, layout="constrained")
+    e_norm = np.linalg.norm(series["e_true"], axis=1)
+    axes[0].semilogy(t, np.maximum(e_norm, 1e-9), label="|e|")
     axes[0].axhline(1e-3, color="r", lw=0.8, label="1 mm")
+    e_tf = [s_["e_tf_norm"] for s_ in metrics["segments"]]
+    hit = [v is not None and v <= 1e-3 for v in e_tf]
+    reached = [(tf, v) for tf, v in zip(tfs, e_tf) if v is not None]
+    if reached:
+        axes[0].plot(*zip(*reached), ls="none", marker="o", mfc="none", color="k", ms=7,
+                     label="|e($t_f$)|")
+    values = ", ".join("n/a" if v is None else f"{v * 1e3:.3g}" for v in e_tf)
+    verdict = ("intercepted" if all(hit) else "NOT intercepted") if len(hit) == 1 else (
+        "every object intercepted" if all(hit) else f"{len(hit) - sum(hit)} of {len(hit)} missed")
+    axes[0].set_title(f"|e($t_f$)| = {values} mm: {verdict} (≤ 1 mm)", fontsize=10)
     axes[0].set_ylabel("|e| [m]")
     for k, axis in enumerate(AXES):  # per axis, as the paper's Fig. 16
         axes[1].plot(t, series["edot_true"][:, k], label=f"ė_{axis.lower()}")
     axes[1].set_ylabel("ė [m/s]")
     for k in range(series["tau"].shape[1]):
-        axes[2].plot(t, series["tau"][:, k], label=f"τ{k + 1}")
+        (line,) = axes[2].plot(t, series["tau"][:, k])
+        t_pk, val = peak_of(t, series["tau"][:, k])
+        mark_peak(axes[2], t_pk, val, color=line.get_color())
+        line.set_label(peak_label(f"τ{k + 1}: ", t_pk, val, "N·m"))
     axes[2].set_ylabel("torque [N·m]")
     axes[2].set_xlabel("time [s]")
     for ax in axes:
         _mark_times(ax, tfs)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.suptitle(f"{title}: interception error, velocity error, torques")
     save(fig, out_dir, "errors")
     stems.append("errors")
 
-    fig, axes = plt.subplots(series["q"].shape[1], 1, figsize=(8, 7), sharex=True)
+    fig, axes = plt.subplots(series["q"].shape[1], 1, figsize=(8, 7), sharex=True,
+                             layout="constrained")
     for k, ax in enumerate(np.atleast_1d(axes)):
         ax.plot(t, np.degrees(series["q"][:, k]))
         ax.set_ylabel(f"θ{k + 1} [deg]")
         _mark_times(ax, tfs)
         ax.grid(alpha=0.3)
+    np.atleast_1d(axes)[0].legend(fontsize=8, loc="best")
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
     fig.suptitle(f"{title}: joint trajectories (model angles θ)")
     save(fig, out_dir, "joints")
     stems.append("joints")
 
-    fig = plt.figure(figsize=(7, 6))
+    fig = plt.figure(figsize=(7.5, 6.5), layout="constrained")
     ax = fig.add_subplot(projection="3d")
     ax.plot(*series["x"].T, label="robot")
     objects = series["objects"].reshape(len(t), -1, 3)
@@ -183,8 +240,9 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     ax.set_xlabel("X [m]")
     ax.set_ylabel("Y [m]")
     ax.set_zlabel("Z [m]")
-    ax.legend(fontsize=8)
-    ax.set_title(f"{title}: 3D paths, red dots at the prescribed times")
+    ax.scatter([], [], color="r", s=30, label="robot at $t_f$")
+    fig.legend(fontsize=8, loc="outside lower center", ncol=6)
+    fig.suptitle(f"{title}: 3D paths, red dots at the prescribed times")
     save(fig, out_dir, "paths3d")
     stems.append("paths3d")
     return stems

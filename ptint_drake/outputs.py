@@ -22,10 +22,33 @@ METRICS = "metrics.json"
 SERIES = "series.npz"
 
 
+def current_umask() -> int:
+    """The process's umask (``os.umask`` can only be read by setting it; set it back at once)."""
+    try:  # Linux ≥ 4.7 shows it without changing it
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _as_if_created(path, mode: int) -> None:
+    """Give a file from ``mkstemp`` (0600) or a folder from ``mkdtemp`` (0700) the mode an
+    ordinary ``open``/``mkdir`` would have: ``mode`` (0666 / 0777) minus the umask."""
+    os.chmod(path, mode & ~current_umask())
+
+
 def write_json_atomic(path: Path, data) -> None:
+    """Write ``data`` as JSON to ``path`` through a temporary file and ``os.replace``; the
+    file gets the usual mode for the user's umask (0644 under umask 022)."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
+        _as_if_created(tmp, 0o666)
         with os.fdopen(fd, "w") as f:
             json.dump(data, f, indent=2)
             f.write("\n")
@@ -51,6 +74,7 @@ def staged_output(out_dir: Path):
     out_dir.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=".ptint-stage-", dir=out_dir))
     try:
+        _as_if_created(stage, 0o777)
         yield stage
         (out_dir / METRICS).unlink(missing_ok=True)
         names = sorted((p.name for p in stage.iterdir()), key=lambda n: n == METRICS)

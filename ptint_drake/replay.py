@@ -6,9 +6,14 @@ separate diagram (plant + SceneGraph + MeshcatVisualizer), while the moving
 objects, the target's path, the gripper's trail and the interception markers
 are animated with ``Meshcat.SetTransform(..., time_in_recording=t)``.
 
-Objects: one sphere per segment target.  Until its segment's prescribed time
-an object follows its own path (rides its conveyor); from then on it is held:
-it moves with the gripper point for the rest of the run (the arm carries it).
+Objects: one sphere per segment target, slightly larger than the end
+effector's own sphere so that a caught object stays visible around the tool
+instead of disappearing inside it.  Until its segment's prescribed time an
+object follows its own path (rides its conveyor); from then on it is held: it
+moves with the gripper point for the rest of the run (the arm carries it).
+
+The floor is a light plate at z = 0 with a 10 cm grid under the working area
+(meshcat's own grid is hidden: in a recorded page it is drawn edge-on).
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from pydrake.geometry import (Box, Meshcat, MeshcatParams, MeshcatVisualizer,
+from pydrake.geometry import (Box, Cylinder, Meshcat, MeshcatParams, MeshcatVisualizer,
                               MeshcatVisualizerParams, Rgba, Role, Sphere)
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
@@ -64,6 +69,61 @@ def with_camera(html: str, camera) -> str:
     return html.replace(_DEFAULT_VIEW, view)
 
 
+OBJECT_RADIUS = 0.018   # m, when the end effector has no geometry to compare with
+FLOOR_COLOR = Rgba(0.93, 0.93, 0.9, 1.0)
+FLOOR_LINES = Rgba(0.55, 0.55, 0.55, 1.0)
+
+
+def end_effector_radius(plant, scene_graph, context, frame_name) -> float:
+    """The radius of the largest illustration shape on the end effector's body (0 if none)."""
+    if not frame_name or not plant.HasFrameNamed(frame_name):
+        return 0.0
+    body = plant.GetFrameByName(frame_name).body()
+    inspector = scene_graph.model_inspector()
+    frame_id = plant.GetBodyFrameIdIfExists(body.index())
+    if frame_id is None:
+        return 0.0
+    radius = 0.0
+    for gid in inspector.GetGeometries(frame_id, Role.kIllustration):
+        shape = inspector.GetShape(gid)
+        if isinstance(shape, Sphere):
+            radius = max(radius, shape.radius())
+        elif isinstance(shape, Cylinder):
+            radius = max(radius, shape.radius(), 0.5 * shape.length())
+        elif isinstance(shape, Box):
+            radius = max(radius, 0.5 * max(shape.width(), shape.depth(), shape.height()))
+    return radius
+
+
+def object_radius(tool_radius: float) -> float:
+    """Objects are drawn 20 % larger than the tool's sphere: a caught object encloses it."""
+    return max(OBJECT_RADIUS, 1.2 * tool_radius)
+
+
+def floor_extent(points: np.ndarray, margin: float = 0.15, step: float = 0.1):
+    """(x_min, x_max, y_min, y_max) on the ``step`` grid, covering the robot's base,
+    ``points`` (N × 3) and ``margin``."""
+    pts = np.vstack([np.zeros((1, 3)), points.reshape(-1, 3)])
+    lo = np.floor((pts[:, :2].min(axis=0) - margin) / step) * step
+    hi = np.ceil((pts[:, :2].max(axis=0) + margin) / step) * step
+    return lo[0], hi[0], lo[1], hi[1]
+
+
+def draw_floor(meshcat: Meshcat, extent, step: float = 0.1) -> None:
+    x0, x1, y0, y1 = extent
+    meshcat.SetProperty("/Grid", "visible", False)
+    meshcat.SetObject("floor/plate", Box(x1 - x0, y1 - y0, 0.004), FLOOR_COLOR)
+    meshcat.SetTransform("floor/plate", RigidTransform([0.5 * (x0 + x1), 0.5 * (y0 + y1), -0.0025]))
+    xs = np.arange(x0, x1 + 0.5 * step, step)
+    ys = np.arange(y0, y1 + 0.5 * step, step)
+    z = 0.0005
+    starts = np.hstack([np.array([xs, np.full_like(xs, y0), np.full_like(xs, z)]),
+                        np.array([np.full_like(ys, x0), ys, np.full_like(ys, z)])])
+    ends = np.hstack([np.array([xs, np.full_like(xs, y1), np.full_like(xs, z)]),
+                      np.array([np.full_like(ys, x1), ys, np.full_like(ys, z)])])
+    meshcat.SetLineSegments("floor/grid", starts, ends, 1.0, FLOOR_LINES)
+
+
 def held_object_index(t: float, starts, ends) -> int:
     """Index of the object the gripper holds at time t (-1 if none).
 
@@ -100,10 +160,11 @@ def object_positions(series: dict, starts, ends) -> np.ndarray:
 
 
 def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
-                 conveyors=None) -> int:
+                 conveyors=None, end_effector: str | None = None) -> int:
     """Write a standalone replay HTML to ``path``; returns its size in bytes.
 
     ``conveyors``: optional list of (start_xyz, end_xyz) belts to draw as boxes.
+    ``end_effector``: the frame whose body's size sets the objects' size (see module doc).
     """
     meshcat = shared_meshcat()
     meshcat.Delete()
@@ -125,20 +186,25 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
     n_obj = objs.shape[1]
 
     raw = series["objects"].reshape(len(t), -1, 3)
+    radius = object_radius(end_effector_radius(plant, scene_graph, context, end_effector))
+    belts = [(np.asarray(a, float), np.asarray(b, float)) for a, b in (conveyors or [])]
+    draw_floor(meshcat, floor_extent(np.vstack([series["x"], raw.reshape(-1, 3)]
+                                               + [np.vstack(b) for b in belts])))
     for i in range(n_obj):
         color = COLORS[i % len(COLORS)]
         meshcat.SetLine(f"paths/target_{i}", raw[:, i, :].T.copy(), 2.0,
                         Rgba(color.r(), color.g(), color.b(), 0.6))
-        meshcat.SetObject(f"objects/object_{i}", Sphere(0.018), color)
+        meshcat.SetObject(f"objects/object_{i}", Sphere(radius), color)
         meshcat.SetObject(f"intercepts/point_{i}", Sphere(0.01), Rgba(1, 0.9, 0, 1))
         k = min(np.searchsorted(t, ends[i]), len(t) - 1)
         meshcat.SetTransform(f"intercepts/point_{i}", RigidTransform(series["x"][k]))
     meshcat.SetLine("paths/gripper_trail", series["x"].T.copy(), 3.0, Rgba(0.1, 0.1, 0.1, 0.9))
-    for j, (a, b) in enumerate(conveyors or []):
-        a, b = np.asarray(a, float), np.asarray(b, float)
+    for j, (a, b) in enumerate(belts):  # a belt under each object, as wide as the object
         length = float(np.linalg.norm(b - a))
-        meshcat.SetObject(f"conveyors/belt_{j}", Box(0.04, length, 0.01), Rgba(0.3, 0.3, 0.3, 1))
-        meshcat.SetTransform(f"conveyors/belt_{j}", RigidTransform(0.5 * (a + b) - [0, 0, 0.025]))
+        meshcat.SetObject(f"conveyors/belt_{j}", Box(2.4 * radius, length, 0.01),
+                          Rgba(0.3, 0.3, 0.3, 1))
+        meshcat.SetTransform(f"conveyors/belt_{j}",
+                             RigidTransform(0.5 * (a + b) - [0, 0, radius + 0.005]))
 
     meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
     frames = np.arange(t[0], t[-1] + 0.5 / fps, 1.0 / fps)

@@ -111,3 +111,42 @@ def test_uniform_derivatives_of_a_known_signal():
     inner = slice(50, -50)
     np.testing.assert_allclose(a_u[inner, 0], 3 * np.cos(3 * t_u[inner]), atol=1e-4)
     np.testing.assert_allclose(j_u[inner, 1], -4 * np.cos(2 * t_u[inner]), atol=1e-3)
+
+
+def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
+    """The floor is a plate seen from above (not an edge-on band), and a caught object
+    is drawn larger than the tool sphere, so it shows around the gripper."""
+    from playwright.sync_api import sync_playwright
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
+    from ptint_drake.replay import end_effector_radius, floor_extent, object_radius
+    from ptint_drake.robot import resolve_model
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    Parser(plant).AddModels(str(resolve_model("rvm1")))
+    plant.Finalize()
+    tool = end_effector_radius(plant, scene_graph, None, "tool")
+    assert tool == pytest.approx(0.03)
+    assert object_radius(tool) > tool
+    x0, x1, y0, y1 = floor_extent(np.array([[0.3, -0.4, 0.1], [0.2, 0.5, 0.3]]))
+    assert x0 <= -0.15 and x1 >= 0.45 and y0 <= -0.55 and y1 >= 0.65
+
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=BROWSER_ARGS)
+        page = browser.new_page(viewport={"width": 1000, "height": 700})
+        page.goto((paper_dir / "curve_b075_tf15" / "replay.html").as_uri())
+        page.wait_for_timeout(5000)  # past tf = 1.5 s: the object is held
+        shot = tmp_path / "held.png"
+        page.screenshot(path=str(shot))
+        browser.close()
+    img = mpimg.imread(shot)[..., :3]
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    floor = (r > 0.85) & (g > 0.85) & (b > 0.8) & (np.abs(r - g) < 0.03)
+    rows = np.nonzero(floor.sum(axis=1) > 50)[0]
+    assert floor.sum() > 0.1 * floor.size  # a plate, not a thin band
+    assert len(rows) > 0.2 * img.shape[0]
+    red = (r > 0.6) & (g < 0.25) & (b < 0.25)  # object 1 (red) around the tool
+    assert red.sum() > 150

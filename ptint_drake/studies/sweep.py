@@ -101,31 +101,72 @@ def write_csv(rows, path: Path) -> None:
 
 
 def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
-    """One heat map per metric over (tf, β); returns the stems written."""
+    """One heat map per metric over (tf, β), plus a map of which points intercepted
+    (README, Results: |e(tf)| ≤ 1 mm, hold ≤ 3 mm, |e(tf/2)| ≥ |e0|/4); returns the stems written."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm  # noqa: PLC0415
+
     metrics = (("e_tf", "|e(tf)| [mm]", 1e3), ("hold", "hold max |e| [mm]", 1e3),
                ("peak_torque", "peak |τ| [N·m]", 1.0), ("peak_jerk", "peak |jerk| [m/s³]", 1.0),
-               ("realtime_factor", "realtime factor", 1.0))
-    fig, axes = plt.subplots(1, len(metrics), figsize=(4.2 * len(metrics), 3.8))
-    lookup = {(r["beta"], r["tf"]): r for r in rows}
+               ("realtime_factor", "realtime factor [-]", 1.0))
+    lookup = {(float(r["beta"]), float(r["tf"])): r for r in rows}
+    nb, nt = len(betas), len(tfs)
+    cell_text = nb * nt <= 100
+    fontsize = 8 if max(nb, nt) <= 6 else 6
+    fig, axes = plt.subplots(2, 3, figsize=(13.5, 7.2 + 0.15 * max(nb - 4, 0)),
+                             layout="constrained", sharex=True, sharey=True)
+    axes = axes.ravel()
+
+    def frame(ax, label):
+        ax.set_xticks(range(nt), [f"{tf:g}" for tf in tfs], rotation=45 if nt > 6 else 0)
+        ax.set_yticks(range(nb), [f"{b:g}" for b in betas])
+        ax.set_title(label, fontsize=10)
+        ax.tick_params(labelbottom=True, labelleft=True)
+        ax.set_xlabel("$t_f$ [s]")
+        ax.set_ylabel("β")
+
+    status = np.full((nb, nt), 2.0)  # 0 intercepted, 1 missed, 2 error / not run
+    for i, b in enumerate(betas):
+        for j, tf in enumerate(tfs):
+            r = lookup.get((float(b), float(tf)))
+            if r and not r.get("error"):
+                status[i, j] = 0.0 if r.get("ok") in (True, "True") else 1.0
     for ax, (key, label, scale) in zip(axes, metrics):
-        grid = np.full((len(betas), len(tfs)), np.nan)
+        grid = np.full((nb, nt), np.nan)
         for i, b in enumerate(betas):
             for j, tf in enumerate(tfs):
                 r = lookup.get((float(b), float(tf)))
-                if r and not r.get("error"):
-                    grid[i, j] = r[key] * scale
-        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
-        ax.set_xticks(range(len(tfs)), [f"{tf:g}" for tf in tfs])
-        ax.set_yticks(range(len(betas)), [f"{b:g}" for b in betas])
-        ax.set_xlabel("tf [s]")
-        ax.set_ylabel("β")
-        ax.set_title(label, fontsize=9)
-        for i in range(len(betas)):
-            for j in range(len(tfs)):
-                if np.isfinite(grid[i, j]):
-                    ax.text(j, i, f"{grid[i, j]:.3g}", ha="center", va="center", color="w", fontsize=7)
-        fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.suptitle(title)
+                if r and not r.get("error") and r.get(key) not in (None, ""):
+                    grid[i, j] = float(r[key]) * scale
+        finite = grid[np.isfinite(grid)]
+        norm = None
+        if finite.size and finite.min() > 0 and finite.max() / finite.min() > 30:
+            norm = LogNorm(finite.min(), finite.max())  # spans decades: colour by order of magnitude
+        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis", norm=norm)
+        frame(ax, label)
+        cbar = fig.colorbar(im, ax=ax, shrink=0.9)
+        cbar.ax.tick_params(labelsize=8)
+        if cell_text and finite.size:
+            for i in range(nb):
+                for j in range(nt):
+                    if np.isfinite(grid[i, j]):
+                        r, g, b_, _ = im.cmap(im.norm(grid[i, j]))
+                        dark = 0.299 * r + 0.587 * g + 0.114 * b_ < 0.5
+                        ax.text(j, i, f"{grid[i, j]:.3g}", ha="center", va="center",
+                                color="w" if dark else "k", fontsize=fontsize)
+    ax = axes[len(metrics)]
+    colors = ListedColormap(["#4caf50", "#e53935", "#9e9e9e"])
+    ax.imshow(status, origin="lower", aspect="auto", cmap=colors,
+              norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], 3))
+    frame(ax, "intercepted?")
+    if cell_text:
+        words = {0.0: "yes", 1.0: "missed", 2.0: "error"}
+        for i in range(nb):
+            for j in range(nt):
+                ax.text(j, i, words[status[i, j]], ha="center", va="center", color="w",
+                        fontsize=fontsize, fontweight="bold")
+    n_ok = int(np.sum(status == 0))
+    fig.suptitle(f"{title}: {n_ok} of {nb * nt} points intercepted "
+                 f"(|e(tf)| ≤ 1 mm, hold ≤ 3 mm, |e(tf/2)| ≥ |e0|/4)")
     save(fig, out_dir, "sweep")
     return ["sweep"]
 
