@@ -96,7 +96,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
              warn: Optional[Callable[[str], None]] = None) -> RunResult:
     """Run a scenario; returns its metrics (with the verdict) and the logged time series.
 
-    ``progress(t, duration)`` is called while it runs; ``warn(message)`` is called for
+    ``progress(t, duration, steps)`` is called while it runs; ``warn(message)`` is called for
     each warning known before the simulation starts, as soon as it is known.  A run
     stopped by the divergence watchdog returns normally with ``status == "failed"``.
     """
@@ -143,9 +143,9 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
         x, xdot, _ = gripper(context)
         target = true_state(t_stop)
         samples[t_stop] = (x - target[0:3], xdot - target[3:6])
-    if progress is not None:
-        progress(context.get_time(), scenario.duration)
     integrator = simulator.get_integrator()
+    if progress is not None:
+        progress(context.get_time(), scenario.duration, int(integrator.get_num_steps_taken()))
     series = collect_series(built, context, kinematics)
     metrics = run_metrics(scenario, samples, series, built.station.effort_limits)
     warnings += singularity_warnings(plant, scenario, series) + joint_limit_warnings(plant, series)

@@ -65,7 +65,7 @@ class Watchdog:
             now = time.perf_counter()
             if now - self._last > 0.2:
                 self._last = now
-                self._progress(t, self._scenario.duration)
+                self._progress(t, self._scenario.duration, self._count)
         return _SUCCEEDED
 
     def _fail(self, t, what):
