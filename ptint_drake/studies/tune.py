@@ -179,8 +179,19 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
     key = "smallest_working" if smallest else "largest_working"
     result |= {"gains": gains, key: {settings.gain: value, "per_variant": best},
                "smallest_working": {settings.gain: value, "per_variant": best},
-               "scenario_obj": _set_gain(scenario, settings.gain, value)}
+               "scenario_obj": _portable(_set_gain(scenario, settings.gain, value))}
     return result
+
+
+def _portable(scenario):
+    """The scenario with its model file written as an absolute path (bundled names stay),
+    so that tuned.yaml runs from any folder."""
+    from ptint_drake.rvm1 import bundled_models  # noqa: PLC0415
+    from ptint_drake.robot import resolve_model  # noqa: PLC0415
+
+    if scenario.robot.model not in bundled_models():
+        scenario.robot.model = str(resolve_model(scenario.robot.model).resolve())
+    return scenario
 
 
 def _mm(value) -> str:
