@@ -322,6 +322,80 @@ def cmd_robust(args) -> int:
     return 0
 
 
+def _where(args):
+    """--workers / --dask of a study, checked."""
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
+    return {"workers": args.workers, "dask": args.dask}
+
+
+def _runs(label: str, quiet: bool):
+    """Progress of a study on stderr: one line per finished run."""
+    if quiet:
+        return None
+    return lambda done, total, *_: print(f"{label}: {done}/{total} runs done", file=sys.stderr)
+
+
+def _dask_errors(call):
+    from ptint_drake.studies.runner import SchedulerUnreachable  # noqa: PLC0415
+
+    try:
+        return call()
+    except SchedulerUnreachable as exc:  # bad input: one line, exit 2
+        raise ScenarioError(f"--dask: {exc}") from None
+
+
+def cmd_compare(args) -> int:
+    from ptint_drake.scenario import CONTROLLER_TYPES  # noqa: PLC0415
+    from ptint_drake.studies import compare  # noqa: PLC0415
+
+    controllers = compare.parse_list(args.controllers, "--controllers", CONTROLLER_TYPES)
+    variants = compare.parse_list(args.variants, "--variants")
+    where = _where(args)
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario, args.set)
+    name, text = load_text(args.scenario, args.set)
+    compare.check_variants(text, name, variants)
+    out = _out_dir(args.out, Path("out") / f"compare_{scenario.name}")
+    result = _dask_errors(lambda: compare.run_compare(
+        text, name, controllers, variants, progress=_runs("compare", args.quiet), **where))
+    compare.write_compare(result, out)
+    print(compare.to_markdown(result))
+    print(f"{compare.summary_line(result)}; wrote {out}/compare.md")
+    return 0
+
+
+def cmd_tune(args) -> int:
+    from ptint_drake.studies import tune  # noqa: PLC0415
+
+    if args.gain not in tune.GAINS:
+        raise ScenarioError(f"--gain: must be one of {', '.join(tune.GAINS)}, got {args.gain!r}")
+    if not args.margin >= 1.0:
+        raise ScenarioError(f"--margin: must be >= 1, got {args.margin}")
+    if not 0.0 <= args.max_saturation <= 1.0:
+        raise ScenarioError(f"--max-saturation: must be in [0, 1], got {args.max_saturation}")
+    variants = [v.strip() for v in args.variants.split(",") if v.strip()]
+    if not variants:
+        raise ScenarioError("--variants: no values given")
+    where = _where(args)
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario, args.set)
+    name, text = load_text(args.scenario, args.set)
+    out = _out_dir(args.out, Path("out") / f"tune_{scenario.name}")
+    settings = tune.TuneSettings(gain=args.gain, variants=tuple(variants), margin=args.margin,
+                                 max_saturation=args.max_saturation)
+    say = (lambda message: None) if args.quiet else (lambda message: print(message, file=sys.stderr))
+    result = _dask_errors(lambda: tune.run_tune(text, name, settings, progress=_runs("tune", args.quiet),
+                                                say=say, **where))
+    tune.write_tune(result, out)
+    print(tune.summary_line(result))
+    if result["gains"] is None:
+        print(f"ptint: no tuned.yaml written; wrote {out}/tune.json, tune.png", file=sys.stderr)
+        return 1
+    print(f"wrote {out}/tuned.yaml (run it: ptint run {out}/tuned.yaml), tune.json, tune.png")
+    return 0
+
+
 def cmd_bench(args) -> int:
     from ptint_drake.studies.benchmark import main as bench_main  # noqa: PLC0415
 
@@ -332,6 +406,16 @@ SET_HELP = ("override a scenario field (repeatable); KEY is a path with dots and
             "indices, VALUE is YAML, e.g. controller.K=40 or 'interceptions[0].tf=1.2' "
             "(README: Scenario files)")
 RESULTS = "Criteria of an interception: README, Results (|e(tf)| <= 1 mm, hold <= 3 mm)."
+
+
+def _study_arguments(parser, default_out: str) -> None:
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
+    where.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
+    parser.add_argument("--set", action="append", metavar="KEY=VALUE",
+                        help="override a scenario field, list items included")
+    parser.add_argument("--out", help=f"output folder (default {default_out})")
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
 def make_parser() -> argparse.ArgumentParser:
@@ -403,6 +487,36 @@ def make_parser() -> argparse.ArgumentParser:
     rb.set_defaults(func=cmd_robust)
 
     # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
+    cmp_ = sub.add_parser(
+        "compare", help="controllers side by side on plant variants (README: Controllers compared)",
+        description="Every controller × plant variant on the same scenario, in parallel; writes "
+                    "compare.json, compare.csv, compare.md and compare.png. Exit 0 when every run "
+                    "completed (a miss is a result), 2 on bad input.")
+    cmp_.add_argument("scenario", help="a bundled scenario name or a YAML file")
+    cmp_.add_argument("--controllers", default="ptsmc,pd,smc,ct_quintic",
+                      help="comma-separated: ptsmc (the paper's), pd, smc, ct_quintic")
+    cmp_.add_argument("--variants", default="nominal,mass_x0.7,mass_x1.5",
+                      help="comma-separated plant variants: nominal, mass_xF, payload_Mkg")
+    _study_arguments(cmp_, "out/compare_NAME")
+    cmp_.set_defaults(func=cmd_compare)
+
+    tn = sub.add_parser(
+        "tune", help="the smallest gain that meets the prescribed time on every variant (README: Your own arm)",
+        description="1-D search of one gain (K or Lambda: the smallest that works; phi: the largest) so "
+                    "that every segment meets the criteria divided by --margin on every plant variant "
+                    "and the actuators saturate at most --max-saturation of the time. Writes tuned.yaml "
+                    "(only when a value works), tune.json and tune.png. Exit 0 when found, 1 when no "
+                    "value in the range works, 2 on bad input.")
+    tn.add_argument("scenario", help="a bundled scenario name or a YAML file")
+    tn.add_argument("--gain", default="K", help="K (default), Lambda or phi")
+    tn.add_argument("--variants", default="nominal,mass_x0.7,mass_x1.5",
+                    help="comma-separated plant variants: nominal, mass_xF, payload_Mkg")
+    tn.add_argument("--margin", type=float, default=2.0, help="e(tf) ≤ 1 mm / M, hold ≤ 3 mm / M (default 2)")
+    tn.add_argument("--max-saturation", type=float, default=0.05,
+                    help="largest fraction of the time an actuator may saturate (default 0.05)")
+    _study_arguments(tn, "out/tune_NAME")
+    tn.set_defaults(func=cmd_tune)
+
     bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
                            add_help=False)
     bench.add_argument("rest", nargs=argparse.REMAINDER)
