@@ -24,6 +24,8 @@ CONFIGS = {
 }
 REFERENCE = ("simulator: {integration_scheme: runge_kutta5, accuracy: 1.0e-10, "
              "max_step_size: 0.01}")
+# The setting before the implicit default (for ``--pair``'s default B).
+BEFORE = "simulator: {integration_scheme: runge_kutta3, accuracy: 1.0e-4}"
 
 
 def _run(name: str, overrides: str) -> dict:
@@ -71,6 +73,95 @@ def benchmark(names=None, configs=("default", "blocks", "sign"), reference: bool
     return out
 
 
+def section_metrics(m: dict) -> dict:
+    """The SPEC 5.3 metrics of one run, flat: ``SEGMENT.NAME`` and ``torque_peak.JOINT``."""
+    out = {}
+    for i, seg in enumerate(m["segments"]):
+        for key in ("e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm"):
+            out[f"{i}.{key}"] = seg[key]
+    for j, v in enumerate(m["torque_peak"]):
+        out[f"torque_peak.{j}"] = v
+    return out
+
+
+def metric_errors(m: dict, ref: dict, rel: float = 0.01, floor: float = 1e-6) -> dict:
+    """Per metric |run − reference| / max(rel·|reference|, floor): ≤ 1 is within tolerance
+    (1 %, or 1 µm, 1 µm/s, 1 µN·m for tiny values).  ``worst`` names the largest."""
+    a, b = section_metrics(m), section_metrics(ref)
+    errors = {k: (float("inf") if a.get(k) is None or b[k] is None
+                  else abs(a[k] - b[k]) / max(rel * abs(b[k]), floor)) for k in b}
+    worst = max(errors, key=errors.get)
+    return {"worst": worst, "worst_ratio": errors[worst], "ratios": errors}
+
+
+def _timed(name: str, overrides: str) -> "tuple[dict, float]":
+    t0 = time.perf_counter()
+    m = _run(name, overrides)
+    return m, time.perf_counter() - t0
+
+
+def scheme_table(names=None, schemes=("runge_kutta3", "radau3"), accuracies=(1e-3, 1e-4),
+                 extra: str = "", progress=None) -> dict:
+    """Scheme × accuracy on each scenario: steps, derivative evaluations, realtime factor
+    (simulated s / wall s of the whole ``simulate`` call) and the metric errors against
+    the reference run.  ``extra`` is more ``simulator`` YAML (e.g. ``max_step_size: 0.02``)."""
+    names = list(names or bundled_scenarios())
+    out = {"reference": REFERENCE, "tolerance": "max(1 %, 1e-6) per metric", "rows": []}
+    for name in names:
+        ref = _run(name, REFERENCE)
+        for scheme in schemes:
+            for accuracy in accuracies:
+                overrides = (f"simulator: {{integration_scheme: {scheme}, accuracy: {accuracy}"
+                             + (f", {extra}" if extra else "") + "}")
+                if progress:
+                    progress(f"{name} {scheme} {accuracy}")
+                row = {"scenario": name, "scheme": scheme, "accuracy": accuracy}
+                try:
+                    m, wall = _timed(name, overrides)
+                except Exception as exc:  # noqa: BLE001 (an integrator failure is a result)
+                    row["error"] = " ".join(str(exc).split())[:200]
+                    out["rows"].append(row)
+                    continue
+                err = metric_errors(m, ref)
+                row.update(steps=m["sim"]["steps"], derivative_evaluations=m["sim"]["derivative_evaluations"],
+                           realtime_factor=round(m["duration"] / wall, 2), status=m["status"],
+                           worst_metric=err["worst"], worst_error_ratio=round(err["worst_ratio"], 4),
+                           within_tolerance=err["worst_ratio"] <= 1.0)
+                out["rows"].append(row)
+    return out
+
+
+def paired(names=None, a: str = "{}", b: str = BEFORE, repeats: int = 5, progress=None) -> dict:
+    """Time two settings side by side, interleaved A B A B … in this process, per scenario.
+
+    Each timing is the whole ``simulate`` call (build, simulation, telemetry, metrics).
+    ``ratio_b_over_a`` is the median over pairs of wall(B) / wall(A): > 1 means A is faster.
+    """
+    import statistics
+
+    names = list(names or bundled_scenarios())
+    out = {"a": a, "b": b, "repeats": repeats, "scenarios": {}}
+    for name in names:
+        if progress:
+            progress(f"{name} paired")
+        _run(name, a), _run(name, b)  # warm-up (imports, first-call costs)
+        walls_a, walls_b, ratios = [], [], []
+        for _ in range(repeats):
+            ma, wa = _timed(name, a)
+            mb, wb = _timed(name, b)
+            walls_a.append(wa), walls_b.append(wb), ratios.append(wb / wa)
+        out["scenarios"][name] = {
+            "wall_a_s": round(statistics.median(walls_a), 4),
+            "wall_b_s": round(statistics.median(walls_b), 4),
+            "ratio_b_over_a": round(statistics.median(ratios), 3),
+            "ratio_range": [round(min(ratios), 3), round(max(ratios), 3)],
+            "steps": [ma["sim"]["steps"], mb["sim"]["steps"]],
+            "derivative_evaluations": [ma["sim"]["derivative_evaluations"],
+                                       mb["sim"]["derivative_evaluations"]],
+        }
+    return out
+
+
 def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
                     tfs=(1.2, 1.5, 1.9), workers=(1, 2)) -> dict:
     """Wall time of a 3 × 3 ``ptint sweep`` grid with 1 and 2 worker processes."""
@@ -93,7 +184,30 @@ def main(argv=None) -> int:
     parser.add_argument("--no-reference", action="store_true", help="skip the tight reference runs")
     parser.add_argument("--sweep", action="store_true",
                         help="also time a 3 x 3 sweep with 1 and 2 worker processes")
+    parser.add_argument("--schemes", metavar="LIST",
+                        help="scheme × accuracy table instead: comma-separated integration schemes")
+    parser.add_argument("--accuracies", default="1e-3,1e-4", metavar="LIST",
+                        help="with --schemes: comma-separated accuracies (default 1e-3,1e-4)")
+    parser.add_argument("--simulator-extra", default="", metavar="YAML",
+                        help="with --schemes: more simulator fields, e.g. 'max_step_size: 0.02'")
+    parser.add_argument("--pair", nargs=2, metavar=("A", "B"),
+                        help="time two override mappings side by side (interleaved), e.g. "
+                             f"'{{}}' '{BEFORE}'")
+    parser.add_argument("--repeats", type=int, default=5, help="with --pair: pairs per scenario")
     args = parser.parse_args(argv)
+    say = lambda s: print(f"bench: {s}", file=__import__("sys").stderr)  # noqa: E731
+    if args.schemes or args.pair:
+        result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
+                              "cpus": __import__("os").cpu_count()}}
+        if args.schemes:
+            result["schemes"] = scheme_table(
+                args.scenarios or None, [s for s in args.schemes.split(",") if s],
+                [float(a) for a in args.accuracies.split(",") if a], args.simulator_extra, say)
+        if args.pair:
+            result["paired"] = paired(args.scenarios or None, args.pair[0], args.pair[1],
+                                      args.repeats, say)
+        print(json.dumps(result, indent=2))
+        return 0
     configs = [c for c in args.configs.split(",") if c]
     unknown = [c for c in configs if c not in CONFIGS]
     if unknown:
