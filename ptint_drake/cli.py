@@ -272,6 +272,14 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("\nptint: interrupted; no partial output was kept", file=sys.stderr)
         return 130
+    except ImportError as exc:  # Ctrl-C while a compiled module (pydrake) initializes
+        cause = exc
+        while cause is not None and not isinstance(cause, KeyboardInterrupt):
+            cause = cause.__cause__ or cause.__context__
+        if cause is None:
+            raise
+        print("\nptint: interrupted; no partial output was kept", file=sys.stderr)
+        return 130
     except RuntimeError as exc:  # Drake's simulation errors
         print(f"ptint: error: simulation failed: {' '.join(str(exc).split())[:400]}", file=sys.stderr)
         return 1
