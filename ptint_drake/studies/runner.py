@@ -141,6 +141,9 @@ def _run_dask(address, fn, tasks, window, progress, stats) -> list:
     except ImportError:
         raise SchedulerUnreachable("dask: the 'distributed' package is not installed") from None
     try:
+        # a malformed address or unknown host fails here, fast; inside Client() it would leave a
+        # half-built client whose __del__ blocks 10 s at exit and prints a traceback
+        distributed.comm.resolve_address(address)
         client = distributed.Client(address, timeout=DASK_CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         detail = " ".join(str(exc).split())[:200] or type(exc).__name__
