@@ -4,8 +4,10 @@
     ptint run NAME_OR_FILE [--out DIR]      one scenario: metrics.json, series.npz, figures, replay.html
     ptint paper [--out DIR]                 every paper scenario + TBG figures + index.html
     ptint diagram NAME_OR_FILE [--out DIR]  the built diagram as Graphviz .dot and .svg
-    ptint sweep NAME_OR_FILE --beta B,.. --tf T,.. [--workers N] [--out DIR]   grid → sweep.csv
-    ptint robust NAME_OR_FILE --samples N [--seed S] [--workers W] [--out DIR]   Monte Carlo
+    ptint sweep NAME_OR_FILE --beta B,.. --tf T,.. [--workers N | --dask ADDRESS] [--out DIR]
+                                            grid → sweep.csv
+    ptint robust NAME_OR_FILE --samples N [--seed S] [--workers W | --dask ADDRESS] [--out DIR]
+                                            Monte Carlo
     ptint bench [SCENARIO ...]              speed and accuracy benchmark, JSON on stdout
 
 ``--set key=value`` (repeatable) overrides any scenario field, list items
@@ -266,6 +268,7 @@ def _floats(text: str, flag: str) -> list:
 def cmd_sweep(args) -> int:
     from ptint_drake.outputs import staged_output  # noqa: PLC0415
     from ptint_drake.studies import sweep  # noqa: PLC0415
+    from ptint_drake.studies.runner import SchedulerUnreachable  # noqa: PLC0415
 
     betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
     for b in betas:
@@ -281,8 +284,12 @@ def cmd_sweep(args) -> int:
     name, text = load_text(args.scenario, args.set)
     out = _out_dir(args.out, Path("out") / f"sweep_{scenario.name}")
     report = None if args.quiet else (lambda i, n: print(f"sweep: {i}/{n} runs done", file=sys.stderr))
-    rows = sweep.run_sweep(text, name, betas, tfs, workers=args.workers, progress=report)
-    with staged_output(out) as stage:
+    try:
+        rows = sweep.run_sweep(text, name, betas, tfs, workers=args.workers, progress=report,
+                               dask=args.dask)
+    except SchedulerUnreachable as exc:  # bad input: one line, exit 2
+        raise ScenarioError(f"--dask: {exc}") from None
+    with staged_output(out) as stage:  # entered only once every run finished
         sweep.heatmaps(rows, betas, tfs, stage, f"{scenario.name}: β × tf sweep")
         sweep.write_csv(rows, stage / "sweep.csv")
     ok = sum(1 for r in rows if r.get("ok"))
@@ -292,6 +299,7 @@ def cmd_sweep(args) -> int:
 
 def cmd_robust(args) -> int:
     from ptint_drake.studies import robust  # noqa: PLC0415
+    from ptint_drake.studies.runner import SchedulerUnreachable  # noqa: PLC0415
 
     if args.samples < 1:
         raise ScenarioError(f"--samples: must be >= 1, got {args.samples}")
@@ -312,11 +320,15 @@ def cmd_robust(args) -> int:
     out = _out_dir(args.out, Path("out") / f"robust_{scenario.name}")
     report = None if args.quiet else (
         lambda i, n: print(f"robust: {i}/{n} samples", file=sys.stderr) if i % 10 == 0 or i == n else None)
-    result = robust.run_robust(text, name, args.samples, args.seed, args.workers, ranges=ranges,
-                               progress=report)
-    robust.write_robust(result, out)
+    try:
+        result = robust.run_robust(text, name, args.samples, args.seed, args.workers, ranges=ranges,
+                                   progress=report, dask=args.dask)
+    except SchedulerUnreachable as exc:  # bad input: one line, exit 2
+        raise ScenarioError(f"--dask: {exc}") from None
+    robust.write_robust(result, out)  # staged: the folder is created only now
     p = result["e_tf_percentiles"]
-    print(f"{result['samples']} samples, success rate {100 * result['success_rate']:.1f} %, "
+    print(f"{result['samples']} samples in {result['wall_time_s']:.1f} s "
+          f"({result['samples_per_s']:.2f} samples/s), success rate {100 * result['success_rate']:.1f} %, "
           f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, max {p.get('max', float('nan')) * 1e3:.4f} mm; "
           f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
     return 0
@@ -462,7 +474,9 @@ def make_parser() -> argparse.ArgumentParser:
                     help="comma-separated β values in (0, 1) (paper eq. 6; default %(default)s)")
     sw.add_argument("--tf", default="1.2,1.5,1.9",
                     help="comma-separated prescribed times tf in s (default %(default)s)")
-    sw.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
+    where = sw.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
+    where.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
     sw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     sw.add_argument("--out", help="output folder (default out/sweep_NAME)")
     sw.add_argument("--quiet", action="store_true", help="no progress on stderr")
@@ -477,7 +491,9 @@ def make_parser() -> argparse.ArgumentParser:
     rb.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     rb.add_argument("--samples", type=int, default=100, help="number of samples (default 100)")
     rb.add_argument("--seed", type=int, default=0, help="sample i uses seed + i")
-    rb.add_argument("--workers", type=int, help="worker processes (default 1)")
+    where = rb.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="worker processes (default 1)")
+    where.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
     rb.add_argument("--range", action="append", metavar="NAME=LOW,HIGH",
                     help="override a parameter range (mass, friction, coulomb, payload, "
                          "disturbance, noise, latency)")
@@ -553,6 +569,14 @@ def _run(argv) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"ptint: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 1
+    except ImportError as exc:  # Ctrl-C while a compiled module (pydrake) initializes
+        cause = exc
+        while cause is not None and not isinstance(cause, KeyboardInterrupt):
+            cause = cause.__cause__ or cause.__context__
+        if cause is None:
+            raise
+        print("\nptint: interrupted; no partial output was kept", file=sys.stderr)
+        return 130
     except RuntimeError as exc:  # Drake's simulation errors
         print(f"ptint: error: simulation failed: {' '.join(str(exc).split())[:400]}", file=sys.stderr)
         return 1

@@ -28,7 +28,7 @@ import numpy as np
 from ptint_drake.figures import plt, save
 from ptint_drake.scenario import ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.simulation import simulate
-from ptint_drake.studies.sweep import default_executor
+from ptint_drake.studies.runner import run_tasks
 
 RANGES = {
     "mass": (0.7, 1.5),
@@ -114,21 +114,17 @@ def _percentiles(values) -> dict:
 
 
 def run_robust(text: str, name: str, samples: int, seed: int = 0, workers: int = None,
-               executor=None, ranges: dict = RANGES, progress=None) -> dict:
-    """Run the study; returns the content of robust.json (plus ``rows`` and ``worst_yaml``)."""
+               executor=None, ranges: dict = RANGES, progress=None, dask: str = None) -> dict:
+    """Run the study; returns the content of robust.json (plus ``rows`` and ``worst_yaml``).
+    ``workers`` local processes (default 1), or ``dask`` (a scheduler address), or
+    ``executor`` (used as given, left open).  ``progress(done, total)`` as samples arrive."""
     t0 = time.perf_counter()
-    own = executor is None
-    executor = executor or default_executor(workers or 1)
-    try:
-        futures = [executor.submit(robust_sample, text, name, seed + i, ranges) for i in range(samples)]
-        rows = []
-        for i, f in enumerate(futures):
-            rows.append(f.result())
-            if progress:
-                progress(i + 1, samples)
-    finally:
-        if own:
-            executor.shutdown()
+    report = (lambda done, total, index, row: progress(done, total)) if progress else None
+    stats = {}
+    rows = run_tasks(robust_sample, [(text, name, seed + i, ranges) for i in range(samples)],
+                     workers=workers or (None if executor or dask else 1), dask=dask,
+                     executor=executor, progress=report, stats=stats)
+    wall = time.perf_counter() - t0
     finished = [r for r in rows if r.get("e_tf_max") is not None]
     failed_first = sorted(rows, key=lambda r: (r["ok"], -(r.get("e_tf_max") or np.inf)))
     worst = failed_first[0]
@@ -147,7 +143,14 @@ def run_robust(text: str, name: str, samples: int, seed: int = 0, workers: int =
         "hold_max_percentiles": _percentiles([r["hold_max"] for r in finished]),
         "worst": {"seed": worst["seed"], "ok": worst["ok"], "e_tf": worst.get("e_tf"),
                   "params": worst["params"]},
-        "wall_time_s": time.perf_counter() - t0,
+        "wall_time_s": wall,
+        "samples_per_s": samples / wall if wall > 0 else None,
+        "workers": stats["workers"],
+        "worker_starts": stats["worker_starts"],
+        # resident set of a worker after each sample (MB): flat when nothing leaks
+        "worker_rss_mb": {"max": stats["worker_rss_mb"],
+                          "first": stats["worker_rss_mb_by_task"][0],
+                          "last": stats["worker_rss_mb_by_task"][-1]},
         "rows": rows,
         "worst_yaml": dump_yaml(worst_scenario),
     }

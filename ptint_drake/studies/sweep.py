@@ -2,20 +2,18 @@
 
 Each grid point is one simulation of the scenario with every segment's β and tf
 replaced, run by a worker that builds its own diagram from the scenario *text*
-(Drake diagrams do not pickle).  ``run_sweep`` takes any
-``concurrent.futures.Executor``: a ``ProcessPoolExecutor`` (the default, forked
-on Linux so workers start without re-importing Drake), or e.g. a Dask cluster's
-``Client.get_executor()``.  When a point makes the last interception fall after
+(Drake diagrams do not pickle).  The points run on ``studies.runner``: local
+worker processes (default), a Dask scheduler (``dask=ADDRESS``) or any
+``concurrent.futures.Executor``.  When a point makes the last interception fall after
 the scenario's end, the duration is extended to the last start + 2 tf.
 """
 
 from __future__ import annotations
 
 import csv
-import multiprocessing
 import os
 import time
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +22,7 @@ import numpy as np
 from ptint_drake.figures import plt, save, uniform_derivatives
 from ptint_drake.scenario import ScenarioError, parse_scenario, validate
 from ptint_drake.simulation import simulate
+from ptint_drake.studies.runner import run_tasks
 
 COLUMNS = ("beta", "tf", "e0", "e_tf", "e_half", "hold", "peak_torque", "peak_jerk",
            "realtime_factor", "steps", "ok", "error")
@@ -63,31 +62,15 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
     return row
 
 
-def default_executor(workers: int) -> Executor:
-    """Worker processes: forked on Linux (fast start), spawned elsewhere."""
-    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
-
-
 def run_sweep(text: str, name: str, betas, tfs, executor: Executor = None, workers: int = None,
-              progress=None) -> list[dict]:
+              progress=None, dask: str = None) -> list[dict]:
     """Rows for the grid betas × tfs, in grid order.  ``executor`` is used as given and
-    left open; without one, a process pool of ``workers`` (default: CPU count) is used."""
-    points = [(float(b), float(tf)) for b in betas for tf in tfs]
-    own = executor is None
-    if own:
-        executor = default_executor(workers or os.cpu_count() or 1)
-    try:
-        futures = [executor.submit(sweep_point, text, name, b, tf) for b, tf in points]
-        rows = []
-        for i, future in enumerate(futures):
-            rows.append(future.result())
-            if progress:
-                progress(i + 1, len(points))
-        return rows
-    finally:
-        if own:
-            executor.shutdown()
+    left open; ``dask`` is a scheduler address; without either, ``workers`` local
+    processes (default: CPU count).  ``progress(done, total)`` as rows arrive."""
+    points = [(text, name, float(b), float(tf)) for b in betas for tf in tfs]
+    report = (lambda done, total, index, row: progress(done, total)) if progress else None
+    return run_tasks(sweep_point, points, workers=workers, dask=dask, executor=executor,
+                     progress=report)
 
 
 def write_csv(rows, path: Path) -> None:

@@ -1,0 +1,307 @@
+"""The one task runner every study uses (sweep, robust, compare, tune).
+
+    results = run_tasks(fn, tasks, workers=N)            # local worker processes
+    results = run_tasks(fn, tasks, dask="tcp://host:8786")  # a Dask scheduler
+    results = run_tasks(fn, tasks, executor=pool)         # any concurrent.futures.Executor
+
+``fn(*task)`` is called once per task (``fn`` must be a module-level function and the
+tasks picklable: Drake diagrams do not pickle, send scenario *text*); the results come
+back in task order, whatever the order in which they finished, so a study gives the
+same numbers with 1 worker, N workers or on a cluster.
+
+Local workers (the default) are this module's own small pool, not a
+``ProcessPoolExecutor``:
+
+- forked on Linux (a fork from a parent that has imported Drake starts in ~10 ms;
+  a spawned/forkserver worker re-imports pydrake, ~2 s each), spawned elsewhere;
+- one task in flight per worker (dispatch on completion: a pipe round trip costs
+  ~0.1 ms against ≥ 0.1 s per simulation), so nothing is submitted up front;
+- recycled after ``max_tasks_per_child`` tasks (default ``MAX_TASKS_PER_CHILD``):
+  Drake < 1.56 never frees a Python ``LeafSystem`` (nor the plant it is wired to)
+  once a diagram was built, ≈ 0.7 MB per simulation of ``curve_b075_tf15``; a new
+  worker is forked from the parent, which never builds a diagram.  The stdlib's
+  ``max_tasks_per_child`` refuses ``fork`` (its executor has a management thread);
+  this pool has no thread, so it forks safely;
+- Ctrl-C: the workers ignore SIGINT (the terminal sends it to the whole process
+  group); the parent gets ``KeyboardInterrupt``, terminates every worker (SIGTERM,
+  then SIGKILL after 1 s), waits for them and re-raises — well under a second;
+- a worker that dies (e.g. killed by the OOM killer) raises ``WorkerDied``.
+
+With ``dask=ADDRESS`` a ``distributed.Client`` is opened on that scheduler (and
+closed at the end), with an executor, a window of 2 × (worker threads) tasks in
+flight; on Ctrl-C the pending tasks are cancelled.  An unreachable scheduler raises
+``SchedulerUnreachable``.  Dask workers are long-lived: to bound the Drake leak
+there, start them with ``--lifetime`` (e.g. ``dask worker ADDR --lifetime 30m
+--lifetime-restart``).
+
+``progress(done, total, index, result)`` is called in the calling process as each
+result arrives.  ``stats`` (a dict, optional) receives ``workers``,
+``worker_starts``, ``worker_rss_mb`` (largest resident set of a worker measured
+after a task) and ``worker_rss_mb_by_task`` (per task, in task order).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing
+import os
+import signal
+import sys
+import traceback
+from multiprocessing.connection import wait as wait_any
+
+MAX_TASKS_PER_CHILD = 50
+DASK_CONNECT_TIMEOUT_S = 5.0
+
+
+class SchedulerUnreachable(ConnectionError):
+    """The Dask scheduler given with ``dask=`` cannot be reached."""
+
+
+class WorkerDied(RuntimeError):
+    """A local worker process ended without returning its task's result."""
+
+
+def _rss_mb() -> float:
+    """Resident set of this process now (MB); 0 where /proc is missing."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
+def _call(fn, args):
+    """Run one task where it is executed; returns (result, RSS after it in MB)."""
+    result = fn(*args)
+    return result, _rss_mb()
+
+
+def run_tasks(fn, tasks, *, workers: int | None = None, dask: str | None = None,
+              executor: cf.Executor | None = None, progress=None,
+              max_tasks_per_child: int | None = MAX_TASKS_PER_CHILD, window: int | None = None,
+              stats: dict | None = None) -> list:
+    """``[fn(*t) for t in tasks]`` computed in parallel; see the module docstring.
+
+    At most one of ``dask`` and ``executor``; neither: ``workers`` local processes
+    (default: CPU count).  ``executor`` is used as given and left open.  ``window``
+    bounds the tasks in flight on an executor/Dask (default 2 × workers).
+    ``max_tasks_per_child`` (local pool only; ``None``: never recycle).
+    """
+    tasks = [tuple(t) for t in tasks]
+    if dask is not None and executor is not None:
+        raise ValueError("give dask= or executor=, not both")
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    stats = {} if stats is None else stats
+    stats.update(workers=0, worker_starts=0, worker_rss_mb=0.0, worker_rss_mb_by_task=[])
+    if not tasks:
+        return []
+    if executor is not None:
+        n = workers or getattr(executor, "_max_workers", None) or os.cpu_count() or 1
+        return _run_executor(executor, fn, tasks, window or 2 * n, progress, stats, n)
+    if dask is not None:
+        return _run_dask(dask, fn, tasks, window, progress, stats)
+    return _run_local(fn, tasks, workers or os.cpu_count() or 1, progress, max_tasks_per_child, stats)
+
+
+# --------------------------------------------------------------------------- executors, Dask
+
+def _run_executor(executor, fn, tasks, window, progress, stats, n_workers) -> list:
+    n = len(tasks)
+    results = [None] * n
+    rss = [0.0] * n
+    stats["workers"] = n_workers
+    running: dict = {}
+    submitted = done = 0
+    try:
+        while done < n:
+            while submitted < n and len(running) < window:
+                running[executor.submit(_call, fn, tasks[submitted])] = submitted
+                submitted += 1
+            finished, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+            for future in sorted(finished, key=running.get):
+                i = running.pop(future)
+                results[i], rss[i] = future.result()
+                done += 1
+                if progress:
+                    progress(done, n, i, results[i])
+    except BaseException:
+        for future in running:
+            future.cancel()
+        raise
+    stats["worker_rss_mb_by_task"] = rss
+    stats["worker_rss_mb"] = max(rss)
+    return results
+
+
+def _run_dask(address, fn, tasks, window, progress, stats) -> list:
+    try:
+        import distributed  # noqa: PLC0415
+    except ImportError:
+        raise SchedulerUnreachable("dask: the 'distributed' package is not installed") from None
+    try:
+        # a malformed address or unknown host fails here, fast; inside Client() it would leave a
+        # half-built client whose __del__ blocks 10 s at exit and prints a traceback
+        distributed.comm.resolve_address(address)
+        client = distributed.Client(address, timeout=DASK_CONNECT_TIMEOUT_S, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        detail = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise SchedulerUnreachable(f"cannot reach the Dask scheduler at {address}: {detail}") from None
+    try:
+        threads = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values()) or 1
+        executor = client.get_executor(pure=False)
+        return _run_executor(executor, fn, tasks, window or 2 * threads, progress, stats, threads)
+    finally:
+        client.close(timeout=2)
+
+
+# --------------------------------------------------------------------------- local pool
+
+def _worker_main(conn, fn):
+    """A local worker: tasks ``(index, args)`` in, ``(index, ok, value, rss_mb)`` out."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _die_with_parent()
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return
+        if message is None:
+            return
+        index, args = message
+        try:
+            reply = (index, True, fn(*args))
+        except BaseException as exc:  # noqa: BLE001  (sent to the parent, re-raised there)
+            exc.add_note("in a worker process:\n" + "".join(traceback.format_exc()).rstrip())
+            reply = (index, False, exc)
+        try:
+            conn.send(reply + (_rss_mb(),))
+        except Exception as exc:  # noqa: BLE001  (an unpicklable result or exception)
+            conn.send((index, False, RuntimeError(f"task {index}: cannot send its result back: "
+                                                  f"{exc!r}: {reply[2]!r}"[:500]), _rss_mb()))
+
+
+def _die_with_parent():
+    """Linux: SIGTERM this worker when the parent dies (even by SIGKILL)."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes  # noqa: PLC0415
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
+class _Worker:
+    def __init__(self, ctx, fn):
+        self.conn, child = ctx.Pipe()
+        self.process = ctx.Process(target=_worker_main, args=(child, fn), daemon=True,
+                                   name="ptint-worker")
+        # SIGINT blocked across the fork: the child ignores it before it can arrive, and a
+        # Ctrl-C meanwhile is delivered to the parent when unblocked below.
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            self.process.start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        child.close()
+        self.task = None  # index in flight
+        self.done = 0
+
+    def send(self, index, args):
+        self.conn.send((index, args))
+        self.task = index
+
+    def stop(self):
+        """Ask to exit (between tasks)."""
+        try:
+            self.conn.send(None)
+        except OSError:
+            pass
+
+    def kill(self):
+        if self.process.is_alive():
+            self.process.terminate()
+
+
+def _start_method() -> str:
+    return "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+
+
+def _run_local(fn, tasks, workers, progress, max_tasks_per_child, stats) -> list:
+    ctx = multiprocessing.get_context(_start_method())
+    n = len(tasks)
+    results = [None] * n
+    rss = [0.0] * n
+    pool: list[_Worker] = []
+    retired: list[_Worker] = []
+    submitted = done = 0
+    stats["workers"] = min(workers, n)
+    clean = False
+    try:
+        for _ in range(min(workers, n)):
+            pool.append(_Worker(ctx, fn))
+            stats["worker_starts"] += 1
+        for w in pool:
+            w.send(submitted, tasks[submitted])
+            submitted += 1
+        while done < n:
+            for w in [w for w in retired if not w.process.is_alive()]:
+                _shutdown([w], graceful=True)
+                retired.remove(w)
+            busy = [w for w in pool if w.task is not None]
+            ready = set(wait_any([w.conn for w in busy] + [w.process.sentinel for w in busy]))
+            for slot, w in enumerate(list(pool)):
+                if w.task is None or not (w.conn in ready or w.process.sentinel in ready):
+                    continue
+                try:
+                    index, ok, value, rss_mb = w.conn.recv()
+                except (EOFError, OSError):
+                    w.process.join(1.0)
+                    raise WorkerDied(f"worker process {w.process.pid} died (exit code "
+                                     f"{w.process.exitcode}) while running task {w.task}") from None
+                if not ok:
+                    raise value
+                results[index], rss[index] = value, rss_mb
+                done += 1
+                w.task = None
+                w.done += 1
+                if progress:
+                    progress(done, n, index, value)
+                if submitted < n:
+                    if max_tasks_per_child and w.done >= max_tasks_per_child:
+                        w.stop()
+                        retired.append(w)
+                        w = pool[slot] = _Worker(ctx, fn)
+                        stats["worker_starts"] += 1
+                    w.send(submitted, tasks[submitted])
+                    submitted += 1
+        clean = True
+    finally:
+        _shutdown(pool + retired, graceful=clean)
+    stats["worker_rss_mb_by_task"] = rss
+    stats["worker_rss_mb"] = max(rss)
+    return results
+
+
+def _shutdown(workers, graceful: bool) -> None:
+    """Stop every worker and wait for it: asked politely after a normal end, terminated
+    otherwise (exception, Ctrl-C); SIGKILL for any still alive after 1 s."""
+    for w in workers:
+        w.stop() if graceful else w.kill()
+    for w in workers:
+        w.process.join(1.0 if graceful else 0.5)
+        if w.process.is_alive():
+            w.process.terminate()
+            w.process.join(1.0)
+        if w.process.is_alive():
+            w.process.kill()
+            w.process.join(1.0)
+        w.conn.close()
+        try:
+            w.process.close()
+        except ValueError:
+            pass
