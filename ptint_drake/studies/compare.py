@@ -109,11 +109,15 @@ def table_rows(result: dict) -> list[dict]:
     out = []
     for row in result["rows"]:
         for i, seg in enumerate(row["segments"] or [{}]):
+            prefix = f"segment {i}: "
+            own = [r[len(prefix):] for r in row["reasons"] if r.startswith(prefix)]
+            other = [r for r in row["reasons"] if not r.startswith("segment ")]  # failed/error
             out.append({"controller": row["controller"], "variant": row["variant"], "segment": i,
-                        "ok": row["ok"], "status": row["status"],
+                        "ok": not own and not other and row["status"] in ("ok", "missed"),
+                        "status": row["status"],
                         **{k: seg.get(k) for k in SEGMENT_KEYS},
                         "torque_peak_max": row["torque_peak_max"],
-                        "reasons": "; ".join(row["reasons"])})
+                        "reasons": ", ".join(own + other)})
     return out
 
 
@@ -136,7 +140,8 @@ def to_markdown(result: dict) -> str:
     for r in table_rows(result):
         seg = result["segments"][r["segment"]] if r["segment"] < len(result["segments"]) else {}
         prescribed = seg.get("start", math.nan) + seg.get("tf", math.nan)
-        verdict = "ok" if r["ok"] else (r["status"] + (f" ({r['reasons']})" if r["reasons"] else ""))
+        verdict = "ok" if r["ok"] else (f"MISSED ({r['reasons']})" if r["status"] == "missed"
+                                        else f"{r['status']} ({r['reasons']})")
         lines.append(
             f"| {r['controller']} | {r['variant']} | {r['segment']} | {_mm(r['e0_norm'])} | "
             f"{_mm(r['e_half_norm'])} | {_mm(r['e_tf_norm'])} | {_mm(r['edot_tf_norm'])} | "
