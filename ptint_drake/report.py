@@ -127,8 +127,90 @@ def _fmt_mm(v) -> str:
     return "n/a" if v is None else f"{v * 1e3:.4g}"
 
 
-def write_paper(out_dir: Path, progress_factory=None) -> Path:
-    """Run every paper scenario and write ``out_dir/index.html`` with all figures."""
+COMPARED = ("curve_b075_tf15", "assembly")
+
+
+def paper_task(kind: str, name: str, *args):
+    """One parallel job of ``ptint paper`` (runs in a worker): a compare row, or the hold of a
+    paper scenario with the paper's own s_d formula after tf (``k_hold = k``)."""
+    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.studies.compare import compare_run  # noqa: PLC0415
+
+    _, text = scenario_text(name)
+    if kind == "compare":
+        return compare_run(text, name, *args)
+    scenario = load_scenario(name)
+    scenario.controller.k_hold = scenario.controller.k
+    return [seg["e_hold_max_norm"] for seg in simulate(scenario, check=False).metrics["segments"]]
+
+
+def _parallel_part(workers=None) -> tuple[dict, dict]:
+    """The comparisons of ``COMPARED`` and the paper-formula holds, all runs in parallel."""
+    from ptint_drake.studies import compare  # noqa: PLC0415
+    from ptint_drake.studies.runner import run_tasks  # noqa: PLC0415
+
+    pairs = [(v, c) for v in compare.DEFAULT_VARIANTS for c in compare.DEFAULT_CONTROLLERS]
+    tasks = [("compare", name, c, v) for name in COMPARED for v, c in pairs]
+    tasks += [("hold", name) for name in PAPER_SCENARIOS]
+    t0 = time.perf_counter()
+    results = run_tasks(paper_task, tasks, workers=workers)
+    comparisons = {}
+    for k, name in enumerate(COMPARED):
+        rows = results[k * len(pairs):(k + 1) * len(pairs)]
+        scenario = load_scenario(name)
+        comparisons[name] = {
+            "scenario": name, "controllers": list(compare.DEFAULT_CONTROLLERS),
+            "variants": list(compare.DEFAULT_VARIANTS),
+            "segments": [{"start": i.start, "tf": i.tf, "beta": i.beta} for i in scenario.interceptions],
+            "criteria": {"e_tf": scenario.criteria.e_tf, "hold": scenario.criteria.hold,
+                         "half_fraction": scenario.criteria.half_fraction},
+            "wall_time_s": time.perf_counter() - t0, "rows": rows}
+    holds = dict(zip(PAPER_SCENARIOS, results[len(COMPARED) * len(pairs):]))
+    return comparisons, holds
+
+
+def _result_rows(name: str, m: dict, scenario, paper_holds, figs: str, claim: str) -> list[str]:
+    rows = []
+    for i, seg in enumerate(m["segments"]):
+        ok = m["status"] != "failed" and not segment_reasons(seg, scenario.criteria)
+        first = i == 0
+        rows.append(
+            f"<tr><td>{name}{'' if len(m['segments']) == 1 else f' #{i + 1}'}</td>"
+            f"<td>{seg['beta']}</td><td>{seg['tf']}</td><td>{_fmt_mm(seg['e0_norm'])}</td>"
+            f"<td>{_fmt_mm(seg['e_half_norm'])}</td><td>{_fmt_mm(seg['e_tf_norm'])}</td>"
+            f"<td>{_fmt_mm(seg['e_hold_max_norm'])}</td><td>{_fmt_mm(paper_holds[i])}</td>"
+            f"<td>{', '.join(f'{v:.2f}' for v in m['torque_peak']) if first else ''}</td>"
+            f"<td>{', '.join(f'{v:.2f}' for v in m['torque_peak_after_startup']) if first else ''}</td>"
+            f"<td>{'yes' if ok else 'NO'}</td>"
+            f"<td>{html.escape(figs + ': ' + claim) if first else ''}</td>"
+            f"<td><a href='{name}/replay.html'>replay</a></td></tr>")
+    return rows
+
+
+def _fmt_s(v) -> str:
+    return "never" if v is None else f"{v:.2f}"
+
+
+def _compare_section(name: str, result: dict) -> str:
+    from ptint_drake.studies.compare import table_rows  # noqa: PLC0415
+
+    cells = "".join(
+        f"<tr><td>{r['controller']}</td><td>{r['variant']}</td><td>{r['segment']}</td>"
+        f"<td>{_fmt_mm(r['e_half_norm'])}</td><td>{_fmt_mm(r['e_tf_norm'])}</td>"
+        f"<td>{_fmt_mm(r['e_hold_max_norm'])}</td>"
+        f"<td>{_fmt_s(r['t_arrive'])}</td>"
+        f"<td>{'ok' if r['ok'] else html.escape('MISSED (' + r['reasons'] + ')')}</td></tr>"
+        for r in table_rows(result))
+    return (f"<h3>{name}</h3><table><tr><th>controller</th><th>variant</th><th>segment</th>"
+            f"<th>e(tf/2)</th><th>e(tf)</th><th>hold max</th><th>t_arrive [s]</th><th>verdict</th></tr>"
+            f"{cells}</table><p><a href='compare_{name}/compare.png'><img src='compare_{name}/compare.png' "
+            f"width='1000'></a></p>")
+
+
+def write_paper(out_dir: Path, progress_factory=None, workers=None) -> Path:
+    """Run every paper scenario and the controller comparisons; write ``out_dir/index.html``."""
+    from ptint_drake.studies.compare import write_compare  # noqa: PLC0415
+
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
@@ -136,32 +218,33 @@ def write_paper(out_dir: Path, progress_factory=None) -> Path:
     with staged_output(out_dir / "tbg") as stage:
         for stem, (settings, title) in TBG_FIGURES.items():
             tbg_family_figure(settings, stage, stem, title)
+    comparisons, paper_holds = _parallel_part(workers)
+    for name, result in comparisons.items():
+        write_compare(result, out_dir / f"compare_{name}")
     rows, sections = [], []
     for name, (figs, claim) in PAPER_SCENARIOS.items():
         scenario = load_scenario(name)
         progress = progress_factory(name) if progress_factory else None
         m = run_and_write(scenario, out_dir / name, progress=progress)
-        for i, seg in enumerate(m["segments"]):
-            ok = m["status"] != "failed" and not segment_reasons(seg, scenario.criteria)
-            rows.append(
-                f"<tr><td>{name}{'' if len(m['segments']) == 1 else f' #{i + 1}'}</td>"
-                f"<td>{seg['beta']}</td><td>{seg['tf']}</td><td>{_fmt_mm(seg['e0_norm'])}</td>"
-                f"<td>{_fmt_mm(seg['e_half_norm'])}</td><td>{_fmt_mm(seg['e_tf_norm'])}</td>"
-                f"<td>{_fmt_mm(seg['e_hold_max_norm'])}</td>"
-                f"<td>{', '.join(f'{v:.2f}' for v in m['torque_peak']) if i == 0 else ''}</td>"
-                f"<td>{'yes' if ok else 'NO'}</td>"
-                f"<td>{html.escape(figs + ': ' + claim) if i == 0 else ''}</td>"
-                f"<td><a href='{name}/replay.html'>replay</a></td></tr>")
+        rows += _result_rows(name, m, scenario, paper_holds[name], figs, claim)
         imgs = "".join(f"<a href='{name}/{f}'><img src='{name}/{f}' width='480'></a>"
                        for f in m.get("figures", []))
         sections.append(f"<h2 id='{name}'>{name} ({figs})</h2><p>{html.escape(claim)}. "
                         f"<a href='{name}/replay.html'>Replay</a> · <a href='{name}/metrics.json'>"
                         f"metrics.json</a> · realtime factor {m['sim']['realtime_factor']:.1f}, "
                         f"{m['sim']['steps']} steps</p>{imgs}")
+    compared = "".join(_compare_section(name, result) for name, result in comparisons.items())
+    page = _page(rows, sections, compared, time.perf_counter() - t_start)
+    tmp = out_dir / ".index.html.tmp"
+    tmp.write_text(page, encoding="utf-8")
+    tmp.replace(out_dir / "index.html")
+    return out_dir / "index.html"
+
+
+def _page(rows, sections, compared: str, elapsed: float) -> str:
     tbg_imgs = "".join(f"<h3>{html.escape(title)}</h3><img src='tbg/{stem}.png' width='520'>"
                        for stem, (_, title) in TBG_FIGURES.items())
-    elapsed = time.perf_counter() - t_start
-    page = f"""<!DOCTYPE html>
+    return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>ptint_drake: paper reproduction</title>
 <style>body{{font-family:sans-serif;margin:2em;max-width:1200px}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #bbb;padding:3px 7px;font-size:90%}}img{{margin:4px}}</style></head><body>
@@ -169,15 +252,20 @@ td,th{{border:1px solid #bbb;padding:3px 7px;font-size:90%}}img{{margin:4px}}</s
 <p>Flores-Campos et al., Robotics 2024, 13(10), 145, reproduced with Drake on the RV-M1 model of
 this package (paper gains K = 50, Λ = 5, k = 3, ϵ = δ = 1e-6). Errors in mm. "Intercepted" applies the
 prescribed-time property (README, Results): |e(tf)| ≤ 1 mm, |e(tf/2)| ≥ |e0|/4, |e| ≤ 3 mm while holding.
+"hold max" uses this package's s_d decay after tf (k_hold = 50 1/s); "hold, paper's s_d" the paper's
+own formula (k_hold = k = 3 1/s), shown for comparison (the verdict uses the package's).
+Peak |τ| after start-up leaves out the first 5 % of each segment's tf (at a segment start the object
+moves while the arm rests, so the first step dominates the overall peak).
 Generated in {elapsed:.0f} s.</p>
 <table><tr><th>scenario</th><th>β</th><th>tf [s]</th><th>e0</th><th>e(tf/2)</th><th>e(tf)</th>
-<th>hold max</th><th>peak |τ| [N·m]</th><th>intercepted</th><th>paper says</th><th></th></tr>
+<th>hold max</th><th>hold, paper's s_d</th><th>peak |τ| [N·m]</th><th>peak |τ| after start-up</th>
+<th>intercepted</th><th>paper says</th><th></th></tr>
 {''.join(rows)}</table>
 <h2>Time base generator and α(t)</h2>{tbg_imgs}
+<h2>Controllers compared</h2><p>The paper's controller (ptsmc) against a task-space PID (pd), a
+first-order sliding mode without the TBG (smc) and a model-based quintic plan tracked by inverse
+dynamics of the nominal model, given the target's future (ct_quintic), on the nominal plant and with
+every mass × 0.7 and × 1.5 (README, Controllers compared).</p>{compared}
 {''.join(sections)}
 </body></html>
 """
-    tmp = out_dir / ".index.html.tmp"
-    tmp.write_text(page, encoding="utf-8")
-    tmp.replace(out_dir / "index.html")
-    return out_dir / "index.html"
