@@ -152,7 +152,9 @@ def estimate_figure(text: str, name: str, out_dir: Path, window: float = 0.3) ->
     segments = scenario.schedule().segments
     fig, axes = plt.subplots(2, len(segments), figsize=(5.5 * len(segments), 6.5), squeeze=False)
     for i, seg in enumerate(segments):
-        mask = (t >= seg.end - window) & (t <= seg.end + window)
+        hold_end = scenario.schedule().hold_end(i, scenario.duration)
+        mask = (t >= seg.end - window) & (t <= min(seg.end + window, hold_end)) & \
+            ~((t >= hold_end) & (i + 1 < len(segments)))  # not the next object's first sample
         truth = s["objects"][mask, 3 * i:3 * i + 3]
         est_err = (s["x_r"][mask] - truth) * 1e3
         arm_err = (s["x"][mask] - truth) * 1e3
