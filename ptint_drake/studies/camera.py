@@ -18,14 +18,17 @@ Outputs in DIR: ``camera_study.json`` (every run and the summary), ``camera_stud
 (the table), ``estimate.png`` (the estimate against the truth around each tf, seed 1,
 the scenario's own settings).
 
-Runs go to a process pool (``concurrent.futures.ProcessPoolExecutor`` as in
-``studies/sweep.py``); each worker builds its own diagram from the scenario text.
+Runs go to a local process pool (``concurrent.futures.ProcessPoolExecutor``, forked, as
+``studies/sweep.py`` did; ``_executor``); each worker builds its own diagram from the
+scenario text.  Full grid, 10 seeds (360 runs): 253 s with 2 workers on a 2-core machine.
 """
 
 from __future__ import annotations
 
 import copy
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +38,7 @@ from ptint_drake.metrics import segment_reasons
 from ptint_drake.outputs import staged_output, write_json_atomic
 from ptint_drake.scenario import ScenarioError, parse_scenario, scenario_text, validate
 from ptint_drake.simulation import simulate
-from ptint_drake.studies.sweep import default_executor
+
 
 SCENARIO = "conveyor_pair_camera"
 NOISES = (0.0005, 0.001, 0.002, 0.005)  # m
@@ -71,6 +74,13 @@ def run_case(text: str, name: str, measurement: dict, seed: int) -> dict:
     return row
 
 
+def _executor(workers: int) -> ProcessPoolExecutor:
+    """A local process pool (forked on Linux).  Stand-in until ``studies/runner.py`` (being
+    written elsewhere, not in this tree) can take over: replace ``run_many``'s pool by it."""
+    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+
+
 def run_many(cases: list, workers: int = 2, progress=None) -> list:
     """``cases`` = [(text, name, measurement, seed), …] → rows in the same order."""
     if workers <= 1:
@@ -80,7 +90,7 @@ def run_many(cases: list, workers: int = 2, progress=None) -> list:
             if progress:
                 progress(i + 1, len(cases))
         return rows
-    executor = default_executor(workers)
+    executor = _executor(workers)
     try:
         futures = [executor.submit(run_case, *case) for case in cases]
         rows = []
