@@ -408,6 +408,24 @@ def cmd_tune(args) -> int:
     return 0
 
 
+def cmd_study(args) -> int:
+    from ptint_drake.studies import camera  # noqa: PLC0415
+
+    if args.seeds < 1:
+        raise ScenarioError(f"--seeds: must be >= 1, got {args.seeds}")
+    if args.workers < 1:
+        raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
+    out = Path(args.out) if args.out else Path("out") / f"study_{args.study}"
+    report = None if args.quiet else (
+        lambda i, n: print(f"study camera: {i}/{n} runs", file=sys.stderr) if i % 10 == 0 or i == n else None)
+    result = camera.run_study(seeds=args.seeds, workers=args.workers, out=out, progress=report)
+    runs = sum(row["summary"]["runs"] for row in result["table"])
+    errors = sum(row["summary"]["errors"] for row in result["table"])
+    print(f"{runs} runs ({errors} could not run) in {result['wall_time_s']:.0f} s with "
+          f"{args.workers} workers; wrote {out}/camera_study.md, camera_study.json, estimate.png")
+    return 0
+
+
 def cmd_bench(args) -> int:
     from ptint_drake.studies.benchmark import main as bench_main  # noqa: PLC0415
 
@@ -532,6 +550,14 @@ def make_parser() -> argparse.ArgumentParser:
                     help="largest fraction of the time an actuator may saturate (default 0.05)")
     _study_arguments(tn, "out/tune_NAME")
     tn.set_defaults(func=cmd_tune)
+
+    st = sub.add_parser("study", help="studies: camera (|e(tf)| against noise × latency × estimator)")
+    st.add_argument("study", choices=["camera"])
+    st.add_argument("--seeds", type=int, default=10, help="seeds per grid point (default 10)")
+    st.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    st.add_argument("--out", help="output folder (default out/study_camera)")
+    st.add_argument("--quiet", action="store_true")
+    st.set_defaults(func=cmd_study)
 
     bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
                            add_help=False)

@@ -84,7 +84,8 @@ def target_view(builder: DiagramBuilder, station_system, scenario: Scenario) -> 
     split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
     builder.Connect(station_system.GetOutputPort("objects"), split.get_input_port())
     return AddCameraEstimators(builder, true_position_ports=[split.get_output_port(i) for i in range(n)],
-                               schedule=scenario.schedule(), config=scenario.measurement).target_port
+                               schedule=scenario.schedule(), config=scenario.measurement,
+                               histories=scenario.targets()).target_port  # in view before t = 0
 
 
 def gains_of(scenario: Scenario) -> ControllerGains:

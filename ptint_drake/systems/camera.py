@@ -10,11 +10,20 @@ What it models (``Camera``, one per object):
   evaluated (nor on the dropouts: sample k always carries the same n_k);
 - a fixed latency L: sample k becomes visible at t_k + L;
 - dropouts: a sample whose time falls in a window ``from ≤ t_k < to`` is never
-  delivered (the output keeps holding the last delivered sample).
+  delivered (the output keeps holding the last delivered sample);
+- the object was in view before the run (``prior_window`` W, with ``history``):
+  given the object's true motion as a function of time, the camera has also taken
+  the samples k = −1, −2, … with −W ≤ t_k < 0 (same rate, same latency, same
+  dropout rule, noise from a second stream of the same seed: the samples k ≥ 0 are
+  the same with or without a history).  Those taken at t_k ≤ −L were visible
+  before the run; they fill the delay buffer at t = 0 (``pre_run_samples`` lists
+  them for a filter to start from).  Without ``history`` (or W = 0) the camera has
+  seen nothing before t = 0.
 
 The output ``measurement`` = [stamp, x, y, z, valid] is the newest sample visible
 at time t, held between samples (zero-order hold); ``stamp`` = t_k is the time it
-was taken, ``valid`` = 0 until the first sample is visible (then [0, 0, 0, 0, 0]).
+was taken, ``valid`` = 0 until the first sample is visible (then [0, 0, 0, 0, 0]); with a
+pre-run history the newest pre-run sample (stamp < 0) is visible from t = 0.
 
 What it does not model: the optics (projection, field of view, occlusion by the
 arm, calibration or hand–eye bias), noise that is correlated in time or
@@ -72,6 +81,10 @@ class MeasurementConfig:
     seed: int = 0
     estimator: str = "none"  # none | kalman_cv | kalman_ca
     process_noise: float = 0.01  # q: m²/s³ (kalman_cv) or m²/s⁵ (kalman_ca)
+    # s: how long the camera had each object in view before t = 0 (samples at
+    # −prior_window ≤ t_k < 0); used when the camera is given the object's motion
+    # before the run (the simulation does); 0: nothing is seen before t = 0
+    prior_window: float = 1.0
 
 
 def _field_error(name: str, message: str) -> ValueError:
@@ -89,7 +102,7 @@ def validate_measurement(m: MeasurementConfig) -> None:
     rate = number("rate_hz")
     if not (math.isfinite(rate) and rate > 0.0):
         raise _field_error("rate_hz", f"must be > 0, got {m.rate_hz}")
-    for name in ("noise_std", "latency", "process_noise"):
+    for name in ("noise_std", "latency", "process_noise", "prior_window"):
         value = number(name)
         if not (math.isfinite(value) and value >= 0.0):
             raise _field_error(name, f"must be >= 0 and finite, got {getattr(m, name)}")
@@ -126,7 +139,7 @@ class _NoiseTable:
     large draw, so n_k depends on k only (not on when or how often it is asked for).
     """
 
-    def __init__(self, std: float, seed: int):
+    def __init__(self, std: float, seed):
         self._std = float(std)
         self._rng = np.random.default_rng(seed)
         self._rows = np.zeros((0, 3))
@@ -145,10 +158,15 @@ class Camera(LeafSystem):
     Input port ``x_true`` (3): the object's true position.
     Output port ``measurement`` (5): [stamp, x, y, z, valid] of the newest visible sample.
     Discrete state (one group, 5·N): N slots [stamp, x, y, z, valid], newest first, of
-    the last N delivered samples (``valid`` = 0 marks an empty slot).
+    the last N delivered samples (``valid`` = 0 marks an empty slot); its default
+    value holds the newest pre-run samples when there is a ``history``.
+
+    ``history``: the object's true position as a function of time (a callable
+    t → [x, y, z], or an object whose ``evaluate(t)`` starts with it), used only
+    for the pre-run samples t_k < 0 (``config.prior_window``).
     """
 
-    def __init__(self, *, config: MeasurementConfig, seed_offset: int = 0):
+    def __init__(self, *, config: MeasurementConfig, seed_offset: int = 0, history=None):
         super().__init__()
         validate_measurement(config)
         self._config = config
@@ -157,9 +175,13 @@ class Camera(LeafSystem):
         self._windows = [(float(a), float(b)) for a, b in config.dropouts]
         self._noise = _NoiseTable(config.noise_std, config.seed + seed_offset)
         self._slots = math.ceil(self._latency * config.rate_hz - TIME_TOL) + 2
+        self._pre_run = self._take_pre_run(history, config.seed + seed_offset)
 
         self._x_in = self.DeclareVectorInputPort("x_true", 3)
-        self._buffer_index = self.DeclareDiscreteState(np.zeros(5 * self._slots))
+        buffer = np.zeros((self._slots, 5))
+        for slot, (t_k, z_k) in zip(buffer, reversed(self._pre_run)):
+            slot[:] = [t_k, *z_k, 1.0]
+        self._buffer_index = self.DeclareDiscreteState(buffer.ravel())
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._take_sample)
         if self._latency > 0.0:
             # no-op: only makes the simulator stop where the output changes
@@ -179,6 +201,27 @@ class Camera(LeafSystem):
     def buffer_slots(self) -> int:
         """N, the number of samples the delay buffer holds."""
         return self._slots
+
+    def pre_run_samples(self, visible_by: float = 0.0) -> list:
+        """[(t_k, z_k), …], oldest first: the delivered pre-run samples (t_k < 0) that are
+        visible at ``visible_by`` (t_k + latency ≤ visible_by); empty without a history."""
+        return [(t_k, z_k.copy()) for t_k, z_k in self._pre_run
+                if t_k + self._latency <= visible_by + TIME_TOL]
+
+    def _take_pre_run(self, history, seed) -> list:
+        window = float(self._config.prior_window)
+        if history is None or window <= 0.0:
+            return []
+        position = history if callable(history) else (lambda t: history.evaluate(t)[0:3])
+        noise = _NoiseTable(self._config.noise_std, [seed, 1])  # second stream: k < 0
+        count = math.floor(window * self._config.rate_hz + TIME_TOL)
+        samples = []
+        for j in range(count, 0, -1):  # k = −j, oldest first
+            t_k = -j * self._period
+            if not self.dropped(t_k):
+                z = np.asarray(position(t_k), dtype=float)[0:3] + noise(j - 1)
+                samples.append((t_k, z))
+        return samples
 
     def get_x_true_input_port(self):
         return self._x_in

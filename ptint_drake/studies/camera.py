@@ -1,0 +1,216 @@
+"""Intercepting what a camera sees (``ptint study camera``).
+
+|e(tf)| against the *true* target, per segment, on ``conveyor_pair_camera`` over a grid
+
+    noise_std ∈ {0.5, 1, 2, 5} mm × latency ∈ {0, 33, 66} ms ×
+    estimator ∈ {none, kalman_cv, kalman_ca}
+
+and ``--seeds`` seeds (measurement.seed = 1 … N): median and 90th percentile over the
+runs and the segments (each segment of each run is one value), the median hold and
+how many segments arrived early.  ``none`` is the legacy noisy analytic path: the
+controller sees x(t − L) + noise (piecewise linear between 30 Hz samples) with the
+profile's *true* derivatives, latency compensated with the true profile — an upper
+bound of what an estimator can achieve, not a camera model.  The Kalman rows use the
+scenario's own filter settings (process noise, 1 s in view before the run), with
+``process_noise`` for ``kalman_ca`` from ``CA_PROCESS_NOISE``.
+
+Outputs in DIR: ``camera_study.json`` (every run and the summary), ``camera_study.md``
+(the table), ``estimate.png`` (the estimate against the truth around each tf, seed 1,
+the scenario's own settings).
+
+Runs go to a local process pool (``concurrent.futures.ProcessPoolExecutor``, forked, as
+``studies/sweep.py`` did; ``_executor``); each worker builds its own diagram from the
+scenario text.  Full grid, 10 seeds (360 runs): 253 s with 2 workers on a 2-core machine.
+"""
+
+from __future__ import annotations
+
+import copy
+import multiprocessing
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from ptint_drake.figures import plt, save
+from ptint_drake.metrics import segment_reasons
+from ptint_drake.outputs import staged_output, write_json_atomic
+from ptint_drake.scenario import ScenarioError, parse_scenario, scenario_text, validate
+from ptint_drake.simulation import simulate
+
+
+SCENARIO = "conveyor_pair_camera"
+NOISES = (0.0005, 0.001, 0.002, 0.005)  # m
+LATENCIES = (0.0, 0.033, 0.066)  # s
+ESTIMATORS = ("none", "kalman_cv", "kalman_ca")
+# kalman_ca on a conveyor: white jerk density (m²/s⁵); the scenario's q is for kalman_cv
+CA_PROCESS_NOISE = 1.0e-3
+DEFAULT_SEEDS = 10
+
+
+def run_case(text: str, name: str, measurement: dict, seed: int) -> dict:
+    """One run of the scenario text with ``measurement`` fields (or dotted scenario fields,
+    e.g. ``controller.alpha_hold``) replaced and measurement.seed = ``seed``;
+    returns per-segment e_tf, hold and verdict reasons (``error`` set if it could not run)."""
+    row = {"measurement": dict(measurement), "seed": seed, "error": ""}
+    try:
+        scenario = parse_scenario(text, name)
+        for key, value in measurement.items():  # "noise_std" or e.g. "controller.alpha_hold"
+            owner, _, field = key.rpartition(".")
+            setattr(getattr(scenario, owner) if owner else scenario.measurement, field, value)
+        scenario.measurement.seed = seed
+        validate(scenario)
+        result = simulate(scenario, check=False)
+    except (ScenarioError, RuntimeError) as exc:
+        row["error"] = " ".join(str(exc).split())[:200]
+        return row
+    m = result.metrics
+    row["status"] = m["status"]
+    row["segments"] = [{"e0": s["e0_norm"], "e_half": s["e_half_norm"], "e_tf": s["e_tf_norm"],
+                        "hold": s["e_hold_max_norm"],
+                        "reasons": segment_reasons(s, scenario.criteria)} for s in m["segments"]]
+    row["wall_s"] = m["sim"]["wall_time_s"]
+    return row
+
+
+def _executor(workers: int) -> ProcessPoolExecutor:
+    """A local process pool (forked on Linux).  Stand-in until ``studies/runner.py`` (being
+    written elsewhere, not in this tree) can take over: replace ``run_many``'s pool by it."""
+    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+
+
+def run_many(cases: list, workers: int = 2, progress=None) -> list:
+    """``cases`` = [(text, name, measurement, seed), …] → rows in the same order."""
+    if workers <= 1:
+        rows = []
+        for i, case in enumerate(cases):
+            rows.append(run_case(*case))
+            if progress:
+                progress(i + 1, len(cases))
+        return rows
+    executor = _executor(workers)
+    try:
+        futures = [executor.submit(run_case, *case) for case in cases]
+        rows = []
+        for i, future in enumerate(futures):
+            rows.append(future.result())
+            if progress:
+                progress(i + 1, len(cases))
+        return rows
+    finally:
+        executor.shutdown(cancel_futures=True)
+
+
+def summarize(rows: list) -> dict:
+    """Median / p90 of |e(tf)| over every segment of every run, median hold, early count."""
+    done = [r for r in rows if not r.get("error")]
+    e_tf = [s["e_tf"] for r in done for s in r["segments"]]
+    hold = [s["hold"] for r in done for s in r["segments"]]
+    out = {"runs": len(rows), "errors": len(rows) - len(done),
+           "early": sum("early" in s["reasons"] for r in done for s in r["segments"])}
+    if e_tf:
+        out.update({"e_tf_median": float(np.median(e_tf)), "e_tf_p90": float(np.percentile(e_tf, 90)),
+                    "hold_median": float(np.median(hold)), "hold_p90": float(np.percentile(hold, 90))})
+        per_segment = list(zip(*[[s["e_tf"] for s in r["segments"]] for r in done]))
+        out["e_tf_median_per_segment"] = [float(np.median(v)) for v in per_segment]
+    return out
+
+
+def grid_cases(text: str, name: str, seeds: int, noises=NOISES, latencies=LATENCIES,
+               estimators=ESTIMATORS) -> list:
+    cases = []
+    for estimator in estimators:
+        for noise in noises:
+            for latency in latencies:
+                m = {"estimator": estimator, "noise_std": noise, "latency": latency,
+                     "compensate_latency": True}
+                if estimator == "kalman_ca":
+                    m["process_noise"] = CA_PROCESS_NOISE
+                cases += [(text, name, m, seed) for seed in range(1, seeds + 1)]
+    return cases
+
+
+def markdown(summary_rows: list, seeds: int, scenario: str) -> str:
+    lines = [f"# Camera study: {scenario}, {seeds} seeds",
+             "",
+             "|e(tf)| against the true target over every segment of every seed (mm); hold = the "
+             "largest |e| after tf (mm, median); early = segments that arrived early.",
+             "",
+             "| estimator | noise (mm) | latency (ms) | e(tf) median | e(tf) p90 | hold median | early |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for row in summary_rows:
+        s = row["summary"]
+        if "e_tf_median" not in s:
+            lines.append(f"| {row['estimator']} | {row['noise_std'] * 1e3:g} | {row['latency'] * 1e3:g} "
+                         f"| error | | | |")
+            continue
+        lines.append(f"| {row['estimator']} | {row['noise_std'] * 1e3:g} | {row['latency'] * 1e3:g} | "
+                     f"{s['e_tf_median'] * 1e3:.2f} | {s['e_tf_p90'] * 1e3:.2f} | "
+                     f"{s['hold_median'] * 1e3:.2f} | {s['early']} |")
+    return "\n".join(lines) + "\n"
+
+
+def estimate_figure(text: str, name: str, out_dir: Path, window: float = 0.3) -> None:
+    """The controller's target (the filter's estimate) and the gripper against the true
+    object around each segment's tf (seed 1, the scenario's own settings)."""
+    scenario = parse_scenario(text, name)
+    result = simulate(scenario, check=False)
+    s = result.series
+    t = s["t"]
+    segments = scenario.schedule().segments
+    fig, axes = plt.subplots(2, len(segments), figsize=(5.5 * len(segments), 6.5), squeeze=False)
+    for i, seg in enumerate(segments):
+        hold_end = scenario.schedule().hold_end(i, scenario.duration)
+        mask = (t >= seg.end - window) & (t <= min(seg.end + window, hold_end)) & \
+            ~((t >= hold_end) & (i + 1 < len(segments)))  # not the next object's first sample
+        truth = s["objects"][mask, 3 * i:3 * i + 3]
+        est_err = (s["x_r"][mask] - truth) * 1e3
+        arm_err = (s["x"][mask] - truth) * 1e3
+        ax = axes[0, i]
+        for k, axis in enumerate("xyz"):
+            ax.plot(t[mask], est_err[:, k], label=f"estimate − truth, {axis}")
+        ax.plot(t[mask], np.linalg.norm(est_err, axis=1), "k", lw=1.5, label="|estimate − truth|")
+        ax.axvline(seg.end, color="gray", ls="--")
+        ax.set_ylabel("mm")
+        ax.set_title(f"segment {i}: the controller's target (Kalman) around tf = {seg.end:g} s", fontsize=9)
+        ax.legend(fontsize=7)
+        ax = axes[1, i]
+        ax.plot(t[mask], np.linalg.norm(arm_err, axis=1), "C3", label="|gripper − truth| (the metric)")
+        ax.plot(t[mask], np.linalg.norm(s["x"][mask] - s["x_r"][mask], axis=1) * 1e3, "C0",
+                label="|gripper − estimate| (what the controller drives to 0)")
+        ax.axvline(seg.end, color="gray", ls="--")
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("mm")
+        ax.legend(fontsize=7)
+    m = scenario.measurement
+    fig.suptitle(f"{name}: {m.estimator}, {m.rate_hz:g} Hz, noise {m.noise_std * 1e3:g} mm, "
+                 f"latency {m.latency * 1e3:g} ms, q = {m.process_noise:g}, seed {m.seed}")
+    save(fig, out_dir, "estimate")
+
+
+def run_study(seeds: int = DEFAULT_SEEDS, workers: int = 2, out: Path = Path("out/study_camera"),
+              scenario: str = SCENARIO, progress=None) -> dict:
+    name, text = scenario_text(scenario)
+    base = parse_scenario(text, name)  # validates before any worker starts
+    t0 = time.perf_counter()
+    cases = grid_cases(text, name, seeds)
+    rows = run_many(cases, workers, progress)
+    table = []
+    for i in range(0, len(rows), seeds):
+        m = cases[i][2]
+        table.append({**{k: m[k] for k in ("estimator", "noise_std", "latency")},
+                      "process_noise": m.get("process_noise", base.measurement.process_noise)
+                      if m["estimator"] != "none" else None,
+                      "summary": summarize(rows[i:i + seeds])})
+    wall = time.perf_counter() - t0
+    result = {"scenario": name, "seeds": seeds, "workers": workers, "wall_time_s": wall,
+              "base_measurement": copy.deepcopy(vars(base.measurement)),
+              "table": table, "runs": rows}
+    with staged_output(out) as stage:
+        estimate_figure(text, name, stage)
+        (stage / "camera_study.md").write_text(markdown(table, seeds, name)
+                                               + f"\n{len(rows)} runs, {wall:.0f} s with {workers} workers.\n")
+        write_json_atomic(stage / "camera_study.json", result)
+    return result
