@@ -415,9 +415,9 @@ def cmd_study(args) -> int:
         raise ScenarioError(f"--seeds: must be >= 1, got {args.seeds}")
     if args.workers < 1:
         raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
-    out = Path(args.out) if args.out else Path("out") / f"study_{args.study}"
+    out = _out_dir(args.out, Path("out") / f"study_{args.study}")
     report = None if args.quiet else (
-        lambda i, n: print(f"study camera: {i}/{n} runs", file=sys.stderr) if i % 10 == 0 or i == n else None)
+        lambda i, n, *_: print(f"study camera: {i}/{n} runs", file=sys.stderr) if i % 10 == 0 or i == n else None)
     result = camera.run_study(seeds=args.seeds, workers=args.workers, out=out, progress=report)
     runs = sum(row["summary"]["runs"] for row in result["table"])
     errors = sum(row["summary"]["errors"] for row in result["table"])

@@ -112,7 +112,7 @@ def test_bad_measurement_value_is_one_line_exit_2(setting, field, capsys, tmp_pa
     code = cli.main(["run", "conveyor_pair_camera", "--set", setting, "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert code == 2
-    assert len(err.splitlines()) == 1 and err.startswith(f"ptint: error: {field}:"), err
+    assert len(err.splitlines()) == 1 and err.startswith(f"ptint: error: --set: {field}:"), err
     assert not (tmp_path / "o").exists()
 
 

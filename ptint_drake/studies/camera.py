@@ -18,17 +18,14 @@ Outputs in DIR: ``camera_study.json`` (every run and the summary), ``camera_stud
 (the table), ``estimate.png`` (the estimate against the truth around each tf, seed 1,
 the scenario's own settings).
 
-Runs go to a local process pool (``concurrent.futures.ProcessPoolExecutor``, forked, as
-``studies/sweep.py`` did; ``_executor``); each worker builds its own diagram from the
-scenario text.  Full grid, 10 seeds (360 runs): 253 s with 2 workers on a 2-core machine.
+Runs go to the studies' runner (``studies.runner.run_tasks``: local worker processes or a
+Dask scheduler); each worker builds its own diagram from the scenario text.  Full grid, 10 seeds (360 runs): 253 s with 2 workers on a 2-core machine.
 """
 
 from __future__ import annotations
 
 import copy
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +33,7 @@ import numpy as np
 from ptint_drake.figures import plt, save
 from ptint_drake.metrics import segment_reasons
 from ptint_drake.outputs import staged_output, write_json_atomic
+from ptint_drake.studies.runner import run_tasks
 from ptint_drake.scenario import ScenarioError, parse_scenario, scenario_text, validate
 from ptint_drake.simulation import simulate
 
@@ -74,33 +72,9 @@ def run_case(text: str, name: str, measurement: dict, seed: int) -> dict:
     return row
 
 
-def _executor(workers: int) -> ProcessPoolExecutor:
-    """A local process pool (forked on Linux).  Stand-in until ``studies/runner.py`` (being
-    written elsewhere, not in this tree) can take over: replace ``run_many``'s pool by it."""
-    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
-
-
-def run_many(cases: list, workers: int = 2, progress=None) -> list:
+def run_many(cases: list, workers: int = 2, dask=None, progress=None) -> list:
     """``cases`` = [(text, name, measurement, seed), …] → rows in the same order."""
-    if workers <= 1:
-        rows = []
-        for i, case in enumerate(cases):
-            rows.append(run_case(*case))
-            if progress:
-                progress(i + 1, len(cases))
-        return rows
-    executor = _executor(workers)
-    try:
-        futures = [executor.submit(run_case, *case) for case in cases]
-        rows = []
-        for i, future in enumerate(futures):
-            rows.append(future.result())
-            if progress:
-                progress(i + 1, len(cases))
-        return rows
-    finally:
-        executor.shutdown(cancel_futures=True)
+    return run_tasks(run_case, cases, workers=workers, dask=dask, progress=progress)
 
 
 def summarize(rows: list) -> dict:
@@ -196,7 +170,7 @@ def run_study(seeds: int = DEFAULT_SEEDS, workers: int = 2, out: Path = Path("ou
     base = parse_scenario(text, name)  # validates before any worker starts
     t0 = time.perf_counter()
     cases = grid_cases(text, name, seeds)
-    rows = run_many(cases, workers, progress)
+    rows = run_many(cases, workers, progress=progress)
     table = []
     for i in range(0, len(rows), seeds):
         m = cases[i][2]
