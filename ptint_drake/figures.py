@@ -184,17 +184,21 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     fig, axes = plt.subplots(3, 1, figsize=(10, 8.5), sharex=True, layout="constrained")
     e_norm = np.linalg.norm(series["e_true"], axis=1)
     axes[0].semilogy(t, np.maximum(e_norm, 1e-9), label="|e|")
-    axes[0].axhline(1e-3, color="r", lw=0.8, label="1 mm")
+    bound = metrics.get("criteria", {}).get("e_tf", 1e-3)
+    axes[0].axhline(bound, color="r", lw=0.8, label=f"{bound * 1e3:g} mm")
     e_tf = [s_["e_tf_norm"] for s_ in metrics["segments"]]
-    hit = [v is not None and v <= 1e-3 for v in e_tf]
+    hit = [v is not None and v <= bound for v in e_tf]
     reached = [(tf, v) for tf, v in zip(tfs, e_tf) if v is not None]
     if reached:
         axes[0].plot(*zip(*reached), ls="none", marker="o", mfc="none", color="k", ms=7,
                      label="|e($t_f$)|")
     values = ", ".join("n/a" if v is None else f"{v * 1e3:.3g}" for v in e_tf)
-    verdict = ("intercepted" if all(hit) else "NOT intercepted") if len(hit) == 1 else (
-        "every object intercepted" if all(hit) else f"{len(hit) - sum(hit)} of {len(hit)} missed")
-    axes[0].set_title(f"|e($t_f$)| = {values} mm: {verdict} (≤ 1 mm)", fontsize=10)
+    status = metrics.get("status")
+    if status is not None:  # the run's verdict (late, early, hold), not e(tf) alone
+        verdict = "intercepted" if status == "ok" else f"{status.upper()} ({', '.join(metrics['reasons'])})"
+    else:
+        verdict = "intercepted" if all(hit) else f"{len(hit) - sum(hit)} of {len(hit)} late"
+    axes[0].set_title(f"|e($t_f$)| = {values} mm (criterion ≤ {bound * 1e3:g} mm): {verdict}", fontsize=10)
     axes[0].set_ylabel("|e| [m]")
     for k, axis in enumerate(AXES):  # per axis, as the paper's Fig. 16
         axes[1].plot(t, series["edot_true"][:, k], label=f"ė_{axis.lower()}")

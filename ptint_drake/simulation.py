@@ -13,6 +13,7 @@ the true objects — never the controller's own view.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional
@@ -152,6 +153,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     if watchdog.failure:
         metrics["failure"] = watchdog.failure
     metrics["status"], metrics["reasons"] = verdict(metrics, scenario.criteria)
+    metrics["criteria"] = dataclasses.asdict(scenario.criteria)
     metrics["warnings"] = warnings
     metrics["warnings_before_run"] = n_before
     metrics["controller"] = {"type": built.controller.name, "notes": built.controller.notes,

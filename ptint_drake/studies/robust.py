@@ -72,16 +72,6 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     return scenario, params
 
 
-def meets_spec(segments) -> bool:
-    """SPEC section 6 on every segment."""
-    for s in segments:
-        if s["e_tf_norm"] is None or s["e_tf_norm"] > 1e-3 or s["e_hold_max_norm"] > 3e-3:
-            return False
-        if s["e0_norm"] >= 1e-2 and s["e_half_norm"] < 0.25 * s["e0_norm"]:
-            return False
-    return True
-
-
 def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dict:
     scenario, params = sample_scenario(text, name, seed, ranges)
     try:
@@ -92,7 +82,7 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
     return {
         "seed": seed, "params": params,
-        "ok": m["status"] == "ok" and meets_spec(m["segments"]),
+        "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
         "status": m["status"],
         "e_tf": e_tf,
         "e_tf_max": max((v for v in e_tf if v is not None), default=None) if all(
