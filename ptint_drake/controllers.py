@@ -101,7 +101,8 @@ def _add_ptsmc(builder, station_system, station: Station, scenario: Scenario) ->
     h = AddPrescribedTimeInterceptor(
         builder, plant, frame, scenario.schedule(),
         controller_targets(scenario) if analytic and fused else None, gains_of(scenario),
-        connect_actuation=False, fused=fused, state_port=station_system.GetOutputPort("state"))
+        connect_actuation=False, fused=fused, state_port=station_system.GetOutputPort("state"),
+        posture=np.radians(scenario.robot.initial_q_deg))
     system = h.fused or h.controller
     builder.Connect(system.GetOutputPort("u"), station_system.GetInputPort("actuation"))
     target = None

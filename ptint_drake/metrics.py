@@ -162,6 +162,8 @@ def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> di
         "torque_command_peak": np.max(np.abs(tau), axis=0).tolist() if len(t) else [],
         "joint_speed_peak": speed["value"],
         "final_joint_speed": float(np.max(np.abs(series["v"][-1]))) if len(t) else 0.0,
+        # redundant arms: the start posture's offset in the null space of J at the end (rad)
+        "self_motion_final": float(series["self_motion"][-1]) if "self_motion" in series and len(t) else None,
         "joint_speed_peak_time": speed["time"],
         "effort_limits": limits.tolist(),
         "saturated_fraction": float(np.sum(dt[over]) / span) if span > 0 else 0.0,

@@ -191,9 +191,17 @@ def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:
     series["q"], series["v"] = state[:, :nq], state[:, nq:]
     x = np.empty((len(t), 3))
     xdot = np.empty((len(t), 3))
+    redundant = plant.num_velocities() > 3
+    self_motion = np.zeros(len(t))
     for k in range(len(t)):
-        x[k], xdot[k], _ = kinematics.compute(state[k, :nq], state[k, nq:])
+        v = state[k, nq:]
+        x[k], xdot[k], J = kinematics.compute(state[k, :nq], v)
+        if redundant:  # |(I − J⁺J)(q − q_start)|: how far the arm wandered in its self-motion
+            dq = state[k, :nq] - state[0, :nq]
+            self_motion[k] = np.linalg.norm(dq - J.T @ np.linalg.solve(J @ J.T, J @ dq))
     series["x"], series["xdot"] = x, xdot
+    if redundant:
+        series["self_motion"] = self_motion
     truth = np.array([np.concatenate([tg.evaluate(tk)[0:6] for tg in station.true_targets])
                       for tk in t]).reshape(len(t), -1, 6)
     series["objects"] = truth[:, :, 0:3].reshape(len(t), -1)

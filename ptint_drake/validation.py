@@ -81,8 +81,8 @@ def validate(s) -> None:
         validate_measurement(s.measurement)
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
-    if c.pinv_damping < 0 or not math.isfinite(c.pinv_damping):
-        raise ScenarioError(f"controller.pinv_damping: must be >= 0, got {c.pinv_damping}")
+    for name in ("pinv_damping", "null_space_damping", "null_space_rate"):
+        _nonnegative(getattr(c, name), f"controller.{name}")
     for name in ("max_error", "max_joint_speed"):
         _positive(getattr(s.limits, name), f"limits.{name}")
     _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")

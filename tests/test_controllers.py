@@ -162,3 +162,24 @@ def test_model_free_controllers_never_evaluate_dynamics(controller, implementati
     result = simulate(scenario, check=False)
     assert result.metrics["segments"][0]["e_tf_norm"] < 0.01  # it did chase the target
     assert calls == []
+
+
+def test_null_space_damping_keeps_a_redundant_arm_near_its_posture(tmp_path):
+    """J⁺ leaves a redundant arm's self-motion free; the optional null-space term (off by
+    default) damps it toward the start posture without changing the interception."""
+    from heavy_arm import heavy_arm_scenario, heavy_arm_urdf  # noqa: PLC0415
+
+    urdf = tmp_path / "heavy6.urdf"
+    urdf.write_text(heavy_arm_urdf())
+    drift = {}
+    for implementation in ("fused", "blocks"):
+        for D in (0.0, 10.0):
+            scenario = parse_scenario(heavy_arm_scenario(urdf))
+            scenario.controller.null_space_damping = D
+            scenario.controller.implementation = implementation
+            m = simulate(scenario, check=False).metrics
+            assert m["status"] == "ok", m["reasons"]
+            drift[implementation, D] = m["self_motion_final"]
+    assert drift["fused", 0.0] > 1.0 and drift["fused", 10.0] < 0.3
+    assert drift["blocks", 10.0] == pytest.approx(drift["fused", 10.0], rel=1e-3)
+    assert load_scenario("curve_b075_tf15").controller.null_space_damping == 0.0  # the paper's law

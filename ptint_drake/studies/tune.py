@@ -36,6 +36,7 @@ from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
 GAINS = ("K", "Lambda", "phi")
+DRIFT_ANGLE = 0.5  # rad: a redundant arm whose null-space offset from the start posture ends above this drifts
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
 
 
@@ -78,14 +79,8 @@ def tune_run(text: str, name: str, gain: str, value: float, variant: str, margin
         "e_tf_norm": None if None in e_tf else max(e_tf),
         "e_hold_max_norm": None if None in hold else max(hold),
         "saturated_fraction": m["saturated_fraction"],
-        "joint_drift": _drift(m),
+        "self_motion_final": m["self_motion_final"],
     }
-
-
-def _drift(metrics: dict) -> float:
-    """The largest joint speed at the end of the run (rad/s): a free self-motion of a
-    redundant arm keeps drifting after the object is held."""
-    return float(metrics.get("final_joint_speed", 0.0))
 
 
 def model_bracket(scenario, gain: str) -> tuple[float, float]:
@@ -177,6 +172,10 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
     best = {row["variant"]: row for row in tried if row["gains"][settings.gain] == works}
     gains = {g: getattr(scenario.controller, g) for g in GAINS} | {settings.gain: value}
     key = "smallest_working" if smallest else "largest_working"
+    drift = [row["self_motion_final"] for row in best.values() if row.get("self_motion_final") is not None]
+    if drift:  # redundant arm: does J⁺ leave it drifting in its null space?
+        result["self_motion_final"] = max(drift)
+        result["drifts"] = max(drift) > DRIFT_ANGLE
     result |= {"gains": gains, key: {settings.gain: value, "per_variant": best},
                "smallest_working": {settings.gain: value, "per_variant": best},
                "scenario_obj": _portable(_set_gain(scenario, settings.gain, value))}
@@ -211,8 +210,13 @@ def summary_line(result: dict) -> str:
     paper = result["paper_value"]
     relation = "the scenario's" if math.isclose(value, paper, rel_tol=0.01) else (
         f"{value / paper:.2f} × the scenario's {paper:g}")
-    return (f"{gain} = {value:.4g} (margin {result['margin']:g}: e(tf) {parts}; {relation}) "
+    line = (f"{gain} = {value:.4g} (margin {result['margin']:g}: e(tf) {parts}; {relation}) "
             f"after {result['runs']} runs in {result['wall_time_s']:.0f} s")
+    if "drifts" in result:
+        line += (f"; redundant arm: {result['self_motion_final']:.2g} rad from its start posture in the "
+                 f"null space at the end" + (" — it drifts: consider controller.null_space_damping "
+                                             "(e.g. 10)" if result["drifts"] else ""))
+    return line
 
 
 def figure(result: dict, out_dir: Path) -> None:

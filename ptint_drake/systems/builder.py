@@ -17,6 +17,7 @@ must actuate each of its velocities (nv = nu).
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
+import numpy as np
 from pydrake.systems.framework import InputPort, OutputPort
 from pydrake.systems.primitives import Demultiplexer
 
@@ -49,7 +50,8 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
                                  targets: Optional[Sequence], gains: ControllerGains = ControllerGains(),
                                  connect_actuation: bool = True, name: str = "interceptor",
                                  fused: bool = False,
-                                 state_port: Optional[OutputPort] = None) -> InterceptorHandles:
+                                 state_port: Optional[OutputPort] = None,
+                                 posture=None) -> InterceptorHandles:
     """Add the interceptor's blocks to ``builder`` and connect them to ``plant``.
 
     With ``connect_actuation=False`` the controller's ``u`` port is left for the
@@ -60,6 +62,8 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     ``target_input`` (9: [x_r, ẋ_r, ẍ_r] of the active segment) is for the caller to
     connect, e.g. to a Kalman filter.  ``state_port`` is where [q; v] comes from
     (default: the plant's state output; e.g. a station's exported ``state``).
+    ``posture``: the joint positions the optional null-space term (``gains.null_space_damping``,
+    redundant arms) pulls toward (default: the plant's default positions).
     """
     if not plant.is_finalized():
         raise ValueError("plant: must be finalized before adding the interceptor")
@@ -74,7 +78,7 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     state_port = state_port or plant.get_state_output_port()
     if fused:
         system = builder.AddNamedSystem(name, PrescribedTimeInterceptor(
-            plant=plant, frame=frame, schedule=schedule, gains=gains, targets=targets))
+            plant=plant, frame=frame, schedule=schedule, gains=gains, targets=targets, posture=posture))
         builder.Connect(state_port, system.GetInputPort("state"))
         if connect_actuation:
             builder.Connect(system.GetOutputPort("u"), plant.get_actuation_input_port())
@@ -92,8 +96,14 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     kin = builder.AddNamedSystem(f"{name}_kinematics", TaskSpaceKinematics(plant, frame))
     surface = builder.AddNamedSystem(f"{name}_surface", SlidingSurface(
         schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy, gains.k_hold))
+    null_space = None
+    if gains.null_space_damping > 0.0 and nv > 3:
+        start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
+        null_space = (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float))
     ctrl = builder.AddNamedSystem(f"{name}_controller", SlidingModeController(
-        nv, gains.K, plant.MakeActuationMatrix(), gains.pinv_damping))
+        nv, gains.K, plant.MakeActuationMatrix(), gains.pinv_damping, null_space))
+    if null_space is not None:
+        builder.Connect(state_port, ctrl.GetInputPort("state"))
 
     builder.Connect(state_port, kin.get_state_input_port())
     builder.Connect(kin.GetOutputPort("x"), surface.GetInputPort("x"))

@@ -48,6 +48,14 @@ def smc_torque(K: np.ndarray, J: np.ndarray, s_x: np.ndarray, damping: float = 0
     return -K * qdot_s
 
 
+def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.ndarray,
+                      damping: float, rate: float) -> np.ndarray:
+    """τ_ns = −D (I − J⁺J)(q̇ + r (q − q_start)): joint damping toward the start posture,
+    projected so that it does not move the gripper point (zero for a square, full-rank J)."""
+    w = v + rate * (q - q_start)
+    return -damping * (w - J.T @ np.linalg.solve(J @ J.T, J @ w))
+
+
 class SlidingModeController(LeafSystem):
     """Inputs ``s_x`` (3) and ``J`` (3·nv, row-major); output ``tau`` (nv joint torques).
 
@@ -56,8 +64,12 @@ class SlidingModeController(LeafSystem):
     maps it to the plant's actuation input order: u = Bᵀ τ.
     """
 
-    def __init__(self, nv: int, K=50.0, actuation_matrix=None, pinv_damping: float = 0.0):
+    def __init__(self, nv: int, K=50.0, actuation_matrix=None, pinv_damping: float = 0.0,
+                 null_space=None):
+        """``null_space`` = (D, r, q_start) adds ``null_space_torque`` and an input ``state``
+        ([q; v], nq = nv) to read q and q̇."""
         super().__init__()
+        self._null_space = null_space
         self._nv = nv
         self._damping = float(pinv_damping)
         self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
@@ -65,6 +77,7 @@ class SlidingModeController(LeafSystem):
         nu = nv if actuation_matrix is None else self._BT.shape[0]
         self._s_x_in = self.DeclareVectorInputPort("s_x", 3)
         self._J_in = self.DeclareVectorInputPort("J", 3 * nv)
+        self._state_in = self.DeclareVectorInputPort("state", 2 * nv) if null_space else None
         deps = {self.all_input_ports_ticket()}
         self._eval = DeclareVectorCache(self, "tau", nv, self._tau, deps)
         self.DeclareVectorOutputPort(
@@ -80,4 +93,9 @@ class SlidingModeController(LeafSystem):
 
     def _tau(self, context) -> np.ndarray:
         J = self._J_in.Eval(context).reshape(3, self._nv)
-        return self.torque(self._s_x_in.Eval(context), J)
+        tau = self.torque(self._s_x_in.Eval(context), J)
+        if self._null_space:
+            qv = self._state_in.Eval(context)
+            D, rate, q_start = self._null_space
+            tau = tau + null_space_torque(J, qv[:self._nv], qv[self._nv:], q_start, D, rate)
+        return tau

@@ -24,3 +24,8 @@ class ControllerGains:
     sigma_policy: str = "keep"  # keep | reset σ at a new segment
     k_hold: float = 50.0  # 1/s, decay of s_d after tf
     pinv_damping: float = 0.0  # m/rad: λ of the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹; 0 = exact
+    # Redundant arms (more joints than 3): J⁺ leaves the self-motion free.  A null-space term
+    # τ_ns = −D (I − J⁺J)(q̇ + r (q − q_start)) damps it toward the start posture; D = 0 (the
+    # default) leaves the paper's law exact.  It reads kinematics only (model-free).
+    null_space_damping: float = 0.0  # N·m·s/rad: D
+    null_space_rate: float = 2.0  # 1/s: r, how fast the posture error is pulled back

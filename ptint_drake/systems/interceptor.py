@@ -23,7 +23,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
-from ptint_drake.systems.controller import smc_torque
+from ptint_drake.systems.controller import null_space_torque, smc_torque
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.schedule import Schedule
@@ -55,7 +55,7 @@ class PrescribedTimeInterceptor(LeafSystem):
     """
 
     def __init__(self, *, plant, frame, schedule: Schedule, gains: ControllerGains,
-                 targets: Optional[Sequence] = None):
+                 targets: Optional[Sequence] = None, posture: Optional[np.ndarray] = None):
         super().__init__()
         if targets is not None and len(targets) != len(schedule):
             raise ValueError(f"targets: one target per segment is needed, got {len(targets)} "
@@ -70,6 +70,10 @@ class PrescribedTimeInterceptor(LeafSystem):
                                gains.sigma_policy, gains.k_hold)
         self._K = np.broadcast_to(np.asarray(gains.K, dtype=float), (nv,)).copy()
         self._damping = float(gains.pinv_damping)
+        self._null_space = None
+        if gains.null_space_damping > 0.0 and nv > 3:  # redundant arms only; needs nq = nv
+            start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
+            self._null_space = (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float))
         self._BT = plant.MakeActuationMatrix().T
         self.layout = telemetry_layout(nv)
         size = self.layout["tau"].stop
@@ -116,6 +120,9 @@ class PrescribedTimeInterceptor(LeafSystem):
             t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
             context.get_discrete_state_vector().value(), sigma)
         tau = smc_torque(self._K, J, s_x, self._damping)
+        if self._null_space is not None:
+            D, rate, q_start = self._null_space
+            tau = tau + null_space_torque(J, qv[: self._nq], qv[self._nq:], q_start, D, rate)
         return np.concatenate([x, xdot, target[0:9], tbg[0:5], s_x, e, edot, s, s_d, sigma, tau,
                                tbg[5:10], sigma_dot])
 
