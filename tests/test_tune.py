@@ -42,6 +42,8 @@ def test_tune_finds_gains_for_a_heavy_six_joint_arm(tmp_path):
         row = result["smallest_working"]["per_variant"][variant]
         assert row["ok"] and row["e_tf_norm"] <= 0.5e-3 and row["e_hold_max_norm"] <= 1.5e-3
     assert (tmp_path / "tuned" / "tune.png").stat().st_size > 10_000
+    # six joints for a 3-D task: without the null-space term the arm wanders, and tune says so
+    assert result["drifts"] and "it drifts" in out.stdout
 
     # a fine grid below the tuned value: nothing much smaller works
     fine = np.geomspace(K / 3.0, K, 9)
