@@ -438,14 +438,13 @@ SET_HELP = ("override a scenario field (repeatable); KEY is a path with dots and
 RESULTS = "Criteria of an interception: README, Results (|e(tf)| <= 1 mm, hold <= 3 mm)."
 
 
-def _study_arguments(parser, default_out: str) -> None:
+def _study_arguments(parser, default_out: str, workers_default: str = "CPU count") -> None:
     where = parser.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
+    where.add_argument("--workers", type=int, help=f"worker processes (default: {workers_default})")
     where.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
-    parser.add_argument("--set", action="append", metavar="KEY=VALUE",
-                        help="override a scenario field, list items included")
+    parser.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     parser.add_argument("--out", help=f"output folder (default {default_out})")
-    parser.add_argument("--quiet", action="store_true", help="no progress lines")
+    parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
 
 
 def make_parser() -> argparse.ArgumentParser:
@@ -454,6 +453,13 @@ def make_parser() -> argparse.ArgumentParser:
         epilog="Paper: Flores-Campos et al., Robotics 2024, 13(10), 145. "
                "README: Command line, Scenario files.")
     sub = parser.add_subparsers(dest="command", required=True)
+    _add_run_parsers(sub)
+    _add_study_parsers(sub)
+    return parser
+
+
+def _add_run_parsers(sub) -> None:
+    """list, run, diagram, paper."""
     sub.add_parser("list", help="names of the bundled scenarios",
                    description="The bundled scenarios (paper section 3, Table 1; README: "
                                "Scenario files).").set_defaults(func=cmd_list)
@@ -462,8 +468,9 @@ def make_parser() -> argparse.ArgumentParser:
         "run", help="run one scenario and write its outputs",
         description="Simulate one scenario: the TBG (paper eqs. 6-10), the sliding surface "
                     "(eqs. 11, 16, 17) and the controller (eq. 18) on the robot; writes "
-                    "metrics.json, series.npz, figures and replay.html. Exit 0 when it ran, "
-                    "1 when the run failed, 2 on bad input.", epilog=RESULTS)
+                    "metrics.json, series.npz, figures and replay.html. Exit 0 when every segment "
+                    "meets the scenario's criteria, 1 when one missed them (late, early, hold) or "
+                    "the run diverged, 2 on bad input (README: Command line, Results).", epilog=RESULTS)
     run.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     run.add_argument("--out", help="output folder (default out/NAME)")
     run.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
@@ -482,6 +489,19 @@ def make_parser() -> argparse.ArgumentParser:
     diagram.add_argument("--quiet", action="store_true", help="accepted like the other commands")
     diagram.set_defaults(func=cmd_diagram)
 
+    paper = sub.add_parser(
+        "paper", help="reproduce the paper: every scenario, figures, comparisons, index.html",
+        description="Run the five curve scenarios (paper Figs. 6-15) and the assembly task "
+                    "(Figs. 16-19), draw the TBG and α families (Figs. 2-4), compare the "
+                    "controllers on curve_b075_tf15 and assembly, and write DIR/index.html "
+                    "(README: Quick start).", epilog=RESULTS)
+    paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")
+    paper.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    paper.set_defaults(func=cmd_paper)
+
+
+def _add_study_parsers(sub) -> None:
+    """sweep, robust, compare, tune, study, bench: many runs, on worker processes or Dask."""
     sw = sub.add_parser(
         "sweep", help="β × tf grid in parallel worker processes",
         description="Run the scenario on a grid of TBG shapes β and prescribed times tf "
@@ -492,12 +512,7 @@ def make_parser() -> argparse.ArgumentParser:
                     help="comma-separated β values in (0, 1) (paper eq. 6; default %(default)s)")
     sw.add_argument("--tf", default="1.2,1.5,1.9",
                     help="comma-separated prescribed times tf in s (default %(default)s)")
-    where = sw.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, help="worker processes (default: CPU count)")
-    where.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
-    sw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
-    sw.add_argument("--out", help="output folder (default out/sweep_NAME)")
-    sw.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    _study_arguments(sw, "out/sweep_NAME")
     sw.set_defaults(func=cmd_sweep)
 
     rb = sub.add_parser(
@@ -509,18 +524,29 @@ def make_parser() -> argparse.ArgumentParser:
     rb.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     rb.add_argument("--samples", type=int, default=100, help="number of samples (default 100)")
     rb.add_argument("--seed", type=int, default=0, help="sample i uses seed + i")
-    where = rb.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, help="worker processes (default 1)")
-    where.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
     rb.add_argument("--range", action="append", metavar="NAME=LOW,HIGH",
                     help="override a parameter range (mass, friction, coulomb, payload, "
                          "disturbance, noise, latency)")
-    rb.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
-    rb.add_argument("--out", help="output folder (default out/robust_NAME)")
-    rb.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    _study_arguments(rb, "out/robust_NAME", workers_default="1")
     rb.set_defaults(func=cmd_robust)
 
+    _add_design_parsers(sub)
+    st = sub.add_parser("study", help="studies: camera (|e(tf)| against noise × latency × estimator)")
+    st.add_argument("study", choices=["camera"])
+    st.add_argument("--seeds", type=int, default=10, help="seeds per grid point (default 10)")
+    st.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    st.add_argument("--out", help="output folder (default out/study_camera)")
+    st.add_argument("--quiet", action="store_true")
+    st.set_defaults(func=cmd_study)
     # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
+    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
+                           add_help=False)
+    bench.add_argument("rest", nargs=argparse.REMAINDER)
+    bench.set_defaults(func=cmd_bench)
+
+
+def _add_design_parsers(sub) -> None:
+    """compare (controllers × plant variants) and tune (gains for an arm)."""
     cmp_ = sub.add_parser(
         "compare", help="controllers side by side on plant variants (README: Controllers compared)",
         description="Every controller × plant variant on the same scenario, in parallel; writes "
@@ -550,29 +576,6 @@ def make_parser() -> argparse.ArgumentParser:
                     help="largest fraction of the time an actuator may saturate (default 0.05)")
     _study_arguments(tn, "out/tune_NAME")
     tn.set_defaults(func=cmd_tune)
-
-    st = sub.add_parser("study", help="studies: camera (|e(tf)| against noise × latency × estimator)")
-    st.add_argument("study", choices=["camera"])
-    st.add_argument("--seeds", type=int, default=10, help="seeds per grid point (default 10)")
-    st.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    st.add_argument("--out", help="output folder (default out/study_camera)")
-    st.add_argument("--quiet", action="store_true")
-    st.set_defaults(func=cmd_study)
-
-    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
-                           add_help=False)
-    bench.add_argument("rest", nargs=argparse.REMAINDER)
-    bench.set_defaults(func=cmd_bench)
-
-    paper = sub.add_parser(
-        "paper", help="reproduce the paper: every scenario, figures, index.html",
-        description="Run the five curve scenarios (paper Figs. 6-15) and the assembly task "
-                    "(Figs. 16-19), draw the TBG and α families (Figs. 2-4) and write "
-                    "DIR/index.html (README: Quick start).", epilog=RESULTS)
-    paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")
-    paper.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    paper.set_defaults(func=cmd_paper)
-    return parser
 
 
 def _run(argv) -> int:

@@ -93,42 +93,21 @@ def _stops(scenario: Scenario) -> list[float]:
     return sorted(stops)
 
 
-def simulate(scenario: Scenario, check: bool = True, progress=None,
-             warn: Optional[Callable[[str], None]] = None) -> RunResult:
-    """Run a scenario; returns its metrics (with the verdict) and the logged time series.
-
-    ``progress(t, duration, steps)`` is called while it runs; ``warn(message)`` is called for
-    each warning known before the simulation starts, as soon as it is known.  A run
-    stopped by the divergence watchdog returns normally with ``status == "failed"``.
-    """
-    built = build(scenario)
-    warnings = pre_run_warnings(built, scenario) if check else []
-    n_before = len(warnings)
-    for message in warnings:
-        if warn is not None:
-            warn(message)
-    t_start = time.perf_counter()  # the realtime factor counts simulation, telemetry, metrics
-    diagram, plant = built.diagram, built.plant
-    simulator = Simulator(diagram)
+def _prepared_simulator(built: Built, scenario: Scenario) -> Simulator:
+    """A simulator of the built diagram at the scenario's start: masses, pose, rest."""
+    simulator = Simulator(built.diagram)
     ApplySimulatorConfig(scenario.simulator, simulator)
-    context = simulator.get_mutable_context()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
+    plant = built.plant
+    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
     scale_masses(plant, plant_context, scenario.plant.mass_scale)
     plant.SetPositions(plant_context, np.radians(scenario.robot.initial_q_deg))
     plant.SetVelocities(plant_context, np.zeros(plant.num_velocities()))
-    kinematics = FrameKinematics(plant, plant.GetFrameByName(scenario.robot.end_effector))
-    nq = plant.num_positions()
+    return simulator
 
-    def gripper(ctx):
-        qv = plant.get_state_output_port().Eval(plant.GetMyContextFromRoot(ctx))
-        return kinematics.compute(qv[:nq], qv[nq:])
 
-    schedule, targets = scenario.schedule(), built.station.true_targets
-    true_state = lambda t: active_target_state(schedule, targets, t)  # noqa: E731
-    watchdog = Watchdog(scenario=scenario, diagram=diagram, plant=plant,
-                        position_of=lambda c: gripper(c)[0], true_target=lambda t: true_state(t)[0:3],
-                        progress=progress)
-    simulator.set_monitor(watchdog)
+def _advance(simulator: Simulator, scenario: Scenario, watchdog: Watchdog, gripper, true_state):
+    """Run to every exact stop; returns (samples: t → (e, ė) against the true target, wall s)."""
+    context = simulator.get_mutable_context()
     samples, wall = {}, 0.0
     simulator.Initialize()
     for t_stop in _stops(scenario):
@@ -144,7 +123,40 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
         x, xdot, _ = gripper(context)
         target = true_state(t_stop)
         samples[t_stop] = (x - target[0:3], xdot - target[3:6])
-    integrator = simulator.get_integrator()
+    return samples, wall
+
+
+def simulate(scenario: Scenario, check: bool = True, progress=None,
+             warn: Optional[Callable[[str], None]] = None) -> RunResult:
+    """Run a scenario; returns its metrics (with the verdict) and the logged time series.
+
+    ``progress(t, duration, steps)`` is called while it runs; ``warn(message)`` is called for
+    each warning known before the simulation starts, as soon as it is known.  A run
+    stopped by the divergence watchdog returns normally with ``status == "failed"``.
+    """
+    built = build(scenario)
+    warnings = pre_run_warnings(built, scenario) if check else []
+    for message in warnings if warn is not None else ():
+        warn(message)
+    n_before = len(warnings)
+    t_start = time.perf_counter()  # the realtime factor counts simulation, telemetry, metrics
+    plant = built.plant
+    simulator = _prepared_simulator(built, scenario)
+    kinematics = FrameKinematics(plant, plant.GetFrameByName(scenario.robot.end_effector))
+    nq = plant.num_positions()
+
+    def gripper(ctx):
+        qv = plant.get_state_output_port().Eval(plant.GetMyContextFromRoot(ctx))
+        return kinematics.compute(qv[:nq], qv[nq:])
+
+    schedule, targets = scenario.schedule(), built.station.true_targets
+    true_state = lambda t: active_target_state(schedule, targets, t)  # noqa: E731
+    watchdog = Watchdog(scenario=scenario, diagram=built.diagram, plant=plant,
+                        position_of=lambda c: gripper(c)[0], true_target=lambda t: true_state(t)[0:3],
+                        progress=progress)
+    simulator.set_monitor(watchdog)
+    samples, wall = _advance(simulator, scenario, watchdog, gripper, true_state)
+    context, integrator = simulator.get_context(), simulator.get_integrator()
     if progress is not None:
         progress(context.get_time(), scenario.duration, int(integrator.get_num_steps_taken()))
     series = collect_series(built, context, kinematics)
@@ -153,17 +165,24 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     if watchdog.failure:
         metrics["failure"] = watchdog.failure
     metrics["status"], metrics["reasons"] = verdict(metrics, scenario.criteria)
-    metrics["criteria"] = dataclasses.asdict(scenario.criteria)
-    metrics["warnings"] = warnings
-    metrics["warnings_before_run"] = n_before
-    metrics["controller"] = {"type": built.controller.name, "notes": built.controller.notes,
-                             "model_based": built.controller.model_based}
-    t_end, total = context.get_time(), time.perf_counter() - t_start
-    metrics["sim"] = {
+    metrics |= {"criteria": dataclasses.asdict(scenario.criteria), "warnings": warnings,
+                "warnings_before_run": n_before,
+                "controller": {"type": built.controller.name, "notes": built.controller.notes,
+                               "model_based": built.controller.model_based}}
+    metrics["sim"] = _sim_info(scenario, integrator, context.get_time(),
+                               time.perf_counter() - t_start, wall)
+    return RunResult(scenario, metrics, series)
+
+
+def _sim_info(scenario: Scenario, integrator, t_end: float, total: float, wall: float) -> dict:
+    """The ``sim`` block of metrics.json; ``realtime_factor`` is end to end (simulation,
+    telemetry, metrics), ``simulation_realtime_factor`` the simulation alone."""
+    return {
         "integration_scheme": scenario.simulator.integration_scheme,
         "accuracy": scenario.simulator.accuracy,
         "switching": scenario.controller.switching,
         "implementation": scenario.controller.implementation,
+        "controller": scenario.controller.type,
         "simulated_s": t_end,
         "wall_time_s": total,
         "simulation_wall_time_s": wall,
@@ -172,7 +191,6 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
         "steps": int(integrator.get_num_steps_taken()),
         "derivative_evaluations": int(integrator.get_num_derivative_evaluations()),
     }
-    return RunResult(scenario, metrics, series)
 
 
 def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:

@@ -38,101 +38,109 @@ def _positive(value: float, where: str):
 
 
 def validate(s) -> None:
-    """Checks that need no robot model (the model-dependent ones live in simulation)."""
+    """Checks that need no robot model (the model-dependent ones live in ``robot``)."""
     _positive(s.duration, "duration")
-    c = s.controller
+    _validate_controller(s.controller)
+    for check, config in ((validate_criteria, s.criteria), (validate_measurement, s.measurement)):
+        try:
+            check(config)
+        except ValueError as exc:
+            raise ScenarioError(str(exc)) from None
+    _validate_plant(s.plant)
+    for name in ("max_error", "max_joint_speed"):
+        _positive(getattr(s.limits, name), f"limits.{name}")
+    _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")
+    _validate_simulator(s.simulator)
+    if not s.interceptions:
+        raise ScenarioError("interceptions: at least one interception is needed")
+    for i, ic in enumerate(s.interceptions):
+        _validate_interception(s, i, ic)
+        _validate_target(ic.target, f"interceptions[{i}].target")
+
+
+def _validate_controller(c) -> None:
     for name in ("K", "Lambda", "k", "k_hold", "epsilon", "delta"):
         _positive(getattr(c, name), f"controller.{name}")
-    if not (math.isfinite(c.alpha_hold) and c.alpha_hold >= 0.0):
-        raise ScenarioError(f"controller.alpha_hold: must be >= 0, got {c.alpha_hold}")
-    if c.switching not in SWITCHING_LAWS:
-        raise ScenarioError(f"controller.switching: must be one of {', '.join(SWITCHING_LAWS)}, got {c.switching!r}")
+    for name in ("alpha_hold", "pinv_damping", "null_space_damping", "null_space_rate"):
+        _nonnegative(getattr(c, name), f"controller.{name}")
+    for name, value, allowed in (("switching", c.switching, SWITCHING_LAWS), ("type", c.type, CONTROLLER_TYPES),
+                                 ("implementation", c.implementation, IMPLEMENTATIONS),
+                                 ("sigma_policy", c.sigma_policy, SIGMA_POLICIES)):
+        if value not in allowed:
+            raise ScenarioError(f"controller.{name}: must be one of {', '.join(allowed)}, got {value!r}")
     if c.switching != "sign":
         _positive(c.phi, "controller.phi")
-    if c.type not in CONTROLLER_TYPES:
-        raise ScenarioError(f"controller.type: must be one of {', '.join(CONTROLLER_TYPES)}, got {c.type!r}")
-    try:
-        validate_criteria(s.criteria)
-    except ValueError as exc:
-        raise ScenarioError(str(exc)) from None
     _positive(c.smc.lambda_factor, "controller.smc.lambda_factor")
     for sub in (c.pd, c.ct_quintic):
         try:
             sub.validate()  # messages name the field from "pd." / "ct_quintic." on
         except ValueError as exc:
             raise ScenarioError(f"controller.{exc}") from None
-    if c.implementation not in IMPLEMENTATIONS:
-        raise ScenarioError(f"controller.implementation: must be one of {', '.join(IMPLEMENTATIONS)}, "
-                            f"got {c.implementation!r}")
-    if c.sigma_policy not in SIGMA_POLICIES:
-        raise ScenarioError(f"controller.sigma_policy: must be one of {', '.join(SIGMA_POLICIES)}, got {c.sigma_policy!r}")
-    _positive(s.plant.mass_scale, "plant.mass_scale")
+
+
+def _validate_plant(p) -> None:
+    _positive(p.mass_scale, "plant.mass_scale")
     for name in ("damping_scale", "payload_kg"):
-        _nonnegative(getattr(s.plant, name), f"plant.{name}")
-    _positive(s.plant.coulomb_speed, "plant.coulomb_speed")
-    for v in s.plant.coulomb:
+        _nonnegative(getattr(p, name), f"plant.{name}")
+    _positive(p.coulomb_speed, "plant.coulomb_speed")
+    for v in p.coulomb:
         _nonnegative(v, "plant.coulomb")
-    d = s.plant.disturbance
+    d = p.disturbance
     for name in ("amplitude", "phase", "step"):
         if not all(math.isfinite(v) for v in getattr(d, name)):
             raise ScenarioError(f"plant.disturbance.{name}: must be finite")
     _positive(d.frequency_hz, "plant.disturbance.frequency_hz")
-    try:
-        validate_measurement(s.measurement)
-    except ValueError as exc:
-        raise ScenarioError(str(exc)) from None
-    for name in ("pinv_damping", "null_space_damping", "null_space_rate"):
-        _nonnegative(getattr(c, name), f"controller.{name}")
-    for name in ("max_error", "max_joint_speed"):
-        _positive(getattr(s.limits, name), f"limits.{name}")
-    _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")
+
+
+def _validate_simulator(sim) -> None:
     schemes = GetIntegrationSchemes()
-    if s.simulator.integration_scheme not in schemes:
+    if sim.integration_scheme not in schemes:
         raise ScenarioError(
-            f"simulator.integration_scheme: unknown {s.simulator.integration_scheme!r} "
-            f"(one of {', '.join(schemes)})")
-    _positive(s.simulator.accuracy, "simulator.accuracy")
-    _positive(s.simulator.max_step_size, "simulator.max_step_size")
-    if s.simulator.start_time != 0.0:
-        raise ScenarioError(f"simulator.start_time: must be 0 (scenario times are absolute), got {s.simulator.start_time}")
-    if not s.interceptions:
-        raise ScenarioError("interceptions: at least one interception is needed")
-    for i, ic in enumerate(s.interceptions):
-        where = f"interceptions[{i}]"
-        if not (0.0 < ic.beta < 1.0):
-            raise ScenarioError(f"{where}.beta: must be in (0, 1), got {ic.beta}")
-        _positive(ic.tf, f"{where}.tf")
-        if not (math.isfinite(ic.start) and ic.start >= 0.0):
-            raise ScenarioError(f"{where}.start: must be >= 0, got {ic.start}")
-        if i == 0 and ic.start != 0.0:
-            raise ScenarioError(f"{where}.start: the first interception must start at 0, got {ic.start}")
-        if i > 0:
-            prev = s.interceptions[i - 1]
-            if ic.start < prev.start + prev.tf:
-                raise ScenarioError(
-                    f"{where}.start: {ic.start} s is before interceptions[{i - 1}] "
-                    f"intercepts at {prev.start + prev.tf} s (segments must be in time order "
-                    f"and may not overlap)")
-        if ic.start + ic.tf > s.duration + 1e-12:
+            f"simulator.integration_scheme: unknown {sim.integration_scheme!r} (one of {', '.join(schemes)})")
+    _positive(sim.accuracy, "simulator.accuracy")
+    _positive(sim.max_step_size, "simulator.max_step_size")
+    if sim.start_time != 0.0:
+        raise ScenarioError(f"simulator.start_time: must be 0 (scenario times are absolute), got {sim.start_time}")
+
+
+def _validate_interception(s, i: int, ic) -> None:
+    where = f"interceptions[{i}]"
+    if not (0.0 < ic.beta < 1.0):
+        raise ScenarioError(f"{where}.beta: must be in (0, 1), got {ic.beta}")
+    _positive(ic.tf, f"{where}.tf")
+    if not (math.isfinite(ic.start) and ic.start >= 0.0):
+        raise ScenarioError(f"{where}.start: must be >= 0, got {ic.start}")
+    if i == 0 and ic.start != 0.0:
+        raise ScenarioError(f"{where}.start: the first interception must start at 0, got {ic.start}")
+    if i > 0:
+        prev = s.interceptions[i - 1]
+        if ic.start < prev.start + prev.tf:
             raise ScenarioError(
-                f"{where}.tf: interception time {ic.start + ic.tf} s is after the end "
-                f"of the simulation (duration {s.duration} s)")
-        t = ic.target
-        kinds = [k for k in TARGET_KINDS if getattr(t, k) is not None]
-        if len(kinds) != 1:
-            raise ScenarioError(
-                f"{where}.target: exactly one of {', '.join(TARGET_KINDS)} is needed, got "
-                f"{', '.join(kinds) if kinds else 'none'}")
-        if t.sinusoid is not None:
-            for name in ("center", "amplitude", "phase"):
-                _vector3(getattr(t.sinusoid, name), f"{where}.target.sinusoid.{name}")
-            if not math.isfinite(t.sinusoid.omega):
-                raise ScenarioError(f"{where}.target.sinusoid.omega: must be finite")
-        elif t.waypoints is not None:
-            try:
-                WaypointTarget(t.waypoints.time, t.waypoints.position)
-            except ValueError as exc:
-                raise ScenarioError(f"{where}.target.waypoints.{exc}") from None
-        else:
-            _vector3(t.linear.start, f"{where}.target.linear.start")
-            _vector3(t.linear.velocity, f"{where}.target.linear.velocity")
+                f"{where}.start: {ic.start} s is before interceptions[{i - 1}] "
+                f"intercepts at {prev.start + prev.tf} s (segments must be in time order "
+                f"and may not overlap)")
+    if ic.start + ic.tf > s.duration + 1e-12:
+        raise ScenarioError(
+            f"{where}.tf: interception time {ic.start + ic.tf} s is after the end "
+            f"of the simulation (duration {s.duration} s)")
+
+
+def _validate_target(t, where: str) -> None:
+    kinds = [k for k in TARGET_KINDS if getattr(t, k) is not None]
+    if len(kinds) != 1:
+        raise ScenarioError(
+            f"{where}: exactly one of {', '.join(TARGET_KINDS)} is needed, got "
+            f"{', '.join(kinds) if kinds else 'none'}")
+    if t.sinusoid is not None:
+        for name in ("center", "amplitude", "phase"):
+            _vector3(getattr(t.sinusoid, name), f"{where}.sinusoid.{name}")
+        if not math.isfinite(t.sinusoid.omega):
+            raise ScenarioError(f"{where}.sinusoid.omega: must be finite")
+    elif t.waypoints is not None:
+        try:
+            WaypointTarget(t.waypoints.time, t.waypoints.position)
+        except ValueError as exc:
+            raise ScenarioError(f"{where}.waypoints.{exc}") from None
+    else:
+        _vector3(t.linear.start, f"{where}.linear.start")
+        _vector3(t.linear.velocity, f"{where}.linear.velocity")

@@ -85,6 +85,15 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
         return InterceptorHandles(schedule, fused=system, target_input=(
             system.GetInputPort("target") if targets is None else None))
 
+    return _add_blocks(builder, plant, frame, schedule=schedule, targets=targets, gains=gains,
+                       connect_actuation=connect_actuation, name=name, state_port=state_port,
+                       posture=posture)
+
+
+def _add_blocks(builder, plant, frame, *, schedule, targets, gains, connect_actuation, name, state_port,
+                posture) -> InterceptorHandles:
+    """The five wired blocks of paper Fig. 1 (see ``AddPrescribedTimeInterceptor``)."""
+    nv = plant.num_velocities()
     tbg = builder.AddNamedSystem(f"{name}_tbg", TimeBaseGenerator(
         schedule, gains.epsilon, gains.delta, gains.alpha_hold))
     if targets is None:

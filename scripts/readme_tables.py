@@ -1,0 +1,154 @@
+"""Regenerate the README's tables from the commands that produce them.
+
+    .venv/bin/python scripts/readme_tables.py            # results + controllers compared (~1 min)
+    .venv/bin/python scripts/readme_tables.py --all      # also tuning and the camera study (~8 min)
+
+Each table sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->`` in README.md and
+is replaced in place, with the command and the machine it was measured on.  Timings (realtime
+factors, study wall times) depend on the machine; errors and verdicts do not (the runs are
+deterministic).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+README = ROOT / "README.md"
+PAPER = ("curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12", "curve_b075_tf19",
+         "assembly")
+
+
+def machine() -> str:
+    import importlib.metadata as md  # noqa: PLC0415
+
+    return (f"{os.cpu_count()}-core {platform.machine()}, Python {platform.python_version()}, "
+            f"Drake {md.version('drake')}")
+
+
+def mm(v, digits: int = 4) -> str:
+    return "–" if v is None else f"{v * 1e3:.{digits}g}"
+
+
+def results_table() -> str:
+    """The paper scenarios: both hold columns and the torque peaks with and without start-up."""
+    from ptint_drake.scenario import load_scenario  # noqa: PLC0415
+    from ptint_drake.simulation import simulate  # noqa: PLC0415
+
+    lines = ["| scenario | β | tf [s] | e0 | e(tf/2) | e(tf) | ė(tf) [mm/s] | hold max (k_hold = 50) "
+             "| hold max (paper: k_hold = k) | peak τ [N·m] | peak τ after start-up [N·m] | verdict | RTF |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name in PAPER:
+        m = simulate(load_scenario(name)).metrics
+        paper = load_scenario(name)
+        paper.controller.k_hold = paper.controller.k
+        pm = simulate(paper, check=False).metrics
+        rtf = f"{m['sim']['realtime_factor']:.1f}"
+        for i, seg in enumerate(m["segments"]):
+            first = i == 0
+            label = name if len(m["segments"]) == 1 else f"{name} #{i + 1}"
+            lines.append(
+                f"| {label} | {seg['beta']:g} | {seg['tf']:g} | {mm(seg['e0_norm'])} | {mm(seg['e_half_norm'])} "
+                f"| {mm(seg['e_tf_norm'], 3)} | {mm(seg['edot_tf_norm'], 3)} | {mm(seg['e_hold_max_norm'], 3)} "
+                f"| {mm(pm['segments'][i]['e_hold_max_norm'], 3)} "
+                f"| {', '.join(f'{v:.2f}' for v in m['torque_peak']) if first else ''} "
+                f"| {', '.join(f'{v:.2f}' for v in m['torque_peak_after_startup']) if first else ''} "
+                f"| {m['status'] if first else ''} | {rtf if first else ''} |")
+    return "\n".join(lines) + f"\n\n`ptint run NAME` for each (and `--set controller.k_hold=3` for the paper's " \
+        f"hold), measured by `scripts/readme_tables.py` on {machine()}; RTF (end-to-end realtime factor) " \
+        f"depends on the machine.\n"
+
+
+def compare_table(name: str, workers: int) -> str:
+    """The compare study of ``name`` condensed: e(tf), t_arrive and the verdict per variant."""
+    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.studies.compare import run_compare, table_rows  # noqa: PLC0415
+
+    _, text = scenario_text(name)
+    result = run_compare(text, name, workers=workers)
+    variants = result["variants"]
+    lines = ["| controller | seg | " + " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants) + " |",
+             "|---|---|" + "---|" * len(variants)]
+    rows = table_rows(result)
+    keys = sorted({(r["controller"], r["segment"]) for r in rows},
+                  key=lambda k: (result["controllers"].index(k[0]), k[1]))
+    for controller, seg in keys:
+        cells = []
+        for v in variants:
+            r = next(x for x in rows if (x["controller"], x["segment"], x["variant"]) == (controller, seg, v))
+            arrive = "never" if r["t_arrive"] is None else f"{r['t_arrive']:.2f} s"
+            cells.append(f"{mm(r['e_tf_norm'], 3)} mm / {arrive} / {'ok' if r['ok'] else r['reasons']}")
+        lines.append(f"| {controller} | {seg} | " + " | ".join(cells) + " |")
+    prescribed = ", ".join(f"{s['start'] + s['tf']:g} s" for s in result["segments"])
+    return ("\n".join(lines) + f"\n\n`ptint compare {name}` (prescribed interception at {prescribed}; "
+            f"{result['wall_time_s']:.0f} s with {workers} workers on {machine()}).\n")
+
+
+def tune_table(workers: int) -> str:
+    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.studies.tune import TuneSettings, run_tune  # noqa: PLC0415
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from heavy_arm import heavy_arm_scenario, heavy_arm_urdf  # noqa: PLC0415
+
+    folder = Path(tempfile.mkdtemp())
+    (folder / "heavy6.urdf").write_text(heavy_arm_urdf())
+    cases = [(n, scenario_text(n)[1]) for n in PAPER + ("conveyor_pair",)]
+    cases.append(("heavy 6-joint arm (tests/heavy_arm.py)", heavy_arm_scenario(folder / "heavy6.urdf")))
+    lines = ["| scenario | tuned K (margin 2) | paper's K | e(tf) nominal / ×0.7 / ×1.5 [mm] | runs | time |",
+             "|---|---|---|---|---|---|"]
+    for name, text in cases:
+        r = run_tune(text, name.split()[0], TuneSettings(), workers=workers, say=lambda m: None)
+        if r["gains"] is None:
+            lines.append(f"| {name} | none works ({', '.join(r['reasons'])}) | {r['paper_value']:g} | – "
+                         f"| {r['runs']} | {r['wall_time_s']:.0f} s |")
+            continue
+        per = r["smallest_working"]["per_variant"]
+        errors = " / ".join(mm(per[v]["e_tf_norm"], 3) for v in r["variants"])
+        lines.append(f"| {name} | {r['gains']['K']:.3g} | {r['paper_value']:g} | {errors} | {r['runs']} "
+                     f"| {r['wall_time_s']:.0f} s |")
+    return "\n".join(lines) + f"\n\n`ptint tune NAME --workers {workers}`, on {machine()}.\n"
+
+
+def camera_table(workers: int) -> str:
+    out = Path(tempfile.mkdtemp()) / "study"
+    subprocess.run([sys.executable, "-m", "ptint_drake", "study", "camera", "--workers", str(workers),
+                    "--out", str(out), "--quiet"], check=True)
+    data = json.loads((out / "camera_study.json").read_text())
+    return (out / "camera_study.md").read_text() + (
+        f"\n`ptint study camera --workers {workers}`: {data['wall_time_s']:.0f} s on {machine()}.\n")
+
+
+def replace(text: str, name: str, table: str) -> str:
+    pattern = re.compile(rf"(<!-- BEGIN {name} -->\n).*?(<!-- END {name} -->)", re.S)
+    if not pattern.search(text):
+        raise SystemExit(f"README.md has no <!-- BEGIN {name} --> … <!-- END {name} --> block")
+    return pattern.sub(lambda m: m.group(1) + table + m.group(2), text)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--all", action="store_true", help="also the tuning and camera tables (slow)")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    text = README.read_text()
+    text = replace(text, "results", results_table())
+    for name in ("curve_b075_tf15", "assembly"):
+        text = replace(text, f"compare_{name}", compare_table(name, args.workers))
+    if args.all:
+        text = replace(text, "tune", tune_table(args.workers))
+        text = replace(text, "camera", camera_table(args.workers))
+    README.write_text(text)
+    print(f"README.md tables regenerated on {machine()}")
+
+
+if __name__ == "__main__":
+    main()
