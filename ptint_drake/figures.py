@@ -143,10 +143,14 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     """Per-axis robot vs target (position, velocity, acceleration, jerk), the error
     (against the true target), the per-axis velocity error (Fig. 16), torques, joint
     trajectories and the 3D paths.  Returns the stems written."""
-    t = series["t"]
     tfs = [s["start"] + s["tf"] for s in metrics["segments"]]
-    stems = []
+    for figure in (_axes_figure, _errors_figure, _joints_figure, _paths_figure):
+        figure(series, metrics, tfs, out_dir, title)
+    return ["axes", "errors", "joints", "paths3d"]
 
+
+def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+    t = series["t"]
     t_u, v, a, j = uniform_derivatives(t, series["xdot"])
     x_u = np.column_stack([np.interp(t_u, t, series["x"][:, k]) for k in range(3)])
     xr_u = np.column_stack([np.interp(t_u, t, series["x_r"][:, k]) for k in range(3)])
@@ -179,8 +183,10 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=9)
     fig.suptitle(f"{title}: robot vs target per axis")
     save(fig, out_dir, "axes")
-    stems.append("axes")
 
+
+def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+    t = series["t"]
     fig, axes = plt.subplots(3, 1, figsize=(10, 8.5), sharex=True, layout="constrained")
     e_norm = np.linalg.norm(series["e_true"], axis=1)
     axes[0].semilogy(t, np.maximum(e_norm, 1e-9), label="|e|")
@@ -216,8 +222,10 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.suptitle(f"{title}: interception error, velocity error, torques")
     save(fig, out_dir, "errors")
-    stems.append("errors")
 
+
+def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+    t = series["t"]
     fig, axes = plt.subplots(series["q"].shape[1], 1, figsize=(8, 7), sharex=True,
                              layout="constrained")
     for k, ax in enumerate(np.atleast_1d(axes)):
@@ -229,8 +237,10 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
     fig.suptitle(f"{title}: joint trajectories (model angles θ)")
     save(fig, out_dir, "joints")
-    stems.append("joints")
 
+
+def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+    t = series["t"]
     fig = plt.figure(figsize=(7.5, 6.5), layout="constrained")
     ax = fig.add_subplot(projection="3d")
     ax.plot(*series["x"].T, label="robot")
@@ -248,5 +258,3 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[
     fig.legend(fontsize=8, loc="outside lower center", ncol=6)
     fig.suptitle(f"{title}: 3D paths, red dots at the prescribed times")
     save(fig, out_dir, "paths3d")
-    stems.append("paths3d")
-    return stems

@@ -159,6 +159,26 @@ def object_positions(series: dict, starts, ends) -> np.ndarray:
     return objs
 
 
+def _record(meshcat, viz, plant, context, series: dict, objs: np.ndarray, ends, fps: float) -> None:
+    """The animation: the robot from the logged q, the objects, the intercept markers."""
+    t = series["t"]
+    n_obj = objs.shape[1]
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
+    frames = np.arange(t[0], t[-1] + 0.5 / fps, 1.0 / fps)
+    nq = plant.num_positions()
+    for tf_ in frames:
+        q = np.array([np.interp(tf_, t, series["q"][:, j]) for j in range(nq)])
+        plant.SetPositions(plant_context, q)
+        context.SetTime(tf_)
+        viz.ForcedPublish(viz.GetMyContextFromRoot(context))
+        for i in range(n_obj):
+            p = np.array([np.interp(tf_, t, objs[:, i, k]) for k in range(3)])
+            meshcat.SetTransform(f"objects/object_{i}", RigidTransform(p), time_in_recording=tf_)
+            meshcat.SetProperty(f"intercepts/point_{i}", "visible", bool(tf_ >= ends[i]),
+                                time_in_recording=tf_)
+
+
 def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
                  conveyors=None, end_effector: str | None = None) -> int:
     """Write a standalone replay HTML to ``path``; returns its size in bytes.
@@ -177,7 +197,6 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
         builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration))
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
 
     t = series["t"]
     starts = [s["start"] for s in metrics["segments"]]
@@ -206,19 +225,7 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
         meshcat.SetTransform(f"conveyors/belt_{j}",
                              RigidTransform(0.5 * (a + b) - [0, 0, radius + 0.005]))
 
-    meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
-    frames = np.arange(t[0], t[-1] + 0.5 / fps, 1.0 / fps)
-    nq = plant.num_positions()
-    for tf_ in frames:
-        q = np.array([np.interp(tf_, t, series["q"][:, j]) for j in range(nq)])
-        plant.SetPositions(plant_context, q)
-        context.SetTime(tf_)
-        viz.ForcedPublish(viz.GetMyContextFromRoot(context))
-        for i in range(n_obj):
-            p = np.array([np.interp(tf_, t, objs[:, i, k]) for k in range(3)])
-            meshcat.SetTransform(f"objects/object_{i}", RigidTransform(p), time_in_recording=tf_)
-            meshcat.SetProperty(f"intercepts/point_{i}", "visible", bool(tf_ >= ends[i]),
-                                time_in_recording=tf_)
+    _record(meshcat, viz, plant, context, series, objs, ends, fps)
     meshcat.StopRecording()
     meshcat.PublishRecording()
     html = with_camera(meshcat.StaticHtml(), CAMERA)

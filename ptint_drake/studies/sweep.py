@@ -82,72 +82,78 @@ def write_csv(rows, path: Path) -> None:
     os.replace(tmp, path)
 
 
-def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
-    """One heat map per metric over (tf, β), plus a map of which points intercepted
-    (README, Results: |e(tf)| ≤ 1 mm, hold ≤ 3 mm, |e(tf/2)| ≥ |e0|/4); returns the stems written."""
-    from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm  # noqa: PLC0415
+def _frame(ax, label: str, betas, tfs) -> None:
+    nt = len(tfs)
+    ax.set_xticks(range(nt), [f"{tf:g}" for tf in tfs], rotation=45 if nt > 6 else 0)
+    ax.set_yticks(range(len(betas)), [f"{b:g}" for b in betas])
+    ax.set_title(label, fontsize=10)
+    ax.tick_params(labelbottom=True, labelleft=True)
+    ax.set_xlabel("$t_f$ [s]")
+    ax.set_ylabel("β")
 
-    metrics = (("e_tf", "|e(tf)| [mm]", 1e3), ("hold", "hold max |e| [mm]", 1e3),
-               ("peak_torque", "peak |τ| [N·m]", 1.0), ("peak_jerk", "peak |jerk| [m/s³]", 1.0),
-               ("realtime_factor", "realtime factor [-]", 1.0))
-    lookup = {(float(r["beta"]), float(r["tf"])): r for r in rows}
-    nb, nt = len(betas), len(tfs)
-    cell_text = nb * nt <= 100
-    fontsize = 8 if max(nb, nt) <= 6 else 6
-    fig, axes = plt.subplots(2, 3, figsize=(13.5, 7.2 + 0.15 * max(nb - 4, 0)),
-                             layout="constrained", sharex=True, sharey=True)
-    axes = axes.ravel()
 
-    def frame(ax, label):
-        ax.set_xticks(range(nt), [f"{tf:g}" for tf in tfs], rotation=45 if nt > 6 else 0)
-        ax.set_yticks(range(nb), [f"{b:g}" for b in betas])
-        ax.set_title(label, fontsize=10)
-        ax.tick_params(labelbottom=True, labelleft=True)
-        ax.set_xlabel("$t_f$ [s]")
-        ax.set_ylabel("β")
-
-    status = np.full((nb, nt), 2.0)  # 0 intercepted, 1 missed, 2 error / not run
+def _grid(lookup: dict, betas, tfs, value) -> np.ndarray:
+    """value(row) on the β × tf grid (NaN where the point did not run)."""
+    grid = np.full((len(betas), len(tfs)), np.nan)
     for i, b in enumerate(betas):
         for j, tf in enumerate(tfs):
             r = lookup.get((float(b), float(tf)))
             if r and not r.get("error"):
-                status[i, j] = 0.0 if r.get("ok") in (True, "True") else 1.0
+                grid[i, j] = value(r)
+    return grid
+
+
+def _metric_map(fig, ax, grid: np.ndarray, label: str, betas, tfs, fontsize: int) -> None:
+    from matplotlib.colors import LogNorm  # noqa: PLC0415
+
+    finite = grid[np.isfinite(grid)]
+    norm = None
+    if finite.size and finite.min() > 0 and finite.max() / finite.min() > 30:
+        norm = LogNorm(finite.min(), finite.max())  # spans decades: colour by order of magnitude
+    im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis", norm=norm)
+    _frame(ax, label, betas, tfs)
+    cbar = fig.colorbar(im, ax=ax, shrink=0.9)
+    cbar.ax.tick_params(labelsize=8)
+    if grid.size <= 100 and finite.size:
+        for i, j in zip(*np.nonzero(np.isfinite(grid))):
+            r, g, b_, _ = im.cmap(im.norm(grid[i, j]))
+            dark = 0.299 * r + 0.587 * g + 0.114 * b_ < 0.5
+            ax.text(j, i, f"{grid[i, j]:.3g}", ha="center", va="center",
+                    color="w" if dark else "k", fontsize=fontsize)
+
+
+def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
+    """One heat map per metric over (tf, β), plus a map of which points intercepted (the
+    run's verdict, README: Results); returns the stems written.  The torque map shows the
+    peak after start-up (the first 5 % of tf, where the first step dominates, left out)."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: PLC0415
+
+    metrics = (("e_tf", "|e(tf)| [mm]", 1e3), ("hold", "hold max |e| [mm]", 1e3),
+               ("peak_torque_after_startup", "peak |τ| after start-up [N·m]", 1.0),
+               ("peak_jerk", "peak |jerk| [m/s³]", 1.0), ("realtime_factor", "realtime factor [-]", 1.0))
+    lookup = {(float(r["beta"]), float(r["tf"])): r for r in rows}
+    nb, nt = len(betas), len(tfs)
+    fontsize = 8 if max(nb, nt) <= 6 else 6
+    fig, axes = plt.subplots(2, 3, figsize=(13.5, 7.2 + 0.15 * max(nb - 4, 0)),
+                             layout="constrained", sharex=True, sharey=True)
+    axes = axes.ravel()
     for ax, (key, label, scale) in zip(axes, metrics):
-        grid = np.full((nb, nt), np.nan)
-        for i, b in enumerate(betas):
-            for j, tf in enumerate(tfs):
-                r = lookup.get((float(b), float(tf)))
-                if r and not r.get("error") and r.get(key) not in (None, ""):
-                    grid[i, j] = float(r[key]) * scale
-        finite = grid[np.isfinite(grid)]
-        norm = None
-        if finite.size and finite.min() > 0 and finite.max() / finite.min() > 30:
-            norm = LogNorm(finite.min(), finite.max())  # spans decades: colour by order of magnitude
-        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis", norm=norm)
-        frame(ax, label)
-        cbar = fig.colorbar(im, ax=ax, shrink=0.9)
-        cbar.ax.tick_params(labelsize=8)
-        if cell_text and finite.size:
-            for i in range(nb):
-                for j in range(nt):
-                    if np.isfinite(grid[i, j]):
-                        r, g, b_, _ = im.cmap(im.norm(grid[i, j]))
-                        dark = 0.299 * r + 0.587 * g + 0.114 * b_ < 0.5
-                        ax.text(j, i, f"{grid[i, j]:.3g}", ha="center", va="center",
-                                color="w" if dark else "k", fontsize=fontsize)
+        grid = _grid(lookup, betas, tfs, lambda r: float(r[key]) * scale if r.get(key) not in (None, "")
+                     else np.nan)
+        _metric_map(fig, ax, grid, label, betas, tfs, fontsize)
+    status = np.nan_to_num(_grid(lookup, betas, tfs, lambda r: 0.0 if r.get("ok") in (True, "True")
+                                 else 1.0), nan=2.0)  # 0 intercepted, 1 missed, 2 error / not run
     ax = axes[len(metrics)]
-    colors = ListedColormap(["#4caf50", "#e53935", "#9e9e9e"])
-    ax.imshow(status, origin="lower", aspect="auto", cmap=colors,
+    ax.imshow(status, origin="lower", aspect="auto", cmap=ListedColormap(["#4caf50", "#e53935", "#9e9e9e"]),
               norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], 3))
-    frame(ax, "intercepted?")
-    if cell_text:
+    _frame(ax, "intercepted?", betas, tfs)
+    if nb * nt <= 100:
         words = {0.0: "yes", 1.0: "missed", 2.0: "error"}
         for i in range(nb):
             for j in range(nt):
                 ax.text(j, i, words[status[i, j]], ha="center", va="center", color="w",
                         fontsize=fontsize, fontweight="bold")
-    n_ok = int(np.sum(status == 0))
-    fig.suptitle(f"{title}: {n_ok} of {nb * nt} points intercepted "
+    fig.suptitle(f"{title}: {int(np.sum(status == 0))} of {nb * nt} points intercepted "
                  f"(|e(tf)| ≤ 1 mm, hold ≤ 3 mm, |e(tf/2)| ≥ |e0|/4)")
     save(fig, out_dir, "sweep")
     return ["sweep"]
