@@ -197,13 +197,13 @@ def singularity_warnings(plant: MultibodyPlant, scenario: Scenario, series: dict
         return []
     frame = plant.GetFrameByName(scenario.robot.end_effector)
     context = plant.CreateDefaultContext()
-    smallest = np.empty(len(series["t"]))
+    Js = np.empty((len(series["t"]), 3, plant.num_velocities()))
+    origin, world = np.zeros(3), plant.world_frame()
     for k, q in enumerate(series["q"]):
         plant.SetPositions(context, q)
-        J = plant.CalcJacobianTranslationalVelocity(
-            context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(),
-            plant.world_frame())
-        smallest[k] = np.linalg.svd(J, compute_uv=False)[-1]
+        Js[k] = plant.CalcJacobianTranslationalVelocity(
+            context, JacobianWrtVariable.kV, frame, origin, world, world)
+    smallest = np.linalg.svd(Js, compute_uv=False)[:, -1]  # one batched call
     below = np.nonzero(smallest < threshold)[0]
     if len(below) == 0:
         return []

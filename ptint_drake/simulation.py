@@ -30,7 +30,7 @@ from ptint_drake.robot import (check_reachable, joint_limit_warnings, scale_mass
 from ptint_drake.scenario import Scenario
 from ptint_drake.station import MakeStation, Station
 from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.targets import active_target_state
+from ptint_drake.systems.targets import active_target_state, target_values
 from ptint_drake.watchdog import Watchdog
 
 
@@ -220,8 +220,9 @@ def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:
     series["x"], series["xdot"] = x, xdot
     if redundant:
         series["self_motion"] = self_motion
-    truth = np.array([np.concatenate([tg.evaluate(tk)[0:6] for tg in station.true_targets])
-                      for tk in t]).reshape(len(t), -1, 6)
+    targets = station.true_targets
+    truth = np.array([[v for tg in targets for v in target_values(tg, tk)[0:6]]
+                      for tk in t.tolist()], dtype=float).reshape(len(t), len(targets), 6)
     series["objects"] = truth[:, :, 0:3].reshape(len(t), -1)
     active = np.array([max(built.schedule.active(tk), 0) for tk in t], dtype=int)
     own = truth[np.arange(len(t)), active]

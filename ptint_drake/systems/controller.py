@@ -14,23 +14,41 @@ from pydrake.systems.framework import LeafSystem
 from ptint_drake.systems.cache import DeclareVectorCache
 
 
+def _solve3_floats(J, b):
+    """J⁻¹ b for a 3 × 3 J (3 rows of plain floats) by Cramer's rule; None when J is
+    numerically singular."""
+    (a, b_, c), (d, e, f), (g, h, i) = J
+    co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
+    det = a * co0 + b_ * co1 + c * co2
+    scale = max(abs(a), abs(b_), abs(c), abs(d), abs(e), abs(f), abs(g), abs(h), abs(i)) or 1.0
+    if abs(det) <= 1e-12 * scale**3:
+        return None
+    x, y, z = b
+    return [(co0 * x + (c * h - b_ * i) * y + (b_ * f - c * e) * z) / det,
+            (co1 * x + (a * i - c * g) * y + (c * d - a * f) * z) / det,
+            (co2 * x + (b_ * g - a * h) * y + (a * e - b_ * d) * z) / det]
+
+
 def solve3(J: np.ndarray, b: np.ndarray) -> np.ndarray:
     """J⁻¹ b for a 3 × 3 J by Cramer's rule in plain floats (numpy's solve costs ~15 µs here).
 
     Falls back to a least-squares solve when J is numerically singular.
     """
-    (a, b_, c), (d, e, f), (g, h, i) = J.tolist()
-    co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
-    det = a * co0 + b_ * co1 + c * co2
-    scale = max(abs(a), abs(b_), abs(c), abs(d), abs(e), abs(f), abs(g), abs(h), abs(i)) or 1.0
-    if abs(det) <= 1e-12 * scale**3:
+    out = _solve3_floats(np.asarray(J, dtype=float).tolist(), np.asarray(b, dtype=float).tolist())
+    if out is None:
         return np.linalg.lstsq(J, b, rcond=None)[0]
-    x, y, z = b.tolist()
-    return np.array([
-        co0 * x + (c * h - b_ * i) * y + (b_ * f - c * e) * z,
-        co1 * x + (a * i - c * g) * y + (c * d - a * f) * z,
-        co2 * x + (b_ * g - a * h) * y + (a * e - b_ * d) * z,
-    ]) / det
+    return np.array(out)
+
+
+def smc_torque_values(K, J, s_x, damping: float = 0.0) -> list:
+    """``smc_torque`` in plain floats: K a sequence of nv gains, J a list of 3 rows, s_x a
+    list of 3; returns τ as a list (the per-derivative fast path)."""
+    if damping > 0.0 or len(J[0]) != 3:
+        return smc_torque(np.asarray(K, dtype=float), np.array(J), np.array(s_x), damping).tolist()
+    qdot_s = _solve3_floats(J, s_x)
+    if qdot_s is None:
+        qdot_s = np.linalg.lstsq(np.array(J), np.array(s_x), rcond=None)[0].tolist()
+    return [-k * a for k, a in zip(K, qdot_s)]
 
 
 def smc_torque(K: np.ndarray, J: np.ndarray, s_x: np.ndarray, damping: float = 0.0) -> np.ndarray:
@@ -42,7 +60,8 @@ def smc_torque(K: np.ndarray, J: np.ndarray, s_x: np.ndarray, damping: float = 0
     if damping > 0.0:
         qdot_s = J.T @ solve3(J @ J.T + damping * damping * np.eye(3), s_x)
     elif J.shape[1] == 3:
-        qdot_s = solve3(J, s_x)
+        return np.array(smc_torque_values(np.broadcast_to(K, (3,)).tolist(), J.tolist(),
+                                          np.asarray(s_x, dtype=float).tolist()))
     else:
         qdot_s = J.T @ np.linalg.solve(J @ J.T, s_x)
     return -K * qdot_s

@@ -23,13 +23,13 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
-from ptint_drake.systems.controller import null_space_torque, smc_torque
+from ptint_drake.systems.controller import null_space_torque, smc_torque_values
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.sliding_surface import DeclareSegmentCapture, SurfaceLaw
-from ptint_drake.systems.targets import active_target_state
-from ptint_drake.systems.tbg import tbg_state
+from ptint_drake.systems.targets import active_target_values
+from ptint_drake.systems.tbg import tbg_values
 
 
 def telemetry_layout(nv: int) -> dict:
@@ -69,6 +69,7 @@ class PrescribedTimeInterceptor(LeafSystem):
         self._law = SurfaceLaw(gains.Lambda, gains.k, gains.switching, gains.phi,
                                gains.sigma_policy, gains.k_hold)
         self._K = np.broadcast_to(np.asarray(gains.K, dtype=float), (nv,)).copy()
+        self._K_floats = tuple(self._K.tolist())
         self._damping = float(gains.pinv_damping)
         self._null_space = None
         if gains.null_space_damping > 0.0 and nv > 3:  # redundant arms only; needs nq = nv
@@ -107,42 +108,49 @@ class PrescribedTimeInterceptor(LeafSystem):
         return self._target_in is not None
 
     def _calc(self, context) -> np.ndarray:
-        t = context.get_time()
-        qv = self._state_in.Eval(context)
-        x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
-        if self._targets is None:
-            target = self._target_in.Eval(context)
-        else:
-            target = active_target_state(self._schedule, self._targets, t)
-        tbg = tbg_state(self._schedule, t, *self._tbg_args)
-        sigma = context.get_continuous_state_vector().CopyToVector()
-        s_x, e, edot, s, s_d, sigma_dot = self._law.parts(
-            t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
-            context.get_discrete_state_vector().value(), sigma)
-        tau = smc_torque(self._K, J, s_x, self._damping)
-        if self._null_space is not None:
+        return np.array(self._row(
+            context.get_time(), self._state_in.Eval(context),
+            context.get_continuous_state_vector().CopyToVector().tolist(),
+            context.get_discrete_state_vector().value().tolist(),
+            None if self._target_in is None else self._target_in.Eval(context).tolist()))
+
+    def _row(self, t: float, qv: np.ndarray, sigma: list, captured: list,
+             target: Optional[list]) -> list:
+        """The cache vector (telemetry, active segment, σ̇) as a list of plain floats, from the
+        time, the plant state [q; v] (an array), σ, [index, s(t0)] and the ``target`` input's
+        value (None: the system's own targets)."""
+        nq = self._nq
+        x, xdot, J = self._kinematics.values(qv[:nq], qv[nq:].tolist())
+        if target is None:
+            target = active_target_values(self._schedule, self._targets, t)
+        tbg = tbg_values(self._schedule, t, *self._tbg_args)
+        parts = self._law.values(t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
+                                 captured, sigma)
+        tau = smc_torque_values(self._K_floats, J, parts[0:3], self._damping)
+        if self._null_space is not None:  # redundant arms, optional (off by default)
             D, rate, q_start = self._null_space
-            tau = tau + null_space_torque(J, qv[: self._nq], qv[self._nq:], q_start, D, rate)
-        return np.concatenate([x, xdot, target[0:9], tbg[0:5], s_x, e, edot, s, s_d, sigma, tau,
-                               tbg[5:10], sigma_dot])
+            tau = (np.array(tau) + null_space_torque(np.array(J), qv[:nq], qv[nq:], q_start, D, rate)).tolist()
+        return x + xdot + target[0:9] + tbg[0:5] + parts[0:15] + sigma + tau + tbg[5:10] + parts[15:18]
 
     def telemetry_at(self, t: np.ndarray, plant_state: np.ndarray, sigma: np.ndarray,
                      captured: np.ndarray, target: Optional[np.ndarray] = None) -> np.ndarray:
         """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0)], and the
-        ``target`` input's value when the system has that port)."""
-        context = self.CreateDefaultContext()
-        port = self._state_in
+        ``target`` input's value when the system has that port).
+
+        The same ``_row`` as a context's cache entry, called directly on the logged values
+        (no context, no cache entry, no crossing into Drake but the kinematics).
+        """
         size = self.layout["tau"].stop
-        rows = np.empty((len(t), size))
-        for k in range(len(t)):
-            context.SetTime(t[k])
-            context.SetContinuousState(sigma[k])
-            context.SetDiscreteState(captured[k])
-            port.FixValue(context, plant_state[k])
-            if self._target_in is not None:
-                self._target_in.FixValue(context, target[k])
-            rows[k] = self._eval(context)[:size]
-        return rows
+        n = len(t)
+        if n == 0:
+            return np.empty((0, size))
+        targets = [None] * n if self._target_in is None else np.asarray(target).tolist()
+        row = self._row
+        rows = np.array([row(tk, qv, sg, cap, tg) for tk, qv, sg, cap, tg in zip(
+            np.asarray(t, dtype=float).tolist(), np.asarray(plant_state, dtype=float),
+            np.asarray(sigma, dtype=float).tolist(), np.asarray(captured, dtype=float).tolist(),
+            targets)])
+        return rows[:, :size]
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self._sigma_dot])

@@ -28,6 +28,19 @@ class FrameKinematics:
         self._frame = frame
         self._world = plant.world_frame()
         self._plant_context = plant.CreateDefaultContext()
+        self._kV = JacobianWrtVariable.kV
+
+    def values(self, q, v):
+        """(x, ẋ, J) at joint positions q and velocities v (arrays), as plain floats:
+        x and ẋ lists of 3, J a list of 3 rows (the per-derivative fast path)."""
+        plant, pc = self._plant, self._plant_context
+        plant.SetPositions(pc, q)
+        x = self._frame.CalcPoseInWorld(pc).translation().tolist()
+        J = plant.CalcJacobianTranslationalVelocity(
+            pc, self._kV, self._frame, _ORIGIN, self._world, self._world)
+        # numpy's J @ v (BLAS, fused multiply-adds) as ``compute`` has it: a plain-float sum
+        # differs from it in the last bit and the run would move with that
+        return x, (J @ v).tolist(), J.tolist()
 
     def compute(self, q, v):
         """(x, ẋ, J) at joint positions q and velocities v."""
@@ -40,8 +53,8 @@ class FrameKinematics:
 
     def evaluate(self, q, v) -> np.ndarray:
         """[x, ẋ, vec(J)] (row-major J, 3 × nv) at joint positions q and velocities v."""
-        x, xdot, J = self.compute(q, v)
-        return np.concatenate([x, xdot, J.ravel()])
+        x, xdot, J = self.values(q, v)
+        return np.array(x + xdot + [a for row in J for a in row])
 
 
 class TaskSpaceKinematics(LeafSystem):

@@ -55,8 +55,25 @@ def switching_function(w: np.ndarray, law: str, phi: float) -> np.ndarray:
     raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
 
 
+def _sign(w: float) -> float:
+    """``np.sign`` of one float (0 stays 0, NaN stays NaN)."""
+    return 1.0 if w > 0.0 else (-1.0 if w < 0.0 else w)
+
+
+def _switch_floats(law: str, phi: float):
+    """``switching_function`` on a list of plain floats, as a function of that list."""
+    if law == "sign":
+        return lambda w: [_sign(a) for a in w]
+    if law == "tanh":
+        # numpy's tanh, not math.tanh: they differ in the last bit for about a quarter of
+        # the arguments, and the run (step sizes, sampled peaks) should not move with it
+        tanh = np.tanh
+        return lambda w: [float(tanh(w[0] / phi)), float(tanh(w[1] / phi)), float(tanh(w[2] / phi))]
+    return lambda w: [min(max(a / phi, -1.0), 1.0) if a == a else a for a in w]
+
+
 class SurfaceLaw:
-    """The surface equations above as plain numpy, shared by ``SlidingSurface`` and the
+    """The surface equations above in plain floats, shared by ``SlidingSurface`` and the
     fused ``PrescribedTimeInterceptor`` so both compute exactly the same thing."""
 
     def __init__(self, Lambda=5.0, k: float = 3.0, switching: str = "tanh", phi: float = 0.01,
@@ -72,35 +89,61 @@ class SurfaceLaw:
         self.law = switching
         self.phi = float(phi)
         self.reset_sigma = sigma_policy == "reset"
+        self._Lambda = tuple(self.Lambda.tolist())
+        self._switch = _switch_floats(switching, self.phi)
 
-    def terms(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma) -> np.ndarray:
-        """[s_x, e, ė, s, s_d, σ̇] (18 values); see ``parts``."""
-        return np.concatenate(self.parts(t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma))
-
-    def parts(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma):
-        """(s_x, e, ė, s, s_d, σ̇).
+    def values(self, t: float, x, xdot, x_r, xdot_r, alpha: float, segment, captured, sigma) -> list:
+        """[s_x, e, ė, s, s_d, σ̇] (18 plain floats) from plain-float sequences (lists).
 
         ``segment`` = [index, t0, tf, ...] of the active segment (TBG output),
         ``captured`` = [index, s(t0)] (the discrete state), ``sigma`` = σ.
         """
-        e = x - x_r
-        edot = xdot - xdot_r
-        s = edot + alpha * e
-        if segment[0] < 0 or captured[0] != segment[0]:
-            s_d = s.copy()  # at the switch instant s(t0) is s itself
+        x0, x1, x2 = x
+        r0, r1, r2 = x_r
+        e = [x0 - r0, x1 - r1, x2 - r2]
+        x0, x1, x2 = xdot
+        r0, r1, r2 = xdot_r
+        edot = [x0 - r0, x1 - r1, x2 - r2]
+        s0, s1, s2 = edot[0] + alpha * e[0], edot[1] + alpha * e[1], edot[2] + alpha * e[2]
+        index = segment[0]
+        if index < 0 or captured[0] != index:
+            d0, d1, d2 = s0, s1, s2  # at the switch instant s(t0) is s itself
         else:
             tau, tf = t - segment[1], segment[2]
+            # numpy's exp (as the array version had), bit-identical to it; math.exp is not
             if tau < tf:
-                s_d = captured[1:4] * np.exp(-self.k * tau)
+                f = float(np.exp(-self.k * tau))
             else:
-                s_d = captured[1:4] * np.exp(-self.k * tf - self.k_hold * (tau - tf))
-        w = s - s_d
-        s_x = w + self.Lambda * sigma
-        return s_x, e, edot, s, s_d, self.switch(w)
+                f = float(np.exp(-self.k * tf - self.k_hold * (tau - tf)))
+            d0, d1, d2 = captured[1] * f, captured[2] * f, captured[3] * f
+        w = [s0 - d0, s1 - d1, s2 - d2]
+        L0, L1, L2 = self._Lambda
+        return ([w[0] + L0 * sigma[0], w[1] + L1 * sigma[1], w[2] + L2 * sigma[2]]
+                + e + edot + [s0, s1, s2, d0, d1, d2] + self._switch(w))
+
+    def terms(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma) -> np.ndarray:
+        """[s_x, e, ė, s, s_d, σ̇] (18 values); see ``parts``."""
+        return np.array(self.values(float(t), _floats(x), _floats(xdot), _floats(x_r),
+                                    _floats(xdot_r), float(alpha), _floats(segment),
+                                    _floats(captured), _floats(sigma)))
+
+    def parts(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma):
+        """(s_x, e, ė, s, s_d, σ̇), six arrays of 3.
+
+        ``segment`` = [index, t0, tf, ...] of the active segment (TBG output),
+        ``captured`` = [index, s(t0)] (the discrete state), ``sigma`` = σ.
+        """
+        out = self.terms(t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma)
+        return tuple(out[i:i + 3] for i in range(0, 18, 3))
 
     def switch(self, w: np.ndarray) -> np.ndarray:
         """σ̇ = switch(s − s_d) with this law's switching function."""
         return switching_function(w, self.law, self.phi)
+
+
+def _floats(values) -> list:
+    """A sequence (numpy array or list) as a list of plain floats."""
+    return values if type(values) is list else np.asarray(values, dtype=float).tolist()
 
 
 def DeclareSegmentCapture(system, schedule: Schedule, law: SurfaceLaw, segment_and_s):
@@ -163,12 +206,13 @@ class SlidingSurface(LeafSystem):
             prerequisites_of_calc={self.xc_ticket()})
 
     def _calc(self, context) -> np.ndarray:
-        return self._law.terms(
-            context.get_time(), self._x_in.Eval(context), self._xdot_in.Eval(context),
-            self._x_r_in.Eval(context), self._xdot_r_in.Eval(context),
-            self._alpha_in.Eval(context)[0], self._segment_in.Eval(context),
-            context.get_discrete_state_vector().value(),
-            context.get_continuous_state_vector().CopyToVector())
+        return np.array(self._law.values(
+            context.get_time(), self._x_in.Eval(context).tolist(),
+            self._xdot_in.Eval(context).tolist(), self._x_r_in.Eval(context).tolist(),
+            self._xdot_r_in.Eval(context).tolist(), float(self._alpha_in.Eval(context)[0]),
+            self._segment_in.Eval(context).tolist(),
+            context.get_discrete_state_vector().value().tolist(),
+            context.get_continuous_state_vector().CopyToVector().tolist()))
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._eval(context)[15:18])

@@ -12,6 +12,7 @@ Both kinds are functions of absolute time t:
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -33,16 +34,22 @@ class SinusoidTarget:
     def __post_init__(self):
         for name in ("center", "amplitude", "phase"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
+        # the k-th derivative of a sin(ωt + φ) is a ωᵏ sin(ωt + φ + kπ/2), for k = 0..3:
+        # (offset, gain, shift) of the 12 values as plain floats
         a, w = self.amplitude, self.omega
-        # the k-th derivative of a sin(ωt + φ) is a ωᵏ sin(ωt + φ + kπ/2): one sin call for all 12
-        object.__setattr__(self, "_offset", np.concatenate([self.center, np.zeros(9)]))
-        object.__setattr__(self, "_gain", np.concatenate([a, a * w, a * w**2, a * w**3]))
-        object.__setattr__(self, "_shift", np.concatenate(
-            [self.phase + k * np.pi / 2 for k in range(4)]))
+        offset = np.concatenate([self.center, np.zeros(9)]).tolist()
+        gain = np.concatenate([a, a * w, a * w**2, a * w**3]).tolist()
+        shift = np.concatenate([self.phase + k * np.pi / 2 for k in range(4)]).tolist()
+        object.__setattr__(self, "_terms", tuple(zip(offset, gain, shift)))
+
+    def values(self, t: float) -> list:
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 plain floats) at time t."""
+        wt, sin = self.omega * t, math.sin
+        return [c + g * sin(wt + p) for c, g, p in self._terms]
 
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
-        return self._offset + self._gain * np.sin(self.omega * t + self._shift)
+        return np.array(self.values(t))
 
 
 @dataclass(frozen=True)
@@ -53,17 +60,32 @@ class LinearTarget:
     def __post_init__(self):
         for name in ("start", "velocity"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
-        object.__setattr__(self, "_offset", np.concatenate([self.start, self.velocity, np.zeros(6)]))
-        object.__setattr__(self, "_rate", np.concatenate([self.velocity, np.zeros(9)]))
+        object.__setattr__(self, "_floats", (self.start.tolist(), self.velocity.tolist()))
+
+    def values(self, t: float) -> list:
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 plain floats) at time t."""
+        start, velocity = self._floats
+        return [x0 + vi * t for x0, vi in zip(start, velocity)] + velocity + [0.0] * 6
 
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
-        return self._offset + self._rate * t
+        return np.array(self.values(t))
+
+
+def target_values(target, t: float) -> list:
+    """``target.evaluate(t)`` as a list of plain floats (its ``values`` when it has one)."""
+    values = getattr(target, "values", None)
+    return values(t) if values is not None else target.evaluate(t).tolist()
+
+
+def active_target_values(schedule: Schedule, targets: Sequence, t: float) -> list:
+    """``active_target_state`` as a list of 12 plain floats (the per-derivative fast path)."""
+    return target_values(targets[max(schedule.active(t), 0)], t)
 
 
 def active_target_state(schedule: Schedule, targets: Sequence, t: float) -> np.ndarray:
     """[x_r, ẋ_r, ẍ_r, x⃛_r] of the target of the segment active at t (the first before it)."""
-    return targets[max(schedule.active(t), 0)].evaluate(t)
+    return np.array(active_target_values(schedule, targets, t))
 
 
 class TargetSource(LeafSystem):

@@ -22,6 +22,9 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 from scipy.special import beta as beta_function
 from scipy.special import betaincinv
+# The same Boost inverse as the ufunc (bit-identical results), without the ufunc's
+# per-call dispatch: about 0.9 µs instead of 1.7 µs for one scalar.
+from scipy.special.cython_special import betaincinv as _betaincinv_scalar
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
@@ -74,10 +77,10 @@ def tbg_profile_scalar(tau: float, tf: float, beta: float, g: float):
     a = 1.0 - beta
     # one inverse per call: the smaller of ξ and η = 1 − ξ directly, the other as 1 − it
     if u < 0.5:
-        eta = float(betaincinv(a, a, u))
+        eta = _betaincinv_scalar(a, a, u)
         xi = 1.0 - eta
     else:
-        xi = float(betaincinv(a, a, 1.0 - u))
+        xi = _betaincinv_scalar(a, a, 1.0 - u)
         eta = 1.0 - xi
     p = xi * eta
     one_m_2xi = 1.0 - 2.0 * xi
@@ -99,29 +102,33 @@ def alpha_peak(tf: float, beta: float, epsilon: float = 1e-6, delta: float = 1e-
     return float(np.max(alpha_gain(xi, xi_d, epsilon, delta)))
 
 
+def tbg_values(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float = 1e-6,
+               alpha_hold: float = 0.0) -> list:
+    """``tbg_state`` as a list of 10 plain floats (the per-derivative fast path).
+
+    [ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] of the segment active at absolute time t;
+    phase: 0 before the first segment, 1 while converging, 2 while holding after tf.
+    """
+    i = schedule.active(t)
+    if i < 0:
+        return [1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0]
+    seg = schedule[i]
+    tau = t - seg.start
+    if tau < seg.tf:
+        xi, xi_d, xi_dd, xi_ddd = tbg_profile_scalar(tau, seg.tf, seg.beta, schedule.gamma(i))
+        return [xi, xi_d, xi_dd, xi_ddd, -(1.0 + epsilon) * xi_d / (xi + delta),
+                float(i), float(seg.start), float(seg.tf), float(seg.beta), 1.0]
+    return [0.0, 0.0, 0.0, 0.0, float(alpha_hold), float(i), float(seg.start), float(seg.tf),
+            float(seg.beta), 2.0]
+
+
 def tbg_state(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float = 1e-6,
               alpha_hold: float = 0.0) -> np.ndarray:
     """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] of the segment active at absolute time t.
 
     phase: 0 before the first segment, 1 while converging, 2 while holding after tf.
     """
-    out = np.zeros(10)
-    i = schedule.active(t)
-    if i < 0:
-        out[0] = 1.0
-        out[5] = -1.0
-        return out
-    seg = schedule[i]
-    tau = t - seg.start
-    out[5:9] = (i, seg.start, seg.tf, seg.beta)
-    if tau < seg.tf:
-        xi, xi_d, xi_dd, xi_ddd = tbg_profile_scalar(tau, seg.tf, seg.beta, schedule.gamma(i))
-        out[0:5] = (xi, xi_d, xi_dd, xi_ddd, -(1.0 + epsilon) * xi_d / (xi + delta))
-        out[9] = 1.0
-    else:
-        out[4] = alpha_hold
-        out[9] = 2.0
-    return out
+    return np.array(tbg_values(schedule, t, epsilon, delta, alpha_hold))
 
 
 class TimeBaseGenerator(LeafSystem):
