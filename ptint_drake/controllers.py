@@ -35,6 +35,7 @@ from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.ct_quintic import CtQuinticController
 from ptint_drake.systems.kalman import AddCameraEstimators
 from ptint_drake.systems.pd import PDController
+from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
 from ptint_drake.systems.measurement import MeasuredTarget
 from ptint_drake.systems.targets import TargetSource
@@ -144,7 +145,8 @@ def _block_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -
     def telemetry(logs: dict) -> dict:
         out = {name: logs[name] for name in ports}
         target_log = out.pop("target")
-        out["x_r"], out["xdot_r"], out["xddot_r"] = np.split(target_log, 3, axis=1)
+        out["x_r"], out["xdot_r"], out["xddot_r"] = (target_log[:, TARGET.x], target_log[:, TARGET.xdot],
+                                                     target_log[:, TARGET.xddot])
         return out
 
     return ControllerHandles("ptsmc", ports, telemetry, notes, system=h.controller)
@@ -162,7 +164,9 @@ def _baseline_handles(name: str, system, target: OutputPort, notes, model_based=
 
     def telemetry(logs: dict) -> dict:
         out = {key: logs["telemetry"][:, part] for key, part in layout.items()}
-        out["x_r"], out["xdot_r"], out["xddot_r"] = np.split(logs["target"], 3, axis=1)
+        target = logs["target"]
+        out["x_r"], out["xdot_r"], out["xddot_r"] = (target[:, TARGET.x], target[:, TARGET.xdot],
+                                                     target[:, TARGET.xddot])
         return out
 
     return ControllerHandles(name, ports, telemetry, notes, model_based, system)

@@ -30,6 +30,7 @@ from ptint_drake.robot import (check_reachable, joint_limit_warnings, scale_mass
 from ptint_drake.scenario import Scenario
 from ptint_drake.station import MakeStation, Station
 from ptint_drake.systems.kinematics import FrameKinematics
+from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.targets import active_target_state, target_values
 from ptint_drake.watchdog import Watchdog
 
@@ -122,7 +123,7 @@ def _advance(simulator: Simulator, scenario: Scenario, watchdog: Watchdog, gripp
             break
         x, xdot, _ = gripper(context)
         target = true_state(t_stop)
-        samples[t_stop] = (x - target[0:3], xdot - target[3:6])
+        samples[t_stop] = (x - target[TARGET.x], xdot - target[TARGET.xdot])
     return samples, wall
 
 
@@ -152,7 +153,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     schedule, targets = scenario.schedule(), built.station.true_targets
     true_state = lambda t: active_target_state(schedule, targets, t)  # noqa: E731
     watchdog = Watchdog(scenario=scenario, diagram=built.diagram, plant=plant,
-                        position_of=lambda c: gripper(c)[0], true_target=lambda t: true_state(t)[0:3],
+                        position_of=lambda c: gripper(c)[0], true_target=lambda t: true_state(t)[TARGET.x],
                         progress=progress)
     simulator.set_monitor(watchdog)
     samples, wall = _advance(simulator, scenario, watchdog, gripper, true_state)

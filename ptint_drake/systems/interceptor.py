@@ -27,6 +27,7 @@ from ptint_drake.systems.controller import null_space_torque, smc_torque_values
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import SURFACE, SURFACE_OUT, TARGET, TARGET_PORT, TBG, TBG_OUT
 from ptint_drake.systems.sliding_surface import DeclareSegmentCapture, SurfaceLaw
 from ptint_drake.systems.targets import active_target_values
 from ptint_drake.systems.tbg import tbg_values
@@ -124,13 +125,14 @@ class PrescribedTimeInterceptor(LeafSystem):
         if target is None:
             target = active_target_values(self._schedule, self._targets, t)
         tbg = tbg_values(self._schedule, t, *self._tbg_args)
-        parts = self._law.values(t, x, xdot, target[0:3], target[3:6], tbg[4], tbg[5:10],
+        parts = self._law.values(t, x, xdot, target[TARGET.x], target[TARGET.xdot], tbg[TBG.alpha], tbg[TBG.segment],
                                  captured, sigma)
-        tau = smc_torque_values(self._K_floats, J, parts[0:3], self._damping)
+        tau = smc_torque_values(self._K_floats, J, parts[SURFACE.s_x], self._damping)
         if self._null_space is not None:  # redundant arms, optional (off by default)
             D, rate, q_start = self._null_space
             tau = (np.array(tau) + null_space_torque(np.array(J), qv[:nq], qv[nq:], q_start, D, rate)).tolist()
-        return x + xdot + target[0:9] + tbg[0:5] + parts[0:15] + sigma + tau + tbg[5:10] + parts[15:18]
+        return (x + xdot + target[TARGET_PORT] + tbg[TBG_OUT] + parts[SURFACE_OUT] + sigma + tau
+                + tbg[TBG.segment] + parts[SURFACE.sigma_dot])
 
     def telemetry_at(self, t: np.ndarray, plant_state: np.ndarray, sigma: np.ndarray,
                      captured: np.ndarray, target: Optional[np.ndarray] = None) -> np.ndarray:

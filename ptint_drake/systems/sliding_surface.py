@@ -37,6 +37,7 @@ from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import CAPTURED, SEGMENT, SURFACE
 
 SWITCHING_LAWS = ("sign", "tanh", "sat")
 SIGMA_POLICIES = ("keep", "reset")
@@ -105,17 +106,17 @@ class SurfaceLaw:
         r0, r1, r2 = xdot_r
         edot = [x0 - r0, x1 - r1, x2 - r2]
         s0, s1, s2 = edot[0] + alpha * e[0], edot[1] + alpha * e[1], edot[2] + alpha * e[2]
-        index = segment[0]
-        if index < 0 or captured[0] != index:
+        index = segment[SEGMENT.index]
+        if index < 0 or captured[CAPTURED.index] != index:
             d0, d1, d2 = s0, s1, s2  # at the switch instant s(t0) is s itself
         else:
-            tau, tf = t - segment[1], segment[2]
+            tau, tf = t - segment[SEGMENT.t0], segment[SEGMENT.tf]
             # numpy's exp (as the array version had), bit-identical to it; math.exp is not
             if tau < tf:
                 f = float(np.exp(-self.k * tau))
             else:
                 f = float(np.exp(-self.k * tf - self.k_hold * (tau - tf)))
-            d0, d1, d2 = captured[1] * f, captured[2] * f, captured[3] * f
+            d0, d1, d2 = (c * f for c in captured[CAPTURED.s0])
         w = [s0 - d0, s1 - d1, s2 - d2]
         L0, L1, L2 = self._Lambda
         return ([w[0] + L0 * sigma[0], w[1] + L1 * sigma[1], w[2] + L2 * sigma[2]]
@@ -158,10 +159,10 @@ def DeclareSegmentCapture(system, schedule: Schedule, law: SurfaceLaw, segment_a
 
     def capture(context, state):
         segment, s = segment_and_s(context)
-        if segment[0] < 0:
+        if segment[SEGMENT.index] < 0:
             return
         state.get_mutable_discrete_state().get_mutable_vector().SetFromVector(
-            np.concatenate([[segment[0]], s]))
+            np.concatenate([[segment[SEGMENT.index]], s]))
         if law.reset_sigma:
             state.get_mutable_continuous_state().get_mutable_vector().SetZero()
 
@@ -193,13 +194,13 @@ class SlidingSurface(LeafSystem):
         self._alpha_in = self.DeclareVectorInputPort("alpha", 1)
         self._segment_in = self.DeclareVectorInputPort("segment", 5)
         DeclareSegmentCapture(self, schedule, self._law,
-                              lambda c: (self._segment_in.Eval(c), self._eval(c)[9:12]))
+                              lambda c: (self._segment_in.Eval(c), self._eval(c)[SURFACE.s]))
 
         deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
-        self._eval = DeclareVectorCache(self, "surface", 18, self._calc, deps)
-        for name, lo in (("s_x", 0), ("e", 3), ("edot", 6), ("s", 9), ("s_d", 12)):
+        self._eval = DeclareVectorCache(self, "surface", SURFACE.size, self._calc, deps)
+        for name in ("s_x", "e", "edot", "s", "s_d"):
             self.DeclareVectorOutputPort(
-                name, 3, lambda c, o, lo=lo: o.SetFromVector(self._eval(c)[lo:lo + 3]),
+                name, 3, lambda c, o, part=getattr(SURFACE, name): o.SetFromVector(self._eval(c)[part]),
                 prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort(
             "sigma", 3, lambda c, o: o.SetFromVector(c.get_continuous_state_vector().CopyToVector()),
@@ -215,7 +216,7 @@ class SlidingSurface(LeafSystem):
             context.get_continuous_state_vector().CopyToVector().tolist()))
 
     def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[15:18])
+        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[SURFACE.sigma_dot])
 
     def get_s_x_output_port(self):
         return self.GetOutputPort("s_x")

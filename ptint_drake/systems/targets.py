@@ -22,6 +22,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import TARGET, TARGET_PORT
 
 
 @dataclass(frozen=True)
@@ -110,21 +111,21 @@ class TargetSource(LeafSystem):
         self._eval = DeclareVectorCache(
             self, "target", 12, lambda c: self.evaluate(c.get_time()), time_only)
         self._x_out = self.DeclareVectorOutputPort(
-            "x_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[0:3]),
+            "x_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[TARGET.x]),
             prerequisites_of_calc=time_only)
         self._xdot_out = self.DeclareVectorOutputPort(
-            "xdot_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[3:6]),
+            "xdot_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[TARGET.xdot]),
             prerequisites_of_calc=time_only)
         self._xddot_out = self.DeclareVectorOutputPort(
-            "xddot_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[6:9]),
+            "xddot_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[TARGET.xddot]),
             prerequisites_of_calc=time_only)
         self._target_out = self.DeclareVectorOutputPort(
-            "target", 9, lambda c, o: o.SetFromVector(self._eval(c)[0:9]),
+            "target", 9, lambda c, o: o.SetFromVector(self._eval(c)[TARGET_PORT]),
             prerequisites_of_calc=time_only)
         self._objects_out = self.DeclareVectorOutputPort(
             "objects", 3 * len(targets),
             lambda c, o: o.SetFromVector(
-                np.concatenate([tg.evaluate(c.get_time())[0:3] for tg in self._targets])),
+                np.concatenate([tg.evaluate(c.get_time())[TARGET.x] for tg in self._targets])),
             prerequisites_of_calc=time_only)
 
     @property

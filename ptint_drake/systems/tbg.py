@@ -28,6 +28,7 @@ from scipy.special.cython_special import betaincinv as _betaincinv_scalar
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import TBG, TBG_PROFILE
 
 
 def gamma_gain(tf: float, beta: float) -> float:
@@ -152,15 +153,15 @@ class TimeBaseGenerator(LeafSystem):
         self._alpha_hold = alpha_hold
         time_only = {self.time_ticket()}
         self._eval = DeclareVectorCache(
-            self, "tbg", 10, lambda c: self.evaluate(c.get_time()), time_only)
+            self, "tbg", TBG.size, lambda c: self.evaluate(c.get_time()), time_only)
         self._xi_out = self.DeclareVectorOutputPort(
-            "xi", 4, lambda c, o: o.SetFromVector(self._eval(c)[0:4]),
+            "xi", 4, lambda c, o: o.SetFromVector(self._eval(c)[TBG_PROFILE]),
             prerequisites_of_calc=time_only)
         self._alpha_out = self.DeclareVectorOutputPort(
-            "alpha", 1, lambda c, o: o.SetFromVector(self._eval(c)[4:5]),
+            "alpha", 1, lambda c, o: o.SetFromVector(self._eval(c)[TBG.alpha:TBG.alpha + 1]),
             prerequisites_of_calc=time_only)
         self._segment_out = self.DeclareVectorOutputPort(
-            "segment", 5, lambda c, o: o.SetFromVector(self._eval(c)[5:10]),
+            "segment", 5, lambda c, o: o.SetFromVector(self._eval(c)[TBG.segment]),
             prerequisites_of_calc=time_only)
 
     @property

@@ -1,0 +1,43 @@
+"""Named slots of the vectors the interceptor's blocks pass to each other — in one place.
+
+Each layout maps a name to its index (a slot of size 1) or slice (a wider one), so code
+reads ``target[TARGET.x]`` and ``tbg[TBG.alpha]`` instead of ``target[0:3]`` and ``tbg[4]``:
+
+- ``TARGET``: [x_r, ẋ_r, ẍ_r, x⃛_r] of a target at time t (``evaluate(t)``, 12); a target
+  *port* carries the first 9;
+- ``TBG``: [ξ, ξ̇, ξ̈, ξ⃛, α, segment…] of ``tbg_state`` (paper eqs. 6–10, 13), 10;
+- ``SEGMENT``: [index, t0, tf, β, phase] of the active segment (the TBG's ``segment`` port);
+- ``CAPTURED``: [index, s(t0)], the surface's discrete state (paper eq. 17's s(t0));
+- ``SURFACE``: [s_x, e, ė, s, s_d, σ̇] of ``SurfaceLaw`` (paper eqs. 11, 16, 17), 18.
+"""
+
+from __future__ import annotations
+
+
+class Slots:
+    """Names → index (size 1) or slice (size > 1) of a flat vector; ``size`` is its length."""
+
+    def __init__(self, *fields: tuple[str, int]):
+        lo = 0
+        self.names = []
+        for name, n in fields:
+            setattr(self, name, lo if n == 1 else slice(lo, lo + n))
+            self.names.append(name)
+            lo += n
+        self.size = lo
+
+    def slices(self) -> dict:
+        """name → slice (size-1 slots too), e.g. for splitting logged columns."""
+        return {name: (slice(v, v + 1) if isinstance(v, int) else v)
+                for name, v in ((n, getattr(self, n)) for n in self.names)}
+
+
+TARGET = Slots(("x", 3), ("xdot", 3), ("xddot", 3), ("xdddot", 3))
+TARGET_PORT = slice(0, 9)  # what a target port carries: [x_r, ẋ_r, ẍ_r]
+TBG = Slots(("xi", 1), ("xi_dot", 1), ("xi_ddot", 1), ("xi_dddot", 1), ("alpha", 1), ("segment", 5))
+TBG_PROFILE = slice(0, 4)  # [ξ, ξ̇, ξ̈, ξ⃛]
+TBG_OUT = slice(0, 5)  # [ξ, ξ̇, ξ̈, ξ⃛, α]: the TBG's part of the telemetry
+SEGMENT = Slots(("index", 1), ("t0", 1), ("tf", 1), ("beta", 1), ("phase", 1))
+CAPTURED = Slots(("index", 1), ("s0", 3))
+SURFACE = Slots(("s_x", 3), ("e", 3), ("edot", 3), ("s", 3), ("s_d", 3), ("sigma_dot", 3))
+SURFACE_OUT = slice(0, 15)  # [s_x, e, ė, s, s_d]: the surface's part of the telemetry
