@@ -39,3 +39,24 @@ def assert_prescribed_time(metrics: dict, label: str = "") -> None:
 @pytest.fixture
 def run():
     return run_cached
+
+
+DYNAMICS = ("CalcMassMatrix", "CalcMassMatrixViaInverseDynamics", "CalcBiasTerm",
+            "CalcGravityGeneralizedForces", "CalcInverseDynamics")
+
+
+@pytest.fixture
+def dynamics_calls(monkeypatch):
+    """A list that records every Python call of a MultibodyPlant dynamics method (the
+    controllers are Python systems: any use of the model would go through these)."""
+    from pydrake.multibody.plant import MultibodyPlant  # noqa: PLC0415
+
+    calls = []
+    for name in DYNAMICS:
+        original = getattr(MultibodyPlant, name)
+
+        def spy(self, *args, _name=name, _original=original, **kwargs):
+            calls.append(_name)
+            return _original(self, *args, **kwargs)
+        monkeypatch.setattr(MultibodyPlant, name, spy)
+    return calls
