@@ -123,7 +123,9 @@ def camera_table(workers: int) -> str:
     subprocess.run([sys.executable, "-m", "ptint_drake", "study", "camera", "--workers", str(workers),
                     "--out", str(out), "--quiet"], check=True)
     data = json.loads((out / "camera_study.json").read_text())
-    return (out / "camera_study.md").read_text() + (
+    text = "\n".join(f"**{line[2:]}**" if line.startswith("# ") else line
+                     for line in (out / "camera_study.md").read_text().splitlines())
+    return text + "\n" + (
         f"\n`ptint study camera --workers {workers}`: {data['wall_time_s']:.0f} s on {machine()}.\n")
 
 
