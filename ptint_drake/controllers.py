@@ -43,7 +43,7 @@ from ptint_drake.systems.targets import TargetSource
 # Logged signals of the wired blocks: name -> (handle attribute, output port name).
 _BLOCK_PORTS = {
     "x": ("kinematics", "x"), "xdot": ("kinematics", "xdot"),
-    "x_r": ("surface", None), "xi": ("tbg", "xi"), "alpha": ("tbg", "alpha"),
+    "xi": ("tbg", "xi"), "alpha": ("tbg", "alpha"),
     "e": ("surface", "e"), "edot": ("surface", "edot"), "s": ("surface", "s"),
     "s_d": ("surface", "s_d"), "s_x": ("surface", "s_x"), "sigma": ("surface", "sigma"),
     "tau": ("controller", "tau"),
@@ -135,8 +135,7 @@ def _fused_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -
 def _block_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -> ControllerHandles:
     ports = {}
     for name, (owner, port) in _BLOCK_PORTS.items():
-        if port is not None:
-            ports[name] = getattr(h, owner).GetOutputPort(port)
+        ports[name] = getattr(h, owner).GetOutputPort(port)
     if h.target_input is None:
         ports["target"] = h.targets.GetOutputPort("target")
     else:

@@ -60,3 +60,12 @@ def dynamics_calls(monkeypatch):
             return _original(self, *args, **kwargs)
         monkeypatch.setattr(MultibodyPlant, name, spy)
     return calls
+
+
+def sigint_default() -> None:
+    """``preexec_fn`` for a child that a test interrupts: SIGINT back to its default action
+    (a shell's background job inherits it ignored, and Python then never raises
+    KeyboardInterrupt), so the child behaves as under a terminal's Ctrl-C."""
+    import signal  # noqa: PLC0415
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

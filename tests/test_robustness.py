@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import assert_prescribed_time, run_cached
+from conftest import assert_prescribed_time, run_cached, sigint_default
 from ptint_drake.systems.disturbance import JointDisturbance
 from ptint_drake.systems.measurement import MeasuredTarget
 from ptint_drake.studies.robust import RANGES, sample_scenario
@@ -160,7 +160,8 @@ def test_forced_divergence_is_reported_and_kept(tmp_path):
 def test_sigint_leaves_no_half_written_files(tmp_path):
     out_dir = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "ptint_drake", "paper", "--out", str(out_dir)],
-                            cwd=HERE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=HERE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=sigint_default)
     deadline = time.time() + 120
     while time.time() < deadline and not (out_dir / "curve_b025_tf15").exists() \
             and not list(out_dir.glob("curve_b025_tf15*")):

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import sigint_default
 
 from ptint_drake.scenario import scenario_text
 from ptint_drake.studies.robust import robust_sample
@@ -119,7 +120,8 @@ def test_cli_ctrl_c_stops_robust_within_5_s(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "ptint_drake.cli", "robust", "curve_b075_tf15",
                              "--samples", "300", "--workers", "2", "--out", str(out)],
                             cwd=HERE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)  # its own process group, like a shell job
+                            start_new_session=True,  # its own process group, like a shell job
+                            preexec_fn=sigint_default)
     try:
         deadline = time.time() + 60
         while time.time() < deadline and len(_children(proc.pid)) < 2:
