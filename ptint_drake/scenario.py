@@ -1,7 +1,8 @@
-"""Scenario files (SPEC section 5.2): a typed schema, loading and validation.
+"""Scenario files (README "Scenario files"): the typed schema and loading.
 
 A scenario is one YAML mapping loaded with Drake's ``yaml_load_typed`` into
-``Scenario``; unknown keys are rejected.  ``simulator`` is Drake's own
+``Scenario``; unknown keys are rejected; the checks live in ``validation``, the
+YAML writing and error messages in ``scenario_yaml``.  ``simulator`` is Drake's own
 ``SimulatorConfig``.  ``load_scenario`` accepts a bundled name (see
 ``bundled_scenarios``) or a file path, and raises ``ScenarioError`` with a
 one-line message that names the offending field.
@@ -19,8 +20,12 @@ open, with their defaults:
   is the paper's formula; see ``sliding_surface`` for why the hold needs it);
 - ``controller.implementation``: ``fused`` (one LeafSystem, the fast default) or
   ``blocks`` (the five wired blocks); both compute the same thing;
+- ``controller.type``: ``ptsmc`` (the paper's) or a baseline of the controller
+  slot (``pd``, ``smc``, ``ct_quintic``; see ``controllers``);
 - ``plant``: scale factors for link masses/inertias and joint damping, used
-  to show that the model-free controller needs no retuning (all 1 by default).
+  to show that the model-free controller needs no retuning (all 1 by default);
+  ``apply_variant`` gives the named plant variants (nominal, mass_xF, payload_Mkg);
+- ``criteria``: the scenario's pass criteria (``metrics.Criteria``).
 """
 
 
@@ -125,7 +130,7 @@ class DisturbanceConfig:
 class PlantConfig:
     """How the simulated robot differs from its model file (the controller never knows)."""
 
-    mass_scale: float = 1.0  # every link's mass and inertia × this
+    mass_scale: float = 1.0  # every link's mass and inertia and every rotor inertia × this
     damping_scale: float = 1.0  # every joint's viscous damping × this
     payload_kg: float = 0.0  # point-like mass (sphere r 3 cm) welded at the end effector
     coulomb: List[float] = field(default_factory=list)  # N·m per joint: −F tanh(v / coulomb_speed)
