@@ -15,6 +15,7 @@ import numpy as np
 
 from ptint_drake.systems.controller import solve3
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import Slots
 
 # One-shot timed events are periodic events whose period exceeds any simulation.
 ONE_SHOT_PERIOD = 1.0e9
@@ -23,11 +24,7 @@ TARGET_SIZE = 9
 
 def make_layout(sizes: Iterable[tuple[str, int]]) -> dict:
     """name -> slice of a telemetry vector made of consecutive slots of the given sizes."""
-    layout, lo = {}, 0
-    for name, n in sizes:
-        layout[name] = slice(lo, lo + n)
-        lo += n
-    return layout
+    return Slots(*sizes).slices()
 
 
 def layout_size(layout: dict) -> int:

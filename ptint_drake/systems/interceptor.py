@@ -27,7 +27,7 @@ from ptint_drake.systems.controller import null_space_torque, smc_torque_values
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.signals import SURFACE, SURFACE_OUT, TARGET, TARGET_PORT, TBG, TBG_OUT
+from ptint_drake.systems.signals import SURFACE, SURFACE_OUT, TARGET, TARGET_PORT, TBG, TBG_OUT, Slots
 from ptint_drake.systems.sliding_surface import DeclareSegmentCapture, SurfaceLaw
 from ptint_drake.systems.targets import active_target_values
 from ptint_drake.systems.tbg import tbg_values
@@ -35,14 +35,9 @@ from ptint_drake.systems.tbg import tbg_values
 
 def telemetry_layout(nv: int) -> dict:
     """name -> slice of the ``telemetry`` vector."""
-    sizes = [("x", 3), ("xdot", 3), ("x_r", 3), ("xdot_r", 3), ("xddot_r", 3), ("xi", 4),
-             ("alpha", 1), ("s_x", 3), ("e", 3), ("edot", 3), ("s", 3), ("s_d", 3),
-             ("sigma", 3), ("tau", nv)]
-    layout, lo = {}, 0
-    for name, n in sizes:
-        layout[name] = slice(lo, lo + n)
-        lo += n
-    return layout
+    return Slots(("x", 3), ("xdot", 3), ("x_r", 3), ("xdot_r", 3), ("xddot_r", 3), ("xi", 4),
+                 ("alpha", 1), ("s_x", 3), ("e", 3), ("edot", 3), ("s", 3), ("s_d", 3),
+                 ("sigma", 3), ("tau", nv)).slices()
 
 
 class PrescribedTimeInterceptor(LeafSystem):
