@@ -265,75 +265,6 @@ def _floats(text: str, flag: str) -> list:
     return values
 
 
-def cmd_sweep(args) -> int:
-    from ptint_drake.outputs import staged_output  # noqa: PLC0415
-    from ptint_drake.studies import sweep  # noqa: PLC0415
-    from ptint_drake.studies.runner import SchedulerUnreachable  # noqa: PLC0415
-
-    betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
-    for b in betas:
-        if not 0.0 < b < 1.0:
-            raise ScenarioError(f"--beta: every value must be in (0, 1), got {b}")
-    for tf in tfs:
-        if not tf > 0.0:
-            raise ScenarioError(f"--tf: every value must be > 0, got {tf}")
-    if args.workers is not None and args.workers < 1:
-        raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
-    _out_dir(args.out, Path("out"))
-    scenario = load(args.scenario, args.set)  # validates the base scenario before any worker starts
-    name, text = load_text(args.scenario, args.set)
-    out = _out_dir(args.out, Path("out") / f"sweep_{scenario.name}")
-    report = None if args.quiet else (lambda i, n: print(f"sweep: {i}/{n} runs done", file=sys.stderr))
-    try:
-        rows = sweep.run_sweep(text, name, betas, tfs, workers=args.workers, progress=report,
-                               dask=args.dask)
-    except SchedulerUnreachable as exc:  # bad input: one line, exit 2
-        raise ScenarioError(f"--dask: {exc}") from None
-    with staged_output(out) as stage:  # entered only once every run finished
-        sweep.heatmaps(rows, betas, tfs, stage, f"{scenario.name}: β × tf sweep")
-        sweep.write_csv(rows, stage / "sweep.csv")
-    ok = sum(1 for r in rows if r.get("ok"))
-    print(f"{len(rows)} runs, {ok} meet the prescribed-time property; wrote {out}/sweep.csv")
-    return 0
-
-
-def cmd_robust(args) -> int:
-    from ptint_drake.studies import robust  # noqa: PLC0415
-    from ptint_drake.studies.runner import SchedulerUnreachable  # noqa: PLC0415
-
-    if args.samples < 1:
-        raise ScenarioError(f"--samples: must be >= 1, got {args.samples}")
-    if args.workers is not None and args.workers < 1:
-        raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
-    ranges = dict(robust.RANGES)
-    for pair in args.range or []:
-        key, _, value = pair.partition("=")
-        if key not in ranges:
-            raise ScenarioError(f"--range: unknown parameter {key!r} (one of {', '.join(ranges)})")
-        lo_hi = _floats(value, f"--range {key}")
-        if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or lo_hi[0] < 0:
-            raise ScenarioError(f"--range {key}: expected LOW,HIGH with 0 <= LOW <= HIGH, got {value!r}")
-        ranges[key] = tuple(lo_hi)
-    _out_dir(args.out, Path("out"))
-    scenario = load(args.scenario, args.set)
-    name, text = load_text(args.scenario, args.set)
-    out = _out_dir(args.out, Path("out") / f"robust_{scenario.name}")
-    report = None if args.quiet else (
-        lambda i, n: print(f"robust: {i}/{n} samples", file=sys.stderr) if i % 10 == 0 or i == n else None)
-    try:
-        result = robust.run_robust(text, name, args.samples, args.seed, args.workers, ranges=ranges,
-                                   progress=report, dask=args.dask)
-    except SchedulerUnreachable as exc:  # bad input: one line, exit 2
-        raise ScenarioError(f"--dask: {exc}") from None
-    robust.write_robust(result, out)  # staged: the folder is created only now
-    p = result["e_tf_percentiles"]
-    print(f"{result['samples']} samples in {result['wall_time_s']:.1f} s "
-          f"({result['samples_per_s']:.2f} samples/s), success rate {100 * result['success_rate']:.1f} %, "
-          f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, max {p.get('max', float('nan')) * 1e3:.4f} mm; "
-          f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
-    return 0
-
-
 def _where(args):
     """--workers / --dask of a study, checked."""
     if args.workers is not None and args.workers < 1:
@@ -355,6 +286,64 @@ def _dask_errors(call):
         return call()
     except SchedulerUnreachable as exc:  # bad input: one line, exit 2
         raise ScenarioError(f"--dask: {exc}") from None
+
+
+def cmd_sweep(args) -> int:
+    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+    from ptint_drake.studies import sweep  # noqa: PLC0415
+
+    betas, tfs = _floats(args.beta, "--beta"), _floats(args.tf, "--tf")
+    for b in betas:
+        if not 0.0 < b < 1.0:
+            raise ScenarioError(f"--beta: every value must be in (0, 1), got {b}")
+    for tf in tfs:
+        if not tf > 0.0:
+            raise ScenarioError(f"--tf: every value must be > 0, got {tf}")
+    where = _where(args)
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario, args.set)  # validates the base scenario before any worker starts
+    name, text = load_text(args.scenario, args.set)
+    out = _out_dir(args.out, Path("out") / f"sweep_{scenario.name}")
+    report = None if args.quiet else (lambda i, n: print(f"sweep: {i}/{n} runs done", file=sys.stderr))
+    rows = _dask_errors(lambda: sweep.run_sweep(text, name, betas, tfs, progress=report, **where))
+    with staged_output(out) as stage:  # entered only once every run finished
+        sweep.heatmaps(rows, betas, tfs, stage, f"{scenario.name}: β × tf sweep")
+        sweep.write_csv(rows, stage / "sweep.csv")
+    ok = sum(1 for r in rows if r.get("ok"))
+    print(f"{len(rows)} runs, {ok} meet the prescribed-time property; wrote {out}/sweep.csv")
+    return 0
+
+
+def cmd_robust(args) -> int:
+    from ptint_drake.studies import robust  # noqa: PLC0415
+
+    if args.samples < 1:
+        raise ScenarioError(f"--samples: must be >= 1, got {args.samples}")
+    where = _where(args)
+    ranges = dict(robust.RANGES)
+    for pair in args.range or []:
+        key, _, value = pair.partition("=")
+        if key not in ranges:
+            raise ScenarioError(f"--range: unknown parameter {key!r} (one of {', '.join(ranges)})")
+        lo_hi = _floats(value, f"--range {key}")
+        if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or lo_hi[0] < 0:
+            raise ScenarioError(f"--range {key}: expected LOW,HIGH with 0 <= LOW <= HIGH, got {value!r}")
+        ranges[key] = tuple(lo_hi)
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario, args.set)
+    name, text = load_text(args.scenario, args.set)
+    out = _out_dir(args.out, Path("out") / f"robust_{scenario.name}")
+    report = None if args.quiet else (
+        lambda i, n: print(f"robust: {i}/{n} samples", file=sys.stderr) if i % 10 == 0 or i == n else None)
+    result = _dask_errors(lambda: robust.run_robust(text, name, args.samples, args.seed, where["workers"],
+                                                    ranges=ranges, progress=report, dask=where["dask"]))
+    robust.write_robust(result, out)  # staged: the folder is created only now
+    p = result["e_tf_percentiles"]
+    print(f"{result['samples']} samples in {result['wall_time_s']:.1f} s "
+          f"({result['samples_per_s']:.2f} samples/s), success rate {100 * result['success_rate']:.1f} %, "
+          f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, max {p.get('max', float('nan')) * 1e3:.4f} mm; "
+          f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
+    return 0
 
 
 def cmd_compare(args) -> int:
