@@ -347,7 +347,7 @@ def cmd_robust(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    from ptint_drake.scenario import CONTROLLER_TYPES  # noqa: PLC0415
+    from ptint_drake.scenario import CONTROLLER_TYPES, check_variants  # noqa: PLC0415
     from ptint_drake.studies import compare  # noqa: PLC0415
 
     controllers = compare.parse_list(args.controllers, "--controllers", CONTROLLER_TYPES)
@@ -356,7 +356,7 @@ def cmd_compare(args) -> int:
     _out_dir(args.out, Path("out"))
     scenario = load(args.scenario, args.set)
     name, text = load_text(args.scenario, args.set)
-    compare.check_variants(text, name, variants)
+    check_variants(scenario, variants)  # a bad name fails before any run
     out = _out_dir(args.out, Path("out") / f"compare_{scenario.name}")
     result = _dask_errors(lambda: compare.run_compare(
         text, name, controllers, variants, progress=_runs("compare", args.quiet), **where))

@@ -132,6 +132,12 @@ def _fused_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -
     return ControllerHandles("ptsmc", ports, telemetry, notes, system=system)
 
 
+def _target_columns(target_log: np.ndarray) -> dict:
+    """x_r, ẋ_r, ẍ_r of a logged target port (what the controller saw)."""
+    return {"x_r": target_log[:, TARGET.x], "xdot_r": target_log[:, TARGET.xdot],
+            "xddot_r": target_log[:, TARGET.xddot]}
+
+
 def _block_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -> ControllerHandles:
     ports = {}
     for name, (owner, port) in _BLOCK_PORTS.items():
@@ -143,9 +149,7 @@ def _block_handles(h: InterceptorHandles, target: Optional[OutputPort], notes) -
 
     def telemetry(logs: dict) -> dict:
         out = {name: logs[name] for name in ports}
-        target_log = out.pop("target")
-        out["x_r"], out["xdot_r"], out["xddot_r"] = (target_log[:, TARGET.x], target_log[:, TARGET.xdot],
-                                                     target_log[:, TARGET.xddot])
+        out |= _target_columns(out.pop("target"))
         return out
 
     return ControllerHandles("ptsmc", ports, telemetry, notes, system=h.controller)
@@ -163,9 +167,7 @@ def _baseline_handles(name: str, system, target: OutputPort, notes, model_based=
 
     def telemetry(logs: dict) -> dict:
         out = {key: logs["telemetry"][:, part] for key, part in layout.items()}
-        target = logs["target"]
-        out["x_r"], out["xdot_r"], out["xddot_r"] = (target[:, TARGET.x], target[:, TARGET.xdot],
-                                                     target[:, TARGET.xddot])
+        out |= _target_columns(logs["target"])
         return out
 
     return ControllerHandles(name, ports, telemetry, notes, model_based, system)

@@ -149,22 +149,16 @@ def _parallel_part(workers=None) -> tuple[dict, dict]:
     from ptint_drake.studies import compare  # noqa: PLC0415
     from ptint_drake.studies.runner import run_tasks  # noqa: PLC0415
 
-    pairs = [(v, c) for v in compare.DEFAULT_VARIANTS for c in compare.DEFAULT_CONTROLLERS]
-    tasks = [("compare", name, c, v) for name in COMPARED for v, c in pairs]
+    controllers, variants = compare.DEFAULT_CONTROLLERS, compare.DEFAULT_VARIANTS
+    pairs = compare.pairs(controllers, variants)
+    tasks = [("compare", name, c, v) for name in COMPARED for c, v in pairs]
     tasks += [("hold", name) for name in PAPER_SCENARIOS]
     t0 = time.perf_counter()
     results = run_tasks(paper_task, tasks, workers=workers)
-    comparisons = {}
-    for k, name in enumerate(COMPARED):
-        rows = results[k * len(pairs):(k + 1) * len(pairs)]
-        scenario = load_scenario(name)
-        comparisons[name] = {
-            "scenario": name, "controllers": list(compare.DEFAULT_CONTROLLERS),
-            "variants": list(compare.DEFAULT_VARIANTS),
-            "segments": [{"start": i.start, "tf": i.tf, "beta": i.beta} for i in scenario.interceptions],
-            "criteria": {"e_tf": scenario.criteria.e_tf, "hold": scenario.criteria.hold,
-                         "half_fraction": scenario.criteria.half_fraction},
-            "wall_time_s": time.perf_counter() - t0, "rows": rows}
+    wall = time.perf_counter() - t0
+    comparisons = {name: compare.comparison(load_scenario(name), name, controllers, variants,
+                                            results[k * len(pairs):(k + 1) * len(pairs)], wall)
+                   for k, name in enumerate(COMPARED)}
     holds = dict(zip(PAPER_SCENARIOS, results[len(COMPARED) * len(pairs):]))
     return comparisons, holds
 

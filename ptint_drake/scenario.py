@@ -50,7 +50,8 @@ from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTa
 from ptint_drake.validation import CONTROLLER_TYPES, TARGET_KINDS, ScenarioError, validate
 
 __all__ = ["CONTROLLER_TYPES", "TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
-           "load_scenario", "parse_scenario", "parse_with_overrides", "apply_variant", "validate"]
+           "load_scenario", "parse_scenario", "parse_with_overrides", "apply_variant", "check_variants",
+           "validate"]
 
 
 @dataclass
@@ -240,6 +241,13 @@ def apply_variant(scenario: Scenario, variant: str) -> Scenario:
     except ValueError:
         pass
     raise ScenarioError(f"variant: unknown plant variant {variant!r} (use {VARIANT_FORMS})")
+
+
+def check_variants(scenario: Scenario, variants) -> None:
+    """A one-line ScenarioError naming the first variant ``apply_variant`` does not know,
+    before any run starts."""
+    for variant in variants:
+        apply_variant(scenario, variant)
 
 
 def parse_with_overrides(text: str, overrides: str, name: str = "scenario") -> Scenario:

@@ -169,3 +169,10 @@ def test_null_space_damping_keeps_a_redundant_arm_near_its_posture(tmp_path):
     assert drift["fused", 0.0] > 1.0 and drift["fused", 10.0] < 0.3
     assert drift["blocks", 10.0] == pytest.approx(drift["fused", 10.0], rel=1e-3)
     assert load_scenario("curve_b075_tf15").controller.null_space_damping == 0.0  # the paper's law
+
+
+def test_the_schema_names_exactly_the_controllers_of_the_slot():
+    from ptint_drake.controllers import CONTROLLERS  # noqa: PLC0415
+    from ptint_drake.scenario import CONTROLLER_TYPES  # noqa: PLC0415
+
+    assert CONTROLLERS == CONTROLLER_TYPES

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import assert_prescribed_time, run_cached, sigint_default
+from conftest import TOO_SHORT_TF, assert_prescribed_time, run_cached, sigint_default
 from ptint_drake.systems.disturbance import JointDisturbance
 from ptint_drake.systems.measurement import MeasuredTarget
 from ptint_drake.studies.robust import RANGES, sample_scenario
@@ -99,11 +99,7 @@ def test_robust_study_and_exact_replay_of_worst_seed(tmp_path):
 
 def test_too_short_tf_warns_and_saturates_but_stays_stable(tmp_path):
     scenario = tmp_path / "short.yaml"
-    scenario.write_text("""duration: 1.0
-robot: {model: rvm1, end_effector: tool, initial_q_deg: [22.5, 45.0, 30.0]}
-interceptions:
-  - {start: 0.0, tf: 0.2, beta: 0.75, target: {linear: {start: [0.30, -0.15, 0.15], velocity: [0.0, 0.1, 0.0]}}}
-""")
+    scenario.write_text(TOO_SHORT_TF)
     out = ptint("run", str(scenario), "--out", str(tmp_path / "out"), "--quiet", "--no-replay",
                 "--no-figures")
     assert out.returncode == 1, out.stderr  # a miss: exit 1

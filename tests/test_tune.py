@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import numpy as np
+from conftest import TOO_SHORT_TF
 from heavy_arm import heavy_arm_scenario, heavy_arm_urdf
 from test_cli import ptint
 
@@ -76,11 +77,7 @@ def test_tune_on_the_paper_robot_says_how_it_compares(tmp_path):
 
 def test_no_gain_can_save_a_too_short_tf(tmp_path):
     scenario = tmp_path / "short.yaml"
-    scenario.write_text("""duration: 1.0
-robot: {model: rvm1, end_effector: tool, initial_q_deg: [22.5, 45.0, 30.0]}
-interceptions:
-  - {start: 0.0, tf: 0.2, beta: 0.75, target: {linear: {start: [0.30, -0.15, 0.15], velocity: [0.0, 0.1, 0.0]}}}
-""")
+    scenario.write_text(TOO_SHORT_TF)
     out = ptint("tune", str(scenario), "--variants", "nominal", "--workers", "2",
                 "--out", str(tmp_path / "out"), "--quiet")
     assert out.returncode == 1, out.stderr

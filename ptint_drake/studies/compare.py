@@ -15,6 +15,7 @@ result, counted in the summary line.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import math
 import time
@@ -42,13 +43,6 @@ def parse_list(text: str, flag: str, allowed=None) -> list[str]:
         if allowed is not None and item not in allowed:
             raise ScenarioError(f"{flag}: unknown {item!r} (one of {', '.join(allowed)})")
     return items
-
-
-def check_variants(text: str, name: str, variants) -> None:
-    """Fail early (one line naming it) on a variant that is not nominal, mass_xF or payload_Mkg."""
-    scenario = parse_scenario(text, name)
-    for variant in variants:
-        apply_variant(scenario, variant)
 
 
 def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
@@ -82,14 +76,23 @@ def run_compare(text: str, name: str, controllers=DEFAULT_CONTROLLERS, variants=
                 workers=None, dask=None, progress=None) -> dict:
     """Every controller × variant; the content of compare.json (rows keep their curves)."""
     t0 = time.perf_counter()
-    scenario = parse_scenario(text, name)
-    tasks = [(text, name, c, v) for v in variants for c in controllers]
+    tasks = [(text, name, c, v) for c, v in pairs(controllers, variants)]
     rows = run_tasks(compare_run, tasks, workers=workers, dask=dask, progress=progress)
+    return comparison(parse_scenario(text, name), name, controllers, variants, rows,
+                      time.perf_counter() - t0)
+
+
+def pairs(controllers, variants) -> list:
+    """(controller, variant) in the order of the rows: variant by variant."""
+    return [(c, v) for v in variants for c in controllers]
+
+
+def comparison(scenario, name: str, controllers, variants, rows: list, wall_time_s: float) -> dict:
+    """compare.json's content from the rows of ``pairs(controllers, variants)``."""
     return {"scenario": name, "controllers": list(controllers), "variants": list(variants),
             "segments": [{"start": i.start, "tf": i.tf, "beta": i.beta} for i in scenario.interceptions],
-            "criteria": {"e_tf": scenario.criteria.e_tf, "hold": scenario.criteria.hold,
-                         "half_fraction": scenario.criteria.half_fraction},
-            "wall_time_s": time.perf_counter() - t0, "rows": rows}
+            "criteria": dataclasses.asdict(scenario.criteria),
+            "wall_time_s": wall_time_s, "rows": rows}
 
 
 def _mm(value) -> str:

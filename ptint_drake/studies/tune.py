@@ -23,6 +23,7 @@ Nothing is written when no value works; the reasons of the best value are report
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -31,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.metrics import segment_reasons
-from ptint_drake.scenario import ScenarioError, apply_variant, parse_scenario
+from ptint_drake.scenario import ScenarioError, apply_variant, check_variants, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
@@ -137,8 +138,7 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
     """The search; returns the content of tune.json (plus ``scenario`` for tuned.yaml)."""
     t0 = time.perf_counter()
     scenario = parse_scenario(text, name)
-    for variant in settings.variants:
-        apply_variant(scenario, variant)  # a bad name fails here, before any run
+    check_variants(scenario, settings.variants)
     lo, hi = settings.bracket or model_bracket(scenario, settings.gain)
     grid = list(np.geomspace(lo, hi, settings.grid_points))
     smallest = settings.gain != "phi"
@@ -161,8 +161,7 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
               "max_saturation": settings.max_saturation, "variants": list(settings.variants),
               "bracket": [lo, hi], "grid": grid, "tolerance": settings.tolerance,
               "paper_value": getattr(scenario.controller, settings.gain),
-              "criteria": {"e_tf": scenario.criteria.e_tf, "hold": scenario.criteria.hold,
-                           "half_fraction": scenario.criteria.half_fraction},
+              "criteria": dataclasses.asdict(scenario.criteria),
               "tried": tried, "wall_time_s": time.perf_counter() - t0, "runs": len(tried)}
     if works is None:
         result |= {"gains": None, "smallest_working": None,
@@ -171,14 +170,15 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
     value = float(works)
     best = {row["variant"]: row for row in tried if row["gains"][settings.gain] == works}
     gains = {g: getattr(scenario.controller, g) for g in GAINS} | {settings.gain: value}
-    key = "smallest_working" if smallest else "largest_working"
     drift = [row["self_motion_final"] for row in best.values() if row.get("self_motion_final") is not None]
     if drift:  # redundant arm: does J⁺ leave it drifting in its null space?
         result["self_motion_final"] = max(drift)
         result["drifts"] = max(drift) > DRIFT_ANGLE
-    result |= {"gains": gains, key: {settings.gain: value, "per_variant": best},
-               "smallest_working": {settings.gain: value, "per_variant": best},
+    # tune.json's contract names the chosen value smallest_working; for φ it is the largest
+    result |= {"gains": gains, "smallest_working": {settings.gain: value, "per_variant": best},
                "scenario_obj": _portable(_set_gain(scenario, settings.gain, value))}
+    if not smallest:
+        result["largest_working"] = result["smallest_working"]
     return result
 
 
