@@ -83,10 +83,6 @@ def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str
     return ("missed" if reasons else "ok"), reasons
 
 
-def is_ok(metrics: dict, criteria: Criteria, margin: float = 1.0) -> bool:
-    return verdict(metrics, criteria, margin)[0] == "ok"
-
-
 def _peak(values: np.ndarray, t: np.ndarray, mask: Optional[np.ndarray] = None) -> dict:
     """Per-column peak of |values| and the time it happens (over ``mask`` rows if given)."""
     if mask is not None:
