@@ -404,14 +404,38 @@ def cmd_study(args) -> int:
         raise ScenarioError(f"--seeds: must be >= 1, got {args.seeds}")
     if args.workers < 1:
         raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
-    out = _out_dir(args.out, Path("out") / f"study_{args.study}")
     report = None if args.quiet else (
         lambda i, n, *_: print(f"study camera: {i}/{n} runs", file=sys.stderr) if i % 10 == 0 or i == n else None)
+    if args.filter_floor:
+        return _filter_floor(args, camera, report)
+    for flag, value in (("--scenario", args.scenario), ("--process-noise", args.process_noise),
+                        ("--set", args.set)):
+        if value is not None:
+            raise ScenarioError(f"{flag}: only with --filter-floor")
+    out = _out_dir(args.out, Path("out") / f"study_{args.study}")
     result = camera.run_study(seeds=args.seeds, workers=args.workers, out=out, progress=report)
     runs = sum(row["summary"]["runs"] for row in result["table"])
     errors = sum(row["summary"]["errors"] for row in result["table"])
     print(f"{runs} runs ({errors} could not run) in {result['wall_time_s']:.0f} s with "
           f"{args.workers} workers; wrote {out}/camera_study.md, camera_study.json, estimate.png")
+    return 0
+
+
+def _filter_floor(args, camera, report) -> int:
+    """``ptint study camera --filter-floor``: the camera + Kalman filter alone, per q and seed."""
+    noises = _floats(args.process_noise, "--process-noise") if args.process_noise is not None \
+        else list(camera.FLOOR_PROCESS_NOISES)
+    for q in noises:
+        if not (q > 0.0 and q != float("inf")):  # NaN fails the first test
+            raise ScenarioError(f"--process-noise: every value must be > 0 and finite, got {q:g}")
+    _out_dir(args.out, Path("out"))
+    scenario = load(args.scenario or camera.FLOOR_SCENARIO, args.set)
+    camera.check_floor_scenario(scenario)
+    name, text = load_text(args.scenario or camera.FLOOR_SCENARIO, args.set)
+    out = _out_dir(args.out, Path("out") / f"filter_floor_{scenario.name}")
+    result = camera.filter_floor(text, name, noises, args.seeds, workers=args.workers, progress=report)
+    camera.write_filter_floor(result, out)
+    print(f"{camera.floor_summary_line(result)}; wrote {out}/filter_floor.md, filter_floor.json")
     return 0
 
 
@@ -520,12 +544,28 @@ def _add_study_parsers(sub) -> None:
     rb.set_defaults(func=cmd_robust)
 
     _add_design_parsers(sub)
-    st = sub.add_parser("study", help="studies: camera (|e(tf)| against noise × latency × estimator)")
+    st = sub.add_parser(
+        "study", help="studies: camera (|e(tf)| against noise × latency × estimator)",
+        description="camera: |e(tf)| on conveyor_pair_camera over noise × latency × estimator "
+                    "(camera_study.md/.json, estimate.png). camera --filter-floor: the camera and "
+                    "Kalman filter alone (no arm) on a camera scenario, per process noise: the "
+                    "largest |estimate − true object| over each hold window, the error a controller "
+                    "that follows the estimate inherits (filter_floor.md/.json).")
     st.add_argument("study", choices=["camera"])
     st.add_argument("--seeds", type=int, default=10, help="seeds per grid point (default 10)")
     st.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    st.add_argument("--out", help="output folder (default out/study_camera)")
+    st.add_argument("--out", help="output folder (default out/study_camera, with --filter-floor "
+                                  "out/filter_floor_NAME)")
     st.add_argument("--quiet", action="store_true")
+    st.add_argument("--filter-floor", action="store_true",
+                    help="measure the camera + Kalman filter alone (no arm) per process noise")
+    st.add_argument("--scenario", help="with --filter-floor: a camera scenario (bundled name or YAML "
+                                       "file with a kalman_cv/kalman_ca estimator; default curve_camera)")
+    st.add_argument("--process-noise", metavar="Q,..",
+                    help="with --filter-floor: comma-separated process noises q > 0 "
+                         "(default 0.003,0.01,0.03,0.1,0.3)")
+    st.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="with --filter-floor: " + SET_HELP)
     st.set_defaults(func=cmd_study)
     # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
     bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
