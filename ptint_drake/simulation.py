@@ -94,7 +94,7 @@ def _stops(scenario: Scenario) -> list[float]:
     return sorted(stops)
 
 
-def _prepared_simulator(built: Built, scenario: Scenario) -> Simulator:
+def prepared_simulator(built: Built, scenario: Scenario) -> Simulator:
     """A simulator of the built diagram at the scenario's start: masses, pose, rest."""
     simulator = Simulator(built.diagram)
     ApplySimulatorConfig(scenario.simulator, simulator)
@@ -142,7 +142,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     n_before = len(warnings)
     t_start = time.perf_counter()  # the realtime factor counts simulation, telemetry, metrics
     plant = built.plant
-    simulator = _prepared_simulator(built, scenario)
+    simulator = prepared_simulator(built, scenario)
     kinematics = FrameKinematics(plant, plant.GetFrameByName(scenario.robot.end_effector))
     nq = plant.num_positions()
 

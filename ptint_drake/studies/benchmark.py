@@ -14,8 +14,13 @@ import json
 import platform
 import time
 
+import numpy as np
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import ConstantVectorSource
+
 from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenario_text
-from ptint_drake.simulation import simulate
+from ptint_drake.simulation import Built, prepared_simulator, build, simulate
+from ptint_drake.station import MakeStation
 
 CONFIGS = {
     "default": "",
@@ -166,6 +171,91 @@ def paired(names=None, a: str = "{}", b: str = BEFORE, repeats: int = 5, progres
     return out
 
 
+def _drake_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("drake")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+class _ZeroTorque(LeafSystem):
+    """A Python controller that does nothing: reads the plant state, outputs zero actuation
+    (what any Python LeafSystem in the loop costs per derivative evaluation)."""
+
+    def __init__(self, n_state: int, n_actuation: int):
+        super().__init__()
+        self._state_in = self.DeclareVectorInputPort("state", n_state)
+        self._zero = np.zeros(n_actuation)
+        self.DeclareVectorOutputPort("u", n_actuation, self._calc)
+
+    def _calc(self, context, output):
+        self._state_in.Eval(context)
+        output.SetFromVector(self._zero)
+
+
+def _floor_diagram(scenario, kind: str):
+    """The scenario's station with ``kind`` in the controller's place: ``cpp`` (a Drake
+    ConstantVectorSource), ``python`` (``_ZeroTorque``) or ``controller`` (the scenario's own
+    controller, no loggers, no monitor)."""
+    if kind == "controller":
+        return build(scenario, log=False)
+    builder = DiagramBuilder()
+    station = MakeStation(scenario)
+    system = builder.AddSystem(station.diagram)
+    n_act = station.plant.num_actuators()
+    if kind == "cpp":
+        source = builder.AddSystem(ConstantVectorSource(np.zeros(n_act)))
+    else:
+        source = builder.AddSystem(_ZeroTorque(station.plant.num_multibody_states(), n_act))
+        builder.Connect(system.GetOutputPort("state"), source.get_input_port())
+    builder.Connect(source.get_output_port(), system.GetInputPort("actuation"))
+    return Built(builder.Build(), station, None, {}, scenario.schedule())
+
+
+def floors(names=None, repeats: int = 3, progress=None) -> dict:
+    """What one derivative evaluation of the closed loop costs, taken apart, per scenario.
+
+    Three diagrams on the scenario's plant (its station: saturation, friction, objects),
+    integrator settings and start state, each simulated over the scenario's duration: the
+    plant with a C++ constant actuation (Drake's own floor: plant dynamics and the framework),
+    with a Python LeafSystem that reads the state and outputs zeros (what any Python controller
+    costs before it computes anything), and with the scenario's own controller (no loggers, no
+    monitor).  µs per derivative evaluation = the fastest of ``repeats`` wall times / the
+    evaluations (the uncontrolled arms take other steps; the cost of an evaluation hardly
+    depends on them).  ``needed_for_3x_us``: what an evaluation may cost for the controlled
+    run to take a third of its time at the same number of evaluations.
+    """
+    names = list(names or bundled_scenarios())
+    out = {}
+    for name in names:
+        if progress:
+            progress(f"{name} floors")
+        _, text = scenario_text(name)
+        scenario = parse_with_overrides(text, "{}", name)
+        row = {}
+        for kind in ("controller", "python", "cpp"):
+            built = _floor_diagram(scenario, kind)
+            best, evals, steps = float("inf"), 0, 0
+            for _ in range(repeats):
+                simulator = prepared_simulator(built, scenario)
+                simulator.Initialize()
+                t0 = time.perf_counter()
+                simulator.AdvanceTo(scenario.duration)
+                best = min(best, time.perf_counter() - t0)
+                integrator = simulator.get_integrator()
+                evals, steps = integrator.get_num_derivative_evaluations(), integrator.get_num_steps_taken()
+            row[kind] = {"us_per_evaluation": round(1e6 * best / evals, 2), "evaluations": int(evals),
+                         "steps": int(steps), "wall_s": round(best, 4)}
+        row["python_crossing_us"] = round(row["python"]["us_per_evaluation"] - row["cpp"]["us_per_evaluation"], 2)
+        row["controller_work_us"] = round(
+            row["controller"]["us_per_evaluation"] - row["python"]["us_per_evaluation"], 2)
+        row["needed_for_3x_us"] = round(row["controller"]["us_per_evaluation"] / 3.0, 2)
+        out[name] = row
+    return out
+
+
 def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
                     tfs=(1.2, 1.5, 1.9), workers=(1, 2)) -> dict:
     """Wall time of a 3 × 3 ``ptint sweep`` grid with 1 and 2 worker processes."""
@@ -198,11 +288,19 @@ def main(argv=None) -> int:
                         help="time two override mappings side by side (interleaved), e.g. "
                              f"'{{}}' '{BEFORE}'")
     parser.add_argument("--repeats", type=int, default=5, help="with --pair: pairs per scenario")
+    parser.add_argument("--floors", action="store_true",
+                        help="instead: µs per derivative evaluation of the plant with a C++ constant "
+                             "actuation, with a do-nothing Python controller, and with the scenario's "
+                             "controller")
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats: must be >= 1, got {args.repeats}")
     say = lambda s: print(f"bench: {s}", file=__import__("sys").stderr)  # noqa: E731
-    if args.schemes or args.pair:
+    if args.schemes or args.pair or args.floors:
         result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
-                              "cpus": __import__("os").cpu_count()}}
+                              "cpus": __import__("os").cpu_count(), "drake": _drake_version()}}
+        if args.floors:
+            result["floors"] = floors(args.scenarios or None, min(args.repeats, 3), say)
         if args.schemes:
             result["schemes"] = scheme_table(
                 args.scenarios or None, [s for s in args.schemes.split(",") if s],
