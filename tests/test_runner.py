@@ -39,6 +39,12 @@ def _comparable(row):
     return {k: v for k, v in row.items() if k != "realtime_factor"}  # wall-clock dependent
 
 
+def _new_children(before):
+    """Child processes of this process that were not there ``before`` (a set of pids): other
+    tests may leave helpers of their own (e.g. Dask's resource tracker) that are not ours."""
+    return set(_children(os.getpid())) - before
+
+
 def _children(pid):
     """Pids whose parent is ``pid``."""
     kids = []
@@ -56,6 +62,7 @@ def _children(pid):
 def test_results_in_task_order_and_progress_sees_every_result():
     # later tasks finish first: the results still come back in task order
     tasks = [(i, 0.02 * (6 - i)) for i in range(6)]
+    before = set(_children(os.getpid()))
     seen = []
     stats = {}
     results = run_tasks(_slow_square, tasks, workers=2, stats=stats,
@@ -66,25 +73,27 @@ def test_results_in_task_order_and_progress_sees_every_result():
     assert all(results[index] == result for _, _, index, result in seen)
     assert len({pid for _, pid in results}) == 2 and os.getpid() not in {pid for _, pid in results}
     assert stats["workers"] == 2 and stats["worker_rss_mb"] > 0
-    assert not _children(os.getpid())  # every worker was waited for
+    assert not _new_children(before)  # every worker was waited for
 
 
 def test_workers_are_recycled():
     stats = {}
+    before = set(_children(os.getpid()))
     results = run_tasks(_slow_square, [(i, 0.0) for i in range(5)], workers=1, max_tasks_per_child=2,
                         stats=stats)
     pids = [pid for _, pid in results]
     assert pids[0] == pids[1] != pids[2] == pids[3] != pids[4]
     assert stats["worker_starts"] == 3
-    assert not _children(os.getpid())
+    assert not _new_children(before)
 
 
 def test_a_task_error_is_raised_in_the_caller_and_no_worker_is_left():
+    before = set(_children(os.getpid()))
     with pytest.raises(ValueError, match="task 2 is bad"):
         run_tasks(_boom, [(i,) for i in range(6)], workers=2)
     with pytest.raises(WorkerDied, match="exit code 3"):
         run_tasks(_die, [(i,) for i in range(4)], workers=2)
-    assert not _children(os.getpid())
+    assert not _new_children(before)
 
 
 def test_robust_samples_identical_on_1_and_2_workers_and_on_dask():
