@@ -1,6 +1,7 @@
 """Parameter sweeps: parallel workers, any Executor (a local Dask cluster), the CLI."""
 
 import csv
+import multiprocessing
 import subprocess
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -35,7 +36,9 @@ def test_sweep_extends_duration_and_reports_bad_points():
 
 
 def test_run_sweep_with_a_process_pool_keeps_grid_order():
-    with ProcessPoolExecutor(max_workers=2) as pool:
+    # forkserver: an earlier test's Dask client may leave threads in this process, and Python
+    # 3.12+ warns (rightly) about fork() from a multi-threaded process
+    with ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("forkserver")) as pool:
         rows = run_sweep(TEXT, NAME, [0.5, 0.75], [1.5], executor=pool)
     assert [(r["beta"], r["tf"]) for r in rows] == [(0.5, 1.5), (0.75, 1.5)]
     assert all(r["ok"] for r in rows)
