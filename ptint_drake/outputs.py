@@ -62,13 +62,15 @@ MANIFEST = ".ptint-manifest.json"
 
 
 @contextmanager
-def staged_output(out_dir: Path):
+def staged_output(out_dir: Path, additive: bool = False):
     """Yield a temporary folder; on success its files replace those in ``out_dir``.
 
     ``metrics.json`` (if staged) is moved last.  Files that the previous run in
     ``out_dir`` wrote (listed in its manifest) and this one did not are removed,
-    so two runs never mix.  On any failure (or Ctrl-C) the temporary folder is
-    deleted and ``out_dir`` keeps no new file.
+    so two runs never mix.  ``additive`` outputs (files named after what they show,
+    e.g. one diagram per scenario) only add or replace their own files and leave the
+    folder's other files and its manifest alone.  On any failure (or Ctrl-C) the
+    temporary folder is deleted and ``out_dir`` keeps no new file.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -83,6 +85,8 @@ def staged_output(out_dir: Path):
             if target.is_dir():
                 shutil.rmtree(target)
             os.replace(stage / name, target)
+        if additive:
+            return
         try:
             previous = set(json.loads((out_dir / MANIFEST).read_text()))
         except (OSError, ValueError):

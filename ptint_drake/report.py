@@ -106,7 +106,7 @@ def write_diagram(scenario: Scenario, out_dir: Path) -> list[Path]:
     diagram = build(scenario, log=False).diagram
     text = normalize_graphviz_ids(diagram.GetGraphvizString(max_depth=1))
     out_dir = Path(out_dir)
-    with staged_output(out_dir) as stage:
+    with staged_output(out_dir, additive=True) as stage:  # one pair of files per scenario
         dot_path = stage / f"{scenario.name}.dot"
         dot_path.write_text(text)
         svg = subprocess.run([dot_exe, "-Tsvg", str(dot_path)], check=True,

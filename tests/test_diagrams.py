@@ -91,3 +91,20 @@ def test_structure_ignores_drake_version_details():
     assert old == structure(export('<TR>\n<TD PORT="u1" BORDER="1" >surface_speeds</TD>\n</TR>\n'))
     assert old["systems"]["interceptor"]["outputs"] == ["sigma", "tau"]
     assert old["connections"] == ["interceptor.tau -> plant.actuation", "plant.state -> interceptor.state"]
+
+
+def test_diagrams_of_two_scenarios_share_a_folder(tmp_path):
+    """`ptint diagram A` then `ptint diagram B --out` the same folder keeps A's files (each
+    scenario's pair is named after it), and a diagram written again replaces its own pair."""
+    from ptint_drake.scenario import load_scenario
+
+    if shutil.which("dot") is None:
+        pytest.skip("Graphviz's dot is not installed")
+    first = write_diagram(load_scenario("curve_b075_tf15"), tmp_path)
+    second = write_diagram(load_scenario("assembly"), tmp_path)
+    assert all(p.exists() and p.stat().st_size > 0 for p in first + second)
+    (tmp_path / "curve_b075_tf15.dot").write_text("stale")
+    again = write_diagram(load_scenario("curve_b075_tf15"), tmp_path)
+    assert again == first and (tmp_path / "curve_b075_tf15.dot").read_text() != "stale"
+    assert all(p.exists() for p in second)
+    assert not list(tmp_path.glob(".ptint-stage-*"))
