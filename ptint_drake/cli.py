@@ -250,7 +250,8 @@ def cmd_diagram(args) -> int:
 def cmd_paper(args) -> int:
     from ptint_drake.report import write_paper  # noqa: PLC0415
 
-    index = write_paper(_out_dir(args.out, Path("out/paper")), progress_factory=None if args.quiet else _progress)
+    index = write_paper(_out_dir(args.out, Path("out/paper")),
+                        progress_factory=None if args.quiet else _progress)
     print(f"wrote {index}")
     return 0
 
@@ -341,7 +342,8 @@ def cmd_robust(args) -> int:
     p = result["e_tf_percentiles"]
     print(f"{result['samples']} samples in {result['wall_time_s']:.1f} s "
           f"({result['samples_per_s']:.2f} samples/s), success rate {100 * result['success_rate']:.1f} %, "
-          f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, max {p.get('max', float('nan')) * 1e3:.4f} mm; "
+          f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, "
+          f"max {p.get('max', float('nan')) * 1e3:.4f} mm; "
           f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
     return 0
 
@@ -405,7 +407,8 @@ def cmd_study(args) -> int:
     if args.workers < 1:
         raise ScenarioError(f"--workers: must be >= 1, got {args.workers}")
     report = None if args.quiet else (
-        lambda i, n, *_: print(f"study camera: {i}/{n} runs", file=sys.stderr) if i % 10 == 0 or i == n else None)
+        lambda i, n, *_: print(f"study camera: {i}/{n} runs", file=sys.stderr)
+        if i % 10 == 0 or i == n else None)
     if args.filter_floor:
         return _filter_floor(args, camera, report)
     for flag, value in (("--scenario", args.scenario), ("--process-noise", args.process_noise),
@@ -590,7 +593,8 @@ def _add_design_parsers(sub) -> None:
     cmp_.set_defaults(func=cmd_compare)
 
     tn = sub.add_parser(
-        "tune", help="the smallest gain that meets the prescribed time on every variant (README: Your own arm)",
+        "tune",
+        help="the smallest gain that meets the prescribed time on every variant (README: Your own arm)",
         description="1-D search of one gain (K or Lambda: the smallest that works; phi: the largest) so "
                     "that every segment meets the criteria divided by --margin on every plant variant "
                     "and the actuators saturate at most --max-saturation of the time. Writes tuned.yaml "

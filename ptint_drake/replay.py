@@ -50,7 +50,8 @@ def shared_meshcat() -> Meshcat:
 # A three-quarter view from the front right (world, z up); meshcat's orbit target stays at the
 # world origin, the robot's base.
 CAMERA = (0.6, -0.5, 0.45)
-_DEFAULT_VIEW = 'viewer.set_property([\'Cameras\', \'default\', \'rotated\', \'<object>\'],\n                        "position", [0.0, 1.0, 3.0])'
+_DEFAULT_VIEW = ('viewer.set_property([\'Cameras\', \'default\', \'rotated\', \'<object>\'],\n'
+                 '                        "position", [0.0, 1.0, 3.0])')
 
 
 def with_camera(html: str, camera) -> str:

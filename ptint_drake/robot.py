@@ -40,7 +40,8 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
     try:
         Parser(plant).AddModels(str(path))
     except Exception as exc:
-        raise ScenarioError(f"robot.model: cannot parse {str(path)!r}: {' '.join(str(exc).split())[:300]}") from None
+        detail = " ".join(str(exc).split())[:300]
+        raise ScenarioError(f"robot.model: cannot parse {str(path)!r}: {detail}") from None
     for i in range(plant.num_joints()):
         joint = plant.get_joint(JointIndex(i))
         if isinstance(joint, (RevoluteJoint, PrismaticJoint)):

@@ -98,7 +98,8 @@ class WaypointsConfig:
     """A recorded path: positions (m) at increasing times (s), interpolated C² (cubic spline)."""
 
     time: List[float] = field(default_factory=list)
-    position: list[list[float]] = field(default_factory=list)  # not List[List[float]]: yaml_load_typed cannot build a typing.List inside a list
+    # not List[List[float]]: yaml_load_typed cannot build a typing.List inside a list
+    position: list[list[float]] = field(default_factory=list)
 
 
 @dataclass

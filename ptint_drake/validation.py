@@ -63,7 +63,8 @@ def _validate_controller(c) -> None:
         _positive(getattr(c, name), f"controller.{name}")
     for name in ("alpha_hold", "pinv_damping", "null_space_damping", "null_space_rate"):
         _nonnegative(getattr(c, name), f"controller.{name}")
-    for name, value, allowed in (("switching", c.switching, SWITCHING_LAWS), ("type", c.type, CONTROLLER_TYPES),
+    for name, value, allowed in (("switching", c.switching, SWITCHING_LAWS),
+                                 ("type", c.type, CONTROLLER_TYPES),
                                  ("implementation", c.implementation, IMPLEMENTATIONS),
                                  ("sigma_policy", c.sigma_policy, SIGMA_POLICIES)):
         if value not in allowed:
@@ -100,7 +101,8 @@ def _validate_simulator(sim) -> None:
     _positive(sim.accuracy, "simulator.accuracy")
     _positive(sim.max_step_size, "simulator.max_step_size")
     if sim.start_time != 0.0:
-        raise ScenarioError(f"simulator.start_time: must be 0 (scenario times are absolute), got {sim.start_time}")
+        raise ScenarioError(
+            f"simulator.start_time: must be 0 (scenario times are absolute), got {sim.start_time}")
 
 
 def _validate_interception(s, i: int, ic) -> None:

@@ -55,15 +55,16 @@ def results_table() -> str:
             first = i == 0
             label = name if len(m["segments"]) == 1 else f"{name} #{i + 1}"
             lines.append(
-                f"| {label} | {seg['beta']:g} | {seg['tf']:g} | {mm(seg['e0_norm'])} | {mm(seg['e_half_norm'])} "
-                f"| {mm(seg['e_tf_norm'], 3)} | {mm(seg['edot_tf_norm'], 3)} | {mm(seg['e_hold_max_norm'], 3)} "
+                f"| {label} | {seg['beta']:g} | {seg['tf']:g} | {mm(seg['e0_norm'])} "
+                f"| {mm(seg['e_half_norm'])} | {mm(seg['e_tf_norm'], 3)} | {mm(seg['edot_tf_norm'], 3)} "
+                f"| {mm(seg['e_hold_max_norm'], 3)} "
                 f"| {mm(paper_holds[i], 3)} "
                 f"| {', '.join(f'{v:.2f}' for v in m['torque_peak']) if first else ''} "
                 f"| {', '.join(f'{v:.2f}' for v in m['torque_peak_after_startup']) if first else ''} "
                 f"| {m['status'] if first else ''} | {rtf if first else ''} |")
-    return "\n".join(lines) + f"\n\n`ptint run NAME` for each (and `--set controller.k_hold=3` for the paper's " \
-        f"hold), measured by `scripts/readme_tables.py` on {machine()}; RTF (end-to-end realtime factor) " \
-        f"depends on the machine.\n"
+    return "\n".join(lines) + "\n\n`ptint run NAME` for each (and `--set controller.k_hold=3` for the " \
+        f"paper's hold), measured by `scripts/readme_tables.py` on {machine()}; " \
+        "RTF (end-to-end realtime factor) depends on the machine.\n"
 
 
 def compare_table(name: str, workers: int) -> str:
@@ -74,7 +75,8 @@ def compare_table(name: str, workers: int) -> str:
     _, text = scenario_text(name)
     result = run_compare(text, name, workers=workers)
     variants = result["variants"]
-    lines = ["| controller | seg | " + " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants) + " |",
+    header = " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants)
+    lines = ["| controller | seg | " + header + " |",
              "|---|---|" + "---|" * len(variants)]
     rows = table_rows(result)
     keys = sorted({(r["controller"], r["segment"]) for r in rows},

@@ -75,5 +75,8 @@ def sigint_default() -> None:
 TOO_SHORT_TF = """duration: 1.0
 robot: {model: rvm1, end_effector: tool, initial_q_deg: [22.5, 45.0, 30.0]}
 interceptions:
-  - {start: 0.0, tf: 0.2, beta: 0.75, target: {linear: {start: [0.30, -0.15, 0.15], velocity: [0.0, 0.1, 0.0]}}}
+  - start: 0.0
+    tf: 0.2
+    beta: 0.75
+    target: {linear: {start: [0.30, -0.15, 0.15], velocity: [0.0, 0.1, 0.0]}}
 """

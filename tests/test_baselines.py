@@ -234,7 +234,8 @@ def test_closed_loop_reaches_static_target(kind):
 
 def test_ct_quintic_intercepts_the_curve_at_tf():
     """The paper's curve from t = 0, tf = 1.5, exact model and exact predictor: |e(tf)| ≤ 1 mm."""
-    predict = lambda i, t, target: CURVE.evaluate(t)[0:6]
+    def predict(i, t, target):
+        return CURVE.evaluate(t)[0:6]
     sim, ctrl, cctx = _closed_loop("ct", Schedule([Segment(0.0, 1.5, 0.75)]), CURVE, predict)
     sim.AdvanceTo(1.5)
     assert _error(ctrl, cctx) <= 1e-3

@@ -15,7 +15,8 @@ VELOCITY = np.array([1.0, -2.0, 0.5])
 
 def _line_source(builder, duration=5.0):
     """x_true(t) = VELOCITY t, as a TrajectorySource (time-dependent, no state)."""
-    traj = PiecewisePolynomial.FirstOrderHold([0.0, duration], np.column_stack([np.zeros(3), VELOCITY * duration]))
+    traj = PiecewisePolynomial.FirstOrderHold(
+        [0.0, duration], np.column_stack([np.zeros(3), VELOCITY * duration]))
     return builder.AddSystem(TrajectorySource(traj))
 
 

@@ -36,7 +36,8 @@ def test_compare_writes_the_table_and_the_paper_controller_is_ok(tmp_path):
     assert not by[("pd", "nominal")]["ok"]
     with open(tmp_path / "compare.csv") as f:
         table = list(csv.DictReader(f))
-    assert len(table) == 6 and {"controller", "variant", "segment", "e_tf_norm", "t_arrive", "ok"} <= set(table[0])
+    assert len(table) == 6
+    assert {"controller", "variant", "segment", "e_tf_norm", "t_arrive", "ok"} <= set(table[0])
     md = (tmp_path / "compare.md").read_text()
     assert md.count("\n| ptsmc |") == 2 and "| verdict |" in md
     assert (tmp_path / "compare.png").stat().st_size > 20_000
@@ -63,7 +64,8 @@ interceptions:
 
 
 @pytest.mark.parametrize("args, message", [
-    (("--controllers", "ptsmc,lqr"), "ptint: error: --controllers: unknown 'lqr' (one of ptsmc, pd, smc, ct_quintic)"),
+    (("--controllers", "ptsmc,lqr"),
+     "ptint: error: --controllers: unknown 'lqr' (one of ptsmc, pd, smc, ct_quintic)"),
     (("--variants", "nominal,heavy"), "ptint: error: variant: unknown plant variant 'heavy'"),
     (("--workers", "0"), "ptint: error: --workers: must be >= 1, got 0"),
 ])

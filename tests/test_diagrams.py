@@ -61,7 +61,8 @@ def test_committed_diagrams_are_current(tmp_path, name):
                                         "interceptor_surface", "interceptor_controller", "station"))):
         dot, svg = write_diagram(scenario, tmp_path)
         committed = DIAGRAMS / dot.name
-        assert committed.is_file(), f"{committed} is missing: run `.venv/bin/python scripts/export_diagrams.py`"
+        assert committed.is_file(), \
+            f"{committed} is missing: run `.venv/bin/python scripts/export_diagrams.py`"
         fresh = structure(dot.read_text())
         assert structure(committed.read_text()) == fresh, (
             f"{committed} is stale: run `.venv/bin/python scripts/export_diagrams.py`")

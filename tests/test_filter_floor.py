@@ -90,7 +90,8 @@ def ptint(*args):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--process-noise", "0.03,-0.1"], "ptint: error: --process-noise: every value must be > 0 and finite, got -0.1"),
+    (["--process-noise", "0.03,-0.1"],
+     "ptint: error: --process-noise: every value must be > 0 and finite, got -0.1"),
     (["--scenario", "curve_b075_tf15"], "ptint: error: measurement.estimator: the filter floor needs "
                                         "kalman_cv or kalman_ca, curve_b075_tf15 has 'none'"),
 ])

@@ -65,7 +65,8 @@ def test_cli_sweep_writes_csv_and_heatmaps(tmp_path):
     assert done.returncode == 0, done.stderr
     with open(tmp_path / "sweep.csv") as f:
         rows = list(csv.DictReader(f))
-    assert [(float(r["beta"]), float(r["tf"])) for r in rows] == [(0.5, 1.2), (0.5, 1.5), (0.75, 1.2), (0.75, 1.5)]
+    grid = [(float(r["beta"]), float(r["tf"])) for r in rows]
+    assert grid == [(0.5, 1.2), (0.5, 1.5), (0.75, 1.2), (0.75, 1.5)]
     for r in rows:
         assert r["ok"] == "True" and float(r["e_tf"]) < 1e-3 and float(r["realtime_factor"]) > 0
         for col in ("e0", "e_half", "hold", "peak_torque", "peak_jerk"):

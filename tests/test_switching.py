@@ -30,7 +30,8 @@ def test_boundary_layer_reproduces_sign():
     # torques: sign chatters, so compare 20 ms moving averages
     grid = np.arange(0.0, exact.metrics["duration"], 1e-4)
     kernel = np.ones(200) / 200
-    avg = lambda y: np.column_stack([np.convolve(y[:, k], kernel, mode="same") for k in range(3)])
+    def avg(y):
+        return np.column_stack([np.convolve(y[:, k], kernel, mode="same") for k in range(3)])
     diff = np.abs(avg(_on_grid(grid, exact, "tau")) - _on_grid(grid, smooth, "tau"))[200:-200]
     assert np.max(diff) < 0.15, f"averaged torques differ by {np.max(diff):.3f} N·m"
     # and the point of it: far fewer integrator steps

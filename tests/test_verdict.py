@@ -36,7 +36,8 @@ def test_the_paper_run_is_ok_and_exits_0(tmp_path):
 def test_assembly_warns_about_joint_speeds_beyond_the_model(tmp_path):
     out = ptint("run", "assembly", "--out", str(tmp_path), "--quiet", "--no-replay", "--no-figures")
     assert out.returncode == 0, out.stderr
-    speed = [line for line in out.stderr.splitlines() if "speed" in line and "beyond the model's limit 3" in line]
+    speed = [line for line in out.stderr.splitlines()
+             if "speed" in line and "beyond the model's limit 3" in line]
     assert speed, out.stderr
     assert speed[0].startswith("ptint: warning: joint ") and " at t = " in speed[0]
     m = json.loads((tmp_path / "metrics.json").read_text())

@@ -248,7 +248,8 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
                 evals, steps = integrator.get_num_derivative_evaluations(), integrator.get_num_steps_taken()
             row[kind] = {"us_per_evaluation": round(1e6 * best / evals, 2), "evaluations": int(evals),
                          "steps": int(steps), "wall_s": round(best, 4)}
-        row["python_crossing_us"] = round(row["python"]["us_per_evaluation"] - row["cpp"]["us_per_evaluation"], 2)
+        row["python_crossing_us"] = round(
+            row["python"]["us_per_evaluation"] - row["cpp"]["us_per_evaluation"], 2)
         row["controller_work_us"] = round(
             row["controller"]["us_per_evaluation"] - row["python"]["us_per_evaluation"], 2)
         row["needed_for_3x_us"] = round(row["controller"]["us_per_evaluation"] / 3.0, 2)

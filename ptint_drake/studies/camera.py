@@ -19,7 +19,8 @@ Outputs in DIR: ``camera_study.json`` (every run and the summary), ``camera_stud
 the scenario's own settings).
 
 Runs go to the studies' runner (``studies.runner.run_tasks``: local worker processes or a
-Dask scheduler); each worker builds its own diagram from the scenario text.  Full grid, 10 seeds (360 runs): 253 s with 2 workers on a 2-core machine.
+Dask scheduler); each worker builds its own diagram from the scenario text.  Full grid, 10
+seeds (360 runs): 156–163 s with 2 workers on a 2-core machine.
 
 The filter's floor (``ptint study camera --filter-floor``, ``filter_floor``): the same
 camera and Kalman filter without any arm — the scenario's true objects
@@ -206,8 +207,8 @@ def run_study(seeds: int = DEFAULT_SEEDS, workers: int = 2, out: Path = Path("ou
               "table": table, "runs": rows}
     with staged_output(out) as stage:
         estimate_figure(text, name, stage)
-        (stage / "camera_study.md").write_text(markdown(table, seeds, name)
-                                               + f"\n{len(rows)} runs, {wall:.0f} s with {workers} workers.\n")
+        footer = f"\n{len(rows)} runs, {wall:.0f} s with {workers} workers.\n"
+        (stage / "camera_study.md").write_text(markdown(table, seeds, name) + footer)
         write_json_atomic(stage / "camera_study.json", result)
     return result
 
@@ -363,8 +364,10 @@ def filter_floor(text: str, name: str, process_noises=FLOOR_PROCESS_NOISES, seed
     return {"scenario": name, "seeds": seeds, "sample_hz": sample_hz, "workers": workers,
             "wall_time_s": time.perf_counter() - t0,
             "measurement_overrides": overrides,
-            "measurement": {k: v for k, v in copy.deepcopy(vars(m)).items() if k not in ("seed", "process_noise")},
-            "segments": [{"start": s.start, "tf": s.tf, "hold_end": base.schedule().hold_end(i, base.duration)}
+            "measurement": {k: v for k, v in copy.deepcopy(vars(m)).items()
+                            if k not in ("seed", "process_noise")},
+            "segments": [{"start": s.start, "tf": s.tf,
+                          "hold_end": base.schedule().hold_end(i, base.duration)}
                          for i, s in enumerate(base.schedule().segments)],
             "duration": base.duration,
             "table": table, "best": best, "runs": rows}

@@ -13,7 +13,7 @@ Default ranges (uniform; ``--set``-style overrides through ``RANGES`` keys):
 | friction | ×[0.5, 2] | every joint's viscous damping (``plant.damping_scale``) |
 | coulomb | [0, 0.3] N·m per joint | smooth Coulomb friction (``plant.coulomb``) |
 | payload | [0, 0.5] kg | mass at the gripper (``plant.payload_kg``) |
-| disturbance | [0, 0.5] N·m per joint | sinusoid amplitude, f ∈ [0.5, 3] Hz, random phase, plus a step of ±the same bound at a random time |
+| disturbance | [0, 0.5] N·m per joint | sine (0.5–3 Hz, random phase) + a step of ± that at a random t |
 | noise | [0, 1e-4] m | std of the target measurement noise at 30 Hz |
 | latency | [0, 0] s | camera latency (compensated with the known target profile) |
 """

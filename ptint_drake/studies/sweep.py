@@ -24,8 +24,8 @@ from ptint_drake.scenario import ScenarioError, parse_scenario, validate
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
-COLUMNS = ("beta", "tf", "e0", "e_tf", "e_half", "hold", "peak_torque", "peak_torque_after_startup", "peak_jerk",
-           "realtime_factor", "steps", "ok", "error")
+COLUMNS = ("beta", "tf", "e0", "e_tf", "e_half", "hold", "peak_torque", "peak_torque_after_startup",
+           "peak_jerk", "realtime_factor", "steps", "ok", "error")
 
 
 def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:

@@ -37,7 +37,8 @@ from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
 GAINS = ("K", "Lambda", "phi")
-DRIFT_ANGLE = 0.5  # rad: a redundant arm whose null-space offset from the start posture ends above this drifts
+# rad: a redundant arm whose null-space offset from the start posture ends above this drifts
+DRIFT_ANGLE = 0.5
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
 
 

@@ -120,12 +120,13 @@ class PrescribedTimeInterceptor(LeafSystem):
         if target is None:
             target = active_target_values(self._schedule, self._targets, t)
         tbg = tbg_values(self._schedule, t, *self._tbg_args)
-        parts = self._law.values(t, x, xdot, target[TARGET.x], target[TARGET.xdot], tbg[TBG.alpha], tbg[TBG.segment],
-                                 captured, sigma)
+        parts = self._law.values(t, x, xdot, target[TARGET.x], target[TARGET.xdot], tbg[TBG.alpha],
+                                 tbg[TBG.segment], captured, sigma)
         tau = smc_torque_values(self._K_floats, J, parts[SURFACE.s_x], self._damping)
         if self._null_space is not None:  # redundant arms, optional (off by default)
             D, rate, q_start = self._null_space
-            tau = (np.array(tau) + null_space_torque(np.array(J), qv[:nq], qv[nq:], q_start, D, rate)).tolist()
+            extra = null_space_torque(np.array(J), qv[:nq], qv[nq:], q_start, D, rate)
+            tau = (np.array(tau) + extra).tolist()
         return (x + xdot + target[TARGET_PORT] + tbg[TBG_OUT] + parts[SURFACE_OUT] + sigma + tau
                 + tbg[TBG.segment] + parts[SURFACE.sigma_dot])
 
