@@ -183,3 +183,22 @@ def test_why_workers_are_recycled_drake_keeps_python_leaf_systems_alive():
     leaf, diagram, alone = build()
     gc.collect()
     assert leaf() is not None and diagram() is not None and alone() is not None
+
+
+def test_a_multi_threaded_caller_gets_forkserver_workers():
+    """fork() copies only the calling thread: from a process with other threads (a Dask
+    client, a notebook kernel) the workers come from a forkserver, with the same results."""
+    import threading
+
+    stop = threading.Event()
+    helper = threading.Thread(target=stop.wait, daemon=True)
+    helper.start()
+    try:
+        stats = {}
+        results = run_tasks(_slow_square, [(i, 0.0) for i in range(4)], workers=2, stats=stats)
+    finally:
+        stop.set()
+        helper.join()
+    assert stats["start_method"] == "forkserver"
+    assert [r[0] for r in results] == [0, 1, 4, 9]
+    assert os.getpid() not in {pid for _, pid in results}

@@ -12,8 +12,11 @@ same numbers with 1 worker, N workers or on a cluster.
 Local workers (the default) are this module's own small pool, not a
 ``ProcessPoolExecutor``:
 
-- forked on Linux (a fork from a parent that has imported Drake starts in ~10 ms;
-  a spawned/forkserver worker re-imports pydrake, ~2 s each), spawned elsewhere;
+- forked on Linux when the calling process has a single thread, as the command line
+  has (a fork from a parent that has imported Drake starts in ~10 ms), from a
+  forkserver when it has more (e.g. a Jupyter kernel or a Dask client: a forked child
+  would inherit their locks held; a forkserver worker re-imports pydrake, ~2 s
+  each), spawned elsewhere;
 - one task in flight per worker (dispatch on completion: a pipe round trip costs
   ~0.1 ms against ≥ 0.1 s per simulation), so nothing is submitted up front;
 - recycled after ``max_tasks_per_child`` tasks (default ``MAX_TASKS_PER_CHILD``):
@@ -37,7 +40,8 @@ there, start them with ``--lifetime`` (e.g. ``dask worker ADDR --lifetime 30m
 ``progress(done, total, index, result)`` is called in the calling process as each
 result arrives.  ``stats`` (a dict, optional) receives ``workers``,
 ``worker_starts``, ``worker_rss_mb`` (largest resident set of a worker measured
-after a task) and ``worker_rss_mb_by_task`` (per task, in task order).
+after a task), ``worker_rss_mb_by_task`` (per task, in task order) and, for local
+workers, ``start_method``.
 """
 
 from __future__ import annotations
@@ -47,6 +51,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
 import traceback
 from multiprocessing.connection import wait as wait_any
 
@@ -228,11 +233,22 @@ class _Worker:
 
 
 def _start_method() -> str:
-    return "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    """``fork`` when this process runs one Python thread (the command line), else
+    ``forkserver``: a fork copies only the calling thread, so a lock another thread holds
+    (a Dask client's event loop, a Jupyter kernel's) stays locked in the child forever; the
+    forkserver's workers re-import pydrake instead (~2 s each).  ``spawn`` where neither
+    exists.  (OpenBLAS's own threads do not count: it re-arms them across a fork, and
+    Python does not warn about them.)"""
+    methods = multiprocessing.get_all_start_methods()
+    if "fork" in methods and threading.active_count() == 1:
+        return "fork"
+    return "forkserver" if "forkserver" in methods else "spawn"
 
 
 def _run_local(fn, tasks, workers, progress, max_tasks_per_child, stats) -> list:
-    ctx = multiprocessing.get_context(_start_method())
+    method = _start_method()
+    stats["start_method"] = method
+    ctx = multiprocessing.get_context(method)
     n = len(tasks)
     results = [None] * n
     rss = [0.0] * n
