@@ -202,3 +202,28 @@ def test_a_multi_threaded_caller_gets_forkserver_workers():
     assert stats["start_method"] == "forkserver"
     assert [r[0] for r in results] == [0, 1, 4, 9]
     assert os.getpid() not in {pid for _, pid in results}
+
+
+def _cube(i):
+    return i ** 3, os.getpid()
+
+
+def test_a_function_of_main_is_forked_even_beside_threads():
+    """A notebook's or script's own function cannot be imported by a forkserver child, so it
+    is forked (as before) whatever other threads run."""
+    import threading
+
+    fn = _cube
+    fn.__module__ = "__main__"  # as if defined in a notebook cell: only a fork can run it
+    stop = threading.Event()
+    helper = threading.Thread(target=stop.wait, daemon=True)
+    helper.start()
+    try:
+        stats = {}
+        results = run_tasks(fn, [(i,) for i in range(3)], workers=2, stats=stats)
+    finally:
+        stop.set()
+        helper.join()
+        fn.__module__ = __name__
+    assert stats["start_method"] == "fork"
+    assert [r[0] for r in results] == [0, 1, 8]

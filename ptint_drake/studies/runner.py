@@ -16,7 +16,7 @@ Local workers (the default) are this module's own small pool, not a
   has (a fork from a parent that has imported Drake starts in ~10 ms), from a
   forkserver when it has more (e.g. a Jupyter kernel or a Dask client: a forked child
   would inherit their locks held; a forkserver worker re-imports pydrake, ~2 s
-  each), spawned elsewhere;
+  each) unless ``fn`` is defined in ``__main__`` (a notebook cell), spawned elsewhere;
 - one task in flight per worker (dispatch on completion: a pipe round trip costs
   ~0.1 ms against ≥ 0.1 s per simulation), so nothing is submitted up front;
 - recycled after ``max_tasks_per_child`` tasks (default ``MAX_TASKS_PER_CHILD``):
@@ -232,21 +232,23 @@ class _Worker:
             self.process.terminate()
 
 
-def _start_method() -> str:
+def _start_method(fn) -> str:
     """``fork`` when this process runs one Python thread (the command line), else
     ``forkserver``: a fork copies only the calling thread, so a lock another thread holds
     (a Dask client's event loop, a Jupyter kernel's) stays locked in the child forever; the
     forkserver's workers re-import pydrake instead (~2 s each).  ``spawn`` where neither
     exists.  (OpenBLAS's own threads do not count: it re-arms them across a fork, and
-    Python does not warn about them.)"""
+    Python does not warn about them.)  A ``fn`` defined in ``__main__`` (a notebook cell, a
+    script) is forked whatever the threads: a forkserver child could not import it."""
     methods = multiprocessing.get_all_start_methods()
-    if "fork" in methods and threading.active_count() == 1:
+    in_main = getattr(fn, "__module__", None) == "__main__"
+    if "fork" in methods and (threading.active_count() == 1 or in_main):
         return "fork"
     return "forkserver" if "forkserver" in methods else "spawn"
 
 
 def _run_local(fn, tasks, workers, progress, max_tasks_per_child, stats) -> list:
-    method = _start_method()
+    method = _start_method(fn)
     stats["start_method"] = method
     ctx = multiprocessing.get_context(method)
     n = len(tasks)
