@@ -5,6 +5,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import pytest
@@ -220,7 +221,9 @@ def test_a_function_of_main_is_forked_even_beside_threads():
     helper.start()
     try:
         stats = {}
-        results = run_tasks(fn, [(i,) for i in range(3)], workers=2, stats=stats)
+        with warnings.catch_warnings():  # Python >= 3.12 warns about this very fork, rightly
+            warnings.filterwarnings("ignore", "This process .* is multi-threaded", DeprecationWarning)
+            results = run_tasks(fn, [(i,) for i in range(3)], workers=2, stats=stats)
     finally:
         stop.set()
         helper.join()
