@@ -305,8 +305,8 @@ def cmd_sweep(args) -> int:
     scenario = load(args.scenario, args.set)  # validates the base scenario before any worker starts
     name, text = load_text(args.scenario, args.set)
     out = _out_dir(args.out, Path("out") / f"sweep_{scenario.name}")
-    report = None if args.quiet else (lambda i, n: print(f"sweep: {i}/{n} runs done", file=sys.stderr))
-    rows = _dask_errors(lambda: sweep.run_sweep(text, name, betas, tfs, progress=report, **where))
+    rows = _dask_errors(lambda: sweep.run_sweep(text, name, betas, tfs, progress=_runs("sweep", args.quiet),
+                                                **where))
     with staged_output(out) as stage:  # entered only once every run finished
         sweep.heatmaps(rows, betas, tfs, stage, f"{scenario.name}: β × tf sweep")
         sweep.write_csv(rows, stage / "sweep.csv")
@@ -336,8 +336,8 @@ def cmd_robust(args) -> int:
     out = _out_dir(args.out, Path("out") / f"robust_{scenario.name}")
     report = None if args.quiet else (
         lambda i, n: print(f"robust: {i}/{n} samples", file=sys.stderr) if i % 10 == 0 or i == n else None)
-    result = _dask_errors(lambda: robust.run_robust(text, name, args.samples, args.seed, where["workers"],
-                                                    ranges=ranges, progress=report, dask=where["dask"]))
+    result = _dask_errors(lambda: robust.run_robust(text, name, args.samples, args.seed, ranges=ranges,
+                                                    progress=report, **where))
     robust.write_robust(result, out)  # staged: the folder is created only now
     p = result["e_tf_percentiles"]
     print(f"{result['samples']} samples in {result['wall_time_s']:.1f} s "
@@ -433,7 +433,6 @@ def _filter_floor(args, camera, report) -> int:
             raise ScenarioError(f"--process-noise: every value must be > 0 and finite, got {q:g}")
     _out_dir(args.out, Path("out"))
     scenario = load(args.scenario or camera.FLOOR_SCENARIO, args.set)
-    camera.check_floor_scenario(scenario)
     name, text = load_text(args.scenario or camera.FLOOR_SCENARIO, args.set)
     out = _out_dir(args.out, Path("out") / f"filter_floor_{scenario.name}")
     result = camera.filter_floor(text, name, noises, args.seeds, workers=args.workers, progress=report)

@@ -20,7 +20,8 @@ from pydrake.systems.analysis import SimulatorConfig
 _VERSION_SPECIFIC_SIMULATOR = {"publish_every_time_step": False}
 
 
-def _drake_version() -> str:
+def drake_version() -> str:
+    """The installed Drake's version (pip's metadata)."""
     from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
 
     try:
@@ -110,7 +111,7 @@ def _locate(raw, schema, path: str) -> Optional[str]:
         known = dump_dataclass(SimulatorConfig()).keys()
         for key in raw:
             if key not in known:
-                hint = (f" (a field of other Drake versions, not of the installed {_drake_version()}: "
+                hint = (f" (a field of other Drake versions, not of the installed {drake_version()}: "
                         f"delete it)" if key in _VERSION_SPECIFIC_SIMULATOR else "")
                 return f"{path}.{key}: unknown field{hint} (known: {', '.join(known)})"
     return None

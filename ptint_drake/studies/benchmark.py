@@ -19,6 +19,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
 from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenario_text
+from ptint_drake.scenario_yaml import drake_version
 from ptint_drake.simulation import Built, prepared_simulator, build, simulate
 from ptint_drake.station import MakeStation
 
@@ -29,11 +30,11 @@ CONFIGS = {
 }
 REFERENCE = ("simulator: {integration_scheme: runge_kutta5, accuracy: 1.0e-10, "
              "max_step_size: 0.01}")
-# The bundled scenarios' setting before they capped the step at 2.2 ms (``--pair``'s default B).
-BEFORE = "simulator: {integration_scheme: runge_kutta3, accuracy: 1.0e-4, max_step_size: 0.1}"
-# ``--schemes`` rows use Drake's default step cap unless ``--simulator-extra`` sets one, so
+# Drake's default step cap.  ``--schemes`` rows use it unless ``--simulator-extra`` sets one, so
 # that the bundled scenarios' 2.2 ms cap does not hold the implicit schemes back.
 SCHEME_MAX_STEP = "max_step_size: 0.1"
+# The bundled scenarios' setting before they capped the step at 2.2 ms (``--pair``'s default B).
+BEFORE = f"simulator: {{integration_scheme: runge_kutta3, accuracy: 1.0e-4, {SCHEME_MAX_STEP}}}"
 
 
 def _run(name: str, overrides: str) -> dict:
@@ -171,15 +172,6 @@ def paired(names=None, a: str = "{}", b: str = BEFORE, repeats: int = 5, progres
     return out
 
 
-def _drake_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("drake")
-    except PackageNotFoundError:
-        return "unknown"
-
-
 class _ZeroTorque(LeafSystem):
     """A Python controller that does nothing: reads the plant state, outputs zero actuation
     (what any Python LeafSystem in the loop costs per derivative evaluation)."""
@@ -299,7 +291,7 @@ def main(argv=None) -> int:
     say = lambda s: print(f"bench: {s}", file=__import__("sys").stderr)  # noqa: E731
     if args.schemes or args.pair or args.floors:
         result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
-                              "cpus": __import__("os").cpu_count(), "drake": _drake_version()}}
+                              "cpus": __import__("os").cpu_count(), "drake": drake_version()}}
         if args.floors:
             result["floors"] = floors(args.scenarios or None, min(args.repeats, 3), say)
         if args.schemes:

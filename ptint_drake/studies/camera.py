@@ -70,18 +70,25 @@ FLOOR_PROCESS_NOISES = (0.003, 0.01, 0.03, 0.1, 0.3)
 FLOOR_SAMPLE_HZ = 960.0
 
 
+def _with_measurement(text: str, name: str, measurement: dict, seed: int) -> Scenario:
+    """The scenario with ``measurement`` fields (or dotted scenario fields, e.g.
+    ``controller.alpha_hold``) replaced and measurement.seed = ``seed``, validated."""
+    scenario = parse_scenario(text, name)
+    for key, value in measurement.items():  # "noise_std" or e.g. "controller.alpha_hold"
+        owner, _, field = key.rpartition(".")
+        setattr(getattr(scenario, owner) if owner else scenario.measurement, field, value)
+    scenario.measurement.seed = seed
+    validate(scenario)
+    return scenario
+
+
 def run_case(text: str, name: str, measurement: dict, seed: int) -> dict:
     """One run of the scenario text with ``measurement`` fields (or dotted scenario fields,
     e.g. ``controller.alpha_hold``) replaced and measurement.seed = ``seed``;
     returns per-segment e_tf, hold and verdict reasons (``error`` set if it could not run)."""
     row = {"measurement": dict(measurement), "seed": seed, "error": ""}
     try:
-        scenario = parse_scenario(text, name)
-        for key, value in measurement.items():  # "noise_std" or e.g. "controller.alpha_hold"
-            owner, _, field = key.rpartition(".")
-            setattr(getattr(scenario, owner) if owner else scenario.measurement, field, value)
-        scenario.measurement.seed = seed
-        validate(scenario)
+        scenario = _with_measurement(text, name, measurement, seed)
         result = simulate(scenario, check=False)
     except (ScenarioError, RuntimeError) as exc:
         row["error"] = " ".join(str(exc).split())[:200]
@@ -214,16 +221,6 @@ def run_study(seeds: int = DEFAULT_SEEDS, workers: int = 2, out: Path = Path("ou
 
 
 # --------------------------------------------------------------------------- the filter's floor
-
-def _with_measurement(text: str, name: str, measurement: dict, seed: int) -> Scenario:
-    """The scenario with ``measurement`` fields replaced and measurement.seed = ``seed``."""
-    scenario = parse_scenario(text, name)
-    for key, value in measurement.items():
-        setattr(scenario.measurement, key, value)
-    scenario.measurement.seed = seed
-    validate(scenario)
-    return scenario
-
 
 def check_floor_scenario(scenario: Scenario) -> None:
     """ScenarioError naming ``measurement.estimator`` unless a Kalman filter is configured."""
