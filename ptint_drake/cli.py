@@ -349,16 +349,19 @@ def cmd_robust(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    from ptint_drake.scenario import CONTROLLER_TYPES, check_variants  # noqa: PLC0415
+    from ptint_drake.controllers import check_controller  # noqa: PLC0415
+    from ptint_drake.scenario import check_variants  # noqa: PLC0415
     from ptint_drake.studies import compare  # noqa: PLC0415
 
-    controllers = compare.parse_list(args.controllers, "--controllers", CONTROLLER_TYPES)
+    controllers = compare.controller_list(args.controllers)
     variants = compare.parse_list(args.variants, "--variants")
     where = _where(args)
     _out_dir(args.out, Path("out"))
     scenario = load(args.scenario, args.set)
     name, text = load_text(args.scenario, args.set)
     check_variants(scenario, variants)  # a bad name fails before any run
+    for controller in controllers:  # a plugin that cannot be used fails before any run
+        check_controller(compare.with_controller(scenario, controller))
     out = _out_dir(args.out, Path("out") / f"compare_{scenario.name}")
     result = _dask_errors(lambda: compare.run_compare(
         text, name, controllers, variants, progress=_runs("compare", args.quiet), **where))

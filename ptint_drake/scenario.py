@@ -20,8 +20,9 @@ open, with their defaults:
   is the paper's formula; see ``sliding_surface`` for why the hold needs it);
 - ``controller.implementation``: ``fused`` (one LeafSystem, the fast default) or
   ``blocks`` (the five wired blocks); both compute the same thing;
-- ``controller.type``: ``ptsmc`` (the paper's) or a baseline of the controller
-  slot (``pd``, ``smc``, ``ct_quintic``; see ``controllers``);
+- ``controller.type``: ``ptsmc`` (the paper's), another controller of the registry
+  (``controllers.REGISTRY``), or a user's own ``module:Class`` with its ``params``
+  (``controllers.plugin``);
 - ``plant``: scale factors for link masses/inertias and joint damping, used
   to show that the model-free controller needs no retuning (all 1 by default);
   ``apply_variant`` gives the named plant variants (nominal, mass_xF, payload_Mkg);
@@ -31,25 +32,24 @@ open, with their defaults:
 
 import copy
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, make_dataclass
 from importlib import resources
 from pathlib import Path
-from typing import List, Optional
+from typing import Dict, List, Optional, Union
 
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import SimulatorConfig
 
+from ptint_drake.controllers import REGISTRY, plugin
 from ptint_drake.metrics import Criteria
 from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
 from ptint_drake.systems.camera import MeasurementConfig
-from ptint_drake.systems.ct_quintic import CtQuinticConfig
 from ptint_drake.systems.gains import ControllerGains
-from ptint_drake.systems.pd import PDConfig
 from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
-from ptint_drake.validation import CONTROLLER_TYPES, TARGET_KINDS, ScenarioError, validate
+from ptint_drake.validation import TARGET_KINDS, ScenarioError, validate
 
-__all__ = ["CONTROLLER_TYPES", "TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
+__all__ = ["TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
            "load_scenario", "parse_scenario", "parse_with_overrides", "apply_variant", "check_variants",
            "validate"]
 
@@ -61,22 +61,26 @@ class RobotConfig:
     initial_q_deg: List[float] = field(default_factory=lambda: [22.5, 45.0, 30.0])
 
 
-@dataclass
-class SmcOptions:
-    lambda_factor: float = 4.0  # smc: constant λ = lambda_factor / tf (1/s); 4 settles in about tf
+ParamValue = Union[List[float], float, int, str]  # a plugin's setting (the order is Drake YAML's)
 
 
-@dataclass
-class ControllerConfig(ControllerGains):
-    """The paper's gains (shared by ``smc``), which controller runs (``type``; a plain
-    field rather than a tagged YAML variant so that ``--set controller.type=pd`` works and
-    an untagged mapping stays the paper's controller), and each baseline's own settings."""
+def _controller_config() -> type:
+    """``ControllerConfig``: the paper's gains flat (``ControllerGains``, shared by ``smc``), which
+    controller runs (``type``), a plugin's ``params``, and one block per registered controller
+    with settings of its own (``controller.pd``, ``controller.smc``, …: from the registry)."""
+    own = [(e.name, e.config, field(default_factory=e.config)) for e in REGISTRY.values() if e.config]
+    cls = make_dataclass("ControllerConfig", [
+        # a plain field rather than a tagged YAML variant, so that ``--set controller.type=pd``
+        # works and an untagged mapping stays the paper's controller
+        ("type", str, field(default="ptsmc")),  # a name of controllers.REGISTRY, or "module:Class"
+        ("implementation", str, field(default="fused")),  # ptsmc: "fused" one LeafSystem, or "blocks"
+        ("params", Dict[str, ParamValue], field(default_factory=dict)),  # a plugin's settings
+        *own], bases=(ControllerGains,), namespace={"__module__": __name__})
+    cls.__doc__ = _controller_config.__doc__
+    return cls
 
-    type: str = "ptsmc"  # the controller in the slot: ptsmc (the paper's) | pd | smc | ct_quintic
-    implementation: str = "fused"  # ptsmc: "fused" one LeafSystem, or "blocks" (the five wired blocks)
-    pd: PDConfig = field(default_factory=PDConfig)
-    smc: SmcOptions = field(default_factory=SmcOptions)
-    ct_quintic: CtQuinticConfig = field(default_factory=CtQuinticConfig)
+
+ControllerConfig = _controller_config()
 
 
 @dataclass
@@ -197,6 +201,7 @@ def scenario_text(name_or_file: str) -> "tuple[str, str]":
         raise ScenarioError(
             f"scenario: {name_or_file!r} is neither a bundled scenario "
             f"({', '.join(bundled_scenarios())}) nor a file")
+    plugin.remember_folder(path.parent)  # a plugin controller's module may sit beside the file
     return path.stem, path.read_text()
 
 

@@ -37,11 +37,15 @@ def dump_yaml(scenario) -> str:
     versions: a ``simulator`` field that only some of them have (``_VERSION_SPECIFIC_SIMULATOR``)
     is left out while it holds the value that means "absent", so a file written under Drake 1.51
     loads under 1.58 and back.  A non-default value is kept (it matters on this Drake); another
-    Drake then rejects it with a message naming the field.
+    Drake then rejects it with a message naming the field.  A plugin's ``controller.params`` are
+    written as plain YAML.
     """
     import yaml  # noqa: PLC0415
 
+    params = dict(scenario.controller.params)  # Drake's dumper cannot write a list inside a sum type
+    scenario = dataclasses.replace(scenario, controller=dataclasses.replace(scenario.controller, params={}))
     data = yaml.safe_load(yaml_dump_typed(scenario))
+    data["controller"]["params"] = params
     simulator = data.get("simulator", {})
     for key, absent in _VERSION_SPECIFIC_SIMULATOR.items():
         if key in simulator and simulator[key] == absent:

@@ -106,8 +106,10 @@ def prepared_simulator(built: Built, scenario: Scenario) -> Simulator:
     return simulator
 
 
-def _advance(simulator: Simulator, scenario: Scenario, watchdog: Watchdog, gripper, true_state):
-    """Run to every exact stop; returns (samples: t → (e, ė) against the true target, wall s)."""
+def _advance(simulator: Simulator, scenario: Scenario, watchdog: Watchdog, gripper, true_state,
+             plugin: bool = False):
+    """Run to every exact stop; returns (samples: t → (e, ė) against the true target, wall s).
+    With a user's controller (``plugin``), an exception it raises fails the run."""
     context = simulator.get_mutable_context()
     samples, wall = {}, 0.0
     simulator.Initialize()
@@ -118,6 +120,10 @@ def _advance(simulator: Simulator, scenario: Scenario, watchdog: Watchdog, gripp
                 simulator.AdvanceTo(t_stop)
             except RuntimeError as exc:  # e.g. a step-size collapse on a non-finite state
                 watchdog.integration_failed(context.get_time(), exc)
+            except Exception as exc:  # noqa: BLE001  (only a plugin's: the package's own are bugs)
+                if not plugin:
+                    raise
+                watchdog.controller_failed(context.get_time(), scenario.controller.type, exc)
             wall += time.perf_counter() - t0
         if watchdog.failure is not None:
             break
@@ -156,7 +162,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
                         position_of=lambda c: gripper(c)[0], true_target=lambda t: true_state(t)[TARGET.x],
                         progress=progress)
     simulator.set_monitor(watchdog)
-    samples, wall = _advance(simulator, scenario, watchdog, gripper, true_state)
+    samples, wall = _advance(simulator, scenario, watchdog, gripper, true_state, built.controller.plugin)
     context, integrator = simulator.get_context(), simulator.get_integrator()
     if progress is not None:
         progress(context.get_time(), scenario.duration, int(integrator.get_num_steps_taken()))

@@ -6,13 +6,13 @@ import math
 
 from pydrake.systems.analysis import GetIntegrationSchemes
 
+from ptint_drake.controllers import CONTROLLERS, REGISTRY, known_type, plugin
 from ptint_drake.metrics import validate_criteria
 from ptint_drake.systems.camera import validate_measurement
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import WaypointTarget
 
 IMPLEMENTATIONS = ("fused", "blocks")
-CONTROLLER_TYPES = ("ptsmc", "pd", "smc", "ct_quintic")  # the slot's (controllers.py); ptsmc: the paper's
 TARGET_KINDS = ("sinusoid", "linear", "waypoints")
 
 
@@ -63,20 +63,35 @@ def _validate_controller(c) -> None:
         _positive(getattr(c, name), f"controller.{name}")
     for name in ("alpha_hold", "pinv_damping", "null_space_damping", "null_space_rate"):
         _nonnegative(getattr(c, name), f"controller.{name}")
+    if not known_type(c.type):
+        raise ScenarioError(f"controller.type: must be one of {', '.join(CONTROLLERS)}, or {plugin.FORM}, "
+                            f"got {c.type!r}")
     for name, value, allowed in (("switching", c.switching, SWITCHING_LAWS),
-                                 ("type", c.type, CONTROLLER_TYPES),
                                  ("implementation", c.implementation, IMPLEMENTATIONS),
                                  ("sigma_policy", c.sigma_policy, SIGMA_POLICIES)):
         if value not in allowed:
             raise ScenarioError(f"controller.{name}: must be one of {', '.join(allowed)}, got {value!r}")
     if c.switching != "sign":
         _positive(c.phi, "controller.phi")
-    _positive(c.smc.lambda_factor, "controller.smc.lambda_factor")
-    for sub in (c.pd, c.ct_quintic):
-        try:
-            sub.validate()  # messages name the field from "pd." / "ct_quintic." on
-        except ValueError as exc:
-            raise ScenarioError(f"controller.{exc}") from None
+    for entry in REGISTRY.values():  # each controller's own block: messages name it from "<name>." on
+        if entry.config is not None and hasattr(entry.config, "validate"):
+            try:
+                getattr(c, entry.name).validate()
+            except ValueError as exc:
+                raise ScenarioError(f"controller.{exc}") from None
+    _validate_params(c)
+
+
+def _validate_params(c) -> None:
+    """``controller.params``: a plugin's settings (numbers, lists of numbers, strings)."""
+    if c.params and c.type in REGISTRY:
+        raise ScenarioError(f"controller.params: only a plugin controller ({plugin.FORM}) takes params; "
+                            f"{c.type!r} has its own settings")
+    for key, value in c.params.items():
+        values = value if isinstance(value, list) else [value]
+        for v in values:
+            if not isinstance(v, str) and not math.isfinite(v):
+                raise ScenarioError(f"controller.params.{key}: must be finite, got {value}")
 
 
 def _validate_plant(p) -> None:

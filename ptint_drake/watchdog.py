@@ -75,3 +75,8 @@ class Watchdog:
     def integration_failed(self, t, exc):
         detail = " ".join(str(exc).split())[:300]
         self.failure = {"time": t, "message": f"integration failed at t = {t:.4f} s: {detail}"}
+
+    def controller_failed(self, t, controller: str, exc: BaseException):
+        """A user's controller (plugin) raised while simulating: the run fails, the program goes on."""
+        detail = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+        self.failure = {"time": t, "message": f"controller {controller} raised at t = {t:.4f} s: {detail}"}

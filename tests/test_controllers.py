@@ -128,7 +128,7 @@ def test_plant_variants_scale_links_and_rotors():
 
 def test_unknown_controller_is_one_line_naming_the_field():
     with pytest.raises(ScenarioError, match=r"^controller\.type: must be one of ptsmc, pd, smc, "
-                                            r"ct_quintic, got 'lqr'$"):
+                                            r"ct_quintic, or 'module:Class' .*, got 'lqr'$"):
         parse_scenario(load_scenario_text().replace("controller: {", "controller: {type: lqr, "))
 
 
@@ -171,8 +171,21 @@ def test_null_space_damping_keeps_a_redundant_arm_near_its_posture(tmp_path):
     assert load_scenario("curve_b075_tf15").controller.null_space_damping == 0.0  # the paper's law
 
 
-def test_the_schema_names_exactly_the_controllers_of_the_slot():
-    from ptint_drake.controllers import CONTROLLERS  # noqa: PLC0415
-    from ptint_drake.scenario import CONTROLLER_TYPES  # noqa: PLC0415
+def test_the_schema_validation_and_compare_read_the_one_registry():
+    """A registered controller's own settings are a scenario block, its name is valid, and
+    compare runs it by default — all from ``controllers.REGISTRY``."""
+    from dataclasses import fields  # noqa: PLC0415
 
-    assert CONTROLLERS == CONTROLLER_TYPES
+    from ptint_drake.controllers import CONTROLLERS, REGISTRY  # noqa: PLC0415
+    from ptint_drake.scenario import ControllerConfig  # noqa: PLC0415
+    from ptint_drake.studies.compare import DEFAULT_CONTROLLERS  # noqa: PLC0415
+
+    assert CONTROLLERS == tuple(REGISTRY) == DEFAULT_CONTROLLERS
+    assert CONTROLLERS[0] == "ptsmc"
+    blocks = {f.name: f.type for f in fields(ControllerConfig)}
+    for entry in REGISTRY.values():
+        if entry.config is not None:
+            assert blocks[entry.name] is entry.config
+        text = load_scenario_text().replace("controller: {", f"controller: {{type: {entry.name}, ")
+        scenario = parse_scenario(text)
+        assert scenario.controller.type == entry.name

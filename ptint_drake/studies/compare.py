@@ -14,6 +14,7 @@ result, counted in the summary line.
 
 from __future__ import annotations
 
+import copy
 import csv
 import dataclasses
 import io
@@ -23,12 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ptint_drake.controllers import CONTROLLERS, known_type, plugin
 from ptint_drake.figures import plt, save
 from ptint_drake.scenario import ScenarioError, apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
-DEFAULT_CONTROLLERS = ("ptsmc", "pd", "smc", "ct_quintic")
+DEFAULT_CONTROLLERS = CONTROLLERS  # every registered controller
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
 SEGMENT_KEYS = ("e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm", "t_arrive")
 _GRID_POINTS = 600
@@ -45,10 +47,29 @@ def parse_list(text: str, flag: str, allowed=None) -> list[str]:
     return items
 
 
+def controller_list(text: str) -> list[str]:
+    """``--controllers``: registered names and plugins' ``module:Class``, comma-separated."""
+    items = parse_list(text, "--controllers")
+    for item in items:
+        if not known_type(item):
+            raise ScenarioError(f"--controllers: unknown {item!r} (one of {', '.join(CONTROLLERS)}, "
+                                f"or {plugin.FORM})")
+    return items
+
+
+def with_controller(scenario, controller: str):
+    """The scenario with ``controller.type`` replaced (a plugin keeps the file's ``params``; a
+    registered controller gets none)."""
+    out = copy.deepcopy(scenario)
+    out.controller.type = controller
+    if controller in CONTROLLERS:
+        out.controller.params = {}
+    return out
+
+
 def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
     """One row: ``controller`` on plant ``variant`` (runs in a worker process)."""
-    scenario = apply_variant(parse_scenario(text, name), variant)
-    scenario.controller.type = controller
+    scenario = apply_variant(with_controller(parse_scenario(text, name), controller), variant)
     row = {"controller": controller, "variant": variant}
     try:
         result = simulate(scenario, check=False)

@@ -47,6 +47,7 @@ workers, ``start_method``.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import functools
 import multiprocessing
 import os
 import signal
@@ -54,6 +55,8 @@ import sys
 import threading
 import traceback
 from multiprocessing.connection import wait as wait_any
+
+from ptint_drake.controllers import plugin
 
 MAX_TASKS_PER_CHILD = 50
 DASK_CONNECT_TIMEOUT_S = 5.0
@@ -76,6 +79,20 @@ def _rss_mb() -> float:
         return 0.0
 
 
+def _with_plugin_folders(fn):
+    """``fn`` that first adopts this process's plugin-controller folders (a scenario file's
+    folder, the current directory) in whatever process runs it, Dask workers included.  A
+    function of ``__main__`` is left as it is: it is forked, and a fork has them already."""
+    if getattr(fn, "__module__", None) == "__main__":
+        return fn
+    return functools.partial(_in_plugin_folders, fn, tuple(plugin.search_folders()))
+
+
+def _in_plugin_folders(fn, folders, *args):
+    plugin.use_search_folders(folders)
+    return fn(*args)
+
+
 def _call(fn, args):
     """Run one task where it is executed; returns (result, RSS after it in MB)."""
     result = fn(*args)
@@ -94,6 +111,7 @@ def run_tasks(fn, tasks, *, workers: int | None = None, dask: str | None = None,
     ``max_tasks_per_child`` (local pool only; ``None``: never recycle).
     """
     tasks = [tuple(t) for t in tasks]
+    fn = _with_plugin_folders(fn)
     if dask is not None and executor is not None:
         raise ValueError("give dask= or executor=, not both")
     if workers is not None and workers < 1:

@@ -54,10 +54,44 @@ class TuneSettings:
     bracket: tuple = field(default_factory=tuple)  # (lo, hi) to override the model's
 
 
+PARAM_PREFIX = "params."  # ``--gain params.NAME``: a plugin controller's parameter
+
+
+def check_gain(gain: str, bracket) -> None:
+    """A paper gain (``GAINS``), or ``params.NAME`` of a plugin with its ``--range``."""
+    if gain.startswith(PARAM_PREFIX):
+        if not gain[len(PARAM_PREFIX):].isidentifier():
+            raise ScenarioError(f"--gain: {gain!r} is not params.NAME")
+        if not bracket:
+            raise ScenarioError(f"--range: {gain} needs --range LO,HI (no model-derived bracket exists "
+                                f"for a plugin's parameter)")
+    elif gain not in GAINS:
+        raise ScenarioError(f"--gain: must be one of {', '.join(GAINS)} or params.NAME, got {gain!r}")
+
+
+def gain_value(scenario, gain: str):
+    """The scenario's current value of ``gain`` (None for a plugin parameter it does not set)."""
+    if gain.startswith(PARAM_PREFIX):
+        return scenario.controller.params.get(gain[len(PARAM_PREFIX):])
+    return getattr(scenario.controller, gain)
+
+
 def _set_gain(scenario, gain: str, value: float):
     out = copy.deepcopy(scenario)
-    setattr(out.controller, gain, float(value))
+    if gain.startswith(PARAM_PREFIX):
+        out.controller.params = dict(out.controller.params) | {gain[len(PARAM_PREFIX):]: float(value)}
+    else:
+        setattr(out.controller, gain, float(value))
     return out
+
+
+def _all_gains(scenario, gain: str, value: float) -> dict:
+    """tune.json's ``gains``: the tunable values of the scenario's controller, the chosen one set."""
+    if gain.startswith(PARAM_PREFIX):
+        own = {PARAM_PREFIX + k: v for k, v in scenario.controller.params.items()}
+    else:
+        own = {g: getattr(scenario.controller, g) for g in GAINS}
+    return own | {gain: value}
 
 
 def tune_run(text: str, name: str, gain: str, value: float, variant: str, margin: float,
@@ -87,7 +121,8 @@ def tune_run(text: str, name: str, gain: str, value: float, variant: str, margin
 
 def model_bracket(scenario, gain: str) -> tuple[float, float]:
     """The search range of ``gain`` from the model at the start pose (see the module docstring)."""
-    current = getattr(scenario.controller, gain)
+    check_gain(gain, None)
+    current = gain_value(scenario, gain)
     if gain != "K":
         return current / 30.0, current * 30.0
     from pydrake.multibody.tree import JacobianWrtVariable  # noqa: PLC0415
@@ -140,6 +175,7 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
     t0 = time.perf_counter()
     scenario = parse_scenario(text, name)
     check_variants(scenario, settings.variants)
+    check_gain(settings.gain, settings.bracket)
     lo, hi = settings.bracket or model_bracket(scenario, settings.gain)
     grid = list(np.geomspace(lo, hi, settings.grid_points))
     smallest = settings.gain != "phi"
@@ -161,7 +197,7 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
     result = {"scenario": name, "gain": settings.gain, "margin": settings.margin,
               "max_saturation": settings.max_saturation, "variants": list(settings.variants),
               "bracket": [lo, hi], "grid": grid, "tolerance": settings.tolerance,
-              "paper_value": getattr(scenario.controller, settings.gain),
+              "paper_value": gain_value(scenario, settings.gain),
               "criteria": dataclasses.asdict(scenario.criteria),
               "tried": tried, "wall_time_s": time.perf_counter() - t0, "runs": len(tried)}
     if works is None:
@@ -170,7 +206,7 @@ def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=No
         return result
     value = float(works)
     best = {row["variant"]: row for row in tried if row["gains"][settings.gain] == works}
-    gains = {g: getattr(scenario.controller, g) for g in GAINS} | {settings.gain: value}
+    gains = _all_gains(scenario, settings.gain, value)
     drift = [row["self_motion_final"] for row in best.values() if row.get("self_motion_final") is not None]
     if drift:  # redundant arm: does J⁺ leave it drifting in its null space?
         result["self_motion_final"] = max(drift)

@@ -1,0 +1,169 @@
+"""A user's own controller in the slot, from the user's own file (SPEC 5.5).
+
+``controller: {type: "my_module:MyController", params: {Kp: 40.0, ...}}`` names a Drake
+``LeafSystem`` class that is constructed as::
+
+    MyController(plant=<finalized MultibodyPlant of the nominal robot model>,
+                 end_effector=<frame name>, params=<dict: numbers, lists of numbers, strings>)
+
+with input ports ``state`` (the arm's [q; v]) and ``target`` ([x_r, ẋ_r, ẍ_r] of the active
+segment, ``signals.TARGET``, 9 values), optionally an input ``segment`` ([index, start, tf] of
+the active segment, ``systems.active_segment``), and an output ``actuation`` (one torque per
+actuator of the arm, in the plant's actuator order).  ``plant`` is for the plugin's
+kinematics; a plugin that uses its dynamics is model-based and should say so.
+
+The module is looked up in the folders of the scenario files this process loaded (most recent
+first), then the current directory, then ``sys.path`` (``PYTHONPATH``).  The study runner hands
+the same folders to its worker processes and Dask workers (``search_folders`` /
+``use_search_folders``).  An import failure, a constructor that raises, a missing port or a
+port of the wrong size is a ``ScenarioError`` naming the controller (exit 2 on the command
+line); an exception raised inside the plugin while simulating ends that run as ``failed``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import re
+import sys
+from pathlib import Path
+from typing import Sequence
+
+from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, target_columns
+from ptint_drake.systems.active_segment import SIZE as SEGMENT_SIZE
+from ptint_drake.systems.active_segment import ActiveSegment
+from ptint_drake.systems.signals import TARGET_PORT
+
+PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*$")
+FORM = "'module:Class' (a LeafSystem in your own file)"
+TARGET_SIZE = TARGET_PORT.stop - TARGET_PORT.start
+
+_folders: list[str] = []  # the scenario files' folders this process loaded, most recent first
+
+
+def is_plugin(type_: str) -> bool:
+    """True for a ``module:Class`` type string (a user's controller)."""
+    return bool(PATTERN.match(type_))
+
+
+def remember_folder(folder) -> None:
+    """Look for plugin modules in ``folder`` (a loaded scenario file's folder) first."""
+    folder = str(Path(folder).resolve())
+    if folder in _folders:
+        _folders.remove(folder)
+    _folders.insert(0, folder)
+
+
+def search_folders() -> list[str]:
+    """Where plugin modules are looked for before ``sys.path``: scenario folders, then cwd."""
+    return [*_folders, os.getcwd()]
+
+
+def use_search_folders(folders: Sequence[str]) -> None:
+    """Adopt another process's ``search_folders()`` (in a study worker)."""
+    for folder in reversed(list(folders)):
+        remember_folder(folder)
+
+
+def _error(message: str):
+    from ptint_drake.validation import ScenarioError  # noqa: PLC0415  (validation imports this package)
+
+    return ScenarioError(" ".join(message.split()))
+
+
+def load_class(type_: str) -> type:
+    """The class named by ``module:Class``; ScenarioError (one line) if it cannot be had."""
+    module_name, _, class_name = type_.partition(":")
+    saved = list(sys.path)
+    sys.path[:0] = search_folders()
+    try:
+        module = importlib.import_module(module_name)
+    except Exception as exc:  # any failure of the user's module is one line
+        raise _error(f"controller.type: cannot import {module_name!r} for {type_!r} "
+                     f"({type(exc).__name__}: {exc}); looked in the scenario's folder, the "
+                     f"current directory and PYTHONPATH") from None
+    finally:
+        sys.path[:] = saved
+    cls = getattr(module, class_name, None)
+    if not isinstance(cls, type):
+        raise _error(f"controller.type: {module_name!r} has no class {class_name!r} ({type_!r})")
+    return cls
+
+
+def plain_params(params: dict) -> dict:
+    """The scenario's ``params`` as the plugin gets them: a text that YAML 1.1 left a string
+    although it is a number (``1e-3``) becomes a float."""
+    out = {}
+    for key, value in params.items():
+        if isinstance(value, str):
+            try:
+                value = float(value)
+            except ValueError:
+                pass
+        out[key] = value
+    return out
+
+
+def make_plugin(type_: str, plant, end_effector: str, params: dict):
+    """Construct the plugin and check its ports against ``plant``; returns the system."""
+    cls = load_class(type_)
+    try:
+        system = cls(plant=plant, end_effector=end_effector, params=dict(params))
+    except Exception as exc:
+        raise _error(f"controller {type_}: constructing it raised {type(exc).__name__}: {exc}") from None
+    sizes = {"state": plant.num_positions() + plant.num_velocities(), "target": TARGET_SIZE}
+    optional = {"segment": SEGMENT_SIZE}
+    for name, size in (sizes | optional).items():
+        if not _has_port(system, "input", name):
+            if name in optional:
+                continue
+            raise _error(f"controller {type_}: needs an input port {name!r} ({size} values)")
+        got = system.GetInputPort(name).size()
+        if got != size:
+            raise _error(f"controller {type_}: input port {name!r} has {got} values, needs {size}")
+    nu = plant.num_actuators()
+    if not _has_port(system, "output", "actuation"):
+        raise _error(f"controller {type_}: needs an output port 'actuation' ({nu} values)")
+    got = system.GetOutputPort("actuation").size()
+    if got != nu:
+        raise _error(f"controller {type_}: output port 'actuation' has {got} values, needs {nu}")
+    return system
+
+
+def _has_port(system, kind: str, name: str) -> bool:
+    count = system.num_input_ports() if kind == "input" else system.num_output_ports()
+    get = system.get_input_port if kind == "input" else system.get_output_port
+    return any(get(i).get_name() == name for i in range(count))
+
+
+def check(type_: str, scenario) -> None:
+    """Import and construct the plugin of ``scenario`` once (before any run): ScenarioError if
+    it cannot be used."""
+    from ptint_drake.robot import make_plant  # noqa: PLC0415
+
+    plant = make_plant(scenario)
+    make_plugin(type_, plant, scenario.robot.end_effector, plain_params(scenario.controller.params))
+
+
+def AddPlugin(slot: ControllerSlot, params: dict, target: TargetView, type_: str) -> ControllerHandles:
+    """Add the user's controller ``type_`` to the slot (ports in the module docstring)."""
+    builder = slot.builder
+    system = make_plugin(type_, slot.nominal_plant(), slot.frame.name(), plain_params(params))
+    if not system.get_name():
+        system.set_name(type_.partition(":")[2])
+    builder.AddSystem(system)
+    builder.Connect(slot.state, system.GetInputPort("state"))
+    port = target.port()
+    builder.Connect(port, system.GetInputPort("target"))
+    if _has_port(system, "input", "segment"):
+        clock = builder.AddNamedSystem("active_segment", ActiveSegment(slot.schedule))
+        builder.Connect(clock.get_output_port(), system.GetInputPort("segment"))
+    builder.Connect(system.GetOutputPort("actuation"), slot.actuation)
+    B = slot.plant.MakeActuationMatrix()
+
+    def telemetry(logs: dict) -> dict:
+        return {"tau": logs["actuation"] @ B.T} | target_columns(logs["target"])
+
+    ports = {"actuation": system.GetOutputPort("actuation"), "target": port}
+    notes = [f"{type_}: a user's controller (params {dict(params) or 'none'})"]
+    return ControllerHandles(type_, ports, telemetry, notes, system=system, plugin=True)

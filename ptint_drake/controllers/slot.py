@@ -1,0 +1,158 @@
+"""What every controller in the slot is wired to, and what it hands back.
+
+``ControllerSlot`` is the station seen from a controller: the ports it connects to (``state``
+out of the station, ``actuation`` into it), the plant for its kinematics, the end-effector
+frame, the schedule of segments, and the start posture.  ``TargetView`` is the target as the
+controller is *allowed* to see it:
+
+- ``measurement.estimator: none``: the analytic targets (or their legacy noisy/delayed
+  version, ``measurement.noise_std`` / ``latency``), as objects in ``analytic`` and, when a
+  controller asks for it, as a ``TargetSource`` port;
+- with an estimator: only what one camera and one Kalman filter per object make of the
+  station's true object positions (``analytic`` is None).
+
+The station's true target never reaches a controller directly.  The port is built on first
+use, so a controller that evaluates the analytic targets itself (the fused interceptor) adds
+no system for it.
+
+``ControllerHandles`` is what an ``Add…`` function returns: the ports to log at every
+integrator step, how to turn those logs into telemetry (named arrays, rows = samples; at
+least ``tau``), lines for the run's output, and whether the controller used the model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Callable, Optional
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import Frame
+from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
+from pydrake.systems.primitives import Demultiplexer
+
+from ptint_drake.systems.kalman import AddCameraEstimators
+from ptint_drake.systems.measurement import MeasuredTarget
+from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import TARGET
+from ptint_drake.systems.targets import TargetSource
+
+if TYPE_CHECKING:  # the scenario module imports this package (its schema comes from the registry)
+    from ptint_drake.scenario import Scenario
+
+
+@dataclass
+class ControllerHandles:
+    """What the slot added: the ports to log every step, how to turn those logs into
+    telemetry (a dict of arrays, rows = samples), and lines for the run's output."""
+
+    name: str
+    log_ports: dict
+    telemetry: Callable[[dict], dict]
+    notes: list = field(default_factory=list)
+    model_based: bool = False
+    system: object = None
+    plugin: bool = False  # a user's controller: an exception inside it fails the run, not the program
+
+
+@dataclass
+class ControllerSlot:
+    """The station as a controller sees it (see the module docstring)."""
+
+    builder: DiagramBuilder
+    plant: MultibodyPlant  # the simulated plant, for kinematics (model-free controllers)
+    frame: Frame  # the end effector: its origin is the interception point
+    schedule: Schedule
+    state: OutputPort  # the arm's [q; v]
+    actuation: InputPort  # one torque per actuator, in the plant's actuator order
+    initial_q: np.ndarray  # the start posture (rad / m)
+    scenario: "Scenario"
+
+    def nominal_plant(self) -> MultibodyPlant:
+        """A finalized plant of the model file as written, without the scenario's deviations
+        (masses, payload): what a model-based controller is allowed to know."""
+        import copy  # noqa: PLC0415
+
+        from ptint_drake.robot import make_plant  # noqa: PLC0415  (robot imports scenario)
+        from ptint_drake.scenario import PlantConfig  # noqa: PLC0415
+
+        nominal = copy.deepcopy(self.scenario)
+        nominal.plant = PlantConfig()
+        return make_plant(nominal)
+
+    def connect(self, system, target: "TargetView") -> OutputPort:
+        """Wire a controller with ports ``state``, ``target`` in and ``u`` out; returns the
+        target port it was given (for logging)."""
+        self.builder.Connect(self.state, system.GetInputPort("state"))
+        self.builder.Connect(system.GetOutputPort("u"), self.actuation)
+        port = target.port()
+        self.builder.Connect(port, system.GetInputPort("target"))
+        return port
+
+
+class TargetView:
+    """The target as the controller may see it: ``analytic`` (the target objects, or None with
+    a camera) and ``port()`` ([x_r, ẋ_r, ẍ_r] of the active segment, built on first use)."""
+
+    def __init__(self, builder: DiagramBuilder, station_system, scenario: "Scenario"):
+        self._builder, self._station, self._scenario = builder, station_system, scenario
+        self.analytic = controller_targets(scenario) if uses_analytic_targets(scenario) else None
+        self._port: Optional[OutputPort] = None
+
+    def port(self) -> OutputPort:
+        if self._port is None:
+            self._port = target_view(self._builder, self._station, self._scenario, self.analytic)
+        return self._port
+
+
+def uses_analytic_targets(scenario: "Scenario") -> bool:
+    """True unless a camera and an estimator are in the loop."""
+    return scenario.measurement.estimator == "none"
+
+
+def controller_targets(scenario: "Scenario") -> list:
+    """The analytic view: the true targets, or their legacy noisy/delayed measurement."""
+    targets = scenario.targets()
+    m = scenario.measurement
+    if m.noise_std == 0.0 and m.latency == 0.0:
+        return targets
+    return [MeasuredTarget(tg, scenario.duration, m.noise_std, m.rate_hz, m.latency,
+                           m.compensate_latency, m.seed + i) for i, tg in enumerate(targets)]
+
+
+def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",
+                analytic: Optional[list] = None) -> OutputPort:
+    """The port that carries [x_r, ẋ_r, ẍ_r] of the active segment as the controller sees it:
+    the analytic targets (``estimator: none``), or one camera + Kalman filter per object
+    fed by the station's true object positions (``kalman_cv`` / ``kalman_ca``)."""
+    if uses_analytic_targets(scenario):
+        source = builder.AddNamedSystem("target_view", TargetSource(
+            scenario.schedule(), analytic if analytic is not None else controller_targets(scenario)))
+        return source.GetOutputPort("target")
+    n = len(scenario.interceptions)
+    split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
+    builder.Connect(station_system.GetOutputPort("objects"), split.get_input_port())
+    return AddCameraEstimators(builder, true_position_ports=[split.get_output_port(i) for i in range(n)],
+                               schedule=scenario.schedule(), config=scenario.measurement,
+                               histories=scenario.targets()).target_port  # in view before t = 0
+
+
+def target_columns(target_log: np.ndarray) -> dict:
+    """x_r, ẋ_r, ẍ_r of a logged target port (what the controller saw)."""
+    return {"x_r": target_log[:, TARGET.x], "xdot_r": target_log[:, TARGET.xdot],
+            "xddot_r": target_log[:, TARGET.xddot]}
+
+
+def telemetry_handles(name: str, system, target: OutputPort, notes, model_based: bool = False
+                      ) -> ControllerHandles:
+    """Handles of a controller with a ``telemetry`` port named by its ``layout`` (the
+    baselines): that port and the target it saw are logged at every step."""
+    ports = {"telemetry": system.GetOutputPort("telemetry"), "target": target}
+    layout = system.layout
+
+    def telemetry(logs: dict) -> dict:
+        out = {key: logs["telemetry"][:, part] for key, part in layout.items()}
+        out |= target_columns(logs["target"])
+        return out
+
+    return ControllerHandles(name, ports, telemetry, notes, model_based, system)

@@ -1,0 +1,178 @@
+"""A user's own controller in the slot: ``controller: {type: "module:Class", params: {...}}``.
+
+The README's example plugin (``examples/task_space_pd.py``) runs through ``ptint run`` and
+``ptint compare`` from a folder of its own; broken plugins are one line and exit 2; a plugin
+that raises while simulating fails its run, nothing else.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ptint_drake.controllers import REGISTRY, plugin
+from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario
+from ptint_drake.simulation import simulate
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "examples" / "task_space_pd.py"
+TYPE = "task_space_pd:TaskSpacePD"
+
+SCENARIO = """duration: 1.6
+controller: {type: "%s", params: {Kp: 2000.0, Kd: 150.0}}
+interceptions:
+  - start: 0.0
+    tf: 1.0
+    beta: 0.75
+    target: {linear: {start: [0.30, -0.05, 0.25], velocity: [0.0, 0.05, 0.0]}}
+"""
+
+BROKEN = '''
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+
+class NoTarget(LeafSystem):
+    def __init__(self, plant, end_effector, params):
+        super().__init__()
+        self.DeclareVectorInputPort("state", plant.num_multibody_states())
+        self.DeclareVectorOutputPort("actuation", plant.num_actuators(), lambda c, o: o.SetZero())
+
+
+class WrongSize(LeafSystem):
+    def __init__(self, plant, end_effector, params):
+        super().__init__()
+        self.DeclareVectorInputPort("state", plant.num_multibody_states())
+        self.DeclareVectorInputPort("target", 9)
+        self.DeclareVectorOutputPort("actuation", 7, lambda c, o: o.SetZero())
+
+
+class Raises(LeafSystem):
+    """Zero torque until t = 0.3 s, then a ZeroDivisionError; reads its segment port."""
+
+    def __init__(self, plant, end_effector, params):
+        super().__init__()
+        self.DeclareVectorInputPort("state", plant.num_multibody_states())
+        self.DeclareVectorInputPort("target", 9)
+        self.segment = self.DeclareVectorInputPort("segment", 3)
+        self.seen = []
+        self.DeclareVectorOutputPort("actuation", plant.num_actuators(), self._calc)
+
+    def _calc(self, context, output):
+        self.seen.append((context.get_time(), *self.segment.Eval(context)))
+        if context.get_time() > 0.3:
+            raise ZeroDivisionError("my bug")
+        output.SetZero()
+'''
+
+
+@pytest.fixture
+def user_folder(tmp_path: Path) -> Path:
+    """A user's folder: the example plugin, a broken one, and a scenario file beside them."""
+    shutil.copy(EXAMPLE, tmp_path / EXAMPLE.name)
+    (tmp_path / "broken_plugins.py").write_text(BROKEN)
+    (tmp_path / "pd_scenario.yaml").write_text(SCENARIO % TYPE)
+    return tmp_path
+
+
+def ptint(*args, cwd) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | {
+        "PYTHONPATH": str(ROOT) if (ROOT / "ptint_drake").is_dir() else ""}
+    return subprocess.run([sys.executable, "-m", "ptint_drake", *args], capture_output=True, text=True,
+                          cwd=cwd, env=env, timeout=600)
+
+
+def test_the_example_plugin_runs_from_its_scenario_folder_and_is_measured_like_any_controller(
+        user_folder, tmp_path_factory):
+    elsewhere = tmp_path_factory.mktemp("elsewhere")  # not the plugin's folder: found beside the scenario
+    out = elsewhere / "run"
+    done = ptint("run", str(user_folder / "pd_scenario.yaml"), "--out", str(out), "--no-replay",
+                 "--no-figures", cwd=elsewhere)
+    assert done.returncode in (0, 1), done.stderr
+    m = json.loads((out / "metrics.json").read_text())
+    assert m["controller"]["type"] == TYPE and m["sim"]["controller"] == TYPE
+    seg = m["segments"][0]
+    # it chased the target: the PD's error at tf is a small fraction of where it started
+    assert seg["e_tf_norm"] < 0.2 * seg["e0_norm"], seg
+    assert m["status"] in ("ok", "missed")
+
+
+def test_compare_runs_the_plugin_beside_ptsmc_named_by_its_type_string(user_folder):
+    out = user_folder / "cmp"
+    done = ptint("compare", "pd_scenario.yaml", "--controllers", f"ptsmc,{TYPE}", "--variants", "nominal",
+                 "--workers", "2", "--out", str(out), cwd=user_folder)
+    assert done.returncode == 0, done.stderr
+    rows = json.loads((out / "compare.json").read_text())["rows"]
+    assert [r["controller"] for r in rows] == ["ptsmc", TYPE]
+    ptsmc, mine = rows
+    assert ptsmc["ok"] and ptsmc["segments"][0]["e_tf_norm"] < 1e-3
+    assert mine["status"] in ("ok", "missed") and mine["segments"][0]["e_tf_norm"] is not None
+    # both started from the same pose against the same target
+    assert mine["segments"][0]["e0_norm"] == pytest.approx(ptsmc["segments"][0]["e0_norm"], rel=1e-9)
+
+
+@pytest.mark.parametrize("type_, message", [
+    ("no_such_module:X", r"controller\.type: cannot import 'no_such_module' for 'no_such_module:X'"),
+    ("broken_plugins:Missing", r"controller\.type: 'broken_plugins' has no class 'Missing'"),
+    ("broken_plugins:NoTarget", r"controller broken_plugins:NoTarget: needs an input port 'target'"),
+    ("broken_plugins:WrongSize", r"controller broken_plugins:WrongSize: output port 'actuation' has 7 "
+                                 r"values, needs 3"),
+])
+def test_a_broken_plugin_is_one_line_exit_2_and_writes_nothing(user_folder, type_, message):
+    import re  # noqa: PLC0415
+
+    (user_folder / "bad.yaml").write_text(SCENARIO % type_)
+    out = user_folder / "out_bad"
+    done = ptint("run", "bad.yaml", "--out", str(out), cwd=user_folder)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and re.search(message, lines[0]), done.stderr
+    assert not out.exists()
+    compare = ptint("compare", "curve_b075_tf15", "--controllers", f"ptsmc,{type_}", "--out", str(out),
+                    cwd=user_folder)
+    assert compare.returncode == 2 and len(compare.stderr.strip().splitlines()) == 1, compare.stderr
+
+
+def test_a_plugin_that_raises_fails_its_run_with_one_line_and_saw_its_segment(user_folder, monkeypatch):
+    monkeypatch.chdir(user_folder)
+    scenario = parse_scenario(SCENARIO % "broken_plugins:Raises")
+    result = simulate(scenario, check=False)
+    assert result.metrics["status"] == "failed"
+    message = result.metrics["failure"]["message"]
+    assert "broken_plugins:Raises" in message and "ZeroDivisionError: my bug" in message
+    assert "\n" not in message
+    system = sys.modules["broken_plugins"]
+    del system  # the module stays importable; the instance lives in the run's diagram
+
+
+def test_the_segment_port_carries_index_start_and_tf():
+    from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
+
+    from ptint_drake.systems.active_segment import ActiveSegment  # noqa: PLC0415
+    from ptint_drake.systems.schedule import Schedule, Segment  # noqa: PLC0415
+
+    builder = DiagramBuilder()
+    clock = builder.AddSystem(ActiveSegment(Schedule([Segment(0.0, 0.5, 0.75), Segment(0.8, 1.4, 0.5)])))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    port = clock.get_output_port()
+    for t, expected in ((0.0, [0, 0.0, 0.5]), (0.79, [0, 0.0, 0.5]), (0.8, [1, 0.8, 1.4]),
+                        (3.0, [1, 0.8, 1.4])):
+        context.SetTime(t)
+        np.testing.assert_array_equal(port.Eval(clock.GetMyContextFromRoot(context)), expected)
+
+
+def test_params_are_plugin_only_and_reach_the_plugin_with_set(user_folder, monkeypatch):
+    text = (user_folder / "pd_scenario.yaml").read_text()
+    with pytest.raises(ScenarioError, match=r"^controller\.params: only a plugin controller"):
+        parse_scenario(text.replace(TYPE, "ptsmc"))
+    scenario = parse_scenario(text.replace("Kd: 150.0", "Kd: 1e-3, name: x, v: [1, 2]"))
+    assert plugin.plain_params(scenario.controller.params) == {"Kp": 2000.0, "Kd": 1e-3, "name": "x",
+                                                                "v": [1.0, 2.0]}
+    assert TYPE not in REGISTRY and plugin.is_plugin(TYPE) and not plugin.is_plugin("ptsmc")
+    assert load_scenario("curve_b075_tf15").controller.params == {}
