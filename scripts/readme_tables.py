@@ -67,13 +67,14 @@ def results_table() -> str:
         "RTF (end-to-end realtime factor) depends on the machine.\n"
 
 
-def compare_table(name: str, workers: int) -> str:
-    """The compare study of ``name`` condensed: e(tf), t_arrive and the verdict per variant."""
+def compare_table(name: str, workers: int, controllers=None) -> str:
+    """The compare study of ``name`` condensed: e(tf), t_arrive and the verdict per variant
+    (``controllers``: the registry's by default)."""
     from ptint_drake.scenario import scenario_text  # noqa: PLC0415
-    from ptint_drake.studies.compare import run_compare, table_rows  # noqa: PLC0415
+    from ptint_drake.studies.compare import DEFAULT_CONTROLLERS, run_compare, table_rows  # noqa: PLC0415
 
     _, text = scenario_text(name)
-    result = run_compare(text, name, workers=workers)
+    result = run_compare(text, name, controllers or DEFAULT_CONTROLLERS, workers=workers)
     variants = result["variants"]
     header = " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants)
     lines = ["| controller | seg | " + header + " |",
@@ -89,7 +90,9 @@ def compare_table(name: str, workers: int) -> str:
             cells.append(f"{mm(r['e_tf_norm'], 3)} mm / {arrive} / {'ok' if r['ok'] else r['reasons']}")
         lines.append(f"| {controller} | {seg} | " + " | ".join(cells) + " |")
     prescribed = ", ".join(f"{s['start'] + s['tf']:g} s" for s in result["segments"])
-    return ("\n".join(lines) + f"\n\n`ptint compare {name}` (prescribed interception at {prescribed}; "
+    option = f" --controllers {','.join(controllers)}" if controllers else ""
+    return ("\n".join(lines) + f"\n\n`ptint compare {name}{option}` (prescribed interception at "
+            f"{prescribed}; "
             f"{result['wall_time_s']:.0f} s with {workers} workers on {machine()}).\n")
 
 
@@ -146,6 +149,11 @@ def main() -> None:
     text = replace(text, "results", results_table())
     for name in ("curve_b075_tf15", "assembly"):
         text = replace(text, f"compare_{name}", compare_table(name, args.workers))
+    from ptint_drake.controllers import plugin  # noqa: PLC0415
+
+    plugin.remember_folder(ROOT / "examples")  # the README's plugin example
+    text = replace(text, "compare_plugin", compare_table(
+        "curve_b075_tf15", args.workers, ["ptsmc", "task_space_pd:TaskSpacePD"]))
     if args.all:
         text = replace(text, "tune", tune_table(args.workers))
         text = replace(text, "camera", camera_table(args.workers))
