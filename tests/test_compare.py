@@ -65,7 +65,8 @@ interceptions:
 
 @pytest.mark.parametrize("args, message", [
     (("--controllers", "ptsmc,lqr"),
-     "ptint: error: --controllers: unknown 'lqr' (one of ptsmc, pd, smc, ct_quintic)"),
+     "ptint: error: --controllers: unknown 'lqr' (one of ptsmc, pd, smc, ct_quintic, or 'module:Class' "
+     "(a LeafSystem in your own file))"),
     (("--variants", "nominal,heavy"), "ptint: error: variant: unknown plant variant 'heavy'"),
     (("--workers", "0"), "ptint: error: --workers: must be >= 1, got 0"),
 ])
