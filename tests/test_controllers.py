@@ -5,7 +5,7 @@ import pytest
 from test_builder import OFFSET_ARM
 
 from ptint_drake.metrics import Criteria, segment_reasons, verdict
-from ptint_drake.robot import make_plant, scale_masses
+from ptint_drake.robot import make_plant
 from ptint_drake.scenario import ScenarioError, apply_variant, load_scenario, parse_scenario
 from ptint_drake.simulation import build, simulate
 
@@ -116,14 +116,13 @@ def test_plant_variants_scale_links_and_rotors():
     for bad in ("mass_x", "mass_x-1", "heavy", "payload_2", "payload_xkg"):
         with pytest.raises(ScenarioError, match=r"^variant: unknown plant variant"):
             apply_variant(base, bad)
-    built = build(base, log=False)
-    plant = built.plant
-    context = plant.CreateDefaultContext()
-    scale_masses(plant, context, 1.5)
+    nominal = build(base, log=False).plant
+    plant = build(apply_variant(base, "mass_x1.5"), log=False).plant
+    context = plant.CreateDefaultContext()  # the variant is in the station's defaults
     for index in plant.GetJointActuatorIndices():
-        actuator = plant.get_joint_actuator(index)
-        if actuator.default_rotor_inertia() > 0:
-            assert actuator.rotor_inertia(context) == pytest.approx(1.5 * actuator.default_rotor_inertia())
+        rotor = nominal.get_joint_actuator(index).default_rotor_inertia()
+        if rotor > 0:
+            assert plant.get_joint_actuator(index).rotor_inertia(context) == pytest.approx(1.5 * rotor)
 
 
 def test_unknown_controller_is_one_line_naming_the_field():
