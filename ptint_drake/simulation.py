@@ -161,7 +161,9 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     warnings += singularity_warnings(plant, scenario, series) + joint_limit_warnings(plant, series)
     if watchdog.failure:
         metrics["failure"] = watchdog.failure
-    metrics["status"], metrics["reasons"] = verdict(metrics, scenario.criteria)
+    metrics["status"], reasons = verdict(metrics, scenario.criteria)
+    metrics["reasons"] = [str(r) for r in reasons]
+    metrics["reason_codes"] = [r.as_dict() for r in reasons]
     metrics |= {"criteria": dataclasses.asdict(scenario.criteria), "warnings": warnings,
                 "warnings_before_run": n_before,
                 "controller": {"type": built.controller.name, "notes": built.controller.notes,

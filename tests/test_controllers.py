@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from test_builder import OFFSET_ARM
 
-from ptint_drake.metrics import Criteria, segment_reasons, verdict
+from ptint_drake.metrics import Criteria, Reason, segment_reasons, verdict
 from ptint_drake.robot import make_plant
 from ptint_drake.scenario import ScenarioError, apply_variant, load_scenario, parse_scenario
 from ptint_drake.simulation import build, simulate
@@ -88,11 +88,15 @@ def test_segment_reasons(seg, reasons):
 
 def test_verdict_uses_the_scenario_criteria_and_margin():
     metrics = {"segments": [_seg(e_tf=2e-3, hold=2.5e-3)]}
-    assert verdict(metrics, Criteria()) == ("missed", ["segment 0: late"])
+    assert verdict(metrics, Criteria()) == ("missed", [Reason(0, "late")])
+    assert str(verdict(metrics, Criteria())[1][0]) == "segment 0: late"
     assert verdict(metrics, Criteria(e_tf=3e-3, hold=5e-3)) == ("ok", [])
-    assert verdict(metrics, Criteria(e_tf=3e-3, hold=5e-3), margin=2.0)[1] == ["segment 0: late"]
+    assert verdict(metrics, Criteria(e_tf=3e-3, hold=5e-3), margin=2.0)[1] == [Reason(0, "late")]
     failed = {"segments": [_seg()], "failure": {"message": "diverged at t = 1 s"}}
-    assert verdict(failed, Criteria()) == ("failed", ["diverged at t = 1 s"])
+    status, reasons = verdict(failed, Criteria())
+    assert (status, [str(r) for r in reasons]) == ("failed", ["diverged at t = 1 s"])
+    assert reasons[0].as_dict() == {"segment": None, "code": "failed", "message": "diverged at t = 1 s"}
+    assert Reason.from_dict(Reason(2, "hold").as_dict()) == Reason(2, "hold")
 
 
 def test_criteria_are_read_from_the_scenario():
