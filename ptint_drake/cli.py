@@ -206,7 +206,7 @@ def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
 
 
 def cmd_run(args) -> int:
-    from ptint_drake.report import run_and_write  # noqa: PLC0415
+    from ptint_drake.run_outputs import run_and_write  # noqa: PLC0415
 
     _out_dir(args.out, Path("out"))  # an --out that is a file fails before the run
     scenario = load(args.scenario, args.set)
@@ -238,7 +238,7 @@ def cmd_run(args) -> int:
 
 
 def cmd_diagram(args) -> int:
-    from ptint_drake.report import write_diagram  # noqa: PLC0415
+    from ptint_drake.run_outputs import write_diagram  # noqa: PLC0415
 
     scenario = load(args.scenario, args.set)
     out = _out_dir(args.out, Path("out") / scenario.name)
@@ -248,7 +248,7 @@ def cmd_diagram(args) -> int:
 
 
 def cmd_paper(args) -> int:
-    from ptint_drake.report import write_paper  # noqa: PLC0415
+    from ptint_drake.paper_report import write_paper  # noqa: PLC0415
 
     index = write_paper(_out_dir(args.out, Path("out/paper")),
                         progress_factory=None if args.quiet else _progress)

@@ -21,6 +21,8 @@ already closer than ``half_fraction`` |e0| at tf/2 (only when |e0| ≥ ``min_e0`
 a segment that starts on its target cannot arrive early), and ``hold`` when the
 hold exceeds ``criteria.hold``.  A run is ``ok`` when every segment passes,
 ``missed`` otherwise, and ``failed`` when the divergence watchdog stopped it.
+The reasons are ``Reason`` values (segment, code); metrics.json holds them printed
+(``reasons``) and as data (``reason_codes``).
 """
 
 
@@ -73,13 +75,40 @@ def segment_reasons(seg: dict, criteria: Criteria, margin: float = 1.0) -> list[
     return reasons
 
 
-def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str, list[str]]:
-    """(status, reasons) of a run: ``ok``, ``missed`` (reasons like ``segment 0: late``) or
-    ``failed`` (the divergence watchdog stopped it; its message is the reason)."""
+@dataclass(frozen=True)
+class Reason:
+    """Why a run did not pass, as data: segment ``segment`` failed the criterion ``code``
+    (``late``, ``early``, ``hold``), or — ``segment`` None — the run ended without a verdict
+    (``code`` ``failed``: the divergence watchdog; ``error``: it could not run) for the
+    reason ``message``.  ``str()`` is the printed form (metrics.json's ``reasons``)."""
+
+    segment: Optional[int]
+    code: str
+    message: str = ""
+
+    def __str__(self) -> str:
+        if self.segment is None:
+            return self.message or self.code
+        return f"segment {self.segment}: {self.code}"
+
+    def as_dict(self) -> dict:
+        """metrics.json's ``reason_codes`` entry: segment and code (and message, if any)."""
+        out = {"segment": self.segment, "code": self.code}
+        return out | ({"message": self.message} if self.message else {})
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "Reason":
+        return cls(data["segment"], data["code"], data.get("message", ""))
+
+
+def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str, list[Reason]]:
+    """(status, reasons) of a run: ``ok``, ``missed`` (a ``Reason`` per failed criterion of
+    each segment, printed ``segment 0: late``) or ``failed`` (the divergence watchdog stopped
+    it; one ``Reason`` carrying its message)."""
     if metrics.get("failure"):
-        return "failed", [metrics["failure"]["message"]]
-    reasons = [f"segment {i}: {r}" for i, seg in enumerate(metrics["segments"])
-               for r in segment_reasons(seg, criteria, margin)]
+        return "failed", [Reason(None, "failed", metrics["failure"]["message"])]
+    reasons = [Reason(i, code) for i, seg in enumerate(metrics["segments"])
+               for code in segment_reasons(seg, criteria, margin)]
     return ("missed" if reasons else "ok"), reasons
 
 

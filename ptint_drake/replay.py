@@ -180,16 +180,9 @@ def _record(meshcat, viz, plant, context, series: dict, objs: np.ndarray, ends, 
                                 time_in_recording=tf_)
 
 
-def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
-                 conveyors=None, end_effector: str | None = None) -> int:
-    """Write a standalone replay HTML to ``path``; returns its size in bytes.
-
-    ``conveyors``: optional list of (start_xyz, end_xyz) belts to draw as boxes.
-    ``end_effector``: the frame whose body's size sets the objects' size (see module doc).
-    """
-    meshcat = shared_meshcat()
-    meshcat.Delete()
-    meshcat.DeleteRecording()
+def _replay_diagram(model_file: str, meshcat: Meshcat):
+    """The model in a plant + SceneGraph + MeshcatVisualizer diagram (no dynamics: the logged
+    q is replayed into it); returns (plant, scene_graph, visualizer, root context)."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     Parser(plant).AddModels(str(model_file))
@@ -197,20 +190,16 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
     viz = MeshcatVisualizer.AddToBuilder(
         builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration))
     diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
+    return plant, scene_graph, viz, diagram.CreateDefaultContext()
 
+
+def _draw_scene(meshcat: Meshcat, series: dict, raw: np.ndarray, ends, radius: float, belts) -> None:
+    """What does not move with the arm: the floor, each target's path, the objects and
+    interception markers (placed later by ``_record``), the gripper's trail, the belts."""
     t = series["t"]
-    starts = [s["start"] for s in metrics["segments"]]
-    ends = [s["start"] + s["tf"] for s in metrics["segments"]]
-    objs = object_positions(series, starts, ends)
-    n_obj = objs.shape[1]
-
-    raw = series["objects"].reshape(len(t), -1, 3)
-    radius = object_radius(end_effector_radius(plant, scene_graph, context, end_effector))
-    belts = [(np.asarray(a, float), np.asarray(b, float)) for a, b in (conveyors or [])]
     draw_floor(meshcat, floor_extent(np.vstack([series["x"], raw.reshape(-1, 3)]
                                                + [np.vstack(b) for b in belts])))
-    for i in range(n_obj):
+    for i in range(raw.shape[1]):
         color = COLORS[i % len(COLORS)]
         meshcat.SetLine(f"paths/target_{i}", raw[:, i, :].T.copy(), 2.0,
                         Rgba(color.r(), color.g(), color.b(), 0.6))
@@ -226,6 +215,25 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
         meshcat.SetTransform(f"conveyors/belt_{j}",
                              RigidTransform(0.5 * (a + b) - [0, 0, radius + 0.005]))
 
+
+def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
+                 conveyors=None, end_effector: str | None = None) -> int:
+    """Write a standalone replay HTML to ``path``; returns its size in bytes.
+
+    ``conveyors``: optional list of (start_xyz, end_xyz) belts to draw as boxes.
+    ``end_effector``: the frame whose body's size sets the objects' size (see module doc).
+    """
+    meshcat = shared_meshcat()
+    meshcat.Delete()
+    meshcat.DeleteRecording()
+    plant, scene_graph, viz, context = _replay_diagram(model_file, meshcat)
+    starts = [s["start"] for s in metrics["segments"]]
+    ends = [s["start"] + s["tf"] for s in metrics["segments"]]
+    objs = object_positions(series, starts, ends)
+    raw = series["objects"].reshape(len(series["t"]), -1, 3)
+    radius = object_radius(end_effector_radius(plant, scene_graph, context, end_effector))
+    belts = [(np.asarray(a, float), np.asarray(b, float)) for a, b in (conveyors or [])]
+    _draw_scene(meshcat, series, raw, ends, radius, belts)
     _record(meshcat, viz, plant, context, series, objs, ends, fps)
     meshcat.StopRecording()
     meshcat.PublishRecording()

@@ -25,8 +25,8 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.controllers import AddController, ControllerHandles
 from ptint_drake.metrics import run_metrics, verdict
-from ptint_drake.robot import (check_reachable, joint_limit_warnings, scale_masses,
-                               singularity_warnings, torque_feasibility)
+from ptint_drake.reachability import check_reachable
+from ptint_drake.run_warnings import joint_limit_warnings, singularity_warnings, torque_feasibility
 from ptint_drake.scenario import Scenario
 from ptint_drake.station import MakeStation, Station
 from ptint_drake.systems.kinematics import FrameKinematics
@@ -95,14 +95,10 @@ def _stops(scenario: Scenario) -> list[float]:
 
 
 def prepared_simulator(built: Built, scenario: Scenario) -> Simulator:
-    """A simulator of the built diagram at the scenario's start: masses, pose, rest."""
+    """A simulator of the built diagram with the scenario's integrator settings, from the
+    diagram's default context (the station's defaults are the scenario's start)."""
     simulator = Simulator(built.diagram)
     ApplySimulatorConfig(scenario.simulator, simulator)
-    plant = built.plant
-    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
-    scale_masses(plant, plant_context, scenario.plant.mass_scale)
-    plant.SetPositions(plant_context, np.radians(scenario.robot.initial_q_deg))
-    plant.SetVelocities(plant_context, np.zeros(plant.num_velocities()))
     return simulator
 
 
@@ -171,7 +167,9 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     warnings += singularity_warnings(plant, scenario, series) + joint_limit_warnings(plant, series)
     if watchdog.failure:
         metrics["failure"] = watchdog.failure
-    metrics["status"], metrics["reasons"] = verdict(metrics, scenario.criteria)
+    metrics["status"], reasons = verdict(metrics, scenario.criteria)
+    metrics["reasons"] = [str(r) for r in reasons]
+    metrics["reason_codes"] = [r.as_dict() for r in reasons]
     metrics |= {"criteria": dataclasses.asdict(scenario.criteria), "warnings": warnings,
                 "warnings_before_run": n_before,
                 "controller": {"type": built.controller.name, "notes": built.controller.notes,

@@ -4,7 +4,12 @@ In the spirit of a hardware station: ``MakeStation`` builds everything the
 controller does *not* decide — the continuous plant with the scenario's
 deviations (``plant``: masses, damping, payload, friction, disturbance), the
 torque saturation at the model's effort limits, and the true moving objects —
-and exports the ports a controller (or a user's own diagram) connects to:
+and exports the ports a controller (or a user's own diagram) connects to.
+
+The station owns its world: the plant variants are in the plant's defaults
+(``robot.make_plant``) and its default pose is ``robot.initial_q_deg`` at rest, so
+the station added to any diagram and simulated from that diagram's default context
+by any ``Simulator`` is the world ``ptint run`` simulates.
 
 =================  ======  ================================================
 port               size    meaning
@@ -50,6 +55,7 @@ def MakeStation(scenario: Scenario) -> Station:
     """The station of ``scenario`` (see the module docstring for its ports)."""
     builder = DiagramBuilder()
     plant = builder.AddNamedSystem("plant", make_plant(scenario))
+    plant.SetDefaultPositions(np.radians(scenario.robot.initial_q_deg))  # at rest: v = 0 by default
     if scenario.limits.saturate:
         limits = actuator_effort_limits(plant)
         saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))

@@ -75,3 +75,21 @@ def test_bad_compare_input_is_one_line(tmp_path, args, message):
     assert out.returncode == 2
     assert out.stderr.startswith(message) and out.stderr.count("\n") == 1, out.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_table_rows_read_the_structured_reasons():
+    """The table's reasons come from ``reason_codes`` (segment, code), not from parsing the
+    printed strings: a row's own codes on its segment, a failure's message on every segment."""
+    from ptint_drake.metrics import Reason  # noqa: PLC0415
+    from ptint_drake.studies.compare import table_rows  # noqa: PLC0415
+
+    seg = dict.fromkeys(SEGMENT_KEYS, 0.001)
+    missed = {"controller": "pd", "variant": "nominal", "status": "missed", "torque_peak_max": 1.0,
+              "segments": [seg, seg], "reasons": ["(printed only)"],
+              "reason_codes": [Reason(1, "late").as_dict(), Reason(1, "hold").as_dict()]}
+    failed = {"controller": "smc", "variant": "nominal", "status": "failed", "torque_peak_max": 1.0,
+              "segments": [seg], "reasons": ["(printed only)"],
+              "reason_codes": [Reason(None, "failed", "diverged at t = 1 s").as_dict()]}
+    rows = table_rows({"rows": [missed, failed]})
+    assert [(r["segment"], r["ok"], r["reasons"]) for r in rows] == [
+        (0, True, ""), (1, False, "late, hold"), (0, False, "diverged at t = 1 s")]

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from test_builder import OFFSET_ARM
 
-from ptint_drake.metrics import Criteria, segment_reasons, verdict
-from ptint_drake.robot import make_plant, scale_masses
+from ptint_drake.metrics import Criteria, Reason, segment_reasons, verdict
+from ptint_drake.robot import make_plant
 from ptint_drake.scenario import ScenarioError, apply_variant, load_scenario, parse_scenario
 from ptint_drake.simulation import build, simulate
 
@@ -88,11 +88,15 @@ def test_segment_reasons(seg, reasons):
 
 def test_verdict_uses_the_scenario_criteria_and_margin():
     metrics = {"segments": [_seg(e_tf=2e-3, hold=2.5e-3)]}
-    assert verdict(metrics, Criteria()) == ("missed", ["segment 0: late"])
+    assert verdict(metrics, Criteria()) == ("missed", [Reason(0, "late")])
+    assert str(verdict(metrics, Criteria())[1][0]) == "segment 0: late"
     assert verdict(metrics, Criteria(e_tf=3e-3, hold=5e-3)) == ("ok", [])
-    assert verdict(metrics, Criteria(e_tf=3e-3, hold=5e-3), margin=2.0)[1] == ["segment 0: late"]
+    assert verdict(metrics, Criteria(e_tf=3e-3, hold=5e-3), margin=2.0)[1] == [Reason(0, "late")]
     failed = {"segments": [_seg()], "failure": {"message": "diverged at t = 1 s"}}
-    assert verdict(failed, Criteria()) == ("failed", ["diverged at t = 1 s"])
+    status, reasons = verdict(failed, Criteria())
+    assert (status, [str(r) for r in reasons]) == ("failed", ["diverged at t = 1 s"])
+    assert reasons[0].as_dict() == {"segment": None, "code": "failed", "message": "diverged at t = 1 s"}
+    assert Reason.from_dict(Reason(2, "hold").as_dict()) == Reason(2, "hold")
 
 
 def test_criteria_are_read_from_the_scenario():
@@ -116,14 +120,13 @@ def test_plant_variants_scale_links_and_rotors():
     for bad in ("mass_x", "mass_x-1", "heavy", "payload_2", "payload_xkg"):
         with pytest.raises(ScenarioError, match=r"^variant: unknown plant variant"):
             apply_variant(base, bad)
-    built = build(base, log=False)
-    plant = built.plant
-    context = plant.CreateDefaultContext()
-    scale_masses(plant, context, 1.5)
+    nominal = build(base, log=False).plant
+    plant = build(apply_variant(base, "mass_x1.5"), log=False).plant
+    context = plant.CreateDefaultContext()  # the variant is in the station's defaults
     for index in plant.GetJointActuatorIndices():
-        actuator = plant.get_joint_actuator(index)
-        if actuator.default_rotor_inertia() > 0:
-            assert actuator.rotor_inertia(context) == pytest.approx(1.5 * actuator.default_rotor_inertia())
+        rotor = nominal.get_joint_actuator(index).default_rotor_inertia()
+        if rotor > 0:
+            assert plant.get_joint_actuator(index).rotor_inertia(context) == pytest.approx(1.5 * rotor)
 
 
 def test_unknown_controller_is_one_line_naming_the_field():

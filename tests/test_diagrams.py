@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from ptint_drake.report import write_diagram
+from ptint_drake.run_outputs import write_diagram
 
 ROOT = Path(__file__).resolve().parent.parent
 DIAGRAMS = ROOT / "diagrams"

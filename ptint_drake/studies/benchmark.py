@@ -261,7 +261,7 @@ def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
             "speedup_2_vs_1": round(walls[1] / walls[2], 2) if 1 in walls and 2 in walls else None}
 
 
-def main(argv=None) -> int:
+def _parser():
     import argparse
 
     parser = argparse.ArgumentParser(prog="ptint bench", description=__doc__.split("\n")[0])
@@ -285,23 +285,33 @@ def main(argv=None) -> int:
                         help="instead: µs per derivative evaluation of the plant with a C++ constant "
                              "actuation, with a do-nothing Python controller, and with the scenario's "
                              "controller")
+    return parser
+
+
+def _studies(args, say) -> dict:
+    """``--floors``, ``--schemes`` and ``--pair`` (any of them) with the machine's description."""
+    result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
+                          "cpus": __import__("os").cpu_count(), "drake": drake_version()}}
+    if args.floors:
+        result["floors"] = floors(args.scenarios or None, min(args.repeats, 3), say)
+    if args.schemes:
+        result["schemes"] = scheme_table(
+            args.scenarios or None, [s for s in args.schemes.split(",") if s],
+            [float(a) for a in args.accuracies.split(",") if a], args.simulator_extra, say)
+    if args.pair:
+        result["paired"] = paired(args.scenarios or None, args.pair[0], args.pair[1],
+                                  args.repeats, say)
+    return result
+
+
+def main(argv=None) -> int:
+    parser = _parser()
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats: must be >= 1, got {args.repeats}")
     say = lambda s: print(f"bench: {s}", file=__import__("sys").stderr)  # noqa: E731
     if args.schemes or args.pair or args.floors:
-        result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
-                              "cpus": __import__("os").cpu_count(), "drake": drake_version()}}
-        if args.floors:
-            result["floors"] = floors(args.scenarios or None, min(args.repeats, 3), say)
-        if args.schemes:
-            result["schemes"] = scheme_table(
-                args.scenarios or None, [s for s in args.schemes.split(",") if s],
-                [float(a) for a in args.accuracies.split(",") if a], args.simulator_extra, say)
-        if args.pair:
-            result["paired"] = paired(args.scenarios or None, args.pair[0], args.pair[1],
-                                      args.repeats, say)
-        print(json.dumps(result, indent=2))
+        print(json.dumps(_studies(args, say), indent=2))
         return 0
     configs = [c for c in args.configs.split(",") if c]
     unknown = [c for c in configs if c not in CONFIGS]

@@ -26,6 +26,7 @@ import numpy as np
 
 from ptint_drake.controllers import CONTROLLERS, known_type, plugin
 from ptint_drake.figures import plt, save
+from ptint_drake.metrics import Reason
 from ptint_drake.scenario import ScenarioError, apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
@@ -74,8 +75,9 @@ def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
     try:
         result = simulate(scenario, check=False)
     except (ScenarioError, RuntimeError, ValueError) as exc:
-        return row | {"ok": False, "status": "error", "reasons": [" ".join(str(exc).split())[:300]],
-                      "torque_peak_max": None, "segments": []}
+        reason = Reason(None, "error", " ".join(str(exc).split())[:300])
+        return row | {"ok": False, "status": "error", "reasons": [str(reason)],
+                      "reason_codes": [reason.as_dict()], "torque_peak_max": None, "segments": []}
     m, series = result.metrics, result.series
     t = series["t"]
     grid = np.linspace(0.0, scenario.duration, _GRID_POINTS)
@@ -83,6 +85,7 @@ def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
     tau = np.abs(series["tau_applied"]).max(axis=1)
     return row | {
         "ok": m["status"] == "ok", "status": m["status"], "reasons": m["reasons"],
+        "reason_codes": m["reason_codes"],
         "torque_peak_max": float(max(m["torque_peak"])),
         "torque_peak_after_startup_max": float(max(m["torque_peak_after_startup"])),
         "segments": [{k: seg[k] for k in SEGMENT_KEYS} for seg in m["segments"]],
@@ -132,10 +135,10 @@ def table_rows(result: dict) -> list[dict]:
     """Flat rows (one per controller × variant × segment) for the CSV and the Markdown table."""
     out = []
     for row in result["rows"]:
+        reasons = [Reason.from_dict(r) for r in row["reason_codes"]]
         for i, seg in enumerate(row["segments"] or [{}]):
-            prefix = f"segment {i}: "
-            own = [r[len(prefix):] for r in row["reasons"] if r.startswith(prefix)]
-            other = [r for r in row["reasons"] if not r.startswith("segment ")]  # failed/error
+            own = [r.code for r in reasons if r.segment == i]
+            other = [str(r) for r in reasons if r.segment is None]  # failed/error: the message
             out.append({"controller": row["controller"], "variant": row["variant"], "segment": i,
                         "ok": not own and not other and row["status"] in ("ok", "missed"),
                         "status": row["status"],

@@ -266,61 +266,96 @@ def _start_method(fn) -> str:
 
 
 def _run_local(fn, tasks, workers, progress, max_tasks_per_child, stats) -> list:
-    method = _start_method(fn)
-    stats["start_method"] = method
-    ctx = multiprocessing.get_context(method)
-    n = len(tasks)
-    results = [None] * n
-    rss = [0.0] * n
-    pool: list[_Worker] = []
-    retired: list[_Worker] = []
-    submitted = done = 0
-    stats["workers"] = min(workers, n)
-    clean = False
-    try:
-        for _ in range(min(workers, n)):
-            pool.append(_Worker(ctx, fn))
-            stats["worker_starts"] += 1
-        for w in pool:
-            w.send(submitted, tasks[submitted])
-            submitted += 1
-        while done < n:
-            for w in [w for w in retired if not w.process.is_alive()]:
-                _shutdown([w], graceful=True)
-                retired.remove(w)
-            busy = [w for w in pool if w.task is not None]
-            ready = set(wait_any([w.conn for w in busy] + [w.process.sentinel for w in busy]))
-            for slot, w in enumerate(list(pool)):
-                if w.task is None or not (w.conn in ready or w.process.sentinel in ready):
-                    continue
-                try:
-                    index, ok, value, rss_mb = w.conn.recv()
-                except (EOFError, OSError):
-                    w.process.join(1.0)
-                    raise WorkerDied(f"worker process {w.process.pid} died (exit code "
-                                     f"{w.process.exitcode}) while running task {w.task}") from None
-                if not ok:
-                    raise value
-                results[index], rss[index] = value, rss_mb
-                done += 1
-                w.task = None
-                w.done += 1
-                if progress:
-                    progress(done, n, index, value)
-                if submitted < n:
-                    if max_tasks_per_child and w.done >= max_tasks_per_child:
-                        w.stop()
-                        retired.append(w)
-                        w = pool[slot] = _Worker(ctx, fn)
-                        stats["worker_starts"] += 1
-                    w.send(submitted, tasks[submitted])
-                    submitted += 1
-        clean = True
-    finally:
-        _shutdown(pool + retired, graceful=clean)
-    stats["worker_rss_mb_by_task"] = rss
-    stats["worker_rss_mb"] = max(rss)
-    return results
+    return _LocalRun(fn, tasks, max_tasks_per_child, stats).run(workers, progress)
+
+
+class _LocalRun:
+    """One ``run_tasks`` on this module's pool: the workers, the next task to send, the results."""
+
+    def __init__(self, fn, tasks, max_tasks_per_child, stats):
+        method = _start_method(fn)
+        stats["start_method"] = method
+        self.ctx = multiprocessing.get_context(method)
+        self.fn, self.tasks, self.max_tasks, self.stats = fn, tasks, max_tasks_per_child, stats
+        self.results = [None] * len(tasks)
+        self.rss = [0.0] * len(tasks)
+        self.pool: list[_Worker] = []
+        self.retired: list[_Worker] = []
+        self.submitted = 0
+
+    def run(self, workers: int, progress) -> list:
+        """Every task, one in flight per worker; the workers are stopped however it ends."""
+        n = len(self.tasks)
+        self.stats["workers"] = min(workers, n)
+        done, clean = 0, False
+        try:
+            for _ in range(min(workers, n)):
+                self.pool.append(self._new_worker())
+            for w in self.pool:
+                self._send_next(w)
+            while done < n:
+                self._reap_retired()
+                ready = self._ready()
+                for slot, w in enumerate(list(self.pool)):
+                    if w.task is None or not (w.conn in ready or w.process.sentinel in ready):
+                        continue
+                    index = self._collect(w)
+                    done += 1
+                    if progress:
+                        progress(done, n, index, self.results[index])
+                    self._refill(slot, w)
+            clean = True
+        finally:
+            _shutdown(self.pool + self.retired, graceful=clean)
+        self.stats["worker_rss_mb_by_task"] = self.rss
+        self.stats["worker_rss_mb"] = max(self.rss)
+        return self.results
+
+    def _new_worker(self) -> _Worker:
+        worker = _Worker(self.ctx, self.fn)
+        self.stats["worker_starts"] += 1
+        return worker
+
+    def _send_next(self, w: _Worker) -> None:
+        w.send(self.submitted, self.tasks[self.submitted])
+        self.submitted += 1
+
+    def _reap_retired(self) -> None:
+        """Wait for the retired workers that have exited (they finish between tasks)."""
+        for w in [w for w in self.retired if not w.process.is_alive()]:
+            _shutdown([w], graceful=True)
+            self.retired.remove(w)
+
+    def _ready(self) -> set:
+        """The pipes and process sentinels of the busy workers that have something to say."""
+        busy = [w for w in self.pool if w.task is not None]
+        return set(wait_any([w.conn for w in busy] + [w.process.sentinel for w in busy]))
+
+    def _collect(self, w: _Worker) -> int:
+        """Store ``w``'s result and return its task index; re-raise the task's exception, or
+        ``WorkerDied`` if the worker ended without answering."""
+        try:
+            index, ok, value, rss_mb = w.conn.recv()
+        except (EOFError, OSError):
+            w.process.join(1.0)
+            raise WorkerDied(f"worker process {w.process.pid} died (exit code "
+                             f"{w.process.exitcode}) while running task {w.task}") from None
+        if not ok:
+            raise value
+        self.results[index], self.rss[index] = value, rss_mb
+        w.task = None
+        w.done += 1
+        return index
+
+    def _refill(self, slot: int, w: _Worker) -> None:
+        """The next task to the worker in ``slot``, a fresh worker if it has done its share."""
+        if self.submitted >= len(self.tasks):
+            return
+        if self.max_tasks and w.done >= self.max_tasks:
+            w.stop()
+            self.retired.append(w)
+            w = self.pool[slot] = self._new_worker()
+        self._send_next(w)
 
 
 def _shutdown(workers, graceful: bool) -> None:

@@ -90,6 +90,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.primitives import Demultiplexer
 
 from ptint_drake.systems.camera import (
     TIME_TOL,
@@ -328,12 +329,15 @@ class CameraEstimators:
     selector: ActiveTargetSelector
 
 
-def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list,
-                        schedule: Schedule, config: MeasurementConfig,
-                        histories=None) -> CameraEstimators:
+def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | None = None,
+                        objects_port: OutputPort | None = None, schedule: Schedule,
+                        config: MeasurementConfig, histories=None) -> CameraEstimators:
     """Add, per object i, ``camera_i`` (seed_offset i) observing ``true_position_ports[i]``
-    and ``target_filter_i``; and ``target_selector`` choosing the active one.
+    and ``target_filter_i``; and ``target_selector`` choosing the active one.  The handles
+    returned hold every camera and filter (index i: object i).
 
+    Instead of ``true_position_ports``, ``objects_port`` (3 per object, e.g. the station's
+    ``objects``) is split into one port per object of ``schedule`` by ``object_positions``.
     ``histories`` (optional, one per object: a callable t → position or an object with
     ``evaluate``): the objects' true motion, so that each camera has also seen its object
     for ``config.prior_window`` s before t = 0 and its filter starts from those samples
@@ -344,6 +348,13 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list,
     if config.estimator not in ("kalman_cv", "kalman_ca"):
         raise ValueError("measurement.estimator: AddCameraEstimators needs kalman_cv or "
                          f"kalman_ca, got {config.estimator!r}")
+    if (true_position_ports is None) == (objects_port is None):
+        raise ValueError("AddCameraEstimators: give true_position_ports or objects_port, not both")
+    if objects_port is not None:
+        n = len(schedule.segments)
+        split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
+        builder.Connect(objects_port, split.get_input_port())
+        true_position_ports = [split.get_output_port(i) for i in range(n)]
     model = config.estimator.split("_", 1)[1]
     selector = builder.AddNamedSystem(
         "target_selector", ActiveTargetSelector(schedule=schedule, count=len(true_position_ports)))

@@ -1,0 +1,141 @@
+"""Warnings about a run: before it, whether the actuators can follow the prescribed time
+(``torque_feasibility``); after it, where the arm came near a singularity or went beyond
+its model's joint limits.  They may use the model: the controller never sees them.
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable
+
+from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.robot import effort_limits
+from ptint_drake.scenario import Scenario
+
+
+def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int = 200) -> list[str]:
+    """Warnings for segments whose tf looks too short for the actuators' effort limits.
+
+    A planning estimate (it uses the model, the controller does not): on the ideal
+    surface the error follows e(t) ≈ e0 ξ(t), so the gripper needs the acceleration
+    a(t) = ẍ_r(t) + e0 ξ̈(t).  ξ̈ is unbounded for β < 1/2; there the closed loop
+    cannot follow it anyway and the β = 1/2 profile's bound is used.  The joint
+    torque estimate is |M(q) J⁻¹ a| + |g(q)| at the segment's start and
+    interception configurations.  The acceleration part scales as 1/tf², which
+    gives the suggested tf.  e0 is taken from the start pose for the first
+    segment and from the previous target for later ones.
+    """
+    from ptint_drake.systems.tbg import tbg_profile  # noqa: PLC0415
+
+    frame = plant.GetFrameByName(scenario.robot.end_effector)
+    context = plant.CreateDefaultContext()
+    limits = effort_limits(plant)
+    q_prev = np.radians(scenario.robot.initial_q_deg)
+    plant.SetPositions(context, q_prev)
+    x_prev = frame.CalcPoseInWorld(context).translation()
+    targets = scenario.targets()
+    warnings = []
+    for i, ic in enumerate(scenario.interceptions):
+        e0 = x_prev - targets[i].evaluate(ic.start)[0:3]
+        tau = ic.tf * np.linspace(0.01, 0.99, samples)
+        xi_dd = tbg_profile(tau, ic.tf, max(ic.beta, 0.5))[2]
+        accelerations = [targets[i].evaluate(ic.start + s)[6:9] + e0 * xi_dd[k] for k, s in enumerate(tau)]
+        x_end = targets[i].evaluate(ic.start + ic.tf)[0:3]
+        q_end = inverse_kinematics(plant, frame, x_end, q_prev)
+        configs = [q_prev] + ([q_end] if q_end is not None else [])
+        need_acc, need_g = _torque_needed(plant, context, frame, configs, accelerations)
+        warning = _too_short(i, ic.tf, need_acc, need_g, limits)
+        if warning:
+            warnings.append(warning)
+        if q_end is not None:
+            q_prev, x_prev = q_end, x_end
+    return warnings
+
+
+def _torque_needed(plant: MultibodyPlant, context, frame, configs: list,
+                   accelerations: list) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint, the largest |M(q) J⁺(q) a| over the configurations and accelerations and
+    the largest |g(q)| over the configurations (at rest)."""
+    need_acc = np.zeros(plant.num_velocities())
+    need_g = np.zeros(plant.num_velocities())
+    for q in configs:
+        plant.SetPositions(context, q)
+        plant.SetVelocities(context, np.zeros(plant.num_velocities()))
+        M = plant.CalcMassMatrix(context)
+        g = np.abs(plant.CalcGravityGeneralizedForces(context))
+        J = plant.CalcJacobianTranslationalVelocity(
+            context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(),
+            plant.world_frame())
+        Jp = np.linalg.pinv(J)
+        for a in accelerations:
+            need_acc = np.maximum(need_acc, np.abs(M @ (Jp @ a)))
+        need_g = np.maximum(need_g, g)
+    return need_acc, need_g
+
+
+def _too_short(i: int, tf: float, need_acc: np.ndarray, need_g: np.ndarray,
+               limits: np.ndarray) -> Optional[str]:
+    """The warning for segment i when a joint needs more than its limit (None otherwise):
+    the joint that exceeds it most, and the tf at which it would fit (need_acc ∝ 1/tf²)."""
+    over = np.nonzero(need_acc + need_g > limits)[0]
+    if not len(over):
+        return None
+    j = int(over[np.argmax((need_acc + need_g - limits)[over])])
+    room = limits[j] - need_g[j]
+    if room <= 0:
+        hint = "gravity alone exceeds the limit there"
+    else:
+        hint = f"tf ≥ {tf * np.sqrt(need_acc[j] / room):.2f} s would fit"
+    return (f"interceptions[{i}].tf = {tf:g} s looks too short for the actuators: joint "
+            f"{j + 1} needs about {need_acc[j] + need_g[j]:.1f} N·m (limit {limits[j]:g} N·m); "
+            f"{hint}")
+
+
+def singularity_warnings(plant: MultibodyPlant, scenario: Scenario, series: dict) -> list:
+    """A warning when J's smallest singular value drops below ``limits.singular_value_warning``:
+    when it first did, and the time and configuration where it was smallest."""
+    threshold = scenario.limits.singular_value_warning
+    if threshold <= 0 or len(series["t"]) == 0:
+        return []
+    frame = plant.GetFrameByName(scenario.robot.end_effector)
+    context = plant.CreateDefaultContext()
+    Js = np.empty((len(series["t"]), 3, plant.num_velocities()))
+    origin, world = np.zeros(3), plant.world_frame()
+    for k, q in enumerate(series["q"]):
+        plant.SetPositions(context, q)
+        Js[k] = plant.CalcJacobianTranslationalVelocity(
+            context, JacobianWrtVariable.kV, frame, origin, world, world)
+    smallest = np.linalg.svd(Js, compute_uv=False)[:, -1]  # one batched call
+    below = np.nonzero(smallest < threshold)[0]
+    if len(below) == 0:
+        return []
+    k = int(np.argmin(smallest))
+    deg = ", ".join(f"{v:.1f}" for v in np.degrees(series["q"][k]))
+    damped = scenario.controller.pinv_damping
+    advice = (f"the damped pseudoinverse (λ = {damped:g} m/rad) keeps the torques bounded" if damped
+              else "consider controller.pinv_damping (e.g. 0.01) for a damped pseudoinverse")
+    return [f"near-singular Jacobian from t = {series['t'][below[0]]:.3f} s; smallest singular value "
+            f"{smallest[k]:.2e} m/rad (< {threshold:g}) at t = {series['t'][k]:.3f} s, q = ({deg}) deg; "
+            f"{advice}"]
+
+
+def joint_limit_warnings(plant: MultibodyPlant, series: dict) -> list[str]:
+    """Warnings for joints that went beyond the model's position or speed limits during the
+    run (a continuous plant does not enforce them): which joint, how far, and when."""
+    warnings = []
+    for kind, values, lower, upper, unit in (
+            ("position", series["q"], plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits(), "rad"),
+            ("speed", series["v"], plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits(), "rad/s")):
+        for j in range(values.shape[1]):
+            over = np.maximum(values[:, j] - upper[j], lower[j] - values[:, j])
+            k = int(np.argmax(over))
+            if len(over) and over[k] > 1e-9:
+                first = float(series["t"][int(np.argmax(over > 1e-9))])
+                limit = upper[j] if values[k, j] > upper[j] else lower[j]
+                warnings.append(
+                    f"joint {j + 1} {kind} {values[k, j]:.3g} {unit} at t = {series['t'][k]:.3f} s is "
+                    f"beyond the model's limit {limit:.3g} {unit} (first beyond it at t = {first:.3f} s)")
+    return warnings
