@@ -29,7 +29,6 @@ import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Frame
 from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
-from pydrake.systems.primitives import Demultiplexer
 
 from ptint_drake.systems.kalman import AddCameraEstimators
 from ptint_drake.systems.measurement import MeasuredTarget
@@ -129,10 +128,7 @@ def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",
         source = builder.AddNamedSystem("target_view", TargetSource(
             scenario.schedule(), analytic if analytic is not None else controller_targets(scenario)))
         return source.GetOutputPort("target")
-    n = len(scenario.interceptions)
-    split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
-    builder.Connect(station_system.GetOutputPort("objects"), split.get_input_port())
-    return AddCameraEstimators(builder, true_position_ports=[split.get_output_port(i) for i in range(n)],
+    return AddCameraEstimators(builder, objects_port=station_system.GetOutputPort("objects"),
                                schedule=scenario.schedule(), config=scenario.measurement,
                                histories=scenario.targets()).target_port  # in view before t = 0
 
