@@ -53,7 +53,8 @@ from ptint_drake.figures import plt, save
 from ptint_drake.metrics import segment_reasons
 from ptint_drake.outputs import staged_output, write_json_atomic
 from ptint_drake.studies.runner import run_tasks
-from ptint_drake.scenario import Scenario, ScenarioError, parse_scenario, scenario_text, validate
+from ptint_drake.scenario import (LoadedScenario, Scenario, ScenarioError, parse_scenario, scenario_text,
+                                  validate)
 from ptint_drake.simulation import simulate
 
 
@@ -70,10 +71,11 @@ FLOOR_PROCESS_NOISES = (0.003, 0.01, 0.03, 0.1, 0.3)
 FLOOR_SAMPLE_HZ = 960.0
 
 
-def _with_measurement(text: str, name: str, measurement: dict, seed: int) -> Scenario:
-    """The scenario with ``measurement`` fields (or dotted scenario fields, e.g.
-    ``controller.alpha_hold``) replaced and measurement.seed = ``seed``, validated."""
-    scenario = parse_scenario(text, name)
+def _with_measurement(text, name: str, measurement: dict, seed: int) -> Scenario:
+    """The scenario (YAML ``text``, or a copy of a parsed Scenario) with ``measurement`` fields
+    (or dotted scenario fields, e.g. ``controller.alpha_hold``) replaced and
+    measurement.seed = ``seed``, validated."""
+    scenario = copy.deepcopy(text) if isinstance(text, Scenario) else parse_scenario(text, name)
     for key, value in measurement.items():  # "noise_std" or e.g. "controller.alpha_hold"
         owner, _, field = key.rpartition(".")
         setattr(getattr(scenario, owner) if owner else scenario.measurement, field, value)
@@ -327,10 +329,10 @@ def summarize_floor(rows: list) -> dict:
     return out
 
 
-def filter_floor(text: str, name: str, process_noises=FLOOR_PROCESS_NOISES, seeds: int = DEFAULT_SEEDS,
+def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, seeds: int = DEFAULT_SEEDS,
                  measurement: dict | None = None, sample_hz: float = FLOOR_SAMPLE_HZ,
                  workers: int | None = 2, dask=None, progress=None) -> dict:
-    """The filter-only error floor of a camera scenario (module docstring): for each
+    """The filter-only error floor of the camera scenario ``loaded`` (module docstring): for each
     process noise q in ``process_noises`` and measurement.seed = 1 … ``seeds``, one
     ``floor_case`` with ``measurement`` fields (e.g. ``{"noise_std": 0.001}``) also
     replaced; returns the settings, a ``table`` (per q: ``summarize_floor``), every run
@@ -347,7 +349,8 @@ def filter_floor(text: str, name: str, process_noises=FLOOR_PROCESS_NOISES, seed
     if not (np.isfinite(sample_hz) and sample_hz > 0.0):
         raise ScenarioError(f"sample_hz: must be > 0, got {sample_hz}")
     overrides = dict(measurement or {})
-    base = _with_measurement(text, name, overrides, 1)  # a bad field fails before any worker starts
+    text, name = loaded.text, loaded.name
+    base = _with_measurement(loaded.scenario, name, overrides, 1)  # a bad field fails before any worker
     check_floor_scenario(base)
     t0 = time.perf_counter()
     cases = [(text, name, {**overrides, "process_noise": q}, seed, sample_hz)
