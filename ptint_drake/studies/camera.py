@@ -72,9 +72,8 @@ FLOOR_SAMPLE_HZ = 960.0
 
 
 def _with_measurement(text, name: str, measurement: dict, seed: int) -> Scenario:
-    """The scenario (YAML ``text``, or a copy of a parsed Scenario) with ``measurement`` fields
-    (or dotted scenario fields, e.g. ``controller.alpha_hold``) replaced and
-    measurement.seed = ``seed``, validated."""
+    """The scenario (YAML ``text`` or a Scenario, copied) with ``measurement`` fields (or dotted scenario
+    fields, e.g. ``controller.alpha_hold``) replaced and measurement.seed = ``seed``, validated."""
     scenario = copy.deepcopy(text) if isinstance(text, Scenario) else parse_scenario(text, name)
     for key, value in measurement.items():  # "noise_std" or e.g. "controller.alpha_hold"
         owner, _, field = key.rpartition(".")
@@ -349,11 +348,10 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
     if not (np.isfinite(sample_hz) and sample_hz > 0.0):
         raise ScenarioError(f"sample_hz: must be > 0, got {sample_hz}")
     overrides = dict(measurement or {})
-    text, name = loaded.text, loaded.name
-    base = _with_measurement(loaded.scenario, name, overrides, 1)  # a bad field fails before any worker
+    base = _with_measurement(loaded.scenario, loaded.name, overrides, 1)  # before any worker starts
     check_floor_scenario(base)
     t0 = time.perf_counter()
-    cases = [(text, name, {**overrides, "process_noise": q}, seed, sample_hz)
+    cases = [(loaded.text, loaded.name, {**overrides, "process_noise": q}, seed, sample_hz)
              for q in qs for seed in range(1, seeds + 1)]
     rows = run_tasks(floor_case, cases, workers=workers, dask=dask, progress=progress)
     table = [{"process_noise": q, "summary": summarize_floor(rows[j * seeds:(j + 1) * seeds])}
@@ -361,7 +359,7 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
     ranked = [row for row in table if "hold_max_median" in row["summary"]]
     best = min(ranked, key=lambda row: row["summary"]["hold_max_median"]) if ranked else None
     m = base.measurement
-    return {"scenario": name, "seeds": seeds, "sample_hz": sample_hz, "workers": workers,
+    return {"scenario": loaded.name, "seeds": seeds, "sample_hz": sample_hz, "workers": workers,
             "wall_time_s": time.perf_counter() - t0,
             "measurement_overrides": overrides,
             "measurement": {k: v for k, v in copy.deepcopy(vars(m)).items()
