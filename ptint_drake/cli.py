@@ -33,6 +33,7 @@ RESULTS = "Criteria of an interception: README, Results (|e(tf)| <= 1 mm, hold <
 
 
 def _study_arguments(parser, default_out: str, workers_default: str = "CPU count") -> None:
+    """The options every study shares: --workers | --dask, --set, --out, --quiet."""
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--workers", type=opt.count("--workers"),
                        help=f"worker processes (default: {workers_default})")
@@ -43,6 +44,8 @@ def _study_arguments(parser, default_out: str, workers_default: str = "CPU count
 
 
 def make_parser() -> argparse.ArgumentParser:
+    """``ptint``'s parser: each subcommand with its options, each option value checked by its
+    type (``cli_options``), ``func`` the command (``cli_runs``, ``cli_studies``)."""
     parser = argparse.ArgumentParser(
         prog="ptint", description=__doc__.split("\n")[0],
         epilog="Paper: Flores-Campos et al., Robotics 2024, 13(10), 145. "
@@ -129,40 +132,6 @@ def _add_grid_parsers(sub) -> None:
     rb.set_defaults(func=cmd_robust)
 
 
-def _add_camera_parsers(sub) -> None:
-    """study (camera, --filter-floor) and bench."""
-    st = sub.add_parser(
-        "study", help="studies: camera (|e(tf)| against noise × latency × estimator)",
-        description="camera: |e(tf)| on conveyor_pair_camera over noise × latency × estimator "
-                    "(camera_study.md/.json, estimate.png). camera --filter-floor: the camera and "
-                    "Kalman filter alone (no arm) on a camera scenario, per process noise: the "
-                    "largest |estimate − true object| over each hold window, the error a controller "
-                    "that follows the estimate inherits (filter_floor.md/.json).")
-    st.add_argument("study", choices=["camera"])
-    st.add_argument("--seeds", type=opt.count("--seeds"), default=10,
-                    help="seeds per grid point (default 10)")
-    st.add_argument("--workers", type=opt.count("--workers"), default=2,
-                    help="worker processes (default 2)")
-    st.add_argument("--out", help="output folder (default out/study_camera, with --filter-floor "
-                                  "out/filter_floor_NAME)")
-    st.add_argument("--quiet", action="store_true")
-    st.add_argument("--filter-floor", action="store_true",
-                    help="measure the camera + Kalman filter alone (no arm) per process noise")
-    st.add_argument("--scenario", help="with --filter-floor: a camera scenario (bundled name or YAML "
-                                       "file with a kalman_cv/kalman_ca estimator; default curve_camera)")
-    st.add_argument("--process-noise", metavar="Q,..", type=opt.process_noises,
-                    help="with --filter-floor: comma-separated process noises q > 0 "
-                         "(default 0.003,0.01,0.03,0.1,0.3)")
-    st.add_argument("--set", action="append", metavar="KEY=VALUE",
-                    help="with --filter-floor: " + SET_HELP)
-    st.set_defaults(func=cmd_study)
-    # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
-    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
-                           add_help=False)
-    bench.add_argument("rest", nargs=argparse.REMAINDER)
-    bench.set_defaults(func=cmd_bench)
-
-
 def _add_design_parsers(sub) -> None:
     """compare (controllers × plant variants) and tune (gains for an arm)."""
     cmp_ = sub.add_parser(
@@ -196,6 +165,40 @@ def _add_design_parsers(sub) -> None:
                     help="largest fraction of the time an actuator may saturate (default 0.05)")
     _study_arguments(tn, "out/tune_NAME")
     tn.set_defaults(func=cmd_tune)
+
+
+def _add_camera_parsers(sub) -> None:
+    """study (camera, --filter-floor) and bench."""
+    st = sub.add_parser(
+        "study", help="studies: camera (|e(tf)| against noise × latency × estimator)",
+        description="camera: |e(tf)| on conveyor_pair_camera over noise × latency × estimator "
+                    "(camera_study.md/.json, estimate.png). camera --filter-floor: the camera and "
+                    "Kalman filter alone (no arm) on a camera scenario, per process noise: the "
+                    "largest |estimate − true object| over each hold window, the error a controller "
+                    "that follows the estimate inherits (filter_floor.md/.json).")
+    st.add_argument("study", choices=["camera"])
+    st.add_argument("--seeds", type=opt.count("--seeds"), default=10,
+                    help="seeds per grid point (default 10)")
+    st.add_argument("--workers", type=opt.count("--workers"), default=2,
+                    help="worker processes (default 2)")
+    st.add_argument("--out", help="output folder (default out/study_camera, with --filter-floor "
+                                  "out/filter_floor_NAME)")
+    st.add_argument("--quiet", action="store_true")
+    st.add_argument("--filter-floor", action="store_true",
+                    help="measure the camera + Kalman filter alone (no arm) per process noise")
+    st.add_argument("--scenario", help="with --filter-floor: a camera scenario (bundled name or YAML "
+                                       "file with a kalman_cv/kalman_ca estimator; default curve_camera)")
+    st.add_argument("--process-noise", metavar="Q,..", type=opt.process_noises,
+                    help="with --filter-floor: comma-separated process noises q > 0 "
+                         "(default 0.003,0.01,0.03,0.1,0.3)")
+    st.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="with --filter-floor: " + SET_HELP)
+    st.set_defaults(func=cmd_study)
+    # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
+    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
+                           add_help=False)
+    bench.add_argument("rest", nargs=argparse.REMAINDER)
+    bench.set_defaults(func=cmd_bench)
 
 
 def _run(argv) -> int:
@@ -233,6 +236,7 @@ def _run(argv) -> int:
 
 
 def main(argv=None) -> int:
+    """``ptint ARGS`` (``sys.argv`` by default): the exit code; a closed stdout ends quietly."""
     try:
         code = _run(argv)
         sys.stdout.flush()  # a closed pipe shows up here, not at interpreter exit
