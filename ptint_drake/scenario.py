@@ -256,12 +256,41 @@ def check_variants(scenario: Scenario, variants) -> None:
         apply_variant(scenario, variant)
 
 
-def parse_with_overrides(text: str, overrides: str, name: str = "scenario") -> Scenario:
-    """Parse ``text``, then merge the YAML mapping ``overrides`` over it, then validate."""
-    base = parse_scenario(text, name)
-    try:
-        scenario = yaml_load_typed(schema=Scenario, data=overrides, defaults=base)
-    except Exception as exc:
-        raise ScenarioError("--set " + yaml_error(overrides, Scenario, exc)) from None
-    validate(scenario)
-    return scenario
+def parse_with_overrides(text: str, overrides, name: str = "scenario") -> Scenario:
+    """The validated scenario of YAML ``text`` with ``overrides`` applied: ``key=value``
+    strings as ``--set`` takes them (``["interceptions[0].tf=1.2", "controller.type=pd"]``,
+    values are YAML) or a YAML mapping text (``"controller: {K: 40}"``); see ``LoadedScenario``."""
+    return LoadedScenario.parse(text, name, overrides).scenario
+
+
+@dataclass(frozen=True)
+class LoadedScenario:
+    """A scenario parsed once for a command: ``name`` (the bundled name or file stem, the
+    fallback of ``scenario.name``), ``text`` (its YAML with every override applied: what
+    worker processes rebuild it from) and the validated ``scenario`` (not to be mutated)."""
+
+    name: str
+    text: str
+    scenario: Scenario
+
+    @classmethod
+    def load(cls, name_or_file: str, overrides=()) -> "LoadedScenario":
+        """A bundled scenario name or a scenario file, with ``overrides`` (``parse``)."""
+        name, text = scenario_text(name_or_file)
+        return cls.parse(text, name, overrides)
+
+    @classmethod
+    def parse(cls, text: str, name: str = "scenario", overrides=()) -> "LoadedScenario":
+        """YAML ``text`` with ``overrides`` applied (``scenario_yaml.override_text``), validated.
+        A bad override is one line naming its key (``--set KEY: ...``) or, when the file
+        itself is valid, the field it made invalid (``--set: FIELD: ...``)."""
+        from ptint_drake.scenario_yaml import override_text  # noqa: PLC0415
+
+        changed = override_text(text, overrides)
+        if changed is text:
+            return cls(name, text, parse_scenario(text, name))
+        try:
+            return cls(name, changed, parse_scenario(changed, name))
+        except ScenarioError as exc:
+            parse_scenario(text, name)  # an error of the file itself is reported as such
+            raise ScenarioError(f"--set: {exc}") from None

@@ -70,11 +70,10 @@ def results_table() -> str:
 def compare_table(name: str, workers: int, controllers=None) -> str:
     """The compare study of ``name`` condensed: e(tf), t_arrive and the verdict per variant
     (``controllers``: the registry's by default)."""
-    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
     from ptint_drake.studies.compare import DEFAULT_CONTROLLERS, run_compare, table_rows  # noqa: PLC0415
 
-    _, text = scenario_text(name)
-    result = run_compare(text, name, controllers or DEFAULT_CONTROLLERS, workers=workers)
+    result = run_compare(LoadedScenario.load(name), controllers or DEFAULT_CONTROLLERS, workers=workers)
     variants = result["variants"]
     header = " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants)
     lines = ["| controller | seg | " + header + " |",
@@ -97,7 +96,7 @@ def compare_table(name: str, workers: int, controllers=None) -> str:
 
 
 def tune_table(workers: int) -> str:
-    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
     from ptint_drake.studies.tune import TuneSettings, run_tune  # noqa: PLC0415
 
     sys.path.insert(0, str(ROOT / "tests"))
@@ -110,7 +109,8 @@ def tune_table(workers: int) -> str:
     lines = ["| scenario | tuned K (margin 2) | paper's K | e(tf) nominal / ×0.7 / ×1.5 [mm] | runs | time |",
              "|---|---|---|---|---|---|"]
     for name, text in cases:
-        r = run_tune(text, name.split()[0], TuneSettings(), workers=workers, say=lambda m: None)
+        r = run_tune(LoadedScenario.parse(text, name.split()[0]), TuneSettings(), workers=workers,
+                     say=lambda m: None)
         if r["gains"] is None:
             lines.append(f"| {name} | none works ({', '.join(r['reasons'])}) | {r['paper_value']:g} | – "
                          f"| {r['runs']} | {r['wall_time_s']:.0f} s |")

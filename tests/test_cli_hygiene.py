@@ -12,9 +12,10 @@ from pathlib import Path
 
 import pytest
 
-from ptint_drake import cli
+from ptint_drake import cli, cli_runs
 from ptint_drake.outputs import staged_output, write_json_atomic
-from ptint_drake.scenario import ScenarioError, scenario_text
+from ptint_drake.scenario import LoadedScenario, ScenarioError, scenario_text
+from ptint_drake.scenario_yaml import override_text
 
 TESTS = Path(__file__).parent
 
@@ -87,7 +88,7 @@ BASE = scenario_text("assembly")[1]
 def test_override_text_reaches_list_items():
     import yaml
 
-    text = cli.override_text(BASE, ["interceptions[0].tf=1.2",
+    text = override_text(BASE, ["interceptions[0].tf=1.2",
                                     "interceptions[1].target.linear.velocity=[0,0.2,0]",
                                     "controller.K=40", "measurement.noise_std=1e-5"])
     tree = yaml.safe_load(text)
@@ -96,8 +97,8 @@ def test_override_text_reaches_list_items():
     assert tree["interceptions"][2] == yaml.safe_load(BASE)["interceptions"][2]
     assert tree["controller"]["K"] == 40
     assert tree["measurement"] == {"noise_std": 1e-5}
-    scenario = cli.load("assembly", ["interceptions[1].target.linear.velocity=[0,0.2,0]",
-                                     "interceptions[0].tf=0.6"])
+    scenario = LoadedScenario.load("assembly", ["interceptions[1].target.linear.velocity=[0,0.2,0]",
+                                                "interceptions[0].tf=0.6"]).scenario
     assert scenario.interceptions[0].tf == 0.6 and scenario.interceptions[1].tf == 1.4
     assert list(scenario.interceptions[1].target.linear.velocity) == [0.0, 0.2, 0.0]
     assert scenario.name == "assembly"
@@ -116,7 +117,7 @@ BAD_SETS = {
 @pytest.mark.parametrize("pair", sorted(BAD_SETS))
 def test_bad_set_path_names_it(pair):
     with pytest.raises(ScenarioError) as err:
-        cli.load("assembly", [pair])
+        LoadedScenario.load("assembly", [pair])
     assert BAD_SETS[pair] in str(err.value) and "\n" not in str(err.value)
 
 
@@ -144,14 +145,14 @@ def test_set_on_a_list_item_changes_the_run(tmp_path):
 def test_progress_prints_a_line_per_tenth_when_not_a_tty(monkeypatch):
     err = io.StringIO()  # not a terminal
     monkeypatch.setattr(sys, "stderr", err)
-    report = cli._progress("demo")
+    report = cli_runs.progress("demo")
     for k in range(61):
         report(0.05 * k, 3.0, steps=10 * k)
     report(3.0, 3.0)  # the final call of simulate; already reported
     lines = err.getvalue().splitlines()
     assert [int(re.search(r"(\d+) %", line).group(1)) for line in lines] == list(range(0, 101, 10))
     assert "steps" in lines[1] and lines[-1].startswith("demo: 100 %")
-    report2 = cli._progress("two-arg")
+    report2 = cli_runs.progress("two-arg")
     report2(1.5, 3.0)  # the (t, duration) signature still works
     assert err.getvalue().splitlines()[-1] == "two-arg:  50 % (1.50/3.00 s simulated)"
 

@@ -9,23 +9,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptint_drake.scenario import ScenarioError, parse_scenario, scenario_text
+from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
 from ptint_drake.studies import filter_floor as floor
 
 TESTS = Path(__file__).parent
 NAME, TEXT = scenario_text("curve_camera")
+LOADED = LoadedScenario.parse(TEXT, NAME)
 SEEDS = 6
 
 
 @pytest.fixture(scope="module")
 def curve_2mm():
-    return floor.filter_floor(TEXT, NAME, [0.03], SEEDS, workers=1)
+    return floor.filter_floor(LOADED, [0.03], SEEDS, workers=1)
 
 
 def test_noiseless_camera_on_a_constant_velocity_belt_has_no_floor():
-    name, text = scenario_text("conveyor_pair_camera")
-    result = floor.filter_floor(text, name, [1e-6], 2, measurement={"noise_std": 0.0, "latency": 0.0},
+    belt = LoadedScenario.load("conveyor_pair_camera")
+    result = floor.filter_floor(belt, [1e-6], 2, measurement={"noise_std": 0.0, "latency": 0.0},
                                  workers=1)
     assert result["measurement"]["estimator"] == "kalman_cv"
     s = result["table"][0]["summary"]
@@ -39,12 +40,12 @@ def test_noiseless_camera_on_a_constant_velocity_belt_has_no_floor():
         # read far more densely than the camera's 30 Hz (at least 240 Hz)
         assert all(seg["samples"] >= 240 * (seg["hold_to"] - seg["hold_from"]) for seg in run["segments"])
     # the same belt with the scenario's 2 mm noise is far from exact: the check above can fail
-    noisy = floor.floor_case(text, name, {"process_noise": 1e-6}, 1)
+    noisy = floor.floor_case(belt.text, belt.name, {"process_noise": 1e-6}, 1)
     assert noisy["segments"][0]["hold_max"] > 1e-4
 
 
 def test_less_noise_lowers_the_floor(curve_2mm):
-    one_mm = floor.filter_floor(TEXT, NAME, [0.03], SEEDS, measurement={"noise_std": 0.001}, workers=1)
+    one_mm = floor.filter_floor(LOADED, [0.03], SEEDS, measurement={"noise_std": 0.001}, workers=1)
     assert one_mm["measurement"]["noise_std"] == 0.001
     low, high = one_mm["table"][0]["summary"], curve_2mm["table"][0]["summary"]
     assert low["hold_max_median"] < high["hold_max_median"]
@@ -77,11 +78,11 @@ def test_floor_is_what_the_closed_loop_controller_sees(curve_2mm):
 
 def test_bad_arguments_name_the_field():
     with pytest.raises(ScenarioError, match=r"^process_noise: "):
-        floor.filter_floor(TEXT, NAME, [0.03, 0.0], 1, workers=1)
+        floor.filter_floor(LOADED, [0.03, 0.0], 1, workers=1)
     with pytest.raises(ScenarioError, match=r"^measurement\.estimator: "):
-        floor.filter_floor(scenario_text("curve_b075_tf15")[1], "curve_b075_tf15", [0.03], 1, workers=1)
+        floor.filter_floor(LoadedScenario.load("curve_b075_tf15"), [0.03], 1, workers=1)
     with pytest.raises(ScenarioError, match=r"^measurement\.noise_std: "):
-        floor.filter_floor(TEXT, NAME, [0.03], 1, measurement={"noise_std": -1.0}, workers=1)
+        floor.filter_floor(LOADED, [0.03], 1, measurement={"noise_std": -1.0}, workers=1)
 
 
 def ptint(*args):

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptint_drake.scenario import parse_scenario, scenario_text
+from ptint_drake.scenario import LoadedScenario, parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.sweep import run_sweep, sweep_point
 
@@ -39,7 +39,7 @@ def test_run_sweep_with_a_process_pool_keeps_grid_order():
     # forkserver: an earlier test's Dask client may leave threads in this process, and Python
     # 3.12+ warns (rightly) about fork() from a multi-threaded process
     with ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("forkserver")) as pool:
-        rows = run_sweep(TEXT, NAME, [0.5, 0.75], [1.5], executor=pool)
+        rows = run_sweep(LoadedScenario.parse(TEXT, NAME), [0.5, 0.75], [1.5], executor=pool)
     assert [(r["beta"], r["tf"]) for r in rows] == [(0.5, 1.5), (0.75, 1.5)]
     assert all(r["ok"] for r in rows)
     # β changes the run: β = 0.75 has a larger e(tf) than β = 0.5 at the same tf (see README)
@@ -51,7 +51,8 @@ def test_run_sweep_on_a_local_dask_cluster():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        rows = run_sweep(TEXT, NAME, [0.5, 0.75], [1.2, 1.9], executor=client.get_executor())
+        rows = run_sweep(LoadedScenario.parse(TEXT, NAME), [0.5, 0.75], [1.2, 1.9],
+                         executor=client.get_executor())
     assert len(rows) == 4 and all(r["ok"] for r in rows)
     direct = sweep_point(TEXT, NAME, 0.75, 1.9)
     assert rows[3]["e_tf"] == pytest.approx(direct["e_tf"], rel=1e-9)

@@ -50,10 +50,11 @@ CA_PROCESS_NOISE = 1.0e-3
 DEFAULT_SEEDS = 10
 
 
-def with_measurement(text: str, name: str, measurement: dict, seed: int) -> Scenario:
-    """The scenario with ``measurement`` fields (or dotted scenario fields, e.g.
-    ``controller.alpha_hold``) replaced and measurement.seed = ``seed``, validated."""
-    scenario = parse_scenario(text, name)
+def with_measurement(text, name: str, measurement: dict, seed: int) -> Scenario:
+    """The scenario (YAML ``text`` or a Scenario, copied) with ``measurement`` fields (or dotted
+    scenario fields, e.g. ``controller.alpha_hold``) replaced and measurement.seed = ``seed``,
+    validated."""
+    scenario = copy.deepcopy(text) if isinstance(text, Scenario) else parse_scenario(text, name)
     for key, value in measurement.items():  # "noise_std" or e.g. "controller.alpha_hold"
         owner, _, field = key.rpartition(".")
         setattr(getattr(scenario, owner) if owner else scenario.measurement, field, value)

@@ -24,10 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.controllers import CONTROLLERS, known_type, plugin
+from ptint_drake.controllers import CONTROLLERS
 from ptint_drake.figures import plt, save
 from ptint_drake.metrics import Reason
-from ptint_drake.scenario import ScenarioError, apply_variant, parse_scenario
+from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
@@ -35,27 +35,6 @@ DEFAULT_CONTROLLERS = CONTROLLERS  # every registered controller
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
 SEGMENT_KEYS = ("e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm", "t_arrive")
 _GRID_POINTS = 600
-
-
-def parse_list(text: str, flag: str, allowed=None) -> list[str]:
-    """A comma-separated option as a list; ScenarioError naming an unknown item."""
-    items = [v.strip() for v in text.split(",") if v.strip()]
-    if not items:
-        raise ScenarioError(f"{flag}: no values given")
-    for item in items:
-        if allowed is not None and item not in allowed:
-            raise ScenarioError(f"{flag}: unknown {item!r} (one of {', '.join(allowed)})")
-    return items
-
-
-def controller_list(text: str) -> list[str]:
-    """``--controllers``: registered names and plugins' ``module:Class``, comma-separated."""
-    items = parse_list(text, "--controllers")
-    for item in items:
-        if not known_type(item):
-            raise ScenarioError(f"--controllers: unknown {item!r} (one of {', '.join(CONTROLLERS)}, "
-                                f"or {plugin.FORM})")
-    return items
 
 
 def with_controller(scenario, controller: str):
@@ -96,13 +75,14 @@ def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
     }
 
 
-def run_compare(text: str, name: str, controllers=DEFAULT_CONTROLLERS, variants=DEFAULT_VARIANTS,
+def run_compare(loaded: LoadedScenario, controllers=DEFAULT_CONTROLLERS, variants=DEFAULT_VARIANTS,
                 workers=None, dask=None, progress=None) -> dict:
-    """Every controller × variant; the content of compare.json (rows keep their curves)."""
+    """Every controller × variant of the scenario ``loaded`` (the workers rebuild it from its
+    text); the content of compare.json (rows keep their curves)."""
     t0 = time.perf_counter()
-    tasks = [(text, name, c, v) for c, v in pairs(controllers, variants)]
+    tasks = [(loaded.text, loaded.name, c, v) for c, v in pairs(controllers, variants)]
     rows = run_tasks(compare_run, tasks, workers=workers, dask=dask, progress=progress)
-    return comparison(parse_scenario(text, name), name, controllers, variants, rows,
+    return comparison(loaded.scenario, loaded.name, controllers, variants, rows,
                       time.perf_counter() - t0)
 
 

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.outputs import staged_output, write_json_atomic
-from ptint_drake.scenario import Scenario, ScenarioError
+from ptint_drake.scenario import LoadedScenario, Scenario, ScenarioError
 from ptint_drake.studies.camera import DEFAULT_SEEDS, with_measurement
 from ptint_drake.studies.runner import run_tasks
 
@@ -149,10 +149,10 @@ def summarize_floor(rows: list) -> dict:
     return out
 
 
-def filter_floor(text: str, name: str, process_noises=FLOOR_PROCESS_NOISES, seeds: int = DEFAULT_SEEDS,
+def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, seeds: int = DEFAULT_SEEDS,
                  measurement: dict | None = None, sample_hz: float = FLOOR_SAMPLE_HZ,
                  workers: int | None = 2, dask=None, progress=None) -> dict:
-    """The filter-only error floor of a camera scenario (module docstring): for each
+    """The filter-only error floor of the camera scenario ``loaded`` (module docstring): for each
     process noise q in ``process_noises`` and measurement.seed = 1 … ``seeds``, one
     ``floor_case`` with ``measurement`` fields (e.g. ``{"noise_std": 0.001}``) also
     replaced; returns the settings, a ``table`` (per q: ``summarize_floor``), every run
@@ -169,10 +169,10 @@ def filter_floor(text: str, name: str, process_noises=FLOOR_PROCESS_NOISES, seed
     if not (np.isfinite(sample_hz) and sample_hz > 0.0):
         raise ScenarioError(f"sample_hz: must be > 0, got {sample_hz}")
     overrides = dict(measurement or {})
-    base = with_measurement(text, name, overrides, 1)  # a bad field fails before any worker starts
+    base = with_measurement(loaded.scenario, loaded.name, overrides, 1)  # before any worker starts
     check_floor_scenario(base)
     t0 = time.perf_counter()
-    cases = [(text, name, {**overrides, "process_noise": q}, seed, sample_hz)
+    cases = [(loaded.text, loaded.name, {**overrides, "process_noise": q}, seed, sample_hz)
              for q in qs for seed in range(1, seeds + 1)]
     rows = run_tasks(floor_case, cases, workers=workers, dask=dask, progress=progress)
     table = [{"process_noise": q, "summary": summarize_floor(rows[j * seeds:(j + 1) * seeds])}
@@ -180,7 +180,7 @@ def filter_floor(text: str, name: str, process_noises=FLOOR_PROCESS_NOISES, seed
     ranked = [row for row in table if "hold_max_median" in row["summary"]]
     best = min(ranked, key=lambda row: row["summary"]["hold_max_median"]) if ranked else None
     m = base.measurement
-    return {"scenario": name, "seeds": seeds, "sample_hz": sample_hz, "workers": workers,
+    return {"scenario": loaded.name, "seeds": seeds, "sample_hz": sample_hz, "workers": workers,
             "wall_time_s": time.perf_counter() - t0,
             "measurement_overrides": overrides,
             "measurement": {k: v for k, v in copy.deepcopy(vars(m)).items()

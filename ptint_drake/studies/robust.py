@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.figures import plt, save
-from ptint_drake.scenario import ScenarioError, dump_yaml, parse_scenario
+from ptint_drake.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
@@ -103,14 +103,16 @@ def _percentiles(values) -> dict:
         "max": float(values.max()), "min": float(values.min())}
 
 
-def run_robust(text: str, name: str, samples: int, seed: int = 0, workers: int = None,
+def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int = None,
                executor=None, ranges: dict = RANGES, progress=None, dask: str = None) -> dict:
-    """Run the study; returns the content of robust.json (plus ``rows`` and ``worst_yaml``).
+    """Run the study on the scenario ``loaded`` (each sample is rebuilt from its text);
+    returns the content of robust.json (plus ``rows`` and ``worst_yaml``).
     ``workers`` local processes (default 1), or ``dask`` (a scheduler address), or
     ``executor`` (used as given, left open).  ``progress(done, total)`` as samples arrive."""
     t0 = time.perf_counter()
     report = (lambda done, total, index, row: progress(done, total)) if progress else None
     stats = {}
+    text, name = loaded.text, loaded.name
     rows = run_tasks(robust_sample, [(text, name, seed + i, ranges) for i in range(samples)],
                      workers=workers or (None if executor or dask else 1), dask=dask,
                      executor=executor, progress=report, stats=stats)

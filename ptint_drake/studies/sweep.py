@@ -20,7 +20,7 @@ import numpy as np
 
 # Imported here, not in the worker function: forked workers then inherit them ready.
 from ptint_drake.figures import plt, save, uniform_derivatives
-from ptint_drake.scenario import ScenarioError, parse_scenario, validate
+from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, validate
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
@@ -61,12 +61,13 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
     return row
 
 
-def run_sweep(text: str, name: str, betas, tfs, executor: Executor = None, workers: int = None,
+def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, workers: int = None,
               progress=None, dask: str = None) -> list[dict]:
-    """Rows for the grid betas × tfs, in grid order.  ``executor`` is used as given and
+    """Rows for the grid betas × tfs of the scenario ``loaded``, in grid order (the workers
+    rebuild it from its text).  ``executor`` is used as given and
     left open; ``dask`` is a scheduler address; without either, ``workers`` local
     processes (default: CPU count).  ``progress(done, total)`` as rows arrive."""
-    points = [(text, name, float(b), float(tf)) for b in betas for tf in tfs]
+    points = [(loaded.text, loaded.name, float(b), float(tf)) for b in betas for tf in tfs]
     report = (lambda done, total, index, row: progress(done, total)) if progress else None
     return run_tasks(sweep_point, points, workers=workers, dask=dask, executor=executor,
                      progress=report)
@@ -162,5 +163,5 @@ def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
 def timed_sweep(text: str, name: str, betas, tfs, workers: int) -> float:
     """Wall seconds of a whole sweep with ``workers`` processes (pool start-up included)."""
     t0 = time.perf_counter()
-    run_sweep(text, name, betas, tfs, workers=workers)
+    run_sweep(LoadedScenario.parse(text, name), betas, tfs, workers=workers)
     return time.perf_counter() - t0

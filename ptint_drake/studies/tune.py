@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.metrics import segment_reasons
-from ptint_drake.scenario import ScenarioError, apply_variant, check_variants, parse_scenario
+from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, check_variants, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
@@ -169,11 +169,12 @@ def _first_bracket(grid, ok: dict, smallest: bool):
     return None, None
 
 
-def run_tune(text: str, name: str, settings: TuneSettings, workers=None, dask=None,
+def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=None,
              progress=None, say=print) -> dict:
-    """The search; returns the content of tune.json (plus ``scenario`` for tuned.yaml)."""
+    """The search on the scenario ``loaded`` (each run rebuilt from its text); returns the
+    content of tune.json (plus ``scenario`` for tuned.yaml)."""
     t0 = time.perf_counter()
-    scenario = parse_scenario(text, name)
+    text, name, scenario = loaded.text, loaded.name, loaded.scenario
     check_variants(scenario, settings.variants)
     check_gain(settings.gain, settings.bracket)
     lo, hi = settings.bracket or model_bracket(scenario, settings.gain)

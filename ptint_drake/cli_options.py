@@ -1,0 +1,193 @@
+"""The command line's option values: each option's parser and check in one argparse ``type=``.
+
+A value that fails its check raises ``OptionError``, which ``cli.main`` prints as the one line
+``ptint: error: FLAG: ...`` (exit 2), the form of every other bad input; a value of the wrong
+type (``--workers abc``) keeps argparse's own message and usage.  Each parser returns the
+value the command uses (a list of floats, a (name, (low, high)) pair, ...).  ``out_folder``
+checks an ``--out`` folder (the file system, not the text, decides).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import math
+from pathlib import Path
+
+from ptint_drake.scenario import ScenarioError
+
+
+class OptionError(Exception):
+    """An option value that fails its check; the message starts with the flag.  Not a
+    ValueError: argparse would turn that into its own "invalid ... value" message."""
+
+
+def _option(parse):
+    """``parse`` (raising ScenarioError naming the flag) as an argparse type."""
+    @functools.wraps(parse)
+    def checked(text: str):
+        try:
+            return parse(text)
+        except ScenarioError as exc:
+            raise OptionError(str(exc)) from None
+    return checked
+
+
+def _number(kind, text: str):
+    """``kind(text)``, or argparse's own message for a value that is not a number."""
+    try:
+        return kind(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid {kind.__name__} value: {text!r}") from None
+
+
+def floats(text: str, flag: str) -> list[float]:
+    """Comma-separated numbers (``0.25,0.5``); empty items are skipped, none at all is an error."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ScenarioError(f"{flag}: expected comma-separated numbers, got {text!r}") from None
+    if not values:
+        raise ScenarioError(f"{flag}: no values given")
+    return values
+
+
+def names(text: str, flag: str, allowed=None) -> list[str]:
+    """Comma-separated names; ScenarioError naming an item not in ``allowed`` (if given)."""
+    items = [v.strip() for v in text.split(",") if v.strip()]
+    if not items:
+        raise ScenarioError(f"{flag}: no values given")
+    for item in items:
+        if allowed is not None and item not in allowed:
+            raise ScenarioError(f"{flag}: unknown {item!r} (one of {', '.join(allowed)})")
+    return items
+
+
+@_option
+def betas(text: str) -> list[float]:
+    """``--beta``: TBG shapes β in (0, 1) (paper eq. 6)."""
+    values = floats(text, "--beta")
+    for b in values:
+        if not 0.0 < b < 1.0:
+            raise ScenarioError(f"--beta: every value must be in (0, 1), got {b}")
+    return values
+
+
+@_option
+def final_times(text: str) -> list[float]:
+    """``--tf``: prescribed times in s, each > 0."""
+    values = floats(text, "--tf")
+    for tf in values:
+        if not tf > 0.0:
+            raise ScenarioError(f"--tf: every value must be > 0, got {tf}")
+    return values
+
+
+@_option
+def process_noises(text: str) -> list[float]:
+    """``--process-noise``: the Kalman filter's process noises q, each > 0 and finite."""
+    values = floats(text, "--process-noise")
+    for q in values:
+        if not (q > 0.0 and q != math.inf):  # NaN fails the first test
+            raise ScenarioError(f"--process-noise: every value must be > 0 and finite, got {q:g}")
+    return values
+
+
+def count(flag: str):
+    """An argparse type for a count ``flag`` (``--workers``, ``--samples``, ``--seeds``): an int >= 1."""
+    def parse(text: str) -> int:
+        value = _number(int, text)
+        if value < 1:
+            raise OptionError(f"{flag}: must be >= 1, got {value}")
+        return value
+    return parse
+
+
+@_option
+def robust_range(pair: str) -> tuple[str, tuple[float, float]]:
+    """``--range NAME=LOW,HIGH`` of ``robust``: (NAME, (LOW, HIGH)) with 0 <= LOW <= HIGH."""
+    from ptint_drake.studies.robust import RANGES  # noqa: PLC0415
+
+    key, _, value = pair.partition("=")
+    if key not in RANGES:
+        raise ScenarioError(f"--range: unknown parameter {key!r} (one of {', '.join(RANGES)})")
+    lo_hi = floats(value, f"--range {key}")
+    if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or lo_hi[0] < 0:
+        raise ScenarioError(f"--range {key}: expected LOW,HIGH with 0 <= LOW <= HIGH, got {value!r}")
+    return key, (lo_hi[0], lo_hi[1])
+
+
+@_option
+def controller_list(text: str) -> list[str]:
+    """``--controllers`` of ``compare``: registered controllers and plugins' ``module:Class``."""
+    from ptint_drake.controllers import parse_types  # noqa: PLC0415
+
+    return parse_types(text, "--controllers")
+
+
+@_option
+def variant_list(text: str) -> list[str]:
+    """``--variants``: plant variant names (``scenario.apply_variant`` checks each one once
+    the scenario is loaded)."""
+    return names(text, "--variants")
+
+
+@_option
+def gain_name(text: str) -> str:
+    """``--gain`` of ``tune``: one of ``tune.GAINS``, or ``params.NAME`` of a plugin controller
+    (which needs ``--range``: checked once the command has every option)."""
+    from ptint_drake.studies.tune import GAINS, PARAM_PREFIX  # noqa: PLC0415
+
+    if text.startswith(PARAM_PREFIX) and text[len(PARAM_PREFIX):].isidentifier():
+        return text
+    if text not in GAINS:
+        raise ScenarioError(f"--gain: must be one of {', '.join(GAINS)} or params.NAME, got {text!r}")
+    return text
+
+
+@_option
+def gain_range(text: str) -> tuple[float, float]:
+    """``--range LO,HI`` of ``tune``: the search range instead of the model-derived one."""
+    values = floats(text, "--range")
+    if len(values) != 2 or not 0.0 < values[0] < values[1]:
+        raise ScenarioError(f"--range: expected LO,HI with 0 < LO < HI, got {text!r}")
+    return values[0], values[1]
+
+
+def margin(text: str) -> float:
+    """``--margin`` of ``tune``: the criteria are divided by it, so >= 1."""
+    value = _number(float, text)
+    if not value >= 1.0:
+        raise OptionError(f"--margin: must be >= 1, got {value}")
+    return value
+
+
+def saturation_fraction(text: str) -> float:
+    """``--max-saturation`` of ``tune``: a fraction of the time, in [0, 1]."""
+    value = _number(float, text)
+    if not 0.0 <= value <= 1.0:
+        raise OptionError(f"--max-saturation: must be in [0, 1], got {value}")
+    return value
+
+
+def out_folder(value, default: Path) -> Path:
+    """The ``--out`` folder (``default`` without one); ScenarioError if it or a parent is a file."""
+    out = Path(value) if value else default
+    for p in (out, *out.parents):
+        if p.exists():
+            if not p.is_dir():
+                raise ScenarioError(f"--out: {p} is a file" if p == out
+                                    else f"--out: {p} (in {out}) is a file")
+            break
+    return out
+
+
+def scenario_and_out(args: argparse.Namespace, prefix: str = "", name_or_file: str | None = None):
+    """(``LoadedScenario``, output folder) of a command: the scenario argument (or
+    ``name_or_file``) with its ``--set`` overrides, parsed once, and ``--out`` or
+    out/PREFIXNAME.  An ``--out`` that is a file fails before the scenario is read."""
+    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+
+    out_folder(args.out, Path("out"))
+    loaded = LoadedScenario.load(name_or_file or args.scenario, args.set)
+    return loaded, out_folder(args.out, Path("out") / f"{prefix}{loaded.scenario.name}")

@@ -1,0 +1,114 @@
+"""The commands that run one scenario or the paper: ``ptint list``, ``run``, ``diagram``, ``paper``,
+and their progress bar on stderr."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ptint_drake.cli_options import out_folder, scenario_and_out
+from ptint_drake.scenario import LoadedScenario, bundled_scenarios, scenario_text
+
+
+def progress(label: str):
+    """Progress on stderr: a bar redrawn in place on a terminal; otherwise (a log file,
+    a pipe) one line per 10 % of simulated time.  The returned ``report(t, duration,
+    steps=None)`` adds the integrator's step count when the caller passes it."""
+    tty = sys.stderr.isatty()
+    printed = [-1]  # the last tenth reported (non-tty)
+
+    def report(t, duration, steps=None):
+        frac = min(t / duration, 1.0) if duration > 0 else 1.0
+        extra = f", {steps} steps" if steps is not None else ""
+        if not tty:
+            tenth = int(frac * 10 + 1e-9)
+            if tenth <= printed[0]:
+                return
+            printed[0] = tenth
+            sys.stderr.write(f"{label}: {10 * tenth:3d} % ({t:.2f}/{duration:.2f} s simulated"
+                             f"{extra})\n")
+            sys.stderr.flush()
+            return
+        width = 30
+        done = int(width * frac)
+        end = "\n" if t >= duration else ""
+        sys.stderr.write(f"\r{label:<18} [{'#' * done}{'.' * (width - done)}] "
+                         f"{t:5.2f}/{duration:.2f} s simulated{extra}{end}")
+        sys.stderr.flush()
+    return report
+
+
+def cmd_list(args: argparse.Namespace) -> int:
+    """Each bundled scenario's name and the first line of its comment."""
+    for name in bundled_scenarios():
+        _, text = scenario_text(name)
+        first = text.splitlines()[0].lstrip("# ").strip() if text.startswith("#") else ""
+        print(f"{name:<18} {first}")
+    return 0
+
+
+def _mm(value) -> str:
+    return "n/a" if value is None else f"{value * 1e3:.4g} mm"
+
+
+def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
+    from ptint_drake.metrics import segment_reasons  # noqa: PLC0415
+
+    reasons = segment_reasons(seg, criteria)
+    return (f"{name} segment {i}: e0 = {_mm(seg['e0_norm'])}, e(tf/2) = {_mm(seg['e_half_norm'])}, "
+            f"e(tf) = {_mm(seg['e_tf_norm'])}, hold max = {_mm(seg['e_hold_max_norm'])}: "
+            + (f"MISSED ({', '.join(reasons)})" if reasons else "ok"))
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    """One scenario: its outputs, a line per segment; exit 1 when a segment missed or the run failed."""
+    from ptint_drake.run_outputs import run_and_write  # noqa: PLC0415
+
+    loaded, out = scenario_and_out(args)
+    scenario = loaded.scenario
+    warn = lambda message: print(f"ptint: warning: {message}", file=sys.stderr)  # noqa: E731
+    metrics = run_and_write(scenario, out, replay=not args.no_replay,
+                            figures=not args.no_figures,
+                            progress=None if args.quiet else progress(scenario.name), warn=warn)
+    for note in metrics["controller"]["notes"]:
+        print(note)
+    for i, seg in enumerate(metrics["segments"]):
+        print(_segment_line(scenario.name, i, seg, scenario.criteria))
+    sim = metrics["sim"]
+    print(f"realtime factor {sim['realtime_factor']:.2f} end to end, {sim['steps']} steps, "
+          f"{sim['derivative_evaluations']} derivative evaluations, saturated "
+          f"{100 * metrics['saturated_fraction']:.1f} % of the time; wrote {out}/")
+    for message in metrics["warnings"][metrics["warnings_before_run"]:]:
+        warn(message)
+    if metrics["status"] == "failed":
+        print(f"ptint: error: run failed: {metrics['failure']['message']} "
+              f"(outputs up to then are in {out}/, metrics.json says status: failed)", file=sys.stderr)
+        return 1
+    if metrics["status"] == "missed":
+        print(f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])}); the gains may not fit "
+              f"this arm or tf: try `ptint tune {args.scenario}`")
+        return 1
+    print(f"{scenario.name}: ok (every segment meets the criteria)")
+    return 0
+
+
+def cmd_diagram(args: argparse.Namespace) -> int:
+    """The scenario's diagram as Graphviz .dot and .svg."""
+    from ptint_drake.run_outputs import write_diagram  # noqa: PLC0415
+
+    scenario = LoadedScenario.load(args.scenario, args.set).scenario
+    out = out_folder(args.out, Path("out") / scenario.name)
+    paths = write_diagram(scenario, out)
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0
+
+
+def cmd_paper(args: argparse.Namespace) -> int:
+    """Every paper scenario, the TBG figures and index.html."""
+    from ptint_drake.paper_report import write_paper  # noqa: PLC0415
+
+    index = write_paper(out_folder(args.out, Path("out/paper")),
+                        progress_factory=None if args.quiet else progress)
+    print(f"wrote {index}")
+    return 0
