@@ -124,7 +124,7 @@ def cmd_study(args: argparse.Namespace) -> int:
 
     report = _every_tenth("study camera", "runs", args.quiet)
     if args.filter_floor:
-        return _filter_floor(args, camera, report)
+        return _filter_floor(args, report)
     for flag, value in (("--scenario", args.scenario), ("--process-noise", args.process_noise),
                         ("--set", args.set)):
         if value is not None:
@@ -138,13 +138,15 @@ def cmd_study(args: argparse.Namespace) -> int:
     return 0
 
 
-def _filter_floor(args: argparse.Namespace, camera, report) -> int:
+def _filter_floor(args: argparse.Namespace, report) -> int:
     """``ptint study camera --filter-floor``: the camera + Kalman filter alone, per q and seed."""
-    noises = args.process_noise if args.process_noise is not None else list(camera.FLOOR_PROCESS_NOISES)
-    loaded, out = scenario_and_out(args, "filter_floor_", args.scenario or camera.FLOOR_SCENARIO)
-    result = camera.filter_floor(loaded, noises, args.seeds, workers=args.workers, progress=report)
-    camera.write_filter_floor(result, out)
-    print(f"{camera.floor_summary_line(result)}; wrote {out}/filter_floor.md, filter_floor.json")
+    from ptint_drake.studies import filter_floor as floor  # noqa: PLC0415
+
+    noises = args.process_noise if args.process_noise is not None else list(floor.FLOOR_PROCESS_NOISES)
+    loaded, out = scenario_and_out(args, "filter_floor_", args.scenario or floor.FLOOR_SCENARIO)
+    result = floor.filter_floor(loaded, noises, args.seeds, workers=args.workers, progress=report)
+    floor.write_filter_floor(result, out)
+    print(f"{floor.floor_summary_line(result)}; wrote {out}/filter_floor.md, filter_floor.json")
     return 0
 
 

@@ -199,17 +199,3 @@ def run_study(seeds: int = DEFAULT_SEEDS, workers: int = 2, out: Path = Path("ou
         (stage / "camera_study.md").write_text(markdown(table, seeds, name) + footer)
         write_json_atomic(stage / "camera_study.json", result)
     return result
-
-
-# The command line's ``--filter-floor`` reads the filter-floor study's names through this module.
-_FLOOR_NAMES = ("FLOOR_SCENARIO", "FLOOR_PROCESS_NOISES", "filter_floor", "floor_summary_line",
-                "write_filter_floor")
-
-
-def __getattr__(name: str):
-    """``studies.filter_floor``'s names used by ``ptint study camera --filter-floor``."""
-    if name in _FLOOR_NAMES:
-        from ptint_drake.studies import filter_floor  # noqa: PLC0415  (it imports this module)
-
-        return getattr(filter_floor, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
