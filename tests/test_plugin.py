@@ -176,3 +176,18 @@ def test_params_are_plugin_only_and_reach_the_plugin_with_set(user_folder, monke
                                                                 "v": [1.0, 2.0]}
     assert TYPE not in REGISTRY and plugin.is_plugin(TYPE) and not plugin.is_plugin("ptsmc")
     assert load_scenario("curve_b075_tf15").controller.params == {}
+
+
+def test_tune_takes_a_plugin_parameter_with_its_range(user_folder):
+    from ptint_drake.studies import tune  # noqa: PLC0415
+
+    scenario = parse_scenario((user_folder / "pd_scenario.yaml").read_text())
+    tuned = tune._set_gain(scenario, "params.Kp", 3000.0)
+    assert tuned.controller.params == {"Kp": 3000.0, "Kd": 150.0} and scenario.controller.params["Kp"] == 2000.0
+    assert tune.gain_value(tuned, "params.Kp") == 3000.0
+    with pytest.raises(ScenarioError, match=r"^--range: params\.Kp needs --range LO,HI"):
+        tune.check_gain("params.Kp", ())
+    done = ptint("tune", "pd_scenario.yaml", "--gain", "params.Kp", "--out", str(user_folder / "t"),
+                 cwd=user_folder)
+    assert done.returncode == 2 and done.stderr.startswith("ptint: error: --range: params.Kp needs"), done.stderr
+    assert not (user_folder / "t").exists()
