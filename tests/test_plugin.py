@@ -183,11 +183,13 @@ def test_tune_takes_a_plugin_parameter_with_its_range(user_folder):
 
     scenario = parse_scenario((user_folder / "pd_scenario.yaml").read_text())
     tuned = tune._set_gain(scenario, "params.Kp", 3000.0)
-    assert tuned.controller.params == {"Kp": 3000.0, "Kd": 150.0} and scenario.controller.params["Kp"] == 2000.0
+    assert tuned.controller.params == {"Kp": 3000.0, "Kd": 150.0}
+    assert scenario.controller.params["Kp"] == 2000.0
     assert tune.gain_value(tuned, "params.Kp") == 3000.0
     with pytest.raises(ScenarioError, match=r"^--range: params\.Kp needs --range LO,HI"):
         tune.check_gain("params.Kp", ())
     done = ptint("tune", "pd_scenario.yaml", "--gain", "params.Kp", "--out", str(user_folder / "t"),
                  cwd=user_folder)
-    assert done.returncode == 2 and done.stderr.startswith("ptint: error: --range: params.Kp needs"), done.stderr
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith("ptint: error: --range: params.Kp needs"), done.stderr
     assert not (user_folder / "t").exists()
