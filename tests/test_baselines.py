@@ -19,6 +19,7 @@ from ptint_drake.systems.ct_quintic import (
 )
 from ptint_drake.systems.pd import PDConfig, PDController
 from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE
 from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
 from ptint_drake.systems.targets import SinusoidTarget
 
@@ -191,7 +192,8 @@ class _CurveSource(LeafSystem):
     def __init__(self, target):
         super().__init__()
         self.DeclareVectorOutputPort(
-            "target", 9, lambda c, o: o.SetFromVector(target.evaluate(c.get_time())[0:9]))
+            "target", TARGET_PORT_SIZE,
+            lambda c, o: o.SetFromVector(target.evaluate(c.get_time())[TARGET_PORT]))
 
 
 def _closed_loop(kind, schedule, target, predict=None):
@@ -293,7 +295,6 @@ def test_every_target_port_has_the_one_width():
     ``signals.TARGET_PORT_SIZE`` values laid out as ``signals.TARGET`` slots."""
     from ptint_drake.systems.builder import AddPrescribedTimeInterceptor
     from ptint_drake.systems.signals import TARGET as SLOTS
-    from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE
     from ptint_drake.systems.targets import TargetSource
 
     assert TARGET_PORT_SIZE == 9 and TARGET_PORT == slice(0, SLOTS.xddot.stop)
