@@ -31,7 +31,7 @@ from ptint_drake.scenario import Scenario
 from ptint_drake.station import MakeStation, Station
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.signals import TARGET
-from ptint_drake.systems.targets import active_target_state, target_values
+from ptint_drake.systems.targets import active_target_values, target_values
 from ptint_drake.watchdog import Watchdog
 
 
@@ -153,7 +153,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
         return kinematics.compute(qv[:nq], qv[nq:])
 
     schedule, targets = scenario.schedule(), built.station.true_targets
-    true_state = lambda t: active_target_state(schedule, targets, t)  # noqa: E731
+    true_state = lambda t: active_target_values(schedule, targets, t)  # noqa: E731
     watchdog = Watchdog(scenario=scenario, diagram=built.diagram, plant=plant,
                         position_of=lambda c: gripper(c)[0], true_target=lambda t: true_state(t)[TARGET.x],
                         progress=progress)

@@ -19,6 +19,7 @@ from ptint_drake.systems.ct_quintic import (
 )
 from ptint_drake.systems.pd import PDConfig, PDController
 from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE
 from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
 from ptint_drake.systems.targets import SinusoidTarget
 
@@ -191,7 +192,8 @@ class _CurveSource(LeafSystem):
     def __init__(self, target):
         super().__init__()
         self.DeclareVectorOutputPort(
-            "target", 9, lambda c, o: o.SetFromVector(target.evaluate(c.get_time())[0:9]))
+            "target", TARGET_PORT_SIZE,
+            lambda c, o: o.SetFromVector(target.evaluate(c.get_time())[TARGET_PORT]))
 
 
 def _closed_loop(kind, schedule, target, predict=None):
@@ -286,3 +288,36 @@ def test_configs_load_from_yaml():
     assert yaml_load_typed(schema=SMCConfig, data="lambda_factor: 3.0\nswitching: sat\n") == \
         SMCConfig(lambda_factor=3.0, switching="sat")
     assert yaml_load_typed(schema=CtQuinticConfig, data="omega: 30.0\n") == CtQuinticConfig(omega=30.0)
+
+
+def test_every_target_port_has_the_one_width():
+    """Baselines, the fused system, the blocks' target input and ``TargetSource`` all take
+    ``signals.TARGET_PORT_SIZE`` values laid out as ``signals.TARGET`` slots."""
+    from ptint_drake.systems.builder import AddPrescribedTimeInterceptor
+    from ptint_drake.systems.signals import TARGET as SLOTS
+    from ptint_drake.systems.targets import TargetSource
+
+    assert TARGET_PORT_SIZE == 9 and TARGET_PORT == slice(0, SLOTS.xddot.stop)
+    schedule = Schedule([Segment(0.0, 1.5, 0.75)])
+    plant = _plant()
+    for kind in ("pd", "smc", "ct_quintic"):
+        assert _make(kind, plant, schedule).GetInputPort("target").size() == TARGET_PORT_SIZE
+    assert TargetSource(schedule, [CURVE]).GetOutputPort("target").size() == TARGET_PORT_SIZE
+    for fused in (True, False):
+        builder = DiagramBuilder()
+        robot = builder.AddSystem(_plant())
+        handles = AddPrescribedTimeInterceptor(builder, robot, robot.GetFrameByName(rvm1.END_EFFECTOR),
+                                               schedule, None, fused=fused)
+        assert handles.target_input.size() == TARGET_PORT_SIZE
+
+
+def test_prediction_reads_the_named_slots():
+    """ct_quintic's constant-acceleration prediction takes x_r, ẋ_r, ẍ_r from their slots."""
+    from ptint_drake.systems.ct_quintic import constant_acceleration_predict
+    from ptint_drake.systems.signals import TARGET as SLOTS
+
+    target = np.zeros(9)
+    target[SLOTS.x], target[SLOTS.xdot], target[SLOTS.xddot] = [0.2, 0.1, 0.3], [0.1, -0.2, 0.0], [1, 2, 3]
+    goal = constant_acceleration_predict(target, 0.5)
+    np.testing.assert_allclose(goal[SLOTS.x], [0.2 + 0.05 + 0.125, 0.1 - 0.1 + 0.25, 0.3 + 0.375])
+    np.testing.assert_allclose(goal[SLOTS.xdot], [0.1 + 0.5, -0.2 + 1.0, 1.5])

@@ -5,7 +5,7 @@ import pytest
 
 from ptint_drake.systems.controller import SlidingModeController
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.sliding_surface import SlidingSurface, switching_function
+from ptint_drake.systems.sliding_surface import SlidingSurface, SurfaceLaw, switching_law
 from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, TargetSource
 from ptint_drake.systems.tbg import TimeBaseGenerator
 
@@ -58,8 +58,8 @@ def test_surface_hold_decay_and_capture_instant():
 
 @pytest.mark.parametrize("law", ["sign", "tanh", "sat"])
 def test_switching_laws(law):
-    w = np.array([-1.0, -1e-3, 0.0, 1e-3, 1.0])
-    out = switching_function(w, law, 0.01)
+    switch = switching_law(law, 0.01)
+    out = np.array(switch([-1.0, -1e-3, 0.0]) + switch([1e-3, 1.0, 2.0])[:2])
     assert out[0] == -1.0 or out[0] == pytest.approx(-1.0)
     assert out[-1] == pytest.approx(1.0)
     assert out[2] == 0.0
@@ -137,15 +137,57 @@ def test_solve3_matches_numpy_and_survives_singular():
     for _ in range(200):
         J = rng.normal(size=(3, 3))
         b = rng.normal(size=3)
-        np.testing.assert_allclose(solve3(J, b), np.linalg.solve(J, b), rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(solve3(J.tolist(), b.tolist()), np.linalg.solve(J, b),
+                                   rtol=1e-9, atol=1e-9)
     singular = np.array([[1.0, 2, 3], [2, 4, 6], [0, 1, 1]])
-    assert np.all(np.isfinite(solve3(singular, np.ones(3))))
+    assert np.all(np.isfinite(solve3(singular.tolist(), [1.0, 1.0, 1.0])))
 
 
-def test_scalar_tbg_matches_vector_form():
-    from ptint_drake.systems.tbg import gamma_gain, tbg_profile, tbg_profile_scalar
+@pytest.mark.parametrize("law", ["sign", "tanh", "sat"])
+def test_switching_law_is_numpys_to_the_last_bit(law):
+    """The plain-float law equals numpy's array form exactly (sign, tanh, clip)."""
+    reference = {"sign": np.sign, "tanh": lambda w: np.tanh(w / 0.01),
+                 "sat": lambda w: np.clip(w / 0.01, -1.0, 1.0)}[law]
+    switch = switching_law(law, 0.01)
+    w = np.random.default_rng(3).normal(scale=0.02, size=(500, 3))
+    for row in w:
+        assert switch(row.tolist()) == reference(row).tolist()
+    with pytest.raises(ValueError, match="controller.switching"):
+        switching_law("relay", 0.01)
 
-    for beta in (0.25, 0.5, 0.75, 0.9):
-        for tau in (-0.1, 0.0, 1e-6, 0.3, 0.75, 1.4999, 1.5, 2.0):
-            np.testing.assert_allclose(tbg_profile_scalar(tau, 1.5, beta, gamma_gain(1.5, beta)),
-                                       tbg_profile(tau, 1.5, beta), rtol=1e-12, atol=1e-300)
+
+def test_surface_law_matches_the_paper_equations():
+    """``SurfaceLaw.values`` (what the fused system and the block call) against eqs. 11, 16, 17
+    written with numpy arrays: e, ė, s = ė + αe, s_d = s(t0) e^(−kτ) (hold: e^(−k tf − k_hold(τ − tf))),
+    s_x = s − s_d + Λσ, σ̇ = tanh((s − s_d)/φ)."""
+    law = SurfaceLaw(Lambda=5.0, k=3.0, switching="tanh", phi=0.01, k_hold=50.0)
+    rng = np.random.default_rng(11)
+    for t, phase_tf in ((0.7, 1.5), (1.8, 1.5)):
+        x, xdot, x_r, xdot_r, sigma, s0 = rng.normal(scale=0.1, size=(6, 3))
+        alpha = 2.5
+        out = np.array(law.values(t, x.tolist(), xdot.tolist(), x_r.tolist(), xdot_r.tolist(), alpha,
+                                  [0.0, 0.0, phase_tf, 0.75, 1.0], [0.0, *s0], sigma.tolist()))
+        e, edot = x - x_r, xdot - xdot_r
+        s = edot + alpha * e
+        decay = np.exp(-3.0 * t) if t < phase_tf else np.exp(-3.0 * phase_tf - 50.0 * (t - phase_tf))
+        s_d = s0 * decay
+        expected = np.concatenate([s - s_d + 5.0 * sigma, e, edot, s, s_d, np.tanh((s - s_d) / 0.01)])
+        np.testing.assert_allclose(out, expected, rtol=1e-13, atol=1e-15)
+
+
+@pytest.mark.parametrize("nv, damping", [(3, 0.0), (3, 0.05), (5, 0.0), (5, 0.05)])
+def test_smc_torque_is_minus_K_pinv_J_s_x(nv, damping):
+    """``smc_torque`` (fused system, block and SMC baseline) against τ = −K J⁺ s_x (eq. 18) with
+    numpy: J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ (λ = 0: the inverse or the minimum-norm pseudoinverse); it takes
+    lists (the fast form) and arrays alike and gives the same floats."""
+    from ptint_drake.systems.controller import smc_torque
+
+    rng = np.random.default_rng(nv + int(100 * damping))
+    K = rng.uniform(10.0, 60.0, nv)
+    for _ in range(20):
+        J = rng.normal(size=(3, nv))
+        s_x = rng.normal(size=3)
+        pinv = J.T @ np.linalg.inv(J @ J.T + damping**2 * np.eye(3))
+        tau = smc_torque(K.tolist(), J.tolist(), s_x.tolist(), damping)
+        np.testing.assert_allclose(tau, -K * (pinv @ s_x), rtol=1e-9, atol=1e-12)
+        assert smc_torque(K.tolist(), J, s_x, damping) == tau

@@ -94,3 +94,45 @@ def test_rejects_plants_it_cannot_drive():
     with pytest.raises(ValueError, match="finalized"):
         AddPrescribedTimeInterceptor(builder, plant, plant.world_frame(),
                                      Schedule([Segment(0, 1, 0.5)]), [LinearTarget([0, 0, 0], [0, 0, 0])])
+
+
+def _closed_loop(urdf, fused, gains, schedule, target):
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    Parser(plant).AddModelsFromString(urdf, "urdf")
+    plant.Finalize()
+    h = AddPrescribedTimeInterceptor(builder, plant, plant.GetFrameByName("hand"), schedule, [target],
+                                     gains, fused=fused)
+    return builder.Build(), plant, h
+
+
+@pytest.mark.parametrize("urdf, q, gains", [
+    (OFFSET_ARM, [0.3, 0.5, 1.2], ControllerGains()),
+    (OFFSET_ARM, [0.3, 0.5, 1.2], ControllerGains(pinv_damping=0.05, switching="sat")),
+    (REDUNDANT_ARM, [0.3, 0.5, 1.0, 0.4], ControllerGains(null_space_damping=2.0))])
+def test_fused_and_blocks_compute_the_same_floats(urdf, q, gains):
+    """The fused system and the five blocks call the same functions: the same torque to the last
+    bit, mid-segment and in the hold, for a given state, σ and captured s(t0)."""
+    schedule = Schedule([Segment(0.0, 1.0, 0.75)])
+    target = LinearTarget([0.35, -0.1, 0.5], [0.0, 0.1, 0.0])
+    rng = np.random.default_rng(len(q))
+    v = rng.normal(scale=0.3, size=len(q))
+    sigma, s0 = rng.normal(scale=0.01, size=(2, 3))
+    torques = []
+    for fused in (True, False):
+        diagram, plant, h = _closed_loop(urdf, fused, gains, schedule, target)
+        ctx = diagram.CreateDefaultContext()
+        diagram.ExecuteInitializationEvents(ctx)
+        plant.SetPositionsAndVelocities(plant.GetMyMutableContextFromRoot(ctx), np.r_[q, v])
+        system = h.fused if fused else h.surface
+        sub = system.GetMyMutableContextFromRoot(ctx)
+        sub.SetContinuousState(sigma)
+        sub.SetDiscreteState(np.r_[0.0, s0])
+        row = []
+        for t in (0.4, 1.3):
+            ctx.SetTime(t)
+            out = h.fused.GetOutputPort("tau") if fused else h.controller.GetOutputPort("tau")
+            row.append(out.Eval(out.get_system().GetMyContextFromRoot(ctx)).tolist())
+        torques.append(row)
+    assert torques[0] == torques[1]
+    assert all(np.all(np.isfinite(r)) and np.any(np.abs(r) > 1e-3) for r in torques[0])

@@ -6,7 +6,15 @@ from scipy.integrate import solve_ivp
 from scipy.special import betaincinv, gamma
 
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.tbg import TimeBaseGenerator, alpha_gain, alpha_peak, gamma_gain, tbg_profile
+from ptint_drake.systems.tbg import (
+    TimeBaseGenerator,
+    alpha_gain,
+    alpha_peak,
+    gamma_gain,
+    tbg_derivatives,
+    tbg_profile,
+    tbg_state,
+)
 
 
 @pytest.mark.parametrize("beta", [0.25, 0.5, 0.75, 0.9])
@@ -118,3 +126,44 @@ def test_leaf_system_restarts_each_segment_and_holds():
     ctx.SetTime(0.8)  # restart: ξ back at 1, α back at 0
     assert tbg.get_xi_output_port().Eval(ctx)[0] == 1.0
     assert tbg.get_alpha_output_port().Eval(ctx)[0] == 0.0
+
+
+def _paper_tbg(tau, tf, beta):
+    """Eqs. 6-10 with numpy arrays: ξ = I⁻¹(1−β, 1−β; 1 − τ/tf), η = 1 − ξ taken directly as
+    I⁻¹(1−β, 1−β; τ/tf), ξ̇ = −γ(ξη)^β and its time derivatives by the chain rule."""
+    u = np.asarray(tau, dtype=float) / tf
+    a, g = 1.0 - beta, gamma_gain(tf, beta)
+    xi, eta = betaincinv(a, a, 1.0 - u), betaincinv(a, a, u)
+    p = xi * eta
+    xi_d = -g * p**beta
+    xi_dd = g**2 * beta * (1.0 - 2.0 * xi) * p ** (2.0 * beta - 1.0)
+    xi_ddd = -g**3 * beta * p ** (3.0 * beta - 2.0) * ((2.0 * beta - 1.0) * (1.0 - 2.0 * xi) ** 2 - 2.0 * p)
+    return np.array([xi, xi_d, xi_dd, xi_ddd])
+
+
+@pytest.mark.parametrize("beta", [0.25, 0.5, 0.75, 0.9])
+def test_one_tbg_function_matches_the_paper_equations(beta):
+    """``tbg_state`` — what the fused system and the TBG block both call — against a numpy
+    reference of eqs. 6-10 and 13 inside the segment, and the fixed values before and after."""
+    tf, start = 1.5, 0.2
+    sched = Schedule([Segment(start, tf, beta)])
+    times = start + tf * np.array([1e-9, 1e-4, 0.1, 0.3, 0.5, 0.75, 0.9, 0.999, 1 - 1e-9])
+    tau = times - start  # as the schedule sees it
+    reference = _paper_tbg(tau, tf, beta)
+    for k, tk in enumerate(tau):
+        row = tbg_state(sched, float(times[k]), epsilon=1e-6, delta=1e-6)
+        assert len(row) == 10 and all(type(v) is float for v in row)
+        np.testing.assert_allclose(row[0:4], reference[:, k], rtol=1e-11, atol=1e-300)
+        assert row[4] == pytest.approx(-(1 + 1e-6) * reference[1, k] / (reference[0, k] + 1e-6), rel=1e-11)
+        assert row[5:] == [0.0, start, tf, beta, 1.0]
+        # the array form is the same function, to the bit
+        assert tbg_profile(np.array([tk]), tf, beta)[1][0] == row[1]
+        assert tbg_derivatives(float(tk), tf, beta, gamma_gain(tf, beta)) == tuple(row[0:4])
+    assert tbg_state(sched, 0.0) == [1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0]
+    assert tbg_state(sched, start + tf, alpha_hold=7.0)[0:5] == [0.0, 0.0, 0.0, 0.0, 7.0]
+    assert TimeBaseGenerator(sched).evaluate(start + 0.4).tolist() == tbg_state(sched, start + 0.4)
+
+
+def test_schedule_gamma_is_gamma_gain():
+    sched = Schedule([Segment(0.0, 1.5, 0.75), Segment(2.0, 0.9, 0.3)])
+    assert [sched.gamma(i) for i in range(2)] == [gamma_gain(1.5, 0.75), gamma_gain(0.9, 0.3)]

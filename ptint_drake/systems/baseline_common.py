@@ -1,25 +1,19 @@
 """Pieces shared by the baseline controllers (``pd``, ``smc``, ``ct_quintic``).
 
 Every baseline has the same ports: inputs ``state`` ([q; v], nq + nv) and ``target``
-([x_r, ẋ_r, ẍ_r], 9); outputs ``u`` (actuation, u = Bᵀ τ), ``tau`` (nv, velocity
+([x_r, ẋ_r, ẍ_r], ``signals.TARGET_PORT``); outputs ``u`` (actuation, u = Bᵀ τ), ``tau`` (nv, velocity
 order) and ``telemetry`` whose slots are named by the system's ``layout``.
-Segment starts are Drake events: one initialization event and one one-shot timed
-event per later start, so the integrator stops exactly at each switch.
+Segment starts are Drake events (``schedule.DeclareSegmentStartEvents``): one
+initialization event and one one-shot timed event per later start, so the integrator stops
+exactly at each switch.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 
-import numpy as np
-
-from ptint_drake.systems.controller import solve3
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import Slots
-
-# One-shot timed events are periodic events whose period exceeds any simulation.
-ONE_SHOT_PERIOD = 1.0e9
-TARGET_SIZE = 9
 
 
 def make_layout(sizes: Iterable[tuple[str, int]]) -> dict:
@@ -28,30 +22,13 @@ def make_layout(sizes: Iterable[tuple[str, int]]) -> dict:
 
 
 def layout_size(layout: dict) -> int:
+    """The length of a telemetry vector with this ``layout``."""
     return max(s.stop for s in layout.values())
 
 
 def segment_index(schedule: Schedule, t: float) -> int:
     """The active segment at t; before the first start, the first segment (it is what comes)."""
     return max(schedule.active(t), 0)
-
-
-def DeclareSegmentStartEvents(system, schedule: Schedule, handler: Callable) -> None:
-    """``handler(context, state)`` as an unrestricted update at initialization and at every
-    segment start after t = 0 (a segment starting at 0 is handled by the initialization)."""
-    system.DeclareInitializationUnrestrictedUpdateEvent(handler)
-    for start in schedule.starts:
-        if start > 0.0:
-            system.DeclarePeriodicUnrestrictedUpdateEvent(ONE_SHOT_PERIOD, start, handler)
-
-
-def pinv_apply(J: np.ndarray, b: np.ndarray, damping: float = 0.0) -> np.ndarray:
-    """J⁺ b: a solve for square J, the (optionally damped) minimum-norm solution otherwise."""
-    if damping > 0.0:
-        return J.T @ solve3(J @ J.T + damping * damping * np.eye(3), b)
-    if J.shape[1] == 3:
-        return solve3(J, b)
-    return J.T @ np.linalg.solve(J @ J.T, b)
 
 
 def DeclareControllerOutputs(system, plant, layout: dict, evaluate: Callable, deps: set) -> None:

@@ -17,15 +17,15 @@ must actuate each of its velocities (nv = nu).
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
-import numpy as np
 from pydrake.systems.framework import InputPort, OutputPort
 from pydrake.systems.primitives import Demultiplexer
 
-from ptint_drake.systems.controller import SlidingModeController
+from ptint_drake.systems.controller import SlidingModeController, null_space_terms
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.interceptor import PrescribedTimeInterceptor
 from ptint_drake.systems.kinematics import TaskSpaceKinematics
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import TARGET_PORT_SIZE
 from ptint_drake.systems.sliding_surface import SlidingSurface
 from ptint_drake.systems.targets import TargetSource
 from ptint_drake.systems.tbg import TimeBaseGenerator
@@ -59,8 +59,8 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     ``fused=True`` adds the same computation as one ``PrescribedTimeInterceptor``
     system (several times faster to simulate; fewer ports to inspect).
     ``targets=None`` builds it without any target object: the handles'
-    ``target_input`` (9: [x_r, ẋ_r, ẍ_r] of the active segment) is for the caller to
-    connect, e.g. to a Kalman filter.  ``state_port`` is where [q; v] comes from
+    ``target_input`` ([x_r, ẋ_r, ẍ_r] of the active segment, ``signals.TARGET_PORT``) is for
+    the caller to connect, e.g. to a Kalman filter.  ``state_port`` is where [q; v] comes from
     (default: the plant's state output; e.g. a station's exported ``state``).
     ``posture``: the joint positions the optional null-space term (``gains.null_space_damping``,
     redundant arms) pulls toward (default: the plant's default positions).
@@ -97,7 +97,8 @@ def _add_blocks(builder, plant, frame, *, schedule, targets, gains, connect_actu
     tbg = builder.AddNamedSystem(f"{name}_tbg", TimeBaseGenerator(
         schedule, gains.epsilon, gains.delta, gains.alpha_hold))
     if targets is None:
-        source = builder.AddNamedSystem(f"{name}_target", Demultiplexer([3, 3, 3]))
+        # x_r | ẋ_r | ẍ_r
+        source = builder.AddNamedSystem(f"{name}_target", Demultiplexer(TARGET_PORT_SIZE, 3))
         x_r, xdot_r = source.get_output_port(0), source.get_output_port(1)
     else:
         source = builder.AddNamedSystem(f"{name}_target", TargetSource(schedule, targets))
@@ -105,10 +106,7 @@ def _add_blocks(builder, plant, frame, *, schedule, targets, gains, connect_actu
     kin = builder.AddNamedSystem(f"{name}_kinematics", TaskSpaceKinematics(plant, frame))
     surface = builder.AddNamedSystem(f"{name}_surface", SlidingSurface(
         schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy, gains.k_hold))
-    null_space = None
-    if gains.null_space_damping > 0.0 and nv > 3:
-        start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
-        null_space = (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float))
+    null_space = null_space_terms(gains, plant, posture)
     ctrl = builder.AddNamedSystem(f"{name}_controller", SlidingModeController(
         nv, gains.K, plant.MakeActuationMatrix(), gains.pinv_damping, null_space))
     if null_space is not None:

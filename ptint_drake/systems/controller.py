@@ -14,57 +14,46 @@ from pydrake.systems.framework import LeafSystem
 from ptint_drake.systems.cache import DeclareVectorCache
 
 
-def _solve3_floats(J, b):
-    """J⁻¹ b for a 3 × 3 J (3 rows of plain floats) by Cramer's rule; None when J is
-    numerically singular."""
-    (a, b_, c), (d, e, f), (g, h, i) = J
+def solve3(A: list, b: list) -> list:
+    """A⁻¹ b for a 3 × 3 A (3 rows of plain floats) and b (3 plain floats) by Cramer's rule
+    (numpy's solve costs ~15 µs here); a least-squares solution when A is numerically singular."""
+    (a, b_, c), (d, e, f), (g, h, i) = A
     co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * co0 + b_ * co1 + c * co2
     scale = max(abs(a), abs(b_), abs(c), abs(d), abs(e), abs(f), abs(g), abs(h), abs(i)) or 1.0
     if abs(det) <= 1e-12 * scale**3:
-        return None
+        return np.linalg.lstsq(np.array(A), np.array(b), rcond=None)[0].tolist()
     x, y, z = b
     return [(co0 * x + (c * h - b_ * i) * y + (b_ * f - c * e) * z) / det,
             (co1 * x + (a * i - c * g) * y + (c * d - a * f) * z) / det,
             (co2 * x + (b_ * g - a * h) * y + (a * e - b_ * d) * z) / det]
 
 
-def solve3(J: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """J⁻¹ b for a 3 × 3 J by Cramer's rule in plain floats (numpy's solve costs ~15 µs here).
-
-    Falls back to a least-squares solve when J is numerically singular.
-    """
-    out = _solve3_floats(np.asarray(J, dtype=float).tolist(), np.asarray(b, dtype=float).tolist())
-    if out is None:
-        return np.linalg.lstsq(J, b, rcond=None)[0]
-    return np.array(out)
-
-
-def smc_torque_values(K, J, s_x, damping: float = 0.0) -> list:
-    """``smc_torque`` in plain floats: K a sequence of nv gains, J a list of 3 rows, s_x a
-    list of 3; returns τ as a list (the per-derivative fast path)."""
-    if damping > 0.0 or len(J[0]) != 3:
-        return smc_torque(np.asarray(K, dtype=float), np.array(J), np.array(s_x), damping).tolist()
-    qdot_s = _solve3_floats(J, s_x)
-    if qdot_s is None:
-        qdot_s = np.linalg.lstsq(np.array(J), np.array(s_x), rcond=None)[0].tolist()
-    return [-k * a for k, a in zip(K, qdot_s)]
-
-
-def smc_torque(K: np.ndarray, J: np.ndarray, s_x: np.ndarray, damping: float = 0.0) -> np.ndarray:
-    """τ = −K J⁺ s_x: a linear solve for square J, the minimum-norm solution otherwise.
+def pinv_apply(J, b, damping: float = 0.0) -> list:
+    """J⁺ b for a 3 × nv J and a 3-vector b (lists of plain floats, the fast form, or arrays),
+    as a list: a solve for square J, the minimum-norm solution Jᵀ(JJᵀ)⁻¹ b otherwise.
 
     With ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which
     stays bounded through singular configurations at the cost of a small bias near them.
     """
     if damping > 0.0:
-        qdot_s = J.T @ solve3(J @ J.T + damping * damping * np.eye(3), s_x)
-    elif J.shape[1] == 3:
-        return np.array(smc_torque_values(np.broadcast_to(K, (3,)).tolist(), J.tolist(),
-                                          np.asarray(s_x, dtype=float).tolist()))
-    else:
-        qdot_s = J.T @ np.linalg.solve(J @ J.T, s_x)
-    return -K * qdot_s
+        Ja = np.asarray(J, dtype=float)  # an array keeps its memory order: BLAS's rounding does too
+        return (Ja.T @ solve3((Ja @ Ja.T + damping * damping * np.eye(3)).tolist(), _floats(b))).tolist()
+    if len(J[0]) == 3:
+        return solve3(J if type(J) is list else J.tolist(), _floats(b))
+    Ja = np.asarray(J, dtype=float)
+    return (Ja.T @ np.linalg.solve(Ja @ Ja.T, b)).tolist()
+
+
+def _floats(values) -> list:
+    """A 3-vector (list or array) as a list of plain floats."""
+    return values if type(values) is list else np.asarray(values, dtype=float).tolist()
+
+
+def smc_torque(K, J, s_x, damping: float = 0.0) -> list:
+    """τ = −K J⁺ s_x (paper eq. 18) as a list of plain floats: K a sequence of nv gains (N·m·s/rad),
+    J (3 × nv) and s_x (3) as ``pinv_apply`` takes them."""
+    return [-k * a for k, a in zip(K, pinv_apply(J, s_x, damping))]
 
 
 def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.ndarray,
@@ -73,6 +62,16 @@ def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.n
     projected so that it does not move the gripper point (zero for a square, full-rank J)."""
     w = v + rate * (q - q_start)
     return -damping * (w - J.T @ np.linalg.solve(J @ J.T, J @ w))
+
+
+def null_space_terms(gains, plant, posture=None):
+    """(D, r, q_start) of ``null_space_torque`` for ``gains`` (a ``ControllerGains``), or None
+    when it is off: ``gains.null_space_damping`` = 0, or a square arm (nv = 3).  q_start is
+    ``posture``, by default the plant's default positions (needs nq = nv)."""
+    if not (gains.null_space_damping > 0.0 and plant.num_velocities() > 3):
+        return None
+    start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
+    return (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float))
 
 
 class SlidingModeController(LeafSystem):
@@ -92,6 +91,7 @@ class SlidingModeController(LeafSystem):
         self._nv = nv
         self._damping = float(pinv_damping)
         self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
+        self._K_floats = tuple(self._K.tolist())
         self._BT = None if actuation_matrix is None else np.asarray(actuation_matrix).T
         nu = nv if actuation_matrix is None else self._BT.shape[0]
         self._s_x_in = self.DeclareVectorInputPort("s_x", 3)
@@ -107,8 +107,8 @@ class SlidingModeController(LeafSystem):
             prerequisites_of_calc=deps)
 
     def torque(self, s_x: np.ndarray, J: np.ndarray) -> np.ndarray:
-        """τ = −K J⁺ s_x for a 3 × nv Jacobian J."""
-        return smc_torque(self._K, J, s_x, self._damping)
+        """τ = −K J⁺ s_x (``smc_torque``) for a 3 × nv Jacobian J."""
+        return np.array(smc_torque(self._K_floats, J, s_x, self._damping))
 
     def _tau(self, context) -> np.ndarray:
         J = self._J_in.Eval(context).reshape(3, self._nv)

@@ -47,16 +47,15 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import Multiplexer
 
 from ptint_drake.systems.baseline_common import (
-    TARGET_SIZE,
-    DeclareSegmentStartEvents,
     layout_size,
     make_layout,
-    pinv_apply,
     segment_index,
 )
 from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.controller import pinv_apply
 from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
+from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
 
 Predictor = Callable[[int, float, np.ndarray], np.ndarray]
 
@@ -103,8 +102,9 @@ def quintic_eval(c: np.ndarray, s: float):
 
 
 def constant_acceleration_predict(target: np.ndarray, dt: float) -> np.ndarray:
-    """[x, ẋ] after dt (s) of a point moving with the constant acceleration of ``target``."""
-    x, v, a = target[0:3], target[3:6], target[6:9]
+    """[x, ẋ] after dt (s) of a point moving with the constant acceleration of ``target``
+    ([x_r, ẋ_r, ẍ_r]); the result's slots are ``TARGET.x`` and ``TARGET.xdot``."""
+    x, v, a = target[TARGET.x], target[TARGET.xdot], target[TARGET.xddot]
     return np.concatenate([x + v * dt + 0.5 * a * dt * dt, v + a * dt])
 
 
@@ -134,7 +134,7 @@ class QuinticReference(LeafSystem):
         self._bias_context = plant.CreateDefaultContext()
         self.layout = ct_reference_layout(nq)
         self._state_in = self.DeclareVectorInputPort("state", 2 * nq)
-        self._target_in = self.DeclareVectorInputPort("target", TARGET_SIZE)
+        self._target_in = self.DeclareVectorInputPort("target", TARGET_PORT_SIZE)
         self._plan_index = self.DeclareDiscreteState(np.concatenate([[-1.0], np.zeros(6 + 8 * nq)]))
         DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
         deps = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
@@ -210,14 +210,14 @@ class QuinticReference(LeafSystem):
         q0, v0 = qv[: self._n], qv[self._n:]
         target = self._target_in.Eval(context)
         goal = self._predicted(i, t0, t1, target)
-        q_f, reached = self.solve_ik(goal[0:3], q0, i, target[0:3])
+        q_f, reached = self.solve_ik(goal[TARGET.x], q0, i, target[TARGET.x])
         _, _, J_f = self._kinematics.compute(q_f, np.zeros(self._n))
-        v_f = pinv_apply(J_f, goal[3:6], self._config.pinv_damping)
+        v_f = pinv_apply(J_f, goal[TARGET.xdot], self._config.pinv_damping)
         zero = np.zeros(self._n)
         c = quintic_coefficients(q0, v0, zero, q_f, v_f, zero, t1 - t0) if t1 > t0 else \
             np.zeros((6, self._n))
         state.get_mutable_discrete_state(self._plan_index).SetFromVector(
-            np.concatenate([[i, t0, t1, float(reached)], goal[0:3], q_f, v_f, c.ravel()]))
+            np.concatenate([[i, t0, t1, float(reached)], goal[TARGET.x], q_f, v_f, c.ravel()]))
 
     def _calc(self, context) -> np.ndarray:
         t = context.get_time()
@@ -232,7 +232,7 @@ class QuinticReference(LeafSystem):
         else:
             mode = 1.0
             q_d, v_d, a_d = self._follow(q, v, x, xdot, J, target)
-        return np.concatenate([x, xdot, x - target[0:3], xdot - target[3:6], plan["x_f"],
+        return np.concatenate([x, xdot, x - target[TARGET.x], xdot - target[TARGET.xdot], plan["x_f"],
                                [float(plan["reached"]), mode], q_d, v_d, a_d])
 
     def _follow(self, q, v, x, xdot, J, target):
@@ -244,14 +244,15 @@ class QuinticReference(LeafSystem):
             pc, JacobianWrtVariable.kV, self._frame, np.zeros(3), plant.world_frame(),
             plant.world_frame()).ravel()
         lam = self._config.pinv_damping
-        v_d = pinv_apply(J, target[3:6] + k_x * (target[0:3] - x), lam)
-        a_d = pinv_apply(J, target[6:9] + k_x * (target[3:6] - xdot) - Jdot_v, lam)
+        x_r, xdot_r = target[TARGET.x], target[TARGET.xdot]
+        v_d = pinv_apply(J, xdot_r + k_x * (x_r - x), lam)
+        a_d = pinv_apply(J, target[TARGET.xddot] + k_x * (xdot_r - xdot) - Jdot_v, lam)
         return q, v_d, a_d
 
 
 class CtQuinticController(Diagram):
-    """Inputs ``state`` (nq + nv), ``target`` (9); outputs ``u`` (nu), ``tau`` (nv) and
-    ``telemetry`` (``layout``: the reference's slots, then ``tau``).
+    """Inputs ``state`` (nq + nv), ``target`` ([x_r, ẋ_r, ẍ_r], ``signals.TARGET_PORT``); outputs
+    ``u`` (nu), ``tau`` (nv) and ``telemetry`` (``layout``: the reference's slots, then ``tau``).
 
     A Diagram of ``QuinticReference`` and Drake's ``InverseDynamicsController`` (nominal plant).
     """

@@ -99,6 +99,7 @@ from ptint_drake.systems.camera import (
     validate_measurement,
 )
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import TARGET_PORT_SIZE
 
 MODELS = ("cv", "ca")
 R_MIN = 1.0e-12  # m², floor of the measurement variance: (1 µm)²
@@ -176,7 +177,7 @@ class TargetKalmanFilter(LeafSystem):
         # ``target`` is read at every derivative evaluation; ``covariance`` (figures) only
         # costs when someone evaluates it
         self._target_out = self.DeclareVectorOutputPort(
-            "target", 9, lambda c, o: o.SetFromVector(self._predict_target(c)),
+            "target", TARGET_PORT_SIZE, lambda c, o: o.SetFromVector(self._predict_target(c)),
             prerequisites_of_calc=state_and_time)
         self._covariance_out = self.DeclareVectorOutputPort(
             "covariance", n * n, lambda c, o: o.SetFromVector(self._predict_covariance(c)),
@@ -276,7 +277,7 @@ class TargetKalmanFilter(LeafSystem):
         """[p + vΔt + aΔt²/2, v + aΔt, a], Δt = t − t_est (zeros before the first sample)."""
         meta = context.get_discrete_state(self._meta).value()
         if meta[0] < 0.5:
-            return np.zeros(9)
+            return np.zeros(TARGET_PORT_SIZE)
         dt = context.get_time() - meta[1]
         X = context.get_discrete_state(self._estimate).value()
         if self._n == 2:
@@ -306,9 +307,10 @@ class ActiveTargetSelector(LeafSystem):
             raise ValueError(f"count: one target per segment is needed, got {count} "
                              f"for {len(schedule)} segments")
         self._schedule = schedule
-        self._inputs = [self.DeclareVectorInputPort(f"target_{i}", 9) for i in range(count)]
+        self._inputs = [self.DeclareVectorInputPort(f"target_{i}", TARGET_PORT_SIZE)
+                        for i in range(count)]
         self._target_out = self.DeclareVectorOutputPort(
-            "target", 9, self._select,
+            "target", TARGET_PORT_SIZE, self._select,
             prerequisites_of_calc={self.time_ticket(), self.all_input_ports_ticket()})
 
     def get_target_output_port(self):

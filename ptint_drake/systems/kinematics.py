@@ -21,7 +21,7 @@ _ORIGIN = np.zeros(3)
 
 
 class FrameKinematics:
-    """x, ẋ, J of one frame's origin, computed on a private plant context."""
+    """x, ẋ, J of one frame's origin (paper eq. 5), computed on a private plant context."""
 
     def __init__(self, plant, frame):
         self._plant = plant
@@ -30,31 +30,14 @@ class FrameKinematics:
         self._plant_context = plant.CreateDefaultContext()
         self._kV = JacobianWrtVariable.kV
 
-    def values(self, q, v):
-        """(x, ẋ, J) at joint positions q and velocities v (arrays), as plain floats:
-        x and ẋ lists of 3, J a list of 3 rows (the per-derivative fast path)."""
-        plant, pc = self._plant, self._plant_context
-        plant.SetPositions(pc, q)
-        x = self._frame.CalcPoseInWorld(pc).translation().tolist()
-        J = plant.CalcJacobianTranslationalVelocity(
-            pc, self._kV, self._frame, _ORIGIN, self._world, self._world)
-        # numpy's J @ v (BLAS, fused multiply-adds) as ``compute`` has it: a plain-float sum
-        # differs from it in the last bit and the run would move with that
-        return x, (J @ v).tolist(), J.tolist()
-
-    def compute(self, q, v):
-        """(x, ẋ, J) at joint positions q and velocities v."""
+    def compute(self, q, v) -> tuple:
+        """(x, ẋ, J) at joint positions q and velocities v: arrays of 3, 3 and 3 × nv."""
         plant, pc = self._plant, self._plant_context
         plant.SetPositions(pc, q)
         x = self._frame.CalcPoseInWorld(pc).translation()
         J = plant.CalcJacobianTranslationalVelocity(
-            pc, JacobianWrtVariable.kV, self._frame, _ORIGIN, self._world, self._world)
+            pc, self._kV, self._frame, _ORIGIN, self._world, self._world)
         return x, J @ v, J
-
-    def evaluate(self, q, v) -> np.ndarray:
-        """[x, ẋ, vec(J)] (row-major J, 3 × nv) at joint positions q and velocities v."""
-        x, xdot, J = self.values(q, v)
-        return np.array(x + xdot + [a for row in J for a in row])
 
 
 class TaskSpaceKinematics(LeafSystem):
@@ -88,8 +71,9 @@ class TaskSpaceKinematics(LeafSystem):
         return self.evaluate(qv[: self._nq], qv[self._nq:])
 
     def evaluate(self, q, v) -> np.ndarray:
-        """[x, ẋ, vec(J)] at joint positions q and velocities v."""
-        return self._kinematics.evaluate(q, v)
+        """[x, ẋ, vec(J)] (row-major J, 3 × nv) at joint positions q and velocities v."""
+        x, xdot, J = self._kinematics.compute(q, v)
+        return np.concatenate([x, xdot, J.ravel()])
 
     def get_state_input_port(self):
         return self._state_in

@@ -31,16 +31,15 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.baseline_common import (
-    TARGET_SIZE,
     DeclareControllerOutputs,
-    DeclareSegmentStartEvents,
     layout_size,
     make_layout,
     segment_index,
 )
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
+from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
 
 INTEGRAL_POLICIES = ("keep", "reset")
 
@@ -82,8 +81,9 @@ def pd_layout(nv: int) -> dict:
 
 
 class PDController(LeafSystem):
-    """Inputs ``state`` (nq + nv), ``target`` (9); outputs ``u`` (nu), ``tau`` (nv),
-    ``telemetry`` (``layout``).  State: ∫e (continuous, 3), [segment, Kp, Kd, Ki] (discrete)."""
+    """Inputs ``state`` (nq + nv), ``target`` ([x_r, ẋ_r, ẍ_r], ``signals.TARGET_PORT``); outputs
+    ``u`` (nu), ``tau`` (nv), ``telemetry`` (``layout``).  State: ∫e (continuous, 3),
+    [segment, Kp, Kd, Ki] (discrete)."""
 
     def __init__(self, *, plant, frame, schedule: Schedule, config: PDConfig):
         super().__init__()
@@ -94,7 +94,7 @@ class PDController(LeafSystem):
         self._kinematics = FrameKinematics(plant, frame)
         self.layout = pd_layout(self._nv)
         self._state_in = self.DeclareVectorInputPort("state", self._nq + self._nv)
-        self._target_in = self.DeclareVectorInputPort("target", TARGET_SIZE)
+        self._target_in = self.DeclareVectorInputPort("target", TARGET_PORT_SIZE)
         self._integral_index = self.DeclareContinuousState(3)
         self._gains_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0, 0.0]))
         DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
@@ -119,7 +119,7 @@ class PDController(LeafSystem):
         qv = self._state_in.Eval(context)
         target = self._target_in.Eval(context)
         x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
-        e, edot = x - target[0:3], xdot - target[3:6]
+        e, edot = x - target[TARGET.x], xdot - target[TARGET.xdot]
         integral = context.get_continuous_state_vector().CopyToVector()
         _, Kp, Kd, Ki = context.get_discrete_state(self._gains_index).value()
         force = -(Kp * e + Kd * edot + Ki * integral)

@@ -12,9 +12,13 @@ from __future__ import annotations
 
 import bisect
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
-from scipy.special import beta as beta_function
+from ptint_drake.systems.tbg import gamma_gain
+
+
+# One-shot timed events are periodic events whose period exceeds any simulation.
+ONE_SHOT_PERIOD = 1.0e9
 
 
 @dataclass(frozen=True)
@@ -48,8 +52,7 @@ class Schedule:
                     f"segment's interception time {segments[i - 1].end}")
         self.segments = tuple(segments)
         self.starts = tuple(s.start for s in segments)
-        # γ of each segment (paper eq. 8), computed once
-        self._gammas = tuple(float(beta_function(1.0 - s.beta, 1.0 - s.beta)) / s.tf for s in segments)
+        self._gammas = tuple(gamma_gain(s.tf, s.beta) for s in segments)  # once per segment
 
     def __len__(self) -> int:
         return len(self.segments)
@@ -68,3 +71,13 @@ class Schedule:
     def hold_end(self, i: int, duration: float) -> float:
         """End of segment i's hold: the next segment's start, or ``duration``."""
         return self.starts[i + 1] if i + 1 < len(self.starts) else duration
+
+
+def DeclareSegmentStartEvents(system, schedule: Schedule, handler: Callable) -> None:
+    """Declare ``handler(context, state)`` on ``system`` as an unrestricted update at
+    initialization and at every segment start after t = 0 (a segment starting at 0 is handled
+    by the initialization), so the integrator stops exactly at each switch."""
+    system.DeclareInitializationUnrestrictedUpdateEvent(handler)
+    for start in schedule.starts:
+        if start > 0.0:
+            system.DeclarePeriodicUnrestrictedUpdateEvent(ONE_SHOT_PERIOD, start, handler)

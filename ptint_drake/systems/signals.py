@@ -4,7 +4,8 @@ Each layout maps a name to its index (a slot of size 1) or slice (a wider one), 
 reads ``target[TARGET.x]`` and ``tbg[TBG.alpha]`` instead of ``target[0:3]`` and ``tbg[4]``:
 
 - ``TARGET``: [x_r, ẋ_r, ẍ_r, x⃛_r] of a target at time t (``evaluate(t)``, 12); a target
-  *port* carries the first 9;
+  *port* carries [x_r, ẋ_r, ẍ_r], the slots ``TARGET_PORT`` of width ``TARGET_PORT_SIZE``
+  (the one place that width is written);
 - ``TBG``: [ξ, ξ̇, ξ̈, ξ⃛, α, segment…] of ``tbg_state`` (paper eqs. 6–10, 13), 10;
 - ``SEGMENT``: [index, t0, tf, β, phase] of the active segment (the TBG's ``segment`` port);
 - ``CAPTURED``: [index, s(t0)], the surface's discrete state (paper eq. 17's s(t0));
@@ -33,7 +34,8 @@ class Slots:
 
 
 TARGET = Slots(("x", 3), ("xdot", 3), ("xddot", 3), ("xdddot", 3))
-TARGET_PORT = slice(0, 9)  # what a target port carries: [x_r, ẋ_r, ẍ_r]
+TARGET_PORT = slice(0, TARGET.xddot.stop)  # what a target port carries: [x_r, ẋ_r, ẍ_r]
+TARGET_PORT_SIZE = TARGET_PORT.stop  # 9: the width of every ``target`` port
 TBG = Slots(("xi", 1), ("xi_dot", 1), ("xi_ddot", 1), ("xi_dddot", 1), ("alpha", 1), ("segment", 5))
 TBG_PROFILE = slice(0, 4)  # [ξ, ξ̇, ξ̈, ξ⃛]
 TBG_OUT = slice(0, 5)  # [ξ, ξ̇, ξ̈, ξ⃛, α]: the TBG's part of the telemetry

@@ -36,33 +36,21 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
-from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
 from ptint_drake.systems.signals import CAPTURED, SEGMENT, SURFACE
 
 SWITCHING_LAWS = ("sign", "tanh", "sat")
 SIGMA_POLICIES = ("keep", "reset")
-# One-shot timed events are periodic events whose period exceeds any simulation.
-_ONE_SHOT_PERIOD = 1.0e9
-
-
-def switching_function(w: np.ndarray, law: str, phi: float) -> np.ndarray:
-    """σ̇ = switch(w): ``sign`` (paper), ``tanh(w/φ)`` or ``sat(w/φ)``."""
-    if law == "sign":
-        return np.sign(w)
-    if law == "tanh":
-        return np.tanh(w / phi)
-    if law == "sat":
-        return np.clip(w / phi, -1.0, 1.0)
-    raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
 
 
 def _sign(w: float) -> float:
-    """``np.sign`` of one float (0 stays 0, NaN stays NaN)."""
+    """The sign of one float (0 stays 0, NaN stays NaN)."""
     return 1.0 if w > 0.0 else (-1.0 if w < 0.0 else w)
 
 
-def _switch_floats(law: str, phi: float):
-    """``switching_function`` on a list of plain floats, as a function of that list."""
+def switching_law(law: str, phi: float):
+    """σ̇ = switch(w) of a 3-vector w (a list of plain floats → a list): the paper's ``sign``,
+    ``tanh(w/φ)`` or ``sat(w/φ)`` = clip(w/φ, −1, 1).  Raises ValueError for another law."""
     if law == "sign":
         return lambda w: [_sign(a) for a in w]
     if law == "tanh":
@@ -70,16 +58,18 @@ def _switch_floats(law: str, phi: float):
         # the arguments, and the run (step sizes, sampled peaks) should not move with it
         tanh = np.tanh
         return lambda w: [float(tanh(w[0] / phi)), float(tanh(w[1] / phi)), float(tanh(w[2] / phi))]
-    return lambda w: [min(max(a / phi, -1.0), 1.0) if a == a else a for a in w]
+    if law == "sat":
+        return lambda w: [min(max(a / phi, -1.0), 1.0) if a == a else a for a in w]
+    raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
 
 
 class SurfaceLaw:
-    """The surface equations above in plain floats, shared by ``SlidingSurface`` and the
-    fused ``PrescribedTimeInterceptor`` so both compute exactly the same thing."""
+    """The surface equations above (paper eqs. 11, 16, 17) in plain floats: the one
+    implementation that ``SlidingSurface`` and the fused ``PrescribedTimeInterceptor`` call."""
 
     def __init__(self, Lambda=5.0, k: float = 3.0, switching: str = "tanh", phi: float = 0.01,
                  sigma_policy: str = "keep", k_hold: float = 50.0):
-        switching_function(np.zeros(1), switching, phi)  # validates the law
+        self._switch = switching_law(switching, float(phi))  # validates the law
         if sigma_policy not in SIGMA_POLICIES:
             raise ValueError(f"controller.sigma_policy: use one of {SIGMA_POLICIES}, got {sigma_policy!r}")
         if switching != "sign" and not phi > 0.0:
@@ -91,10 +81,10 @@ class SurfaceLaw:
         self.phi = float(phi)
         self.reset_sigma = sigma_policy == "reset"
         self._Lambda = tuple(self.Lambda.tolist())
-        self._switch = _switch_floats(switching, self.phi)
 
     def values(self, t: float, x, xdot, x_r, xdot_r, alpha: float, segment, captured, sigma) -> list:
-        """[s_x, e, ė, s, s_d, σ̇] (18 plain floats) from plain-float sequences (lists).
+        """[s_x, e, ė, s, s_d, σ̇] (``signals.SURFACE``, 18 plain floats) from plain-float
+        sequences (lists).
 
         ``segment`` = [index, t0, tf, ...] of the active segment (TBG output),
         ``captured`` = [index, s(t0)] (the discrete state), ``sigma`` = σ.
@@ -111,7 +101,7 @@ class SurfaceLaw:
             d0, d1, d2 = s0, s1, s2  # at the switch instant s(t0) is s itself
         else:
             tau, tf = t - segment[SEGMENT.t0], segment[SEGMENT.tf]
-            # numpy's exp (as the array version had), bit-identical to it; math.exp is not
+            # numpy's exp, not math.exp: they differ in the last bit, and the run would move
             if tau < tf:
                 f = float(np.exp(-self.k * tau))
             else:
@@ -121,30 +111,6 @@ class SurfaceLaw:
         L0, L1, L2 = self._Lambda
         return ([w[0] + L0 * sigma[0], w[1] + L1 * sigma[1], w[2] + L2 * sigma[2]]
                 + e + edot + [s0, s1, s2, d0, d1, d2] + self._switch(w))
-
-    def terms(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma) -> np.ndarray:
-        """[s_x, e, ė, s, s_d, σ̇] (18 values); see ``parts``."""
-        return np.array(self.values(float(t), _floats(x), _floats(xdot), _floats(x_r),
-                                    _floats(xdot_r), float(alpha), _floats(segment),
-                                    _floats(captured), _floats(sigma)))
-
-    def parts(self, t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma):
-        """(s_x, e, ė, s, s_d, σ̇), six arrays of 3.
-
-        ``segment`` = [index, t0, tf, ...] of the active segment (TBG output),
-        ``captured`` = [index, s(t0)] (the discrete state), ``sigma`` = σ.
-        """
-        out = self.terms(t, x, xdot, x_r, xdot_r, alpha, segment, captured, sigma)
-        return tuple(out[i:i + 3] for i in range(0, 18, 3))
-
-    def switch(self, w: np.ndarray) -> np.ndarray:
-        """σ̇ = switch(s − s_d) with this law's switching function."""
-        return switching_function(w, self.law, self.phi)
-
-
-def _floats(values) -> list:
-    """A sequence (numpy array or list) as a list of plain floats."""
-    return values if type(values) is list else np.asarray(values, dtype=float).tolist()
 
 
 def DeclareSegmentCapture(system, schedule: Schedule, law: SurfaceLaw, segment_and_s):
@@ -166,10 +132,7 @@ def DeclareSegmentCapture(system, schedule: Schedule, law: SurfaceLaw, segment_a
         if law.reset_sigma:
             state.get_mutable_continuous_state().get_mutable_vector().SetZero()
 
-    system.DeclareInitializationUnrestrictedUpdateEvent(capture)
-    for start in schedule.starts:
-        if start > 0.0:
-            system.DeclarePeriodicUnrestrictedUpdateEvent(_ONE_SHOT_PERIOD, start, capture)
+    DeclareSegmentStartEvents(system, schedule, capture)
     return sigma_index, capture_index
 
 

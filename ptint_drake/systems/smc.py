@@ -24,9 +24,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.baseline_common import (
-    TARGET_SIZE,
     DeclareControllerOutputs,
-    DeclareSegmentStartEvents,
     layout_size,
     make_layout,
     segment_index,
@@ -34,8 +32,9 @@ from ptint_drake.systems.baseline_common import (
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.controller import smc_torque
 from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, switching_function
+from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
+from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
+from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, switching_law
 
 _SHARED = ("K", "Lambda", "switching", "phi", "sigma_policy", "pinv_damping")
 
@@ -58,7 +57,7 @@ class SMCConfig:
         return cls(lambda_factor=lambda_factor, **{k: getattr(gains, k) for k in _SHARED})
 
     def validate(self) -> None:
-        switching_function(np.zeros(1), self.switching, self.phi)
+        switching_law(self.switching, self.phi)  # validates the law
         if self.switching != "sign" and not self.phi > 0.0:
             raise ValueError(f"smc.phi: must be > 0, got {self.phi}")
         if self.sigma_policy not in SIGMA_POLICIES:
@@ -74,8 +73,9 @@ def smc_layout(nv: int) -> dict:
 
 
 class FirstOrderSMC(LeafSystem):
-    """Inputs ``state`` (nq + nv), ``target`` (9); outputs ``u`` (nu), ``tau`` (nv),
-    ``telemetry`` (``layout``).  State: σ (continuous, 3), [segment, λ] (discrete)."""
+    """Inputs ``state`` (nq + nv), ``target`` ([x_r, ẋ_r, ẍ_r], ``signals.TARGET_PORT``); outputs
+    ``u`` (nu), ``tau`` (nv), ``telemetry`` (``layout``).  State: σ (continuous, 3),
+    [segment, λ] (discrete)."""
 
     def __init__(self, *, plant, frame, schedule: Schedule, config: SMCConfig):
         super().__init__()
@@ -83,12 +83,13 @@ class FirstOrderSMC(LeafSystem):
         self._config = config
         self._schedule = schedule
         self._nq, self._nv = plant.num_positions(), plant.num_velocities()
-        self._K = np.broadcast_to(np.asarray(config.K, dtype=float), (self._nv,)).copy()
+        self._K_floats = np.broadcast_to(np.asarray(config.K, dtype=float), (self._nv,)).tolist()
         self._Lambda = np.broadcast_to(np.asarray(config.Lambda, dtype=float), (3,)).copy()
+        self._switch = switching_law(config.switching, float(config.phi))
         self._kinematics = FrameKinematics(plant, frame)
         self.layout = smc_layout(self._nv)
         self._state_in = self.DeclareVectorInputPort("state", self._nq + self._nv)
-        self._target_in = self.DeclareVectorInputPort("target", TARGET_SIZE)
+        self._target_in = self.DeclareVectorInputPort("target", TARGET_PORT_SIZE)
         self._sigma_index = self.DeclareContinuousState(3)
         self._lambda_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
         DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
@@ -115,13 +116,13 @@ class FirstOrderSMC(LeafSystem):
         qv = self._state_in.Eval(context)
         target = self._target_in.Eval(context)
         x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
-        e, edot = x - target[0:3], xdot - target[3:6]
+        e, edot = x - target[TARGET.x], xdot - target[TARGET.xdot]
         lam = context.get_discrete_state(self._lambda_index).value()[1]
         sigma = context.get_continuous_state_vector().CopyToVector()
         s = edot + lam * e
         s_x = s + self._Lambda * sigma
-        tau = smc_torque(self._K, J, s_x, self._config.pinv_damping)
-        sigma_dot = switching_function(s, self._config.switching, self._config.phi)
+        tau = smc_torque(self._K_floats, J, s_x, self._config.pinv_damping)
+        sigma_dot = self._switch(s.tolist())
         return np.concatenate([x, xdot, e, edot, [lam], s, s_x, sigma, tau, sigma_dot])
 
     def DoCalcTimeDerivatives(self, context, derivatives):

@@ -22,7 +22,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.signals import TARGET, TARGET_PORT
+from ptint_drake.systems.signals import TARGET, TARGET_PORT, TARGET_PORT_SIZE
 
 
 @dataclass(frozen=True)
@@ -80,20 +80,16 @@ def target_values(target, t: float) -> list:
 
 
 def active_target_values(schedule: Schedule, targets: Sequence, t: float) -> list:
-    """``active_target_state`` as a list of 12 plain floats (the per-derivative fast path)."""
+    """[x_r, ẋ_r, ẍ_r, x⃛_r] (``signals.TARGET``, 12 plain floats) of the target of the segment
+    active at t (the first before it)."""
     return target_values(targets[max(schedule.active(t), 0)], t)
-
-
-def active_target_state(schedule: Schedule, targets: Sequence, t: float) -> np.ndarray:
-    """[x_r, ẋ_r, ẍ_r, x⃛_r] of the target of the segment active at t (the first before it)."""
-    return np.array(active_target_values(schedule, targets, t))
 
 
 class TargetSource(LeafSystem):
     """x_r, ẋ_r, ẍ_r of the target of the active segment (one target per segment).
 
     Output ports ``x_r``, ``xdot_r``, ``xddot_r`` (3 each) and ``target`` (the three
-    stacked, 9) depend on time only.
+    stacked, ``signals.TARGET_PORT``) depend on time only.
     Before the first segment starts, the first target is emitted.  Output port
     ``objects`` (3 × number of segments) gives every target's position at t,
     which a replay uses to draw the objects that are not being chased.
@@ -120,7 +116,7 @@ class TargetSource(LeafSystem):
             "xddot_r", 3, lambda c, o: o.SetFromVector(self._eval(c)[TARGET.xddot]),
             prerequisites_of_calc=time_only)
         self._target_out = self.DeclareVectorOutputPort(
-            "target", 9, lambda c, o: o.SetFromVector(self._eval(c)[TARGET_PORT]),
+            "target", TARGET_PORT_SIZE, lambda c, o: o.SetFromVector(self._eval(c)[TARGET_PORT]),
             prerequisites_of_calc=time_only)
         self._objects_out = self.DeclareVectorOutputPort(
             "objects", 3 * len(targets),
@@ -134,7 +130,7 @@ class TargetSource(LeafSystem):
 
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] of the target active at absolute time t."""
-        return active_target_state(self._schedule, self._targets, t)
+        return np.array(active_target_values(self._schedule, self._targets, t))
 
     def get_x_r_output_port(self):
         return self._x_out

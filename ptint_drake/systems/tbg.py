@@ -18,17 +18,20 @@ and, after tf, the hold gain ``alpha_hold`` (0 in the paper).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 from scipy.special import beta as beta_function
-from scipy.special import betaincinv
-# The same Boost inverse as the ufunc (bit-identical results), without the ufunc's
-# per-call dispatch: about 0.9 µs instead of 1.7 µs for one scalar.
-from scipy.special.cython_special import betaincinv as _betaincinv_scalar
+# scipy's Boost inverse through its Cython binding: bit-identical to the ``betaincinv`` ufunc,
+# without the ufunc's per-call dispatch (about 0.9 µs instead of 1.7 µs for one scalar).
+from scipy.special.cython_special import betaincinv
 
 from ptint_drake.systems.cache import DeclareVectorCache
-from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TBG, TBG_PROFILE
+
+if TYPE_CHECKING:
+    from ptint_drake.systems.schedule import Schedule
 
 
 def gamma_gain(tf: float, beta: float) -> float:
@@ -36,39 +39,13 @@ def gamma_gain(tf: float, beta: float) -> float:
     return float(beta_function(1.0 - beta, 1.0 - beta)) / tf
 
 
-def tbg_profile(tau, tf: float, beta: float):
-    """ξ, ξ̇, ξ̈, ξ⃛ at times τ = t − t0 since the segment start (scalars or arrays).
+def tbg_derivatives(tau: float, tf: float, beta: float, gamma: float) -> tuple:
+    """(ξ, ξ̇, ξ̈, ξ⃛) at one time τ = t − t0 since the segment start, in plain floats
+    (paper eqs. 6-10); ``gamma`` = ``gamma_gain(tf, beta)``, computed once per segment.
 
-    For τ ≤ 0 the TBG sits at ξ = 1 (not yet started); for τ ≥ tf it is 0.
-    Returns a tuple of four arrays of the shape of ``tau`` (floats for scalars).
-    """
-    tau_arr = np.asarray(tau, dtype=float)
-    u = np.clip(tau_arr / tf, 0.0, 1.0)
-    a = 1.0 - beta
-    xi = betaincinv(a, a, 1.0 - u)
-    eta = betaincinv(a, a, u)  # 1 − ξ, computed directly
-    g = gamma_gain(tf, beta)
-    p = xi * eta  # ξ(1−ξ)
-    inside = (u > 0.0) & (u < 1.0)
-    safe_p = np.where(inside, p, 1.0)
-    xi_d = np.where(inside, -g * safe_p**beta, 0.0)
-    xi_dd = np.where(inside, g**2 * beta * (1.0 - 2.0 * xi) * safe_p ** (2.0 * beta - 1.0), 0.0)
-    xi_ddd = np.where(
-        inside,
-        -g**3 * beta * safe_p ** (3.0 * beta - 2.0)
-        * ((2.0 * beta - 1.0) * (1.0 - 2.0 * xi) ** 2 - 2.0 * p),
-        0.0)
-    xi = np.where(u >= 1.0, 0.0, xi)
-    out = (xi, xi_d, xi_dd, xi_ddd)
-    if tau_arr.ndim == 0:
-        return tuple(float(v) for v in out)
-    return out
-
-
-def tbg_profile_scalar(tau: float, tf: float, beta: float, g: float):
-    """``tbg_profile`` for one time, in plain floats (the per-derivative fast path).
-
-    ``g`` is ``gamma_gain(tf, beta)``, passed in so that it is computed once per segment.
+    For τ ≤ 0 the TBG sits at ξ = 1 (not yet started); for τ ≥ tf it is 0.  The smaller of
+    ξ and η = 1 − ξ is the inverse incomplete beta function, the other 1 − it, and every
+    derivative is written with the product ξη, so neither end loses precision.
     """
     u = tau / tf
     if u <= 0.0:
@@ -76,14 +53,14 @@ def tbg_profile_scalar(tau: float, tf: float, beta: float, g: float):
     if u >= 1.0:
         return 0.0, 0.0, 0.0, 0.0
     a = 1.0 - beta
-    # one inverse per call: the smaller of ξ and η = 1 − ξ directly, the other as 1 − it
     if u < 0.5:
-        eta = _betaincinv_scalar(a, a, u)
+        eta = betaincinv(a, a, u)
         xi = 1.0 - eta
     else:
-        xi = _betaincinv_scalar(a, a, 1.0 - u)
+        xi = betaincinv(a, a, 1.0 - u)
         eta = 1.0 - xi
-    p = xi * eta
+    g = gamma
+    p = xi * eta  # ξ(1−ξ)
     one_m_2xi = 1.0 - 2.0 * xi
     xi_d = -g * p**beta
     xi_dd = g * g * beta * one_m_2xi * p ** (2.0 * beta - 1.0)
@@ -91,9 +68,20 @@ def tbg_profile_scalar(tau: float, tf: float, beta: float, g: float):
     return xi, xi_d, xi_dd, xi_ddd
 
 
+def tbg_profile(tau, tf: float, beta: float) -> tuple:
+    """``tbg_derivatives`` at times τ (a scalar or an array): a tuple of four floats, or of
+    four arrays of the shape of ``tau``."""
+    g = gamma_gain(tf, beta)
+    if np.ndim(tau) == 0:
+        return tbg_derivatives(float(tau), tf, beta, g)
+    tau_arr = np.asarray(tau, dtype=float)
+    rows = np.array([tbg_derivatives(t, tf, beta, g) for t in tau_arr.ravel().tolist()])
+    return tuple(rows[:, k].reshape(tau_arr.shape) for k in range(4))
+
+
 def alpha_gain(xi, xi_dot, epsilon: float = 1e-6, delta: float = 1e-6):
-    """α = −(1 + ϵ) ξ̇ / (ξ + δ)  (paper eq. 13), ≥ 0 during the segment."""
-    return -(1.0 + epsilon) * np.asarray(xi_dot) / (np.asarray(xi) + delta)
+    """α = −(1 + ϵ) ξ̇ / (ξ + δ)  (paper eq. 13), ≥ 0 during the segment (floats or arrays)."""
+    return -(1.0 + epsilon) * xi_dot / (xi + delta)
 
 
 def alpha_peak(tf: float, beta: float, epsilon: float = 1e-6, delta: float = 1e-6) -> float:
@@ -103,12 +91,13 @@ def alpha_peak(tf: float, beta: float, epsilon: float = 1e-6, delta: float = 1e-
     return float(np.max(alpha_gain(xi, xi_d, epsilon, delta)))
 
 
-def tbg_values(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float = 1e-6,
-               alpha_hold: float = 0.0) -> list:
-    """``tbg_state`` as a list of 10 plain floats (the per-derivative fast path).
+def tbg_state(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float = 1e-6,
+              alpha_hold: float = 0.0) -> list:
+    """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] (``signals.TBG``, plain floats) of the
+    segment active at absolute time t.
 
-    [ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] of the segment active at absolute time t;
-    phase: 0 before the first segment, 1 while converging, 2 while holding after tf.
+    phase: 0 before the first segment, 1 while converging, 2 while holding after tf
+    (α = ``alpha_hold`` there).
     """
     i = schedule.active(t)
     if i < 0:
@@ -116,20 +105,11 @@ def tbg_values(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float
     seg = schedule[i]
     tau = t - seg.start
     if tau < seg.tf:
-        xi, xi_d, xi_dd, xi_ddd = tbg_profile_scalar(tau, seg.tf, seg.beta, schedule.gamma(i))
-        return [xi, xi_d, xi_dd, xi_ddd, -(1.0 + epsilon) * xi_d / (xi + delta),
+        xi, xi_d, xi_dd, xi_ddd = tbg_derivatives(tau, seg.tf, seg.beta, schedule.gamma(i))
+        return [xi, xi_d, xi_dd, xi_ddd, alpha_gain(xi, xi_d, epsilon, delta),
                 float(i), float(seg.start), float(seg.tf), float(seg.beta), 1.0]
     return [0.0, 0.0, 0.0, 0.0, float(alpha_hold), float(i), float(seg.start), float(seg.tf),
             float(seg.beta), 2.0]
-
-
-def tbg_state(schedule: Schedule, t: float, epsilon: float = 1e-6, delta: float = 1e-6,
-              alpha_hold: float = 0.0) -> np.ndarray:
-    """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] of the segment active at absolute time t.
-
-    phase: 0 before the first segment, 1 while converging, 2 while holding after tf.
-    """
-    return np.array(tbg_values(schedule, t, epsilon, delta, alpha_hold))
 
 
 class TimeBaseGenerator(LeafSystem):
@@ -169,8 +149,8 @@ class TimeBaseGenerator(LeafSystem):
         return self._schedule
 
     def evaluate(self, t: float) -> np.ndarray:
-        """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] at absolute time t."""
-        return tbg_state(self._schedule, t, self._epsilon, self._delta, self._alpha_hold)
+        """[ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] at absolute time t (``tbg_state``)."""
+        return np.array(tbg_state(self._schedule, t, self._epsilon, self._delta, self._alpha_hold))
 
     def get_xi_output_port(self):
         return self._xi_out
