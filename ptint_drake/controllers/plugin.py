@@ -32,11 +32,10 @@ from typing import Sequence
 from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, target_columns
 from ptint_drake.systems.active_segment import SIZE as SEGMENT_SIZE
 from ptint_drake.systems.active_segment import ActiveSegment
-from ptint_drake.systems.signals import TARGET_PORT
+from ptint_drake.systems.signals import TARGET_PORT_SIZE
 
 PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*$")
 FORM = "'module:Class' (a LeafSystem in your own file)"
-TARGET_SIZE = TARGET_PORT.stop - TARGET_PORT.start
 
 _folders: list[str] = []  # the scenario files' folders this process loaded, most recent first
 
@@ -111,7 +110,7 @@ def make_plugin(type_: str, plant, end_effector: str, params: dict):
         system = cls(plant=plant, end_effector=end_effector, params=dict(params))
     except Exception as exc:
         raise _error(f"controller {type_}: constructing it raised {type(exc).__name__}: {exc}") from None
-    sizes = {"state": plant.num_positions() + plant.num_velocities(), "target": TARGET_SIZE}
+    sizes = {"state": plant.num_positions() + plant.num_velocities(), "target": TARGET_PORT_SIZE}
     optional = {"segment": SEGMENT_SIZE}
     for name, size in (sizes | optional).items():
         if not _has_port(system, "input", name):
