@@ -1,4 +1,9 @@
-"""Shared helpers: scenario runs cached per session (a run is deterministic)."""
+"""Shared helpers: scenario runs cached per session (a run is deterministic).
+
+``tests/unit`` holds the fast tests (no whole scenario is simulated: run them every few minutes,
+``pytest tests/unit``); ``tests/e2e`` the end-to-end runs, marked ``e2e`` here (``-m "not e2e"``
+deselects them).  Helper modules shared by both (``arms.py``, ``heavy_arm.py``, this file) sit in
+``tests/``, which pytest puts on ``sys.path`` with this file."""
 
 from __future__ import annotations
 
@@ -80,3 +85,10 @@ interceptions:
     beta: 0.75
     target: {linear: {start: [0.30, -0.15, 0.15], velocity: [0.0, 0.1, 0.0]}}
 """
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark every test under tests/e2e as ``e2e``."""
+    for item in items:
+        if "e2e" in item.path.parts:
+            item.add_marker(pytest.mark.e2e)

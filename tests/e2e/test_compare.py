@@ -4,7 +4,7 @@ import csv
 import json
 
 import pytest
-from test_builder import OFFSET_ARM
+from arms import OFFSET_ARM
 from test_cli import ptint
 
 SEGMENT_KEYS = {"e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm", "t_arrive"}

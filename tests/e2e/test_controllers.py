@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from test_builder import OFFSET_ARM
+from arms import OFFSET_ARM
 
 from ptint_drake.metrics import Criteria, Reason, segment_reasons, verdict
 from ptint_drake.robot import make_plant
@@ -129,12 +129,6 @@ def test_plant_variants_scale_links_and_rotors():
             assert plant.get_joint_actuator(index).rotor_inertia(context) == pytest.approx(1.5 * rotor)
 
 
-def test_unknown_controller_is_one_line_naming_the_field():
-    with pytest.raises(ScenarioError, match=r"^controller\.type: must be one of ptsmc, pd, smc, "
-                                            r"ct_quintic, or 'module:Class' .*, got 'lqr'$"):
-        parse_scenario(load_scenario_text().replace("controller: {", "controller: {type: lqr, "))
-
-
 @pytest.mark.parametrize("controller, implementation", [
     ("ptsmc", "fused"), ("ptsmc", "blocks"), ("pd", "fused"), ("smc", "fused")])
 def test_model_free_controllers_never_evaluate_dynamics(controller, implementation, dynamics_calls):
@@ -172,23 +166,3 @@ def test_null_space_damping_keeps_a_redundant_arm_near_its_posture(tmp_path):
     assert drift["fused", 0.0] > 1.0 and drift["fused", 10.0] < 0.3
     assert drift["blocks", 10.0] == pytest.approx(drift["fused", 10.0], rel=1e-3)
     assert load_scenario("curve_b075_tf15").controller.null_space_damping == 0.0  # the paper's law
-
-
-def test_the_schema_validation_and_compare_read_the_one_registry():
-    """A registered controller's own settings are a scenario block, its name is valid, and
-    compare runs it by default — all from ``controllers.REGISTRY``."""
-    from dataclasses import fields  # noqa: PLC0415
-
-    from ptint_drake.controllers import CONTROLLERS, REGISTRY  # noqa: PLC0415
-    from ptint_drake.scenario import ControllerConfig  # noqa: PLC0415
-    from ptint_drake.studies.compare import DEFAULT_CONTROLLERS  # noqa: PLC0415
-
-    assert CONTROLLERS == tuple(REGISTRY) == DEFAULT_CONTROLLERS
-    assert CONTROLLERS[0] == "ptsmc"
-    blocks = {f.name: f.type for f in fields(ControllerConfig)}
-    for entry in REGISTRY.values():
-        if entry.config is not None:
-            assert blocks[entry.name] is entry.config
-        text = load_scenario_text().replace("controller: {", f"controller: {{type: {entry.name}, ")
-        scenario = parse_scenario(text)
-        assert scenario.controller.type == entry.name

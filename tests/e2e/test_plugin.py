@@ -12,14 +12,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-from ptint_drake.controllers import REGISTRY, plugin
-from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario
+from ptint_drake.scenario import ScenarioError, parse_scenario
 from ptint_drake.simulation import simulate
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "task_space_pd.py"
 TYPE = "task_space_pd:TaskSpacePD"
 
@@ -148,34 +146,6 @@ def test_a_plugin_that_raises_fails_its_run_with_one_line_and_saw_its_segment(us
     assert "\n" not in message
     system = sys.modules["broken_plugins"]
     del system  # the module stays importable; the instance lives in the run's diagram
-
-
-def test_the_segment_port_carries_index_start_and_tf():
-    from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
-
-    from ptint_drake.systems.active_segment import ActiveSegment  # noqa: PLC0415
-    from ptint_drake.systems.schedule import Schedule, Segment  # noqa: PLC0415
-
-    builder = DiagramBuilder()
-    clock = builder.AddSystem(ActiveSegment(Schedule([Segment(0.0, 0.5, 0.75), Segment(0.8, 1.4, 0.5)])))
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
-    port = clock.get_output_port()
-    for t, expected in ((0.0, [0, 0.0, 0.5]), (0.79, [0, 0.0, 0.5]), (0.8, [1, 0.8, 1.4]),
-                        (3.0, [1, 0.8, 1.4])):
-        context.SetTime(t)
-        np.testing.assert_array_equal(port.Eval(clock.GetMyContextFromRoot(context)), expected)
-
-
-def test_params_are_plugin_only_and_reach_the_plugin_with_set(user_folder, monkeypatch):
-    text = (user_folder / "pd_scenario.yaml").read_text()
-    with pytest.raises(ScenarioError, match=r"^controller\.params: only a plugin controller"):
-        parse_scenario(text.replace(TYPE, "ptsmc"))
-    scenario = parse_scenario(text.replace("Kd: 150.0", "Kd: 1e-3, name: x, v: [1, 2]"))
-    assert plugin.plain_params(scenario.controller.params) == {"Kp": 2000.0, "Kd": 1e-3, "name": "x",
-                                                                "v": [1.0, 2.0]}
-    assert TYPE not in REGISTRY and plugin.is_plugin(TYPE) and not plugin.is_plugin("ptsmc")
-    assert load_scenario("curve_b075_tf15").controller.params == {}
 
 
 def test_tune_takes_a_plugin_parameter_with_its_range(user_folder):

@@ -17,7 +17,7 @@ PAPER = ["assembly", "curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf12", "c
 def ptint(*args):
     """Run the installed command (from a neutral folder, so the source tree is not imported)."""
     return subprocess.run([sys.executable, "-m", "ptint_drake", *args], capture_output=True,
-                          text=True, cwd=Path(__file__).parent.parent / "tests", timeout=600)
+                          text=True, cwd=Path(__file__).parent, timeout=600)
 
 
 def test_list_names_every_paper_scenario():

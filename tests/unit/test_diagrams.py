@@ -16,7 +16,7 @@ import pytest
 
 from ptint_drake.run_outputs import write_diagram
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DIAGRAMS = ROOT / "diagrams"
 _spec = importlib.util.spec_from_file_location("export_diagrams", ROOT / "scripts" / "export_diagrams.py")
 export = importlib.util.module_from_spec(_spec)

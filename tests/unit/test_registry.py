@@ -1,0 +1,76 @@
+"""The controller registry and the plugin interface, without simulating: one list of names that
+the schema, the validation and compare read; the plugin's params; the segment port."""
+
+import numpy as np
+import pytest
+
+from ptint_drake.controllers import REGISTRY, plugin
+from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario, scenario_text
+
+TYPE = "task_space_pd:TaskSpacePD"
+SCENARIO = """duration: 1.6
+controller: {type: "%s", params: {Kp: 2000.0, Kd: 150.0}}
+interceptions:
+  - start: 0.0
+    tf: 1.0
+    beta: 0.75
+    target: {linear: {start: [0.30, -0.05, 0.25], velocity: [0.0, 0.05, 0.0]}}
+"""
+
+
+def load_scenario_text() -> str:
+    return scenario_text("curve_b075_tf15")[1]
+
+
+def test_unknown_controller_is_one_line_naming_the_field():
+    with pytest.raises(ScenarioError, match=r"^controller\.type: must be one of ptsmc, pd, smc, "
+                                            r"ct_quintic, or 'module:Class' .*, got 'lqr'$"):
+        parse_scenario(load_scenario_text().replace("controller: {", "controller: {type: lqr, "))
+
+
+def test_the_schema_validation_and_compare_read_the_one_registry():
+    """A registered controller's own settings are a scenario block, its name is valid, and
+    compare runs it by default — all from ``controllers.REGISTRY``."""
+    from dataclasses import fields  # noqa: PLC0415
+
+    from ptint_drake.controllers import CONTROLLERS, REGISTRY  # noqa: PLC0415
+    from ptint_drake.scenario import ControllerConfig  # noqa: PLC0415
+    from ptint_drake.studies.compare import DEFAULT_CONTROLLERS  # noqa: PLC0415
+
+    assert CONTROLLERS == tuple(REGISTRY) == DEFAULT_CONTROLLERS
+    assert CONTROLLERS[0] == "ptsmc"
+    blocks = {f.name: f.type for f in fields(ControllerConfig)}
+    for entry in REGISTRY.values():
+        if entry.config is not None:
+            assert blocks[entry.name] is entry.config
+        text = load_scenario_text().replace("controller: {", f"controller: {{type: {entry.name}, ")
+        scenario = parse_scenario(text)
+        assert scenario.controller.type == entry.name
+
+
+def test_the_segment_port_carries_index_start_and_tf():
+    from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
+
+    from ptint_drake.systems.active_segment import ActiveSegment  # noqa: PLC0415
+    from ptint_drake.systems.schedule import Schedule, Segment  # noqa: PLC0415
+
+    builder = DiagramBuilder()
+    clock = builder.AddSystem(ActiveSegment(Schedule([Segment(0.0, 0.5, 0.75), Segment(0.8, 1.4, 0.5)])))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    port = clock.get_output_port()
+    for t, expected in ((0.0, [0, 0.0, 0.5]), (0.79, [0, 0.0, 0.5]), (0.8, [1, 0.8, 1.4]),
+                        (3.0, [1, 0.8, 1.4])):
+        context.SetTime(t)
+        np.testing.assert_array_equal(port.Eval(clock.GetMyContextFromRoot(context)), expected)
+
+
+def test_params_are_plugin_only_and_reach_the_plugin():
+    text = SCENARIO % TYPE
+    with pytest.raises(ScenarioError, match=r"^controller\.params: only a plugin controller"):
+        parse_scenario(text.replace(TYPE, "ptsmc"))
+    scenario = parse_scenario(text.replace("Kd: 150.0", "Kd: 1e-3, name: x, v: [1, 2]"))
+    assert plugin.plain_params(scenario.controller.params) == {"Kp": 2000.0, "Kd": 1e-3, "name": "x",
+                                                                "v": [1.0, 2.0]}
+    assert TYPE not in REGISTRY and plugin.is_plugin(TYPE) and not plugin.is_plugin("ptsmc")
+    assert load_scenario("curve_b075_tf15").controller.params == {}
