@@ -163,3 +163,18 @@ def test_tune_takes_a_plugin_parameter_with_its_range(user_folder):
     assert done.returncode == 2, done.stderr
     assert done.stderr.startswith("ptint: error: --range: params.Kp needs"), done.stderr
     assert not (user_folder / "t").exists()
+
+
+def test_dask_workers_find_the_plugin_beside_its_scenario_file(user_folder):
+    """Dask worker processes start elsewhere: the runner hands them the scenario's folder."""
+    distributed = pytest.importorskip("distributed", reason="install the [cluster] extra")
+    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+    from ptint_drake.studies.compare import run_compare  # noqa: PLC0415
+
+    assert Path.cwd() != user_folder
+    loaded = LoadedScenario.load(str(user_folder / "pd_scenario.yaml"))
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        result = run_compare(loaded, [TYPE], ["nominal"], dask=cluster.scheduler_address)
+    row = result["rows"][0]
+    assert row["controller"] == TYPE and row["status"] in ("ok", "missed"), row.get("reasons")
