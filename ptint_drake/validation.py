@@ -178,7 +178,7 @@ def _validate_orientation(t, where: str) -> None:
     if not rpy:
         return
     if t.orientation is not None:
-        raise ScenarioError(f"{where}.waypoints.rpy_deg: give either orientation or waypoints' rpy_deg, not both")
+        raise ScenarioError(f"{where}.waypoints.rpy_deg: orientation or rpy_deg, not both")
     if len(rpy) != len(t.waypoints.time):
         raise ScenarioError(f"{where}.waypoints.rpy_deg: one [r, p, y] per time is needed, got {len(rpy)} "
                             f"for {len(t.waypoints.time)} times")
