@@ -166,7 +166,8 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
         progress(context.get_time(), scenario.duration, int(integrator.get_num_steps_taken()))
     series = collect_series(built, context, kinematics)
     if scenario.controller.task != "position":
-        series |= orientation_series(scenario.controller.task, kinematics, series, built.station.true_targets)
+        series |= orientation_series(scenario.controller.task, kinematics, series, built.station.true_targets,
+                                     scenario.schedule(), scenario.duration)
     metrics = run_metrics(scenario, samples, series, built.station.effort_limits)
     warnings += singularity_warnings(plant, scenario, series) + joint_limit_warnings(plant, series)
     if watchdog.failure:
@@ -243,16 +244,20 @@ def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:
     return series
 
 
-def orientation_series(task: str, kinematics: FrameKinematics, series: dict, targets) -> dict:
+def orientation_series(task: str, kinematics: FrameKinematics, series: dict, targets, schedule,
+                       duration: float) -> dict:
     """Per sample and per object i: the angle (deg) between the tool's orientation (forward
     kinematics of the logged plant state) and object i's TRUE orientation as the task asks for it
-    (``rot_angle_deg``), and the rate of that error rotation |ω − R R_rᵀ ω_r| (``rot_rate_deg_s``)."""
+    (``rot_angle_deg``), and the rate of that error rotation |ω − R R_rᵀ ω_r| (``rot_rate_deg_s``),
+    from segment i's start to the end of its hold (NaN elsewhere)."""
     t, q, v = series["t"], series["q"], series["v"]
-    angle = np.empty((len(t), len(targets)))
-    rate = np.empty((len(t), len(targets)))
+    angle = np.full((len(t), len(targets)), np.nan)
+    rate = np.full((len(t), len(targets)), np.nan)
+    windows = [(seg.start, schedule.hold_end(i, duration)) for i, seg in enumerate(schedule.segments)]
     for k, tk in enumerate(t.tolist()):
         _, _, R, omega, _, _ = kinematics.compute_pose(q[k], v[k])
         for i, tg in enumerate(targets):
-            e_R, edot_R = rotation_error(R, omega, task_reference(task, target_rotation_values(tg, tk), R))
-            angle[k, i], rate[k, i] = np.linalg.norm(e_R), np.linalg.norm(edot_R)
+            if windows[i][0] <= tk <= windows[i][1]:
+                e_R, edot_R = rotation_error(R, omega, task_reference(task, target_rotation_values(tg, tk), R))
+                angle[k, i], rate[k, i] = np.linalg.norm(e_R), np.linalg.norm(edot_R)
     return {"rot_angle_deg": np.degrees(angle), "rot_rate_deg_s": np.degrees(rate)}
