@@ -258,6 +258,7 @@ def orientation_series(task: str, kinematics: FrameKinematics, series: dict, tar
         _, _, R, omega, _, _ = kinematics.compute_pose(q[k], v[k])
         for i, tg in enumerate(targets):
             if windows[i][0] <= tk <= windows[i][1]:
-                e_R, edot_R = rotation_error(R, omega, task_reference(task, target_rotation_values(tg, tk), R))
+                reference = task_reference(task, target_rotation_values(tg, tk), R)
+                e_R, edot_R = rotation_error(R, omega, reference)
                 angle[k, i], rate[k, i] = np.linalg.norm(e_R), np.linalg.norm(edot_R)
     return {"rot_angle_deg": np.degrees(angle), "rot_rate_deg_s": np.degrees(rate)}

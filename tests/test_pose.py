@@ -182,7 +182,8 @@ def ptint(*args):
 @pytest.mark.parametrize("overrides, field", [
     (["controller.task=pose"], "controller.task"),
     (["controller.task=top_down"], "controller.task"),
-    (["interceptions[0].target.orientation={rpy_deg: [0, 0]}"], "interceptions[0].target.orientation.rpy_deg"),
+    (["interceptions[0].target.orientation={rpy_deg: [0, 0]}"],
+     "interceptions[0].target.orientation.rpy_deg"),
     (["controller.rot_scale=0"], "controller.rot_scale"),
 ])
 def test_bad_orientation_input_is_one_line_exit_2(tmp_path, overrides, field):
