@@ -76,6 +76,8 @@ def _validate_controller(c) -> None:
         _positive(c.phi, "controller.phi")
     if c.task not in TASKS:
         raise ScenarioError(f"controller.task: must be one of {', '.join(TASKS)}, got {c.task!r}")
+    if c.task != "position" and c.type != "ptsmc":
+        raise ScenarioError(f"controller.task: {c.task!r} is implemented by ptsmc only, not {c.type!r}")
     _positive(c.rot_scale, "controller.rot_scale")
     for entry in REGISTRY.values():  # each controller's own block: messages name it from "<name>." on
         if entry.config is not None and hasattr(entry.config, "validate"):
