@@ -47,7 +47,8 @@ def table(results: dict) -> str:
             rows.append(f"| {variant} | {i} ({yaw}) | {cell(seg, 'e_half_norm', 'e_rot_half_deg')} | "
                         f"{cell(seg, 'e_tf_norm', 'e_rot_tf_deg')} | "
                         f"{cell(seg, 'e_hold_max_norm', 'e_rot_hold_max_deg')} | {metrics['status']} |")
-    return "\n".join(rows) + "\n\n`python scripts/pose_table.py` (distance / angle of the gripper to the part)."
+    note = "`python scripts/pose_table.py` (distance / angle of the gripper to the part)."
+    return "\n".join(rows) + "\n\n" + note
 
 
 def main() -> int:
