@@ -52,12 +52,20 @@ def _mm(value) -> str:
     return "n/a" if value is None else f"{value * 1e3:.4g} mm"
 
 
+def _mm_deg(seg: dict, distance: str, angle: str) -> str:
+    """A distance, with the orientation angle beside it when the task has one."""
+    value = seg.get(angle)
+    return _mm(seg[distance]) + ("" if value is None else f" / {value:.3g}°")
+
+
 def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
     from ptint_drake.metrics import segment_reasons  # noqa: PLC0415
 
     reasons = segment_reasons(seg, criteria)
-    return (f"{name} segment {i}: e0 = {_mm(seg['e0_norm'])}, e(tf/2) = {_mm(seg['e_half_norm'])}, "
-            f"e(tf) = {_mm(seg['e_tf_norm'])}, hold max = {_mm(seg['e_hold_max_norm'])}: "
+    return (f"{name} segment {i}: e0 = {_mm_deg(seg, 'e0_norm', 'e_rot0_deg')}, "
+            f"e(tf/2) = {_mm_deg(seg, 'e_half_norm', 'e_rot_half_deg')}, "
+            f"e(tf) = {_mm_deg(seg, 'e_tf_norm', 'e_rot_tf_deg')}, "
+            f"hold max = {_mm_deg(seg, 'e_hold_max_norm', 'e_rot_hold_max_deg')}: "
             + (f"MISSED ({', '.join(reasons)})" if reasons else "ok"))
 
 

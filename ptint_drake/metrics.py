@@ -44,11 +44,15 @@ class Criteria:
     hold: float = 3.0e-3  # m: |e| while holding at most this ("hold" otherwise)
     half_fraction: float = 0.25  # |e(tf/2)| at least this × |e0| ("early" otherwise)
     min_e0: float = 1.0e-2  # m: the early check applies only when |e0| is at least this
+    # tasks with orientation (controller.task pose | top_down), issue 19:
+    e_rot_tf_deg: float = 2.0  # deg: the angle at start + tf at most this ("orientation" otherwise)
+    rot_hold_deg: float = 5.0  # deg: the angle while holding at most this ("orientation" otherwise)
+    min_e_rot0_deg: float = 5.0  # deg: the early check of the angle applies only from this
 
 
 def validate_criteria(c: Criteria) -> None:
     """ValueError naming the field of a criterion that is not a positive number."""
-    for name in ("e_tf", "hold", "half_fraction", "min_e0"):
+    for name in ("e_tf", "hold", "half_fraction", "min_e0", "e_rot_tf_deg", "rot_hold_deg", "min_e_rot0_deg"):
         value = getattr(c, name)
         if not (math.isfinite(value) and value > 0.0):
             raise ValueError(f"criteria.{name}: must be > 0, got {value}")
@@ -57,7 +61,9 @@ def validate_criteria(c: Criteria) -> None:
 
 
 def segment_reasons(seg: dict, criteria: Criteria, margin: float = 1.0) -> list[str]:
-    """The criteria a segment's metrics fail: a subset of ``late``, ``early``, ``hold``.
+    """The criteria a segment's metrics fail: a subset of ``late``, ``early``, ``hold``,
+    ``orientation`` (a task with orientation: the angle at tf or in the hold too large; an angle
+    that halved too soon is ``early`` too).
 
     ``margin`` M tightens the bounds to e_tf / M and hold / M (used by tuning).
     A segment the run never reached is ``late``.
@@ -72,6 +78,22 @@ def segment_reasons(seg: dict, criteria: Criteria, margin: float = 1.0) -> list[
         reasons.append("early")
     if (seg.get("e_hold_max_norm") or 0.0) > criteria.hold / margin:
         reasons.append("hold")
+    return reasons + _orientation_reasons(seg, criteria, margin, "early" in reasons)
+
+
+def _orientation_reasons(seg: dict, criteria: Criteria, margin: float, early: bool) -> list[str]:
+    """``orientation`` when the angle at tf or in the hold is beyond its bound; ``early`` when
+    the angle was already below ``half_fraction`` of its start at tf/2 (not for ``position``)."""
+    if seg.get("e_rot_tf_deg") is None:
+        return []
+    reasons = []
+    r0, half = seg.get("e_rot0_deg"), seg.get("e_rot_half_deg")
+    if not early and r0 is not None and half is not None and r0 >= criteria.min_e_rot0_deg \
+            and half < criteria.half_fraction * r0:
+        reasons.append("early")
+    if seg["e_rot_tf_deg"] > criteria.e_rot_tf_deg / margin or \
+            (seg.get("e_rot_hold_max_deg") or 0.0) > criteria.rot_hold_deg / margin:
+        reasons.append("orientation")
     return reasons
 
 
@@ -159,6 +181,34 @@ def segment_metrics(schedule, duration: float, samples: dict, t: np.ndarray, x: 
     return rows
 
 
+ROTATION_KEYS = ("e_rot0_deg", "e_rot_half_deg", "e_rot_tf_deg", "e_rot_hold_max_deg", "edot_rot_tf_deg_s")
+
+
+def rotation_metrics(schedule, duration: float, t: np.ndarray, angle: Optional[np.ndarray],
+                     rate: Optional[np.ndarray]) -> list[dict]:
+    """Per segment ``ROTATION_KEYS`` from the per-sample angle (deg, N × segments: the tool's
+    orientation against object i's, as the task asks for it) and its rate (deg/s), at the exact
+    stops (logged samples at start, start + tf/2, start + tf); all None without orientation."""
+    rows = []
+    for i, seg in enumerate(schedule.segments):
+        if angle is None:
+            rows.append(dict.fromkeys(ROTATION_KEYS))
+            continue
+        a, r = angle[:, i], rate[:, i]
+
+        def at(time: float, values: np.ndarray):
+            k = np.nonzero(t == time)[0]
+            return float(values[k[-1]]) if len(k) else None
+
+        hold = (t >= seg.end) & (t <= schedule.hold_end(i, duration))
+        tf = at(seg.end, a)
+        rows.append({"e_rot0_deg": at(seg.start, a), "e_rot_half_deg": at(seg.start + 0.5 * seg.tf, a),
+                     "e_rot_tf_deg": tf, "e_rot_hold_max_deg": None if tf is None else max(
+                         float(np.max(a[hold])) if hold.any() else 0.0, tf),
+                     "edot_rot_tf_deg_s": at(seg.end, r)})
+    return rows
+
+
 def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> dict:
     """The metrics of a run (README "Outputs"): segments, torque and joint-speed peaks with
     their times, the peaks after start-up, and the fraction of time the actuators saturate.
@@ -175,11 +225,15 @@ def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> di
     steady = after_startup(t, schedule.segments)
     torque, torque_late = _peak(applied, t), _peak(applied, t, steady)
     speed = _peak(series["v"], t)
+    segments = segment_metrics(schedule, scenario.duration, samples, t, series["x"], series["objects"])
+    rotations = rotation_metrics(schedule, scenario.duration, t, series.get("rot_angle_deg"),
+                                 series.get("rot_rate_deg_s"))
+    for row, rot in zip(segments, rotations):
+        row |= rot
     return {
         "scenario": scenario.name,
         "duration": scenario.duration,
-        "segments": segment_metrics(schedule, scenario.duration, samples, t, series["x"],
-                                    series["objects"]),
+        "segments": segments,
         "torque_peak": torque["value"],
         "torque_peak_time": torque["time"],
         "torque_peak_after_startup": torque_late["value"],

@@ -20,6 +20,7 @@ from pydrake.multibody.tree import (JointIndex, PrismaticJoint, RevoluteJoint, S
 from ptint_drake.mass_scaling import scaled_copy
 from ptint_drake.rvm1 import bundled_models, model_path
 from ptint_drake.scenario import Scenario, ScenarioError
+from ptint_drake.systems.task import TASK_MIN_JOINTS
 
 
 def resolve_model(model: str) -> Path:
@@ -67,6 +68,10 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
             scenario.plant.payload_kg, np.zeros(3), UnitInertia.SolidSphere(0.03)))
         plant.WeldFrames(frame, payload.body_frame(), RigidTransform())
     plant.Finalize()
+    task, needed = scenario.controller.task, TASK_MIN_JOINTS[scenario.controller.task]
+    if plant.num_velocities() < needed:
+        raise ScenarioError(f"controller.task: {task!r} needs an arm with at least {needed} joints, "
+                            f"{scenario.robot.model!r} has {plant.num_velocities()}")
     if len(scenario.robot.initial_q_deg) != plant.num_positions():
         raise ScenarioError(
             f"robot.initial_q_deg: the model has {plant.num_positions()} joints, "

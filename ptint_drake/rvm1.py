@@ -18,10 +18,19 @@ H1, L1, L2 = 0.3, 0.25, 0.16
 START_Q_DEG = (22.5, 45.0, -120.0)
 START_THETA_DEG = (22.5, 45.0, 30.0)
 END_EFFECTOR = "tool"
+# The 5-joint RV-M1 with its wrist (models/rvm1_5dof.urdf): frame ``tool`` is the centre between
+# the fingertips, this far from the wrist-pitch axis along the hand (z = approach direction, x
+# across the fingers); any later gripper model must put its fingertip centre there.
+MODEL_5DOF = "rvm1_5dof"
+FINGERTIP_OFFSET = 0.12  # m
 
 
 def _models_dir() -> Path:
-    """The bundled models: ``ptint_drake.models`` when installed, else the source tree's models/."""
+    """The bundled models: the source tree's models/ beside this package when there is one (a
+    checkout, whatever else is installed), else ``ptint_drake.models`` (an installed package)."""
+    source = Path(__file__).resolve().parent.parent / "models"
+    if (source / "rvm1.urdf").is_file():
+        return source
     try:
         return Path(str(resources.files("ptint_drake.models")))
     except ModuleNotFoundError:

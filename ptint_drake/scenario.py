@@ -45,6 +45,7 @@ from ptint_drake.metrics import Criteria
 from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
 from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.gains import ControllerGains
+from ptint_drake.systems.orientation import OrientedTarget, SlerpOrientation, SpinningOrientation
 from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
 from ptint_drake.validation import TARGET_KINDS, ScenarioError, validate
@@ -104,6 +105,17 @@ class WaypointsConfig:
     time: List[float] = field(default_factory=list)
     # not List[List[float]]: yaml_load_typed cannot build a typing.List inside a list
     position: list[list[float]] = field(default_factory=list)
+    # optional: the object's roll-pitch-yaw (degrees) at each time, slerped between samples
+    rpy_deg: list[list[float]] = field(default_factory=list)
+
+
+@dataclass
+class OrientationConfig:
+    """The object frame's orientation: Drake RollPitchYaw (R = Rz·Ry·Rx, degrees) at t = 0 and a
+    constant world-frame angular velocity (deg/s)."""
+
+    rpy_deg: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rate_deg_s: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 @dataclass
@@ -111,6 +123,7 @@ class TargetConfig:
     sinusoid: Optional[SinusoidConfig] = None
     linear: Optional[LinearConfig] = None
     waypoints: Optional[WaypointsConfig] = None
+    orientation: Optional[OrientationConfig] = None
 
 
 @dataclass
@@ -178,12 +191,21 @@ class Scenario:
 
 
 def make_target(config: TargetConfig):
+    """The target object of a ``target`` block: its position kind, with its orientation
+    (``orientation.OrientedTarget``) when it has one (``orientation`` or waypoints' ``rpy_deg``)."""
     if config.sinusoid is not None:
         s = config.sinusoid
-        return SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
-    if config.waypoints is not None:
-        return WaypointTarget(config.waypoints.time, config.waypoints.position)
-    return LinearTarget(config.linear.start, config.linear.velocity)
+        target = SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
+    elif config.waypoints is not None:
+        target = WaypointTarget(config.waypoints.time, config.waypoints.position)
+    else:
+        target = LinearTarget(config.linear.start, config.linear.velocity)
+    if config.orientation is not None:
+        o = config.orientation
+        return OrientedTarget(target, SpinningOrientation(o.rpy_deg, o.rate_deg_s))
+    if config.waypoints is not None and config.waypoints.rpy_deg:
+        return OrientedTarget(target, SlerpOrientation(config.waypoints.time, config.waypoints.rpy_deg))
+    return target
 
 
 def bundled_scenarios() -> "list[str]":

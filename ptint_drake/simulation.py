@@ -30,8 +30,10 @@ from ptint_drake.run_warnings import joint_limit_warnings, singularity_warnings,
 from ptint_drake.scenario import Scenario
 from ptint_drake.station import MakeStation, Station
 from ptint_drake.systems.kinematics import FrameKinematics
+from ptint_drake.systems.orientation import rotation_error, target_rotation_values
 from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.targets import active_target_values, target_values
+from ptint_drake.systems.task import task_reference
 from ptint_drake.watchdog import Watchdog
 
 
@@ -163,6 +165,9 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     if progress is not None:
         progress(context.get_time(), scenario.duration, int(integrator.get_num_steps_taken()))
     series = collect_series(built, context, kinematics)
+    if scenario.controller.task != "position":
+        series |= orientation_series(scenario.controller.task, kinematics, series, built.station.true_targets,
+                                     scenario.schedule(), scenario.duration)
     metrics = run_metrics(scenario, samples, series, built.station.effort_limits)
     warnings += singularity_warnings(plant, scenario, series) + joint_limit_warnings(plant, series)
     if watchdog.failure:
@@ -237,3 +242,23 @@ def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:
     series["tau_applied"] = np.clip(series["tau"], -limits, limits) if station.saturate \
         else series["tau"].copy()
     return series
+
+
+def orientation_series(task: str, kinematics: FrameKinematics, series: dict, targets, schedule,
+                       duration: float) -> dict:
+    """Per sample and per object i: the angle (deg) between the tool's orientation (forward
+    kinematics of the logged plant state) and object i's TRUE orientation as the task asks for it
+    (``rot_angle_deg``), and the rate of that error rotation |ω − R R_rᵀ ω_r| (``rot_rate_deg_s``),
+    from segment i's start to the end of its hold (NaN elsewhere)."""
+    t, q, v = series["t"], series["q"], series["v"]
+    angle = np.full((len(t), len(targets)), np.nan)
+    rate = np.full((len(t), len(targets)), np.nan)
+    windows = [(seg.start, schedule.hold_end(i, duration)) for i, seg in enumerate(schedule.segments)]
+    for k, tk in enumerate(t.tolist()):
+        _, _, R, omega, _, _ = kinematics.compute_pose(q[k], v[k])
+        for i, tg in enumerate(targets):
+            if windows[i][0] <= tk <= windows[i][1]:
+                reference = task_reference(task, target_rotation_values(tg, tk), R)
+                e_R, edot_R = rotation_error(R, omega, reference)
+                angle[k, i], rate[k, i] = np.linalg.norm(e_R), np.linalg.norm(edot_R)
+    return {"rot_angle_deg": np.degrees(angle), "rot_rate_deg_s": np.degrees(rate)}

@@ -11,6 +11,7 @@ from ptint_drake.metrics import validate_criteria
 from ptint_drake.systems.camera import validate_measurement
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import WaypointTarget
+from ptint_drake.systems.task import TASKS
 
 IMPLEMENTATIONS = ("fused", "blocks")
 TARGET_KINDS = ("sinusoid", "linear", "waypoints")
@@ -73,6 +74,11 @@ def _validate_controller(c) -> None:
             raise ScenarioError(f"controller.{name}: must be one of {', '.join(allowed)}, got {value!r}")
     if c.switching != "sign":
         _positive(c.phi, "controller.phi")
+    if c.task not in TASKS:
+        raise ScenarioError(f"controller.task: must be one of {', '.join(TASKS)}, got {c.task!r}")
+    if c.task != "position" and c.type != "ptsmc":
+        raise ScenarioError(f"controller.task: {c.task!r} is implemented by ptsmc only, not {c.type!r}")
+    _positive(c.rot_scale, "controller.rot_scale")
     for entry in REGISTRY.values():  # each controller's own block: messages name it from "<name>." on
         if entry.config is not None and hasattr(entry.config, "validate"):
             try:
@@ -161,3 +167,22 @@ def _validate_target(t, where: str) -> None:
     else:
         _vector3(t.linear.start, f"{where}.linear.start")
         _vector3(t.linear.velocity, f"{where}.linear.velocity")
+    _validate_orientation(t, where)
+
+
+def _validate_orientation(t, where: str) -> None:
+    """``orientation`` (rpy_deg, rate_deg_s: 3 finite numbers each) and waypoints' ``rpy_deg``
+    (one [r, p, y] per sample time); not both."""
+    if t.orientation is not None:
+        _vector3(t.orientation.rpy_deg, f"{where}.orientation.rpy_deg")
+        _vector3(t.orientation.rate_deg_s, f"{where}.orientation.rate_deg_s")
+    rpy = t.waypoints.rpy_deg if t.waypoints is not None else []
+    if not rpy:
+        return
+    if t.orientation is not None:
+        raise ScenarioError(f"{where}.waypoints.rpy_deg: orientation or rpy_deg, not both")
+    if len(rpy) != len(t.waypoints.time):
+        raise ScenarioError(f"{where}.waypoints.rpy_deg: one [r, p, y] per time is needed, got {len(rpy)} "
+                            f"for {len(t.waypoints.time)} times")
+    for k, sample in enumerate(rpy):
+        _vector3(sample, f"{where}.waypoints.rpy_deg[{k}]")

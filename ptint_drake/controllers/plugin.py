@@ -32,7 +32,7 @@ from typing import Sequence
 from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, target_columns
 from ptint_drake.systems.active_segment import SIZE as SEGMENT_SIZE
 from ptint_drake.systems.active_segment import ActiveSegment
-from ptint_drake.systems.signals import TARGET_PORT_SIZE
+from ptint_drake.systems.signals import TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
 
 PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*$")
 FORM = "'module:Class' (a LeafSystem in your own file)"
@@ -111,7 +111,7 @@ def make_plugin(type_: str, plant, end_effector: str, params: dict):
     except Exception as exc:
         raise _error(f"controller {type_}: constructing it raised {type(exc).__name__}: {exc}") from None
     sizes = {"state": plant.num_positions() + plant.num_velocities(), "target": TARGET_PORT_SIZE}
-    optional = {"segment": SEGMENT_SIZE}
+    optional = {"segment": SEGMENT_SIZE, "target_rotation": TARGET_ROTATION_SIZE}
     for name, size in (sizes | optional).items():
         if not _has_port(system, "input", name):
             if name in optional:
@@ -157,6 +157,8 @@ def AddPlugin(slot: ControllerSlot, params: dict, target: TargetView, type_: str
     if _has_port(system, "input", "segment"):
         clock = builder.AddNamedSystem("active_segment", ActiveSegment(slot.schedule))
         builder.Connect(clock.get_output_port(), system.GetInputPort("segment"))
+    if _has_port(system, "input", "target_rotation"):  # the object's orientation (issue 19)
+        builder.Connect(target.rotation_port(), system.GetInputPort("target_rotation"))
     builder.Connect(system.GetOutputPort("actuation"), slot.actuation)
     B = slot.plant.MakeActuationMatrix()
 

@@ -32,6 +32,7 @@ from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
 
 from ptint_drake.systems.kalman import AddCameraEstimators
 from ptint_drake.systems.measurement import MeasuredTarget
+from ptint_drake.systems.orientation import OrientedTarget
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.targets import TargetSource
@@ -80,28 +81,40 @@ class ControllerSlot:
         return make_plant(nominal)
 
     def connect(self, system, target: "TargetView") -> OutputPort:
-        """Wire a controller with ports ``state``, ``target`` in and ``u`` out; returns the
-        target port it was given (for logging)."""
+        """Wire a controller with ports ``state``, ``target`` in and ``u`` out (and
+        ``target_rotation`` when it declares one); returns the target port it was given."""
         self.builder.Connect(self.state, system.GetInputPort("state"))
         self.builder.Connect(system.GetOutputPort("u"), self.actuation)
         port = target.port()
         self.builder.Connect(port, system.GetInputPort("target"))
+        if system.HasInputPort("target_rotation"):
+            self.builder.Connect(target.rotation_port(), system.GetInputPort("target_rotation"))
         return port
 
 
 class TargetView:
     """The target as the controller may see it: ``analytic`` (the target objects, or None with
-    a camera) and ``port()`` ([x_r, ẋ_r, ẍ_r] of the active segment, built on first use)."""
+    a camera), ``port()`` ([x_r, ẋ_r, ẍ_r] of the active segment, built on first use) and
+    ``rotation_port()`` ([R_r, ω_r, ω̇_r], ``signals.TARGET_ROTATION``: the object's orientation,
+    not measured — the camera estimates positions only)."""
 
     def __init__(self, builder: DiagramBuilder, station_system, scenario: "Scenario"):
         self._builder, self._station, self._scenario = builder, station_system, scenario
         self.analytic = controller_targets(scenario) if uses_analytic_targets(scenario) else None
         self._port: Optional[OutputPort] = None
+        self._rotation_port: Optional[OutputPort] = None
 
     def port(self) -> OutputPort:
         if self._port is None:
             self._port = target_view(self._builder, self._station, self._scenario, self.analytic)
         return self._port
+
+    def rotation_port(self) -> OutputPort:
+        if self._rotation_port is None:
+            source = self._builder.AddNamedSystem("target_rotation_view", TargetSource(
+                self._scenario.schedule(), self.analytic or self._scenario.targets()))
+            self._rotation_port = source.GetOutputPort("target_rotation")
+        return self._rotation_port
 
 
 def uses_analytic_targets(scenario: "Scenario") -> bool:
@@ -115,8 +128,11 @@ def controller_targets(scenario: "Scenario") -> list:
     m = scenario.measurement
     if m.noise_std == 0.0 and m.latency == 0.0:
         return targets
-    return [MeasuredTarget(tg, scenario.duration, m.noise_std, m.rate_hz, m.latency,
-                           m.compensate_latency, m.seed + i) for i, tg in enumerate(targets)]
+    measured = [MeasuredTarget(tg, scenario.duration, m.noise_std, m.rate_hz, m.latency,
+                               m.compensate_latency, m.seed + i) for i, tg in enumerate(targets)]
+    # the legacy measurement is of positions: an orientation passes through as it is
+    return [OrientedTarget(mt, tg.orientation) if isinstance(tg, OrientedTarget) else mt
+            for mt, tg in zip(measured, targets)]
 
 
 def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",

@@ -26,7 +26,7 @@ import numpy as np
 
 from ptint_drake.controllers import CONTROLLERS
 from ptint_drake.figures import plt, save
-from ptint_drake.metrics import Reason
+from ptint_drake.metrics import ROTATION_KEYS, Reason
 from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
@@ -67,7 +67,7 @@ def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
         "reason_codes": m["reason_codes"],
         "torque_peak_max": float(max(m["torque_peak"])),
         "torque_peak_after_startup_max": float(max(m["torque_peak_after_startup"])),
-        "segments": [{k: seg[k] for k in SEGMENT_KEYS} for seg in m["segments"]],
+        "segments": [{k: seg.get(k) for k in SEGMENT_KEYS + ROTATION_KEYS} for seg in m["segments"]],
         "notes": m["controller"]["notes"], "model_based": m["controller"]["model_based"],
         "realtime_factor": m["sim"]["realtime_factor"],
         "curve": {"t": grid.tolist(), "e": np.interp(grid, t, e_norm).tolist(),

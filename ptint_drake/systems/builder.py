@@ -28,6 +28,7 @@ from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET_PORT_SIZE
 from ptint_drake.systems.sliding_surface import SlidingSurface
 from ptint_drake.systems.targets import TargetSource
+from ptint_drake.systems.task import TASK_DIM, TASK_MIN_JOINTS
 from ptint_drake.systems.tbg import TimeBaseGenerator
 
 
@@ -44,6 +45,8 @@ class InterceptorHandles:
     controller: Optional[SlidingModeController] = None
     fused: Optional[PrescribedTimeInterceptor] = None
     target_input: Optional[InputPort] = None  # with targets=None: where [x_r, ẋ_r, ẍ_r] goes in
+    # with targets=None and an orientation task: where [R_r, ω_r, ω̇_r] goes in
+    rotation_input: Optional[InputPort] = None
 
 
 def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
@@ -60,8 +63,10 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
     system (several times faster to simulate; fewer ports to inspect).
     ``targets=None`` builds it without any target object: the handles'
     ``target_input`` ([x_r, ẋ_r, ẍ_r] of the active segment, ``signals.TARGET_PORT``) is for
-    the caller to connect, e.g. to a Kalman filter.  ``state_port`` is where [q; v] comes from
-    (default: the plant's state output; e.g. a station's exported ``state``).
+    the caller to connect, e.g. to a Kalman filter (and, with an orientation ``gains.task``,
+    ``rotation_input``: [R_r, ω_r, ω̇_r], ``signals.TARGET_ROTATION``).
+    ``state_port`` is where [q; v] comes from (default: the plant's state output; e.g. a station's
+    exported ``state``).
     ``posture``: the joint positions the optional null-space term (``gains.null_space_damping``,
     redundant arms) pulls toward (default: the plant's default positions).
     """
@@ -72,8 +77,9 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
         raise ValueError(
             f"robot.model: the plant must actuate every velocity (nv = {nv}, "
             f"actuated = {plant.num_actuated_dofs()})")
-    if nv < 3:
-        raise ValueError(f"robot.model: at least 3 joints are needed for 3-D interception, got {nv}")
+    if nv < TASK_MIN_JOINTS[gains.task]:
+        raise ValueError(f"controller.task: {gains.task!r} needs at least {TASK_MIN_JOINTS[gains.task]} "
+                         f"joints, the arm has {nv}")
 
     state_port = state_port or plant.get_state_output_port()
     if fused:
@@ -83,7 +89,8 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
         if connect_actuation:
             builder.Connect(system.GetOutputPort("u"), plant.get_actuation_input_port())
         return InterceptorHandles(schedule, fused=system, target_input=(
-            system.GetInputPort("target") if targets is None else None))
+            system.GetInputPort("target") if targets is None else None), rotation_input=(
+            system.GetInputPort("target_rotation") if system.has_rotation_input else None))
 
     return _add_blocks(builder, plant, frame, schedule=schedule, targets=targets, gains=gains,
                        connect_actuation=connect_actuation, name=name, state_port=state_port,
@@ -93,9 +100,10 @@ def AddPrescribedTimeInterceptor(builder, plant, frame, schedule: Schedule,
 def _add_blocks(builder, plant, frame, *, schedule, targets, gains, connect_actuation, name, state_port,
                 posture) -> InterceptorHandles:
     """The five wired blocks of paper Fig. 1 (see ``AddPrescribedTimeInterceptor``)."""
-    nv = plant.num_velocities()
+    nv, rotation = plant.num_velocities(), gains.task != "position"
     tbg = builder.AddNamedSystem(f"{name}_tbg", TimeBaseGenerator(
         schedule, gains.epsilon, gains.delta, gains.alpha_hold))
+    rotation_input = None
     if targets is None:
         # x_r | ẋ_r | ẍ_r
         source = builder.AddNamedSystem(f"{name}_target", Demultiplexer(TARGET_PORT_SIZE, 3))
@@ -103,18 +111,24 @@ def _add_blocks(builder, plant, frame, *, schedule, targets, gains, connect_actu
     else:
         source = builder.AddNamedSystem(f"{name}_target", TargetSource(schedule, targets))
         x_r, xdot_r = source.GetOutputPort("x_r"), source.GetOutputPort("xdot_r")
-    kin = builder.AddNamedSystem(f"{name}_kinematics", TaskSpaceKinematics(plant, frame))
+    kin = builder.AddNamedSystem(f"{name}_kinematics", TaskSpaceKinematics(
+        plant, frame, gains.task, gains.rot_scale))
     surface = builder.AddNamedSystem(f"{name}_surface", SlidingSurface(
-        schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy, gains.k_hold))
+        schedule, gains.Lambda, gains.k, gains.switching, gains.phi, gains.sigma_policy, gains.k_hold,
+        gains.task, gains.rot_scale))
     null_space = null_space_terms(gains, plant, posture)
     ctrl = builder.AddNamedSystem(f"{name}_controller", SlidingModeController(
-        nv, gains.K, plant.MakeActuationMatrix(), gains.pinv_damping, null_space))
+        nv, gains.K, plant.MakeActuationMatrix(), gains.pinv_damping, null_space, TASK_DIM[gains.task]))
     if null_space is not None:
         builder.Connect(state_port, ctrl.GetInputPort("state"))
 
     builder.Connect(state_port, kin.get_state_input_port())
-    builder.Connect(kin.GetOutputPort("x"), surface.GetInputPort("x"))
-    builder.Connect(kin.GetOutputPort("xdot"), surface.GetInputPort("xdot"))
+    for port in ("x", "xdot") + (("R", "omega") if rotation else ()):
+        builder.Connect(kin.GetOutputPort(port), surface.GetInputPort(port))
+    if rotation and targets is not None:
+        builder.Connect(source.GetOutputPort("target_rotation"), surface.GetInputPort("target_rotation"))
+    elif rotation:
+        rotation_input = surface.GetInputPort("target_rotation")
     builder.Connect(x_r, surface.GetInputPort("x_r"))
     builder.Connect(xdot_r, surface.GetInputPort("xdot_r"))
     builder.Connect(tbg.GetOutputPort("alpha"), surface.GetInputPort("alpha"))
@@ -124,4 +138,5 @@ def _add_blocks(builder, plant, frame, *, schedule, targets, gains, connect_actu
     if connect_actuation:
         builder.Connect(ctrl.GetOutputPort("u"), plant.get_actuation_input_port())
     return InterceptorHandles(schedule, tbg, source, kin, surface, ctrl,
-                              target_input=source.get_input_port() if targets is None else None)
+                              target_input=source.get_input_port() if targets is None else None,
+                              rotation_input=rotation_input)

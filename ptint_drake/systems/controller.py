@@ -12,6 +12,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.task import TASK_DIM
 
 
 def solve3(A: list, b: list) -> list:
@@ -32,10 +33,18 @@ def solve3(A: list, b: list) -> list:
 def pinv_apply(J, b, damping: float = 0.0) -> list:
     """J⁺ b for a 3 × nv J and a 3-vector b (lists of plain floats, the fast form, or arrays),
     as a list: a solve for square J, the minimum-norm solution Jᵀ(JJᵀ)⁻¹ b otherwise.
+    For a task of another dimension (6 rows: position and orientation, ``systems.task``) it is
+    the minimum-norm least-squares solution (``lstsq``): J⁻¹ b for a square J, the least-squares
+    fit for fewer joints than rows (a 5-joint wrist), the minimum-norm one for more.
 
     With ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which
     stays bounded through singular configurations at the cost of a small bias near them.
     """
+    if len(J) != 3:
+        Ja = np.asarray(J, dtype=float)
+        if damping > 0.0:
+            return (Ja.T @ np.linalg.solve(Ja @ Ja.T + damping * damping * np.eye(len(Ja)), b)).tolist()
+        return np.linalg.lstsq(Ja, np.asarray(b, dtype=float), rcond=None)[0].tolist()
     if damping > 0.0:
         Ja = np.asarray(J, dtype=float)  # an array keeps its memory order: BLAS's rounding does too
         return (Ja.T @ solve3((Ja @ Ja.T + damping * damping * np.eye(3)).tolist(), _floats(b))).tolist()
@@ -52,7 +61,7 @@ def _floats(values) -> list:
 
 def smc_torque(K, J, s_x, damping: float = 0.0) -> list:
     """τ = −K J⁺ s_x (paper eq. 18) as a list of plain floats: K a sequence of nv gains (N·m·s/rad),
-    J (3 × nv) and s_x (3) as ``pinv_apply`` takes them."""
+    J (n × nv) and s_x (n; n = 3, or 6 with orientation) as ``pinv_apply`` takes them."""
     return [-k * a for k, a in zip(K, pinv_apply(J, s_x, damping))]
 
 
@@ -66,16 +75,18 @@ def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.n
 
 def null_space_terms(gains, plant, posture=None):
     """(D, r, q_start) of ``null_space_torque`` for ``gains`` (a ``ControllerGains``), or None
-    when it is off: ``gains.null_space_damping`` = 0, or a square arm (nv = 3).  q_start is
+    when it is off: ``gains.null_space_damping`` = 0, or no redundancy (nv ≤ the task's
+    dimension).  q_start is
     ``posture``, by default the plant's default positions (needs nq = nv)."""
-    if not (gains.null_space_damping > 0.0 and plant.num_velocities() > 3):
+    if not (gains.null_space_damping > 0.0 and plant.num_velocities() > TASK_DIM[gains.task]):
         return None
     start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
     return (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float))
 
 
 class SlidingModeController(LeafSystem):
-    """Inputs ``s_x`` (3) and ``J`` (3·nv, row-major); output ``tau`` (nv joint torques).
+    """Inputs ``s_x`` (n) and ``J`` (n·nv, row-major; n = 3, or 6 for a task with orientation);
+    output ``tau`` (nv joint torques).
 
     ``K`` is a scalar or a length-nv diagonal (N·m·s/rad).  The output is in
     generalized-velocity order; ``actuation_matrix`` (the plant's B, nv × nu)
@@ -83,19 +94,20 @@ class SlidingModeController(LeafSystem):
     """
 
     def __init__(self, nv: int, K=50.0, actuation_matrix=None, pinv_damping: float = 0.0,
-                 null_space=None):
+                 null_space=None, dim: int = 3):
         """``null_space`` = (D, r, q_start) adds ``null_space_torque`` and an input ``state``
         ([q; v], nq = nv) to read q and q̇."""
         super().__init__()
         self._null_space = null_space
         self._nv = nv
+        self._dim = dim
         self._damping = float(pinv_damping)
         self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
         self._K_floats = tuple(self._K.tolist())
         self._BT = None if actuation_matrix is None else np.asarray(actuation_matrix).T
         nu = nv if actuation_matrix is None else self._BT.shape[0]
-        self._s_x_in = self.DeclareVectorInputPort("s_x", 3)
-        self._J_in = self.DeclareVectorInputPort("J", 3 * nv)
+        self._s_x_in = self.DeclareVectorInputPort("s_x", dim)
+        self._J_in = self.DeclareVectorInputPort("J", dim * nv)
         self._state_in = self.DeclareVectorInputPort("state", 2 * nv) if null_space else None
         deps = {self.all_input_ports_ticket()}
         self._eval = DeclareVectorCache(self, "tau", nv, self._tau, deps)
@@ -107,11 +119,11 @@ class SlidingModeController(LeafSystem):
             prerequisites_of_calc=deps)
 
     def torque(self, s_x: np.ndarray, J: np.ndarray) -> np.ndarray:
-        """τ = −K J⁺ s_x (``smc_torque``) for a 3 × nv Jacobian J."""
+        """τ = −K J⁺ s_x (``smc_torque``) for an n × nv Jacobian J."""
         return np.array(smc_torque(self._K_floats, J, s_x, self._damping))
 
     def _tau(self, context) -> np.ndarray:
-        J = self._J_in.Eval(context).reshape(3, self._nv)
+        J = self._J_in.Eval(context).reshape(self._dim, self._nv)
         tau = self.torque(self._s_x_in.Eval(context), J)
         if self._null_space:
             qv = self._state_in.Eval(context)

@@ -29,3 +29,9 @@ class ControllerGains:
     # default) leaves the paper's law exact.  It reads kinematics only (model-free).
     null_space_damping: float = 0.0  # N·m·s/rad: D
     null_space_rate: float = 2.0  # 1/s: r, how fast the posture error is pulled back
+    # Issue 19: which error the surface drives to zero (``systems.task``): ``position`` (the
+    # paper's), ``pose`` (position and orientation, ≥ 6 joints) or ``top_down`` (position, approach
+    # axis down, yaw matched to the object's modulo 180°, ≥ 5 joints); and how a radian of
+    # orientation error weighs against a metre of position error.
+    task: str = "position"  # position | pose | top_down
+    rot_scale: float = 0.1  # m per rad

@@ -15,6 +15,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.task import task_jacobian
 
 
 _ORIGIN = np.zeros(3)
@@ -39,28 +40,47 @@ class FrameKinematics:
             pc, self._kV, self._frame, _ORIGIN, self._world, self._world)
         return x, J @ v, J
 
+    def compute_pose(self, q, v) -> tuple:
+        """(x, ẋ, R, ω, J_v, J_ω) at q, v: the frame's position, velocity, orientation (3 × 3),
+        angular velocity (world frame) and the translational and rotational Jacobians (3 × nv)."""
+        plant, pc = self._plant, self._plant_context
+        plant.SetPositions(pc, q)
+        X = self._frame.CalcPoseInWorld(pc)
+        Js = plant.CalcJacobianSpatialVelocity(pc, self._kV, self._frame, _ORIGIN, self._world, self._world)
+        J_w, J_v = Js[0:3], Js[3:6]
+        return X.translation(), J_v @ v, X.rotation().matrix(), J_w @ v, J_v, J_w
+
 
 class TaskSpaceKinematics(LeafSystem):
     """Input ``state`` = [q; v] of the plant; outputs ``x`` (3), ``xdot`` (3), ``J`` (3·nv, row-major).
 
+    With an orientation ``task`` (``pose``, ``top_down``) also ``R`` (the frame's orientation,
+    row-major, 9) and ``omega`` (its angular velocity, 3), and ``J`` is the task's
+    [J_v; c J_ω] (6·nv, ``task.task_jacobian``, c = ``rot_scale``).
     The system owns a private plant context: each change of the input writes it
-    once and one cache entry computes x, ẋ and J together.
+    once and one cache entry computes everything together.
     """
 
-    def __init__(self, plant, frame):
+    def __init__(self, plant, frame, task: str = "position", rot_scale: float = 0.1):
         super().__init__()
         self._kinematics = FrameKinematics(plant, frame)
         nq, nv = plant.num_positions(), plant.num_velocities()
         self._nq, self._nv = nq, nv
+        self._rotation = task != "position"
+        self._rot_scale = float(rot_scale)
         self._state_in = self.DeclareVectorInputPort("state", nq + nv)
         deps = {self._state_in.ticket()}
-        self._eval = DeclareVectorCache(self, "kinematics", 6 + 3 * nv, self._calc, deps)
-        self._x_out = self.DeclareVectorOutputPort(
-            "x", 3, lambda c, o: o.SetFromVector(self._eval(c)[0:3]), prerequisites_of_calc=deps)
-        self._xdot_out = self.DeclareVectorOutputPort(
-            "xdot", 3, lambda c, o: o.SetFromVector(self._eval(c)[3:6]), prerequisites_of_calc=deps)
-        self._J_out = self.DeclareVectorOutputPort(
-            "J", 3 * nv, lambda c, o: o.SetFromVector(self._eval(c)[6:]), prerequisites_of_calc=deps)
+        parts = [("x", 3), ("xdot", 3)] + ([("R", 9), ("omega", 3), ("J", 6 * nv)] if self._rotation
+                                           else [("J", 3 * nv)])
+        size = sum(n for _, n in parts)
+        self._eval = DeclareVectorCache(self, "kinematics", size, self._calc, deps)
+        lo = 0
+        for name, n in parts:
+            self.DeclareVectorOutputPort(
+                name, n, lambda c, o, part=slice(lo, lo + n): o.SetFromVector(self._eval(c)[part]),
+                prerequisites_of_calc=deps)
+            lo += n
+        self._x_out, self._xdot_out, self._J_out = (self.GetOutputPort(n) for n in ("x", "xdot", "J"))
 
     @property
     def num_velocities(self) -> int:
@@ -71,7 +91,11 @@ class TaskSpaceKinematics(LeafSystem):
         return self.evaluate(qv[: self._nq], qv[self._nq:])
 
     def evaluate(self, q, v) -> np.ndarray:
-        """[x, ẋ, vec(J)] (row-major J, 3 × nv) at joint positions q and velocities v."""
+        """[x, ẋ, vec(J)] (row-major J, 3 × nv) at joint positions q and velocities v; with
+        orientation [x, ẋ, vec(R), ω, vec([J_v; c J_ω])]."""
+        if self._rotation:
+            x, xdot, R, w, J_v, J_w = self._kinematics.compute_pose(q, v)
+            return np.concatenate([x, xdot, R.ravel(), w, task_jacobian(J_v, J_w, self._rot_scale).ravel()])
         x, xdot, J = self._kinematics.compute(q, v)
         return np.concatenate([x, xdot, J.ravel()])
 

@@ -7,6 +7,8 @@ Both kinds are functions of absolute time t:
   ω = 1.5, phase (0, π/2, 0));
 - ``LinearTarget``: x_r = start + velocity · t (an object on a conveyor);
 - ``WaypointTarget``: a C² cubic spline through recorded samples (SPEC 5.4 ``waypoints``).
+
+Any of them may carry an orientation (``orientation.OrientedTarget``, issue 19).
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.signals import TARGET, TARGET_PORT, TARGET_PORT_SIZE
+from ptint_drake.systems.orientation import active_rotation_values
+from ptint_drake.systems.signals import TARGET, TARGET_PORT, TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,8 @@ class TargetSource(LeafSystem):
 
     Output ports ``x_r``, ``xdot_r``, ``xddot_r`` (3 each) and ``target`` (the three
     stacked, ``signals.TARGET_PORT``) depend on time only.
+    Output port ``target_rotation`` ([R_r row-major, ω_r, ω̇_r], ``signals.TARGET_ROTATION``,
+    15) is the active target's orientation (an unturned, fixed frame for a target without one).
     Before the first segment starts, the first target is emitted.  Output port
     ``objects`` (3 × number of segments) gives every target's position at t,
     which a replay uses to draw the objects that are not being chased.
@@ -117,6 +122,10 @@ class TargetSource(LeafSystem):
             prerequisites_of_calc=time_only)
         self._target_out = self.DeclareVectorOutputPort(
             "target", TARGET_PORT_SIZE, lambda c, o: o.SetFromVector(self._eval(c)[TARGET_PORT]),
+            prerequisites_of_calc=time_only)
+        self.DeclareVectorOutputPort(
+            "target_rotation", TARGET_ROTATION_SIZE,
+            lambda c, o: o.SetFromVector(active_rotation_values(self._schedule, self._targets, c.get_time())),
             prerequisites_of_calc=time_only)
         self._objects_out = self.DeclareVectorOutputPort(
             "objects", 3 * len(targets),
