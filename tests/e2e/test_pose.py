@@ -19,7 +19,7 @@ from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.systems.sliding_surface import SlidingSurface
 from ptint_drake.systems.targets import LinearTarget
 from ptint_drake.systems.tbg import alpha_gain, tbg_profile
-from test_builder import _joint, _link
+from arms import _joint, _link
 
 # A 6-joint arm (waist, shoulder, elbow, a roll-pitch-roll wrist) that is not the RV-M1.
 SIX_ARM = ("""<?xml version="1.0"?><robot name="six_arm">""" + _link("base", 5, "0 0 0", 0.05)
