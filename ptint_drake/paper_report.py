@@ -127,8 +127,9 @@ def _camera_figure(out_dir: Path) -> None:
         estimate_figure(scenario_text(CAMERA_SCENARIO)[1], CAMERA_SCENARIO, stage)
 
 
-def write_paper(out_dir: Path, progress_factory=None, workers=None) -> Path:
-    """Run every paper scenario and the controller comparisons; write ``out_dir/index.html``."""
+def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = False) -> Path:
+    """Run every paper scenario and the controller comparisons; write ``out_dir/index.html``
+    (``svg``: the run figures as SVG too)."""
     from ptint_drake.studies.compare import write_compare  # noqa: PLC0415
 
     out_dir = Path(out_dir)
@@ -146,7 +147,7 @@ def write_paper(out_dir: Path, progress_factory=None, workers=None) -> Path:
     for name, (figs, claim) in PAPER_SCENARIOS.items():
         scenario = load_scenario(name)
         progress = progress_factory(name) if progress_factory else None
-        m = run_and_write(scenario, out_dir / name, progress=progress)
+        m = run_and_write(scenario, out_dir / name, progress=progress, svg=svg, workers=workers)
         rows += _result_rows(name, m, scenario, paper_holds[name], figs, claim)
         imgs = "".join(f"<a href='{name}/{f}'><img src='{name}/{f}' width='480'></a>"
                        for f in m.get("figures", []))
