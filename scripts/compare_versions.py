@@ -70,7 +70,8 @@ class Version:
         self.env = {"PYTHONPATH": str(tree), "PATH": "/usr/bin:/bin", "HOME": str(Path.home()),
                     "MPLBACKEND": "Agg", "PYTHONHASHSEED": "0"}
         where = subprocess.run([python, "-c", "import ptint_drake; print(ptint_drake.__file__)"],
-                               env=self.env, capture_output=True, text=True, check=True).stdout
+                               env=self.env, cwd=scratch, capture_output=True, text=True,
+                               check=True).stdout
         if not Path(where.strip()).resolve().is_relative_to(tree.resolve()):
             raise SystemExit(f"compare_versions: {label} imports ptint_drake from {where.strip()}, "
                              f"not from {tree}")
@@ -184,9 +185,9 @@ def main(argv=None) -> int:
         new = Version("new", new_tree, args.python, tmp / "new")
         log = lambda message: print(message, file=sys.stderr, flush=True)  # noqa: E731
         report = compare(old, new, cases, args.pairs, log)
-    python = subprocess.run([args.python, "-c", "import sys, pydrake; print(sys.version.split()[0], "
-                             "getattr(pydrake, '__version__', '?'))"], capture_output=True, text=True,
-                            env={"PATH": "/usr/bin:/bin"}).stdout.split()
+    python = subprocess.run([args.python, "-c", "import sys, importlib.metadata as m; "
+                             "print(sys.version.split()[0], m.version('drake'))"],
+                            capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"}).stdout.split()
     print(json.dumps({"old": ref, "new": str(new_tree), "python": python[:1], "drake": python[1:],
                       "pairs": args.pairs, "cases": report}, indent=2))
     return 0
