@@ -204,3 +204,16 @@ def test_views_in_workers_equal_views_drawn_here(tmp_path):
         assert (here / f"{stem}.png").read_bytes() == (there / f"{stem}.png").read_bytes(), stem
         assert (here / f"{stem}.svg").stat().st_size > 10_000 and not (there / f"{stem}.svg").exists()
     assert (there / "replay.html").stat().st_size > 100_000
+
+
+def test_run_writes_svg_only_with_the_flag(tmp_path):
+    """`ptint run` writes PNG figures; `--svg` adds an SVG beside each (SPEC 5.3 asks for PNG)."""
+    for flag, out in (([], tmp_path / "png"), (["--svg"], tmp_path / "svg")):
+        done = subprocess.run([sys.executable, "-m", "ptint_drake", "run", "curve_b075_tf15", "--quiet",
+                               "--no-replay", "--set", "duration=0.6", "--set", "interceptions[0].tf=0.5",
+                               "--out", str(out), *flag],
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode in (0, 1), done.stderr
+        for stem in ("axes", "errors", "joints", "paths3d"):
+            assert (out / f"{stem}.png").stat().st_size > 10_000
+            assert (out / f"{stem}.svg").exists() == bool(flag)
