@@ -77,6 +77,7 @@ def _add_run_parsers(sub) -> None:
     run.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     run.add_argument("--no-replay", action="store_true", help="skip replay.html")
     run.add_argument("--no-figures", action="store_true", help="skip the figures")
+    run.add_argument("--svg", action="store_true", help="the figures as SVG too (PNG always)")
     run.add_argument("--quiet", action="store_true", help="no progress on stderr")
     run.set_defaults(func=cmd_run)
 
@@ -98,6 +99,7 @@ def _add_run_parsers(sub) -> None:
                     "(README: Quick start).", epilog=RESULTS)
     paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")
     paper.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    paper.add_argument("--svg", action="store_true", help="the run figures as SVG too (PNG always)")
     paper.set_defaults(func=cmd_paper)
 
 

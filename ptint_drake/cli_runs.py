@@ -77,7 +77,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     scenario = loaded.scenario
     warn = lambda message: print(f"ptint: warning: {message}", file=sys.stderr)  # noqa: E731
     metrics = run_and_write(scenario, out, replay=not args.no_replay,
-                            figures=not args.no_figures,
+                            figures=not args.no_figures, svg=args.svg,
                             progress=None if args.quiet else progress(scenario.name), warn=warn)
     for note in metrics["controller"]["notes"]:
         print(note)
@@ -117,6 +117,6 @@ def cmd_paper(args: argparse.Namespace) -> int:
     from ptint_drake.paper_report import write_paper  # noqa: PLC0415
 
     index = write_paper(out_folder(args.out, Path("out/paper")),
-                        progress_factory=None if args.quiet else progress)
+                        progress_factory=None if args.quiet else progress, svg=args.svg)
     print(f"wrote {index}")
     return 0

@@ -1,39 +1,117 @@
 """Matplotlib figures of a run and of the TBG families (paper Figs. 2-4, 6-19).
 
-Every figure is written as PNG and SVG, with units, legends and the prescribed
-interception time(s) marked by dashed vertical lines.  Robot accelerations and
-jerks are Savitzky–Golay derivatives (21 ms window) of the logged Cartesian
-velocity resampled on a uniform 1 ms grid (the integrator's steps are not uniform).
+Every figure is written as PNG (and SVG when asked), with units, legends and the
+prescribed interception time(s) marked by dashed vertical lines.  Robot accelerations
+and jerks are Savitzky–Golay derivatives (21 ms window) of the logged Cartesian
+velocity resampled on a uniform 1 ms grid (the integrator's steps are not uniform;
+``derivatives.py``).
+
+What a figure costs is what it shows: matplotlib is imported when a figure is drawn
+(not with this module; ``pyplot`` only for the studies that ask for ``figures.plt``), a
+line is drawn with at most two points (its minimum and maximum) per pixel column
+(``envelope``), and a figure laid out by matplotlib's constrained layout is drawn once,
+at the PNG's resolution, its pixels written as the PNG (``save``).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from scipy.interpolate import CubicSpline  # noqa: E402
-from scipy.signal import savgol_filter  # noqa: E402
-
-from ptint_drake.systems.tbg import alpha_gain, tbg_profile  # noqa: E402
+from ptint_drake.derivatives import uniform_derivatives
+from ptint_drake.systems.tbg import alpha_gain, tbg_profile
 
 AXES = ("X", "Y", "Z")
 FORMATS = ("png", "svg")
+DPI = 120
 
 
-def save(fig, out_dir: Path, stem: str) -> list[Path]:
-    """Write ``stem.png`` and ``stem.svg`` in ``out_dir``; returns the paths."""
-    paths = []
-    for ext in FORMATS:
-        path = Path(out_dir) / f"{stem}.{ext}"
-        fig.savefig(path, dpi=120 if ext == "png" else None, bbox_inches="tight")
-        paths.append(path)
-    plt.close(fig)
+def __getattr__(name: str):
+    """``figures.plt``: pyplot, imported (with the Agg backend) by the studies that use it."""
+    if name == "plt":
+        import matplotlib  # noqa: PLC0415
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt  # noqa: PLC0415
+
+        return plt
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def new_figure(figsize, **kwargs):
+    """A matplotlib ``Figure`` outside pyplot (nothing to close, no pyplot import) at ``DPI``."""
+    from matplotlib.figure import Figure  # noqa: PLC0415
+
+    return Figure(figsize=figsize, dpi=DPI, **kwargs)
+
+
+def preload() -> None:
+    """Import what drawing a run's figures needs (matplotlib's figure, Agg and 3D axes,
+    Pillow, SciPy's spline) now: worker processes forked afterwards share it."""
+    import matplotlib.backends.backend_agg  # noqa: F401, PLC0415
+    import matplotlib.figure  # noqa: F401, PLC0415
+    import mpl_toolkits.mplot3d  # noqa: F401, PLC0415
+    import PIL.Image  # noqa: F401, PLC0415
+    import scipy.interpolate  # noqa: F401, PLC0415
+
+
+def envelope(x: np.ndarray, y: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) with at most the first, the last, and the smallest and largest y of each of
+    ``columns`` equal slices of x's range, in x order: a line through them covers the same
+    pixels as the whole series when the line is ``columns`` pixels wide (or wider)."""
+    n = len(x)
+    if n <= 4 * columns or columns < 1:
+        return x, y
+    span = (x[-1] - x[0]) or 1.0
+    col = np.minimum(((x - x[0]) / span * columns).astype(int), columns - 1)
+    starts = np.flatnonzero(np.r_[True, col[1:] != col[:-1]])
+    order = np.lexsort((y, col))  # by column, then by value: each column's min first, max last
+    keep = np.zeros(n, dtype=bool)
+    keep[[0, n - 1]] = True
+    keep[order[starts]] = True
+    keep[order[np.r_[starts[1:], n] - 1]] = True
+    return x[keep], y[keep]
+
+
+def save(fig, out_dir: Path, stem: str, formats=FORMATS) -> list[Path]:
+    """Write ``stem.png`` (and ``stem.svg`` when in ``formats``) in ``out_dir``; returns the paths.
+
+    A figure with a constrained layout is drawn once at ``DPI`` and its pixels written as
+    the PNG; the SVG (on request) reuses that layout.  Other figures are cropped to their
+    contents (``bbox_inches="tight"``).
+    """
+    from matplotlib.layout_engine import ConstrainedLayoutEngine  # noqa: PLC0415
+
+    paths = [Path(out_dir) / f"{stem}.{ext}" for ext in formats]
+    if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+        _save_laid_out(fig, paths)
+    else:
+        for path in paths:
+            fig.savefig(path, dpi=DPI if path.suffix == ".png" else None, bbox_inches="tight")
+    import sys  # noqa: PLC0415
+
+    if "matplotlib.pyplot" in sys.modules:  # a figure the studies made with pyplot
+        sys.modules["matplotlib.pyplot"].close(fig)
     return paths
+
+
+def _save_laid_out(fig, paths) -> None:
+    """One draw at ``DPI`` (layout included), its pixels as the PNG; then the layout frozen
+    for the vector formats."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: PLC0415
+    from PIL import Image  # noqa: PLC0415
+
+    fig.set_dpi(DPI)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    for path in paths:
+        if path.suffix == ".png":
+            Image.fromarray(np.asarray(canvas.buffer_rgba())).save(path, format="png", dpi=(DPI, DPI))
+    fig.set_layout_engine("none")
+    for path in paths:
+        if path.suffix != ".png":
+            fig.savefig(path)
 
 
 def _mark_times(ax, times):
@@ -75,26 +153,8 @@ def mark_peak(ax, t_peak: float, value: float, limit: float | None = None, **sty
     return h
 
 
-def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3, window_s: float = 0.021):
-    """(t_u, ẋ, ẍ, x⃛) on a uniform grid from per-step samples of ẋ.
-
-    The samples are put on a uniform ``dt`` grid by a cubic spline, then
-    differentiated with a Savitzky–Golay filter (cubic, ``window_s`` wide): the
-    integrator's error (relative 1e-4) would otherwise dominate the jerk.
-    """
-    keep = np.concatenate([[True], np.diff(t) > 1e-12])
-    spline = CubicSpline(t[keep], xdot[keep], axis=0)
-    t_u = np.arange(t[0], t[-1], dt)
-    v = spline(t_u)
-    n = max(5, int(round(window_s / dt)) | 1)
-    if len(t_u) <= n:
-        return t_u, v, spline(t_u, 1), spline(t_u, 2)
-    a = savgol_filter(v, n, 3, deriv=1, delta=dt, axis=0)
-    j = savgol_filter(v, n, 3, deriv=2, delta=dt, axis=0)
-    return t_u, v, a, j
-
-
-def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2000):
+def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2000,
+                      formats=("png",)):
     """ξ, ξ̇, ξ̈, ξ⃛ and α(t) for a list of (tf, β) settings (paper Figs. 2-4).
 
     The time grid is refined geometrically towards each tf, where α peaks.  ξ̈ is
@@ -102,7 +162,8 @@ def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2
     curves and the unbounded ones run off the plot (as in the paper).
     Returns the sampled data {label: dict(t, xi, xi_dot, xi_ddot, xi_dddot, alpha, tf, beta)}.
     """
-    fig, axes = plt.subplots(5, 1, figsize=(7, 11), sharex=True, layout="constrained")
+    fig = new_figure((7, 11), layout="constrained")
+    axes = fig.subplots(5, 1, sharex=True)
     data = {}
     t_max = max(tf for tf, _ in settings) * 1.15
     limits = {2: [0.0], 3: [0.0]}
@@ -114,7 +175,7 @@ def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2
         label = f"β = {beta}, $t_f$ = {tf} s"
         data[label] = dict(t=t, xi=xi, xi_dot=xd, xi_ddot=xdd, xi_dddot=xddd, alpha=alpha, tf=tf, beta=beta)
         for ax, y in zip(axes, (xi, xd, xdd, xddd, alpha)):
-            ax.plot(t, y, label=label)
+            ax.plot(*envelope(t, y, _columns(fig)), label=label)
         if beta >= 0.5:
             limits[2].append(np.max(np.abs(xdd)))
         if beta >= 2.0 / 3.0:
@@ -135,34 +196,48 @@ def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2
     axes[0].legend(fontsize=7)
     axes[-1].set_xlabel("time since segment start [s]")
     fig.suptitle(title)
-    save(fig, out_dir, stem)
+    save(fig, out_dir, stem, formats)
     return data
 
 
-def run_figures(series: dict, metrics: dict, out_dir: Path, title: str) -> list[str]:
+def _columns(fig, ncols: int = 1) -> int:
+    """Pixel columns of one of ``ncols`` side-by-side axes in ``fig`` (an upper bound)."""
+    return int(fig.get_figwidth() * DPI / ncols)
+
+
+def run_figures(series: dict, metrics: dict, out_dir: Path, title: str, formats=("png",)) -> list[str]:
     """Per-axis robot vs target (position, velocity, acceleration, jerk), the error
     (against the true target), the per-axis velocity error (Fig. 16), torques, joint
     trajectories and the 3D paths.  Returns the stems written."""
+    for stem in RUN_FIGURES:
+        run_figure(stem, series, metrics, out_dir, title, formats)
+    return list(RUN_FIGURES)
+
+
+def run_figure(stem: str, series: dict, metrics: dict, out_dir: Path, title: str,
+               formats=("png",)) -> str:
+    """The run figure ``stem`` (one of ``RUN_FIGURES``) written in ``out_dir``; returns ``stem``.
+    Module-level, so that a worker process can draw one figure while another draws the next."""
     tfs = [s["start"] + s["tf"] for s in metrics["segments"]]
-    for figure in (_axes_figure, _errors_figure, _joints_figure, _paths_figure):
-        figure(series, metrics, tfs, out_dir, title)
-    return ["axes", "errors", "joints", "paths3d"]
+    RUN_FIGURES[stem](series, metrics, tfs, out_dir, title, formats)
+    return stem
 
 
-def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
     t_u, v, a, j = uniform_derivatives(t, series["xdot"])
     x_u = np.column_stack([np.interp(t_u, t, series["x"][:, k]) for k in range(3)])
     xr_u = np.column_stack([np.interp(t_u, t, series["x_r"][:, k]) for k in range(3)])
     _, vr, ar, jr = uniform_derivatives(t, series["xdot_r"])
-    fig, axes = plt.subplots(4, 3, figsize=(12, 10.5), sharex=True, layout="constrained")
+    fig = new_figure((12, 10.5), layout="constrained")
+    axes = fig.subplots(4, 3, sharex=True)
     rows = (("position", "m", x_u, xr_u), ("velocity", "m/s", v, vr),
             ("acceleration", "m/s²", a, ar), ("jerk", "m/s³", j, jr))
     for r, (name, unit, robot, target) in enumerate(rows):
         for k in range(3):
             ax = axes[r, k]
-            ax.plot(t_u, robot[:, k], label="robot")
-            ax.plot(t_u, target[:, k], "--", label="target")
+            ax.plot(*envelope(t_u, robot[:, k], _columns(fig, 3)), label="robot")
+            ax.plot(*envelope(t_u, target[:, k], _columns(fig, 3)), "--", label="target")
             _mark_times(ax, tfs)
             ax.grid(alpha=0.3)
             if r == 0:
@@ -182,14 +257,16 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) ->
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=9)
     fig.suptitle(f"{title}: robot vs target per axis")
-    save(fig, out_dir, "axes")
+    save(fig, out_dir, "axes", formats)
 
 
-def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig, axes = plt.subplots(3, 1, figsize=(10, 8.5), sharex=True, layout="constrained")
+    fig = new_figure((10, 8.5), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
     e_norm = np.linalg.norm(series["e_true"], axis=1)
-    axes[0].semilogy(t, np.maximum(e_norm, 1e-9), label="|e|")
+    width = _columns(fig)
+    axes[0].semilogy(*envelope(t, np.maximum(e_norm, 1e-9), width), label="|e|")
     bound = metrics.get("criteria", {}).get("e_tf", 1e-3)
     axes[0].axhline(bound, color="r", lw=0.8, label=f"{bound * 1e3:g} mm")
     e_tf = [s_["e_tf_norm"] for s_ in metrics["segments"]]
@@ -207,10 +284,10 @@ def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) 
     axes[0].set_title(f"|e($t_f$)| = {values} mm (criterion ≤ {bound * 1e3:g} mm): {verdict}", fontsize=10)
     axes[0].set_ylabel("|e| [m]")
     for k, axis in enumerate(AXES):  # per axis, as the paper's Fig. 16
-        axes[1].plot(t, series["edot_true"][:, k], label=f"ė_{axis.lower()}")
+        axes[1].plot(*envelope(t, series["edot_true"][:, k], width), label=f"ė_{axis.lower()}")
     axes[1].set_ylabel("ė [m/s]")
     for k in range(series["tau"].shape[1]):
-        (line,) = axes[2].plot(t, series["tau"][:, k])
+        (line,) = axes[2].plot(*envelope(t, series["tau"][:, k], width))
         t_pk, val = peak_of(t, series["tau"][:, k])
         mark_peak(axes[2], t_pk, val, color=line.get_color())
         line.set_label(peak_label(f"τ{k + 1}: ", t_pk, val, "N·m"))
@@ -221,27 +298,27 @@ def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) 
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.suptitle(f"{title}: interception error, velocity error, torques")
-    save(fig, out_dir, "errors")
+    save(fig, out_dir, "errors", formats)
 
 
-def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig, axes = plt.subplots(series["q"].shape[1], 1, figsize=(8, 7), sharex=True,
-                             layout="constrained")
+    fig = new_figure((8, 7), layout="constrained")
+    axes = fig.subplots(series["q"].shape[1], 1, sharex=True)
     for k, ax in enumerate(np.atleast_1d(axes)):
-        ax.plot(t, np.degrees(series["q"][:, k]))
+        ax.plot(*envelope(t, np.degrees(series["q"][:, k]), _columns(fig)))
         ax.set_ylabel(f"θ{k + 1} [deg]")
         _mark_times(ax, tfs)
         ax.grid(alpha=0.3)
     np.atleast_1d(axes)[0].legend(fontsize=8, loc="best")
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
     fig.suptitle(f"{title}: joint trajectories (model angles θ)")
-    save(fig, out_dir, "joints")
+    save(fig, out_dir, "joints", formats)
 
 
-def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -> None:
+def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig = plt.figure(figsize=(7.5, 6.5), layout="constrained")
+    fig = new_figure((7.5, 6.5), layout="constrained")
     ax = fig.add_subplot(projection="3d")
     ax.plot(*series["x"].T, label="robot")
     objects = series["objects"].reshape(len(t), -1, 3)
@@ -257,4 +334,8 @@ def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str) -
     ax.scatter([], [], color="r", s=30, label="robot at $t_f$")
     fig.legend(fontsize=8, loc="outside lower center", ncol=6)
     fig.suptitle(f"{title}: 3D paths, red dots at the prescribed times")
-    save(fig, out_dir, "paths3d")
+    save(fig, out_dir, "paths3d", formats)
+
+
+RUN_FIGURES = {"axes": _axes_figure, "errors": _errors_figure, "joints": _joints_figure,
+               "paths3d": _paths_figure}

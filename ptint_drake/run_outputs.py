@@ -6,16 +6,18 @@ replay.html, metrics.json last) through ``outputs.staged_output``.
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 import re
 import shutil
 import subprocess
+import sys
+import threading
 from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.figures import run_figures
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
-from ptint_drake.replay import write_replay
 from ptint_drake.robot import resolve_model
 from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
 from ptint_drake.simulation import build, simulate
@@ -36,23 +38,105 @@ def conveyor_belts(scenario: Scenario):
 
 
 def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figures: bool = True,
-                  progress=None, warn=None) -> dict:
+                  progress=None, warn=None, svg: bool = False, workers: int | None = None) -> dict:
     """Simulate ``scenario`` and write its outputs into ``out_dir``; returns the metrics.
-    ``warn(message)`` gets the warnings known before the simulation, before it starts."""
+    ``warn(message)`` gets the warnings known before the simulation, before it starts.
+    ``svg``: the figures as SVG too; ``workers``: processes drawing the figures and the
+    replay (default: one per CPU; see ``draw_views``)."""
     result = simulate(scenario, progress=progress, warn=warn)
-    metrics = dict(result.metrics)
-    metrics["scenario_config"] = dump_dataclass(scenario)
+    metrics = run_metrics(scenario, result.metrics, figures)
     with staged_output(out_dir) as stage:
         save_series(stage / SERIES, result.series)
-        if figures:
-            metrics["figures"] = [f"{s}.png" for s in run_figures(
-                result.series, result.metrics, stage, scenario.name)]
-        if replay:
-            write_replay(result.series, result.metrics, resolve_model(scenario.robot.model),
-                         stage / "replay.html", conveyors=conveyor_belts(scenario),
-                         end_effector=scenario.robot.end_effector)
+        draw_views(view_tasks(scenario, result.series, result.metrics, stage, figures=figures,
+                              replay=replay, svg=svg), workers)
         write_json_atomic(stage / METRICS, metrics)
     return metrics
+
+
+def run_metrics(scenario: Scenario, metrics: dict, figures: bool = True) -> dict:
+    """metrics.json of a run: the simulation's metrics, the scenario as run, the figures' files."""
+    from ptint_drake.figures import RUN_FIGURES  # noqa: PLC0415  (no matplotlib import)
+
+    metrics = dict(metrics)
+    metrics["scenario_config"] = dump_dataclass(scenario)
+    if figures:
+        metrics["figures"] = [f"{s}.png" for s in RUN_FIGURES]
+    return metrics
+
+
+# the longest first: with two workers, the axes figure on one and the rest on the other
+VIEW_ORDER = ("axes", "errors", "paths3d", "joints", "replay")
+
+
+def view_task(name: str, series: dict, metrics: dict, stage: Path, title: str, replay_args: tuple):
+    """One figure (``name`` in ``figures.RUN_FIGURES``, ``replay_args`` = (formats,)) or the
+    replay (``name == "replay"``, ``replay_args`` = (model file, belts, end effector)),
+    written in ``stage``; module-level, so that a worker process can run it."""
+    if name == "replay":
+        from ptint_drake.replay import write_replay  # noqa: PLC0415
+
+        model_file, belts, end_effector = replay_args
+        write_replay(series, metrics, model_file, stage / "replay.html", conveyors=belts,
+                     end_effector=end_effector)
+        return name
+    from ptint_drake.figures import run_figure  # noqa: PLC0415
+
+    return run_figure(name, series, metrics, stage, title, *replay_args)
+
+
+def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, figures: bool = True,
+               replay: bool = True, svg: bool = False) -> list[tuple]:
+    """``view_task`` arguments for a run's figures (PNG, and SVG when ``svg``) and its
+    ``replay.html``, written in ``stage``."""
+    formats = ("png", "svg") if svg else ("png",)
+    replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
+                   scenario.robot.end_effector)
+    names = [n for n in VIEW_ORDER if (n == "replay" and replay) or (n != "replay" and figures)]
+    return [(n, series, metrics, stage, scenario.name, replay_args if n == "replay" else (formats,))
+            for n in names]
+
+
+def can_fork() -> bool:
+    """Whether a forked worker is safe: this process runs one Python thread and holds no
+    Meshcat (its server threads are C++ threads: a fork would copy the ``Meshcat`` object
+    without them, and a replay drawn in the child would wait on them forever)."""
+    replay = sys.modules.get("ptint_drake.replay")
+    return ("fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
+            and getattr(replay, "_MESHCAT", None) is None)
+
+
+def draw_views(tasks: list[tuple], workers: int | None = None) -> None:
+    """Run ``view_task`` on each of ``tasks``.
+
+    Each view is drawn on up to ``workers`` processes forked from this one (default: one
+    per CPU) while this process waits: the figures cost matplotlib's layout, not
+    arithmetic, and they are independent.  In a process with other threads (a notebook),
+    or with one worker, or once this process made a Meshcat (``can_fork``), they are drawn
+    here one after the other.  With workers, the replay's Meshcat lives in a worker, so this
+    process stays fit to fork.
+    """
+    if any(task[0] != "replay" for task in tasks):
+        from ptint_drake.figures import preload  # noqa: PLC0415
+
+        preload()  # once here, not in every worker
+    workers = min(len(tasks), workers or os.cpu_count() or 1)
+    if workers > 1 and can_fork():
+        from ptint_drake.studies.runner import run_tasks  # noqa: PLC0415
+
+        run_tasks(view_task, tasks, workers=workers, max_tasks_per_child=None)
+    else:
+        for task in tasks:
+            view_task(*task)
+
+
+def write_views(scenario: Scenario, series: dict, metrics: dict, stage: Path, figures: bool = True,
+                replay: bool = True, svg: bool = False, workers: int | None = None) -> list[str]:
+    """The run's figures and replay in ``stage`` (``view_tasks``, ``draw_views``); returns
+    the figure stems."""
+    draw_views(view_tasks(scenario, series, metrics, stage, figures, replay, svg), workers)
+    from ptint_drake.figures import RUN_FIGURES  # noqa: PLC0415
+
+    return list(RUN_FIGURES) if figures else []
 
 
 def normalize_graphviz_ids(text: str) -> str:

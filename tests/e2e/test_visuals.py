@@ -10,7 +10,8 @@ import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
-from ptint_drake.figures import tbg_family_figure, uniform_derivatives
+from ptint_drake.derivatives import savgol
+from ptint_drake.figures import envelope, tbg_family_figure, uniform_derivatives
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 BROWSER_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
@@ -75,7 +76,7 @@ def test_paper_report_has_every_scenario(paper_dir):
         assert (paper_dir / name / "replay.html").stat().st_size > 1_000_000
         for fig in ("axes", "errors", "joints", "paths3d"):
             assert (paper_dir / name / f"{fig}.png").stat().st_size > 10_000
-            assert (paper_dir / name / f"{fig}.svg").is_file()
+            assert not (paper_dir / name / f"{fig}.svg").exists()  # SVG on --svg only
     # 5 curve rows + 3 assembly rows, every one meeting SPEC section 6
     rows = re.findall(r"<td>(yes|NO)</td>", index)
     assert rows == ["yes"] * 8
@@ -88,7 +89,7 @@ def test_tbg_figure_data(tmp_path):
     """Figs. 2-4: each ξ reaches 0 at its tf, is 1/2 at tf/2, and α peaks just before tf."""
     data = tbg_family_figure([(1.5, b) for b in (0.25, 0.5, 0.75, 0.9)] + [(1.2, 0.7), (1.9, 0.7)],
                              tmp_path, "fam", "test")
-    assert (tmp_path / "fam.png").is_file() and (tmp_path / "fam.svg").is_file()
+    assert (tmp_path / "fam.png").is_file() and not (tmp_path / "fam.svg").exists()
     for label, d in data.items():
         t, tf = d["t"], d["tf"]
         assert np.all(d["xi"][t >= tf] == 0.0), label
@@ -150,3 +151,69 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
     assert len(rows) > 0.2 * img.shape[0]
     red = (r > 0.6) & (g < 0.25) & (b < 0.25)  # object 1 (red) around the tool
     assert red.sum() > 150
+
+
+def test_savgol_is_scipys_savgol_filter():
+    """The NumPy Savitzky–Golay filter gives SciPy's ``mode="interp"`` result, edges included."""
+    from scipy.signal import savgol_filter
+
+    y = np.cumsum(np.random.default_rng(3).normal(size=(400, 3)), axis=0)
+    for deriv in (0, 1, 2):
+        ref = savgol_filter(y, 21, 3, deriv=deriv, delta=1e-3, axis=0)
+        np.testing.assert_allclose(savgol(y, 21, 3, deriv=deriv, delta=1e-3), ref,
+                                   rtol=0, atol=1e-11 * np.max(np.abs(ref)))
+
+
+def test_envelope_keeps_each_pixel_columns_extremes():
+    """Thinned to a min and a max per pixel column: every column keeps its extremes (so the
+    line covers the same pixels), the ends stay, and short series are left whole."""
+    rng = np.random.default_rng(4)
+    x = np.sort(rng.uniform(0, 3, 20_000))
+    y = np.sin(7 * x) + 0.3 * rng.normal(size=x.size)
+    xs, ys = envelope(x, y, 400)
+    assert len(xs) <= 2 * 400 + 2 and np.all(np.diff(xs) >= 0)
+    assert (xs[0], xs[-1]) == (x[0], x[-1])
+    col = np.minimum(((x - x[0]) / (x[-1] - x[0]) * 400).astype(int), 399)
+    col_s = np.minimum(((xs - x[0]) / (x[-1] - x[0]) * 400).astype(int), 399)
+    for c in range(400):
+        assert ys[col_s == c].max() == y[col == c].max() and ys[col_s == c].min() == y[col == c].min()
+    assert len(envelope(x[:1000], y[:1000], 400)[0]) == 1000  # at most 4 points a column: whole
+
+
+def test_views_in_workers_equal_views_drawn_here(tmp_path):
+    """Figures drawn by forked workers are byte for byte those drawn in this process; the
+    default is PNG only, ``svg=True`` adds the SVGs; the replay is written either way."""
+    from ptint_drake.run_outputs import can_fork, write_views
+    from ptint_drake.scenario import load_scenario
+    from ptint_drake.simulation import simulate
+
+    scenario = load_scenario("curve_b075_tf15")
+    scenario.duration = 0.6
+    result = simulate(scenario)
+    here, there = tmp_path / "here", tmp_path / "there"
+    here.mkdir()
+    there.mkdir()
+    if not can_fork():
+        pytest.skip("this test process already holds a Meshcat: views are drawn here only")
+    write_views(scenario, result.series, result.metrics, there, workers=2)
+    assert can_fork()  # the replay's Meshcat was made in a worker
+    stems = write_views(scenario, result.series, result.metrics, here, workers=1, svg=True)
+    assert stems == ["axes", "errors", "joints", "paths3d"]
+    assert not can_fork()  # ... and now here: no more forks from this process
+    for stem in stems:
+        assert (here / f"{stem}.png").read_bytes() == (there / f"{stem}.png").read_bytes(), stem
+        assert (here / f"{stem}.svg").stat().st_size > 10_000 and not (there / f"{stem}.svg").exists()
+    assert (there / "replay.html").stat().st_size > 100_000
+
+
+def test_run_writes_svg_only_with_the_flag(tmp_path):
+    """`ptint run` writes PNG figures; `--svg` adds an SVG beside each (SPEC 5.3 asks for PNG)."""
+    for flag, out in (([], tmp_path / "png"), (["--svg"], tmp_path / "svg")):
+        done = subprocess.run([sys.executable, "-m", "ptint_drake", "run", "curve_b075_tf15", "--quiet",
+                               "--no-replay", "--set", "duration=0.6", "--set", "interceptions[0].tf=0.5",
+                               "--out", str(out), *flag],
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode in (0, 1), done.stderr
+        for stem in ("axes", "errors", "joints", "paths3d"):
+            assert (out / f"{stem}.png").stat().st_size > 10_000
+            assert (out / f"{stem}.svg").exists() == bool(flag)
