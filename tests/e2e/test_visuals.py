@@ -10,7 +10,6 @@ import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
-from ptint_drake.derivatives import savgol
 from ptint_drake.figures import envelope, tbg_family_figure, uniform_derivatives
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
@@ -151,17 +150,6 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
     assert len(rows) > 0.2 * img.shape[0]
     red = (r > 0.6) & (g < 0.25) & (b < 0.25)  # object 1 (red) around the tool
     assert red.sum() > 150
-
-
-def test_savgol_is_scipys_savgol_filter():
-    """The NumPy Savitzky–Golay filter gives SciPy's ``mode="interp"`` result, edges included."""
-    from scipy.signal import savgol_filter
-
-    y = np.cumsum(np.random.default_rng(3).normal(size=(400, 3)), axis=0)
-    for deriv in (0, 1, 2):
-        ref = savgol_filter(y, 21, 3, deriv=deriv, delta=1e-3, axis=0)
-        np.testing.assert_allclose(savgol(y, 21, 3, deriv=deriv, delta=1e-3), ref,
-                                   rtol=0, atol=1e-11 * np.max(np.abs(ref)))
 
 
 def test_envelope_keeps_each_pixel_columns_extremes():
