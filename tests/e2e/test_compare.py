@@ -7,7 +7,9 @@ import pytest
 from arms import OFFSET_ARM
 from test_cli import ptint
 
-SEGMENT_KEYS = {"e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm", "t_arrive"}
+SEGMENT_KEYS = {"e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm", "t_arrive",
+                # the orientation metrics (null for a position task: the paper's)
+                "e_rot0_deg", "e_rot_half_deg", "e_rot_tf_deg", "e_rot_hold_max_deg", "edot_rot_tf_deg_s"}
 
 
 def test_compare_writes_the_table_and_the_paper_controller_is_ok(tmp_path):
