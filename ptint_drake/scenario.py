@@ -164,7 +164,7 @@ class Scenario:
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     interceptions: List[InterceptionConfig] = field(default_factory=list)
     plant: PlantConfig = field(default_factory=PlantConfig)
-    measurement: MeasurementConfig = field(default_factory=MeasurementConfig)
+    measurement: Optional[MeasurementConfig] = None  # None: no camera, the analytic target
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)
     criteria: Criteria = field(default_factory=Criteria)

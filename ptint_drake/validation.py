@@ -42,6 +42,8 @@ def validate(s) -> None:
     _positive(s.duration, "duration")
     _validate_controller(s.controller)
     for check, config in ((validate_criteria, s.criteria), (validate_measurement, s.measurement)):
+        if config is None:
+            continue
         try:
             check(config)
         except ValueError as exc:

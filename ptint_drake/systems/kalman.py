@@ -96,8 +96,10 @@ from ptint_drake.systems.camera import (
     TIME_TOL,
     Camera,
     MeasurementConfig,
+    process_noise,
     validate_measurement,
 )
+from ptint_drake.systems.imm import AdaptiveTargetEstimator
 from ptint_drake.systems.schedule import Schedule
 
 MODELS = ("cv", "ca")
@@ -158,7 +160,7 @@ class TargetKalmanFilter(LeafSystem):
         self._n = n = model_order(model)
         self._model = model
         self._config = config
-        self._q = float(config.process_noise)
+        self._q = process_noise(config)
         self._R = measurement_variance(config)
         self._latency = float(config.latency)
         self._compensate = bool(config.compensate_latency)
@@ -319,6 +321,13 @@ class ActiveTargetSelector(LeafSystem):
         output.SetFromVector(self._inputs[i].Eval(context))
 
 
+def _estimator(config: MeasurementConfig, prior) -> LeafSystem:
+    """The estimator ``config.estimator`` names, primed with ``prior``."""
+    if config.estimator == "auto":
+        return AdaptiveTargetEstimator(config=config, prior=prior)
+    return TargetKalmanFilter(config=config, model=config.estimator.split("_", 1)[1], prior=prior)
+
+
 @dataclass
 class CameraEstimators:
     """What ``AddCameraEstimators`` added: wire ``target_port`` to a controller's target."""
@@ -342,11 +351,12 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     ``evaluate``): the objects' true motion, so that each camera has also seen its object
     for ``config.prior_window`` s before t = 0 and its filter starts from those samples
     (priming); without it the cameras start seeing at t = 0.
-    ``config.estimator`` must be ``kalman_cv`` or ``kalman_ca``.
+    ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object), or
+    ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
     """
     validate_measurement(config)
-    if config.estimator not in ("kalman_cv", "kalman_ca"):
-        raise ValueError("measurement.estimator: AddCameraEstimators needs kalman_cv or "
+    if config.estimator not in ("auto", "kalman_cv", "kalman_ca"):
+        raise ValueError("measurement.estimator: AddCameraEstimators needs auto, kalman_cv or "
                          f"kalman_ca, got {config.estimator!r}")
     if (true_position_ports is None) == (objects_port is None):
         raise ValueError("AddCameraEstimators: give true_position_ports or objects_port, not both")
@@ -355,7 +365,6 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
         builder.Connect(objects_port, split.get_input_port())
         true_position_ports = [split.get_output_port(i) for i in range(n)]
-    model = config.estimator.split("_", 1)[1]
     selector = builder.AddNamedSystem(
         "target_selector", ActiveTargetSelector(schedule=schedule, count=len(true_position_ports)))
     if histories is not None and len(histories) != len(true_position_ports):
@@ -366,8 +375,7 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         history = None if histories is None else histories[i]
         camera = builder.AddNamedSystem(f"camera_{i}", Camera(config=config, seed_offset=i,
                                                               history=history))
-        kf = builder.AddNamedSystem(f"target_filter_{i}", TargetKalmanFilter(
-            config=config, model=model, prior=camera.pre_run_samples()))
+        kf = builder.AddNamedSystem(f"target_filter_{i}", _estimator(config, camera.pre_run_samples()))
         builder.Connect(port, camera.get_x_true_input_port())
         builder.Connect(camera.get_measurement_output_port(), kf.get_measurement_input_port())
         builder.Connect(kf.get_target_output_port(), selector.get_input_port(i))
