@@ -46,7 +46,7 @@ from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
 from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
+from ptint_drake.systems.targets import BallisticTarget, LinearTarget, SinusoidTarget, WaypointTarget
 from ptint_drake.validation import TARGET_KINDS, ScenarioError, validate
 
 __all__ = ["TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
@@ -107,10 +107,21 @@ class WaypointsConfig:
 
 
 @dataclass
+class BallisticConfig:
+    """A thrown object: free flight from ``release`` (s) at ``start`` (m) with ``velocity`` (m/s)."""
+
+    start: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    velocity: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    gravity: List[float] = field(default_factory=lambda: [0.0, 0.0, -9.81])  # m/s²
+    release: float = 0.0
+
+
+@dataclass
 class TargetConfig:
     sinusoid: Optional[SinusoidConfig] = None
     linear: Optional[LinearConfig] = None
     waypoints: Optional[WaypointsConfig] = None
+    ballistic: Optional[BallisticConfig] = None
 
 
 @dataclass
@@ -183,6 +194,9 @@ def make_target(config: TargetConfig):
         return SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
     if config.waypoints is not None:
         return WaypointTarget(config.waypoints.time, config.waypoints.position)
+    if config.ballistic is not None:
+        b = config.ballistic
+        return BallisticTarget(b.start, b.velocity, b.gravity, b.release)
     return LinearTarget(config.linear.start, config.linear.velocity)
 
 

@@ -10,7 +10,8 @@ What it models (``Camera``, one per object):
   evaluated (nor on the dropouts: sample k always carries the same n_k);
 - a fixed latency L: sample k becomes visible at t_k + L;
 - dropouts: a sample whose time falls in a window ``from ≤ t_k < to`` is never
-  delivered (the output keeps holding the last delivered sample);
+  delivered (the output keeps holding the last delivered sample); nor is a sample
+  taken before the object can be seen (``history.visible_from``: a throw's release);
 - the object was in view before the run (``prior_window`` W, with ``history``):
   given the object's true motion as a function of time, the camera has also taken
   the samples k = −1, −2, … with −W ≤ t_k < 0 (same rate, same latency, same
@@ -198,6 +199,8 @@ class Camera(LeafSystem):
         super().__init__()
         validate_measurement(config)
         self._config = config
+        # a thrown object is seen from its release on (``visible_from`` of its history)
+        self._visible_from = float(getattr(history, "visible_from", -math.inf))
         self._period = 1.0 / config.rate_hz
         self._latency = float(config.latency) if config.latency > TIME_TOL else 0.0
         self._windows = [(float(a), float(b)) for a, b in config.dropouts]
@@ -258,8 +261,9 @@ class Camera(LeafSystem):
         return self._measurement_out
 
     def dropped(self, t: float) -> bool:
-        """Whether a sample taken at t falls in a dropout window [from, to)."""
-        return any(lo - TIME_TOL <= t < hi - TIME_TOL for lo, hi in self._windows)
+        """Whether a sample taken at t falls in a dropout window [from, to) or before the
+        object can be seen (a thrown object before its release)."""
+        return t < self._visible_from - TIME_TOL or any(lo - TIME_TOL <= t < hi - TIME_TOL for lo, hi in self._windows)
 
     def sample(self, k: int, x_true: np.ndarray) -> np.ndarray:
         """z_k = x_true + n_k (3 values); n_k is fixed by k and the seed."""
