@@ -108,8 +108,8 @@ def validate_measurement(m: MeasurementConfig) -> None:
     rate = number("rate_hz")
     if not (math.isfinite(rate) and rate > 0.0):
         raise _field_error("rate_hz", f"must be > 0, got {m.rate_hz}")
-    names = ("noise_std", "latency", "prior_window") + (("process_noise",) if m.process_noise is not None else ())
-    for name in names:
+    names = ("noise_std", "latency", "prior_window")
+    for name in names + (("process_noise",) if m.process_noise is not None else ()):
         value = number(name)
         if not (math.isfinite(value) and value >= 0.0):
             raise _field_error(name, f"must be >= 0 and finite, got {getattr(m, name)}")
@@ -263,7 +263,9 @@ class Camera(LeafSystem):
     def dropped(self, t: float) -> bool:
         """Whether a sample taken at t falls in a dropout window [from, to) or before the
         object can be seen (a thrown object before its release)."""
-        return t < self._visible_from - TIME_TOL or any(lo - TIME_TOL <= t < hi - TIME_TOL for lo, hi in self._windows)
+        if t < self._visible_from - TIME_TOL:
+            return True
+        return any(lo - TIME_TOL <= t < hi - TIME_TOL for lo, hi in self._windows)
 
     def sample(self, k: int, x_true: np.ndarray) -> np.ndarray:
         """z_k = x_true + n_k (3 values); n_k is fixed by k and the seed."""

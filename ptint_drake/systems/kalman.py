@@ -86,6 +86,7 @@ over seeds 1–10 (``*_camera.yaml``; steady-state per-axis position std from th
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -156,8 +157,9 @@ class TargetKalmanFilter(LeafSystem):
 
     def __init__(self, *, config: MeasurementConfig, model: str, prior=None):
         super().__init__()
-        validate_measurement(config)
         self._n = n = model_order(model)
+        config = dataclasses.replace(config, estimator=f"kalman_{model}")  # this filter, whatever named
+        validate_measurement(config)
         self._model = model
         self._config = config
         self._q = process_noise(config)
