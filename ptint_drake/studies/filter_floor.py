@@ -5,8 +5,8 @@ true objects (``TargetSource``) feed ``kalman.AddCameraEstimators`` as the contr
 target view does (one ``Camera`` + estimator per object, primed, and the
 selector), so the error of the filter's continuous output against the truth is what *any* controller
 that follows the estimate inherits.  Rows: ``auto`` (the adaptive estimator, nothing to
-tune), then a hand-set filter (``FLOOR_MODEL``, or the ``estimator`` of the overrides)
-per process noise q.  Per row and seed
+tune), then a hand-set filter per process noise q: the scenario's (or the overrides')
+``kalman_cv`` / ``kalman_ca``, else ``FLOOR_MODEL``.  Per row and seed
 (measurement.seed = 1 … N): the largest |x̂ − x| of object i's filter over segment
 i's hold window [start + tf, next start or duration] (the window of the hold metric),
 its RMS there, and the RMS and largest error of the selector's output (what the
@@ -175,7 +175,7 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
     overrides = dict(measurement or {})
     base = with_measurement(loaded.scenario, loaded.name, overrides, 1)  # before any worker starts
     check_floor_scenario(base)
-    hand = overrides.pop("estimator", FLOOR_MODEL)
+    hand = overrides.pop("estimator", base.measurement.estimator)
     hand = hand if hand in ("kalman_cv", "kalman_ca") else FLOOR_MODEL
     overrides.pop("process_noise", None)
     settings = [{"estimator": "auto", "process_noise": None}] + [
