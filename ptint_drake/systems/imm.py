@@ -47,10 +47,12 @@ from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.camera import TIME_TOL, MeasurementConfig, validate_measurement
 
-MODELS = ("cv", "ca", "turn")
+MODELS = ("cv", "ca", "turn", "fall")
 N = 10  # state size: p, v, a (3 each) and Ω
 R_MIN = 1.0e-12  # m², floor of the measurement variance
 Q_CV = 1.0e-6  # m²/s³, white acceleration of ``cv``
+Q_FALL = 1.0e-4  # m²/s³, white acceleration of ``fall`` (about g, e.g. drag)
+GRAVITY = np.array([0.0, 0.0, -9.81])  # m/s², the world's (z up), known to the camera system
 Q_CA = 1.0e-2  # m²/s⁵, white jerk of ``ca``
 Q_TURN = 1.0e-4  # m²/s⁵, white jerk of ``turn``
 Q_OMEGA = 0.1  # rad⁴/s⁵, random walk of Ω in ``turn``
@@ -58,7 +60,7 @@ A_CV = 0.3  # m/s², standard deviation of the (unused) acceleration of ``cv``
 V0, A0 = 1.0, 10.0  # m/s, m/s²: initial standard deviations
 OMEGA0, OMEGA_SD0, OMEGA_MAX = 1.0, 3.0, 100.0  # rad²/s²: initial Ω, its sd, largest Ω
 SOJOURN = 20.0  # s, mean time the motion stays with one model
-MU0 = np.array([1.0, 1.0, 1.0]) / 3.0
+MU0 = np.full(4, 0.25)
 
 
 def _turn_terms(omega2: float, dt: float) -> tuple[float, float, float]:
@@ -101,13 +103,16 @@ def predict_model(model: str, x: np.ndarray, P: np.ndarray, dt: float):
     """(χ, P) of one model predicted over dt (the module docstring's models)."""
     F = np.eye(N)
     Q = np.zeros((N, N))
-    if model == "cv":
+    if model in ("cv", "fall"):
         F[0:9, 0:9] = _axis_block(dt, 1.0, 0.0, 0.0)
-        F[:, 6:9] = 0.0  # a is neither used nor kept
+        F[:, 6:9] = 0.0  # a is not estimated: 0 (cv) or g (fall)
         d2 = dt * dt
-        Q[0:6, 0:6] = per_axis(Q_CV * np.array([[d2 * dt / 3.0, d2 / 2.0], [d2 / 2.0, dt]]))
+        q = Q_CV if model == "cv" else Q_FALL
+        Q[0:6, 0:6] = per_axis(q * np.array([[d2 * dt / 3.0, d2 / 2.0], [d2 / 2.0, dt]]))
         Q[6:9, 6:9] = A_CV * A_CV * np.eye(3)
         x_new = F @ x
+        if model == "fall":
+            x_new[0:9] += np.concatenate([0.5 * d2 * GRAVITY, dt * GRAVITY, GRAVITY])
     elif model == "ca":
         F[0:9, 0:9] = _axis_block(dt, 1.0, 0.5 * dt * dt, 0.0)
         Q[0:9, 0:9] = jerk_covariance(dt, Q_CA)
