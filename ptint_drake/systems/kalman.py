@@ -68,8 +68,10 @@ smooths more).  q = 0.001 or 0.1 raises the errors above by up to 1.7×; q = 1e-
 lags by millimetres on the curve.  Closed-loop
 tuning (what the interceptor tolerates) is left to the scenarios.
 
-The camera scenarios (30 Hz, 2 mm, 33 ms compensated) choose q per motion, closed loop
-over seeds 1–10 (``*_camera.yaml``; steady-state per-axis position std from the DARE):
+The best hand-set q per motion (30 Hz, 2 mm, 33 ms compensated), closed loop over seeds
+1–10 — what the camera scenarios used before ``estimator: auto`` (``imm``) made tuning
+unnecessary, and the hand-set rows the README compares ``auto`` with (steady-state per-axis
+position std from the DARE):
 
 - constant-speed conveyors, ``kalman_cv`` q = 1e-6 m²/s³ (the belt speed may wander
   √(q·1 s) = 1 mm/s per second): 0.55 mm per axis; q = 1e-5 → 0.72 mm and 1e-4 →
@@ -81,7 +83,8 @@ over seeds 1–10 (``*_camera.yaml``; steady-state per-axis position std from th
   axis; 0.003 lags, 0.1–0.3 is noisier (open-loop RMS 3.3–3.7 mm against 3.1 mm).
 
 ``ActiveTargetSelector`` passes on the estimate of the segment active at t, and
-``AddCameraEstimators`` wires a camera and a filter per object plus the selector.
+``AddCameraEstimators`` wires a camera and an estimator per object (``auto``: the IMM of
+``imm``; ``kalman_cv`` / ``kalman_ca``: this filter) plus the selector.
 """
 
 from __future__ import annotations
