@@ -172,6 +172,7 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
         raise ScenarioError(f"seeds: must be an integer >= 1, got {seeds!r}")
     if not (np.isfinite(sample_hz) and sample_hz > 0.0):
         raise ScenarioError(f"sample_hz: must be > 0, got {sample_hz}")
+    check_floor_scenario(loaded.scenario)  # a camera of its own, before any override
     overrides = dict(measurement or {})
     base = with_measurement(loaded.scenario, loaded.name, overrides, 1)  # before any worker starts
     check_floor_scenario(base)
