@@ -121,7 +121,7 @@ def _add_grid_parsers(sub) -> None:
     rb = sub.add_parser(
         "robust", help="Monte Carlo study over unknown dynamics and disturbances",
         description="Monte Carlo over what the controller does not know: masses, friction, "
-                    "payload, the disturbance d of paper eq. 1, measurement noise (README: "
+                    "payload, the disturbance d of paper eq. 1, camera noise (README: "
                     "Robustness and safety); writes robust.json, samples.json, worst.yaml and "
                     "a histogram.", epilog=RESULTS)
     rb.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
@@ -180,7 +180,8 @@ def _add_camera_parsers(sub) -> None:
         "study", help="studies: camera (|e(tf)| against noise × latency × estimator)",
         description="camera: |e(tf)| on conveyor_pair_camera over noise × latency × estimator "
                     "(camera_study.md/.json, estimate.png). camera --filter-floor: the camera and "
-                    "Kalman filter alone (no arm) on a camera scenario, per process noise: the "
+                    "estimator alone (no arm) on a camera scenario, auto and a hand-set Kalman "
+                    "filter per process noise: the "
                     "largest |estimate − true object| over each hold window, the error a controller "
                     "that follows the estimate inherits (filter_floor.md/.json).")
     st.add_argument("study", choices=["camera"])
@@ -192,9 +193,10 @@ def _add_camera_parsers(sub) -> None:
                                   "out/filter_floor_NAME)")
     st.add_argument("--quiet", action="store_true")
     st.add_argument("--filter-floor", action="store_true",
-                    help="measure the camera + Kalman filter alone (no arm) per process noise")
+                    help="measure the camera + estimator alone (no arm): auto, and kalman_ca "
+                         "(or --set measurement.estimator=kalman_cv) per process noise")
     st.add_argument("--scenario", help="with --filter-floor: a camera scenario (bundled name or YAML "
-                                       "file with a kalman_cv/kalman_ca estimator; default curve_camera)")
+                                       "file with a camera; default curve_camera)")
     st.add_argument("--process-noise", metavar="Q,..", type=opt.process_noises,
                     help="with --filter-floor: comma-separated process noises q > 0 "
                          "(default 0.003,0.01,0.03,0.1,0.3)")

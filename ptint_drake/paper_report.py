@@ -140,7 +140,7 @@ CAMERA_SCENARIO = "conveyor_pair_camera"
 
 
 def _camera_figure(out_dir: Path) -> None:
-    """Beyond the paper: the Kalman estimate a camera-fed run chases, against the truth, around tf."""
+    """Beyond the paper: the estimate a camera-fed run chases, against the truth, around tf."""
     from ptint_drake.scenario import scenario_text  # noqa: PLC0415
     from ptint_drake.studies.camera import estimate_figure  # noqa: PLC0415
 
@@ -230,7 +230,7 @@ first-order sliding mode without the TBG (smc) and a model-based quintic plan tr
 dynamics of the nominal model, given the target's future (ct_quintic), on the nominal plant and with
 every mass × 0.7 and × 1.5 (README, Controllers compared).</p>{compared}
 <h2>What a camera sees</h2><p>Beyond the paper: {CAMERA_SCENARIO} with a 30 Hz camera (2 mm noise,
-33 ms latency) and a constant-velocity Kalman filter in the loop; the controller sees only the
+33 ms latency) and the adaptive estimator (auto) in the loop; the controller sees only the
 estimate. Top: estimate − truth around each tf; bottom: the gripper against the truth (the metric)
 and against the estimate (README, What a camera sees; <code>ptint study camera</code> for the
 noise × latency × estimator study).</p><p><a href='camera/estimate.png'><img src='camera/estimate.png'

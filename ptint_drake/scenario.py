@@ -47,7 +47,7 @@ from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.orientation import OrientedTarget, SlerpOrientation, SpinningOrientation
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, WaypointTarget
+from ptint_drake.systems.targets import BallisticTarget, LinearTarget, SinusoidTarget, WaypointTarget
 from ptint_drake.validation import TARGET_KINDS, ScenarioError, validate
 
 __all__ = ["TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
@@ -119,11 +119,22 @@ class OrientationConfig:
 
 
 @dataclass
+class BallisticConfig:
+    """A thrown object: free flight from ``release`` (s) at ``start`` (m) with ``velocity`` (m/s)."""
+
+    start: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    velocity: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    gravity: List[float] = field(default_factory=lambda: [0.0, 0.0, -9.81])  # m/s²
+    release: float = 0.0
+
+
+@dataclass
 class TargetConfig:
     sinusoid: Optional[SinusoidConfig] = None
     linear: Optional[LinearConfig] = None
     waypoints: Optional[WaypointsConfig] = None
     orientation: Optional[OrientationConfig] = None
+    ballistic: Optional[BallisticConfig] = None
 
 
 @dataclass
@@ -177,7 +188,7 @@ class Scenario:
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     interceptions: List[InterceptionConfig] = field(default_factory=list)
     plant: PlantConfig = field(default_factory=PlantConfig)
-    measurement: MeasurementConfig = field(default_factory=MeasurementConfig)
+    measurement: Optional[MeasurementConfig] = None  # None: no camera, the analytic target
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)
     criteria: Criteria = field(default_factory=Criteria)
@@ -198,6 +209,9 @@ def make_target(config: TargetConfig):
         target = SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
     elif config.waypoints is not None:
         target = WaypointTarget(config.waypoints.time, config.waypoints.position)
+    elif config.ballistic is not None:
+        b = config.ballistic
+        target = BallisticTarget(b.start, b.velocity, b.gravity, b.release)
     else:
         target = LinearTarget(config.linear.start, config.linear.velocity)
     if config.orientation is not None:

@@ -14,7 +14,7 @@ from ptint_drake.systems.targets import WaypointTarget
 from ptint_drake.systems.task import TASKS
 
 IMPLEMENTATIONS = ("fused", "blocks")
-TARGET_KINDS = ("sinusoid", "linear", "waypoints")
+TARGET_KINDS = ("sinusoid", "linear", "waypoints", "ballistic")
 
 
 class ScenarioError(ValueError):
@@ -43,6 +43,8 @@ def validate(s) -> None:
     _positive(s.duration, "duration")
     _validate_controller(s.controller)
     for check, config in ((validate_criteria, s.criteria), (validate_measurement, s.measurement)):
+        if config is None:
+            continue
         try:
             check(config)
         except ValueError as exc:
@@ -57,6 +59,8 @@ def validate(s) -> None:
     for i, ic in enumerate(s.interceptions):
         _validate_interception(s, i, ic)
         _validate_target(ic.target, f"interceptions[{i}].target")
+        if ic.target.ballistic is not None:
+            _validate_throw(ic, f"interceptions[{i}]")
 
 
 def _validate_controller(c) -> None:
@@ -164,6 +168,11 @@ def _validate_target(t, where: str) -> None:
             WaypointTarget(t.waypoints.time, t.waypoints.position)
         except ValueError as exc:
             raise ScenarioError(f"{where}.waypoints.{exc}") from None
+    elif t.ballistic is not None:
+        for name in ("start", "velocity", "gravity"):
+            _vector3(getattr(t.ballistic, name), f"{where}.ballistic.{name}")
+        if not (math.isfinite(t.ballistic.release) and t.ballistic.release >= 0.0):
+            raise ScenarioError(f"{where}.ballistic.release: must be >= 0, got {t.ballistic.release}")
     else:
         _vector3(t.linear.start, f"{where}.linear.start")
         _vector3(t.linear.velocity, f"{where}.linear.velocity")
@@ -186,3 +195,17 @@ def _validate_orientation(t, where: str) -> None:
                             f"for {len(t.waypoints.time)} times")
     for k, sample in enumerate(rpy):
         _vector3(sample, f"{where}.waypoints.rpy_deg[{k}]")
+
+
+def _validate_throw(ic, where: str) -> None:
+    """A thrown object: the segment starts at or after the release, and the object is above the
+    floor (z ≥ 0) at the interception time (the reach is checked with the robot model)."""
+    b = ic.target.ballistic
+    if ic.start < b.release:
+        raise ScenarioError(f"{where}.start: {ic.start} s is before the object is thrown "
+                            f"(target.ballistic.release {b.release} s)")
+    tau = ic.tf + ic.start - b.release
+    z = b.start[2] + b.velocity[2] * tau + 0.5 * b.gravity[2] * tau * tau
+    if z < 0.0:
+        raise ScenarioError(f"{where}.tf: the thrown object is below the floor at tf "
+                            f"(z = {z:.3f} m at t = {ic.start + ic.tf:g} s)")

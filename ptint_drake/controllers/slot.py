@@ -5,11 +5,10 @@ out of the station, ``actuation`` into it), the plant for its kinematics, the en
 frame, the schedule of segments, and the start posture.  ``TargetView`` is the target as the
 controller is *allowed* to see it:
 
-- ``measurement.estimator: none``: the analytic targets (or their legacy noisy/delayed
-  version, ``measurement.noise_std`` / ``latency``), as objects in ``analytic`` and, when a
-  controller asks for it, as a ``TargetSource`` port;
-- with an estimator: only what one camera and one Kalman filter per object make of the
-  station's true object positions (``analytic`` is None).
+- no ``measurement`` (or ``estimator: none``): the analytic targets, as objects in
+  ``analytic`` and, when a controller asks for it, as a ``TargetSource`` port;
+- with a camera: only what one camera and one estimator per object (``auto`` or a
+  hand-set Kalman filter) make of the station's true object positions (``analytic`` is None).
 
 The station's true target never reaches a controller directly.  The port is built on first
 use, so a controller that evaluates the analytic targets itself (the fused interceptor) adds
@@ -31,8 +30,6 @@ from pydrake.multibody.tree import Frame
 from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
 
 from ptint_drake.systems.kalman import AddCameraEstimators
-from ptint_drake.systems.measurement import MeasuredTarget
-from ptint_drake.systems.orientation import OrientedTarget
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.targets import TargetSource
@@ -119,27 +116,19 @@ class TargetView:
 
 def uses_analytic_targets(scenario: "Scenario") -> bool:
     """True unless a camera and an estimator are in the loop."""
-    return scenario.measurement.estimator == "none"
+    return scenario.measurement is None or scenario.measurement.estimator == "none"
 
 
 def controller_targets(scenario: "Scenario") -> list:
-    """The analytic view: the true targets, or their legacy noisy/delayed measurement."""
-    targets = scenario.targets()
-    m = scenario.measurement
-    if m.noise_std == 0.0 and m.latency == 0.0:
-        return targets
-    measured = [MeasuredTarget(tg, scenario.duration, m.noise_std, m.rate_hz, m.latency,
-                               m.compensate_latency, m.seed + i) for i, tg in enumerate(targets)]
-    # the legacy measurement is of positions: an orientation passes through as it is
-    return [OrientedTarget(mt, tg.orientation) if isinstance(tg, OrientedTarget) else mt
-            for mt, tg in zip(measured, targets)]
+    """The analytic view: the true targets."""
+    return scenario.targets()
 
 
 def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",
                 analytic: Optional[list] = None) -> OutputPort:
     """The port that carries [x_r, ẋ_r, ẍ_r] of the active segment as the controller sees it:
-    the analytic targets (``estimator: none``), or one camera + Kalman filter per object
-    fed by the station's true object positions (``kalman_cv`` / ``kalman_ca``)."""
+    the analytic targets (no camera), or one camera + estimator per object fed by the
+    station's true object positions (``auto``, ``kalman_cv``, ``kalman_ca``)."""
     if uses_analytic_targets(scenario):
         source = builder.AddNamedSystem("target_view", TargetSource(
             scenario.schedule(), analytic if analytic is not None else controller_targets(scenario)))

@@ -1,10 +1,12 @@
 """The filter's floor (``ptint study camera --filter-floor``, ``filter_floor``).
 
-The camera and Kalman filter of a camera scenario without any arm: the scenario's
+The camera and estimator of a camera scenario without any arm: the scenario's
 true objects (``TargetSource``) feed ``kalman.AddCameraEstimators`` as the controllers'
-target view does (one ``Camera`` + ``TargetKalmanFilter`` per object, primed, and the
+target view does (one ``Camera`` + estimator per object, primed, and the
 selector), so the error of the filter's continuous output against the truth is what *any* controller
-that follows the estimate inherits.  Per process noise q and seed
+that follows the estimate inherits.  Rows: ``auto`` (the adaptive estimator, nothing to
+tune), then a hand-set filter per process noise q: the scenario's (or the overrides')
+``kalman_cv`` / ``kalman_ca``, else ``FLOOR_MODEL``.  Per row and seed
 (measurement.seed = 1 … N): the largest |x̂ − x| of object i's filter over segment
 i's hold window [start + tf, next start or duration] (the window of the hold metric),
 its RMS there, and the RMS and largest error of the selector's output (what the
@@ -35,13 +37,14 @@ from ptint_drake.studies.runner import run_tasks
 FLOOR_SCENARIO = "curve_camera"
 FLOOR_PROCESS_NOISES = (0.003, 0.01, 0.03, 0.1, 0.3)
 FLOOR_SAMPLE_HZ = 960.0
+FLOOR_MODEL = "kalman_ca"  # the hand-set filter of the q rows
 
 
 def check_floor_scenario(scenario: Scenario) -> None:
-    """ScenarioError naming ``measurement.estimator`` unless a Kalman filter is configured."""
-    if scenario.measurement.estimator not in ("kalman_cv", "kalman_ca"):
-        raise ScenarioError(f"measurement.estimator: the filter floor needs kalman_cv or kalman_ca, "
-                            f"{scenario.name} has {scenario.measurement.estimator!r}")
+    """ScenarioError naming ``measurement`` unless the scenario has a camera and an estimator."""
+    if scenario.measurement is None or scenario.measurement.estimator == "none":
+        raise ScenarioError(f"measurement: the filter floor needs a camera scenario, {scenario.name} "
+                            "has no camera")
 
 
 def floor_times(scenario: Scenario, sample_hz: float) -> np.ndarray:
@@ -155,8 +158,9 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
     """The filter-only error floor of the camera scenario ``loaded`` (module docstring): for each
     process noise q in ``process_noises`` and measurement.seed = 1 … ``seeds``, one
     ``floor_case`` with ``measurement`` fields (e.g. ``{"noise_std": 0.001}``) also
-    replaced; returns the settings, a ``table`` (per q: ``summarize_floor``), every run
-    (``runs``, ordered q-major) and ``best`` (the q with the smallest median hold max).
+    replaced; returns the settings, a ``table`` (``auto``, then per q: ``summarize_floor``),
+    every run (``runs``, ordered row-major) and ``best`` (the hand-set q with the smallest
+    median hold max).
     ScenarioError (naming the field) on a bad scenario, q ≤ 0, seeds < 1 or sample_hz ≤ 0."""
     qs = [float(q) for q in process_noises]
     if not qs:
@@ -168,23 +172,29 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
         raise ScenarioError(f"seeds: must be an integer >= 1, got {seeds!r}")
     if not (np.isfinite(sample_hz) and sample_hz > 0.0):
         raise ScenarioError(f"sample_hz: must be > 0, got {sample_hz}")
+    check_floor_scenario(loaded.scenario)  # a camera of its own, before any override
     overrides = dict(measurement or {})
     base = with_measurement(loaded.scenario, loaded.name, overrides, 1)  # before any worker starts
     check_floor_scenario(base)
+    hand = overrides.pop("estimator", base.measurement.estimator)
+    hand = hand if hand in ("kalman_cv", "kalman_ca") else FLOOR_MODEL
+    overrides.pop("process_noise", None)
+    settings = [{"estimator": "auto", "process_noise": None}] + [
+        {"estimator": hand, "process_noise": q} for q in qs]
     t0 = time.perf_counter()
-    cases = [(loaded.text, loaded.name, {**overrides, "process_noise": q}, seed, sample_hz)
-             for q in qs for seed in range(1, seeds + 1)]
+    cases = [(loaded.text, loaded.name, {**overrides, **setting}, seed, sample_hz)
+             for setting in settings for seed in range(1, seeds + 1)]
     rows = run_tasks(floor_case, cases, workers=workers, dask=dask, progress=progress)
-    table = [{"process_noise": q, "summary": summarize_floor(rows[j * seeds:(j + 1) * seeds])}
-             for j, q in enumerate(qs)]
-    ranked = [row for row in table if "hold_max_median" in row["summary"]]
+    table = [{**setting, "summary": summarize_floor(rows[j * seeds:(j + 1) * seeds])}
+             for j, setting in enumerate(settings)]
+    ranked = [row for row in table[1:] if "hold_max_median" in row["summary"]]
     best = min(ranked, key=lambda row: row["summary"]["hold_max_median"]) if ranked else None
     m = base.measurement
     return {"scenario": loaded.name, "seeds": seeds, "sample_hz": sample_hz, "workers": workers,
             "wall_time_s": time.perf_counter() - t0,
             "measurement_overrides": overrides,
             "measurement": {k: v for k, v in copy.deepcopy(vars(m)).items()
-                            if k not in ("seed", "process_noise")},
+                            if k not in ("seed", "process_noise", "estimator")},
             "segments": [{"start": s.start, "tf": s.tf,
                           "hold_end": base.schedule().hold_end(i, base.duration)}
                          for i, s in enumerate(base.schedule().segments)],
@@ -198,7 +208,7 @@ def floor_markdown(result: dict) -> str:
     windows = ", ".join(f"[{s['start'] + s['tf']:g}, {s['hold_end']:g}] s" for s in result["segments"])
     lines = [f"# Filter floor: {result['scenario']}, {result['seeds']} seeds",
              "",
-             f"Camera + Kalman filter only (no arm): {m['estimator']}, {m['rate_hz']:g} Hz, noise "
+             f"Camera + estimator only (no arm): {m['rate_hz']:g} Hz, noise "
              f"{m['noise_std'] * 1e3:g} mm, latency {m['latency'] * 1e3:g} ms"
              f"{' (compensated)' if m['compensate_latency'] else ''}"
              + (f"; overrides {result['measurement_overrides']}" if result["measurement_overrides"] else "")
@@ -207,15 +217,16 @@ def floor_markdown(result: dict) -> str:
              "hold RMS = its RMS there (median); run RMS / run max = the selector's output against the "
              f"active true object over [0, {result['duration']:g}] s (median). All in mm.",
              "",
-             "| q | hold max median | hold max p90 | hold max worst | hold RMS median | run RMS median | "
-             "run max median | errors |",
-             "|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| estimator | q | hold max median | hold max p90 | hold max worst | hold RMS median | "
+             "run RMS median | run max median | errors |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for row in result["table"]:
         s = row["summary"]
+        q = "" if row["process_noise"] is None else f"{row['process_noise']:g}"
         if "hold_max_median" not in s:
-            lines.append(f"| {row['process_noise']:g} | error | | | | | | {s['errors']} |")
+            lines.append(f"| {row['estimator']} | {q} | error | | | | | | {s['errors']} |")
             continue
-        lines.append(f"| {row['process_noise']:g} | {s['hold_max_median'] * 1e3:.2f} | "
+        lines.append(f"| {row['estimator']} | {q} | {s['hold_max_median'] * 1e3:.2f} | "
                      f"{s['hold_max_p90'] * 1e3:.2f} | {s['hold_max_worst'] * 1e3:.2f} | "
                      f"{s['hold_rms_median'] * 1e3:.2f} | {s['run_rms_median'] * 1e3:.2f} | "
                      f"{s['run_max_median'] * 1e3:.2f} | {s['errors']} |")
@@ -223,16 +234,18 @@ def floor_markdown(result: dict) -> str:
 
 
 def floor_summary_line(result: dict) -> str:
-    """One line: the best q and its median / p90 hold max."""
+    """One line: auto's and the best q's median / p90 hold max."""
     runs = sum(row["summary"]["runs"] for row in result["table"])
     errors = sum(row["summary"]["errors"] for row in result["table"])
     head = f"{result['scenario']} filter floor, {runs} runs ({errors} could not run)"
-    best = result["best"]
-    if best is None:
+    best, auto = result["best"], result["table"][0]["summary"]
+    if best is None or "hold_max_median" not in auto:
         return head + " in {:.0f} s: no run completed".format(result["wall_time_s"])
     s = best["summary"]
-    return (f"{head} in {result['wall_time_s']:.0f} s: best q = {best['process_noise']:g}, hold max "
-            f"median {s['hold_max_median'] * 1e3:.2f} mm, p90 {s['hold_max_p90'] * 1e3:.2f} mm")
+    return (f"{head} in {result['wall_time_s']:.0f} s: auto hold max median "
+            f"{auto['hold_max_median'] * 1e3:.2f} mm, p90 {auto['hold_max_p90'] * 1e3:.2f} mm; best "
+            f"{best['estimator']} q = {best['process_noise']:g}: {s['hold_max_median'] * 1e3:.2f} mm, "
+            f"p90 {s['hold_max_p90'] * 1e3:.2f} mm")
 
 
 def write_filter_floor(result: dict, out: Path) -> None:

@@ -14,8 +14,12 @@ Default ranges (uniform; ``--set``-style overrides through ``RANGES`` keys):
 | coulomb | [0, 0.3] N·m per joint | smooth Coulomb friction (``plant.coulomb``) |
 | payload | [0, 0.5] kg | mass at the gripper (``plant.payload_kg``) |
 | disturbance | [0, 0.5] N·m per joint | sine (0.5–3 Hz, random phase) + a step of ± that at a random t |
-| noise | [0, 1e-4] m | std of the target measurement noise at 30 Hz |
-| latency | [0, 0] s | camera latency (compensated with the known target profile) |
+| noise | [0, 1e-4] m | the camera's noise std (``measurement.noise_std``) |
+| latency | [0, 0] s | the camera's latency (compensated by the estimator) |
+
+The target is seen through a camera with ``estimator: auto`` (the scenario's own camera,
+or a 30 Hz one) unless both the noise and the latency ranges are [0, 0] (then the
+controller gets the analytic target, the paper's setting).
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from ptint_drake.figures import plt, save
 from ptint_drake.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.systems.camera import MeasurementConfig
 
 RANGES = {
     "mass": (0.7, 1.5),
@@ -58,18 +63,27 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     p.disturbance.phase = rng.uniform(0.0, 2 * np.pi, nv).tolist()
     p.disturbance.step = rng.uniform(-bound[1], bound[1], nv).tolist()
     p.disturbance.step_time = float(rng.uniform(0.0, scenario.duration))
-    m = scenario.measurement
-    m.noise_std = float(u("noise"))
-    m.latency = float(u("latency"))
-    m.compensate_latency = True
-    m.seed = int(seed)
+    m = _camera(scenario, ranges)
+    noise, latency = float(u("noise")), float(u("latency"))
+    if m is not None:
+        m.noise_std, m.latency, m.seed = noise, latency, int(seed)
     scenario.name = f"{name}_seed{seed}"
     params = {"mass_scale": p.mass_scale, "damping_scale": p.damping_scale, "coulomb": p.coulomb,
               "payload_kg": p.payload_kg, "disturbance_amplitude": p.disturbance.amplitude,
               "disturbance_frequency_hz": p.disturbance.frequency_hz,
               "disturbance_step": p.disturbance.step, "disturbance_step_time": p.disturbance.step_time,
-              "noise_std": m.noise_std, "latency": m.latency}
+              "noise_std": noise, "latency": latency}
     return scenario, params
+
+
+def _camera(scenario, ranges: dict):
+    """The sample's camera (``estimator: auto``; the scenario's own if it has one), or None
+    when the noise and latency ranges are both [0, 0]."""
+    if max(ranges["noise"]) <= 0.0 and max(ranges["latency"]) <= 0.0:
+        return scenario.measurement
+    if scenario.measurement is None or scenario.measurement.estimator == "none":
+        scenario.measurement = MeasurementConfig()
+    return scenario.measurement
 
 
 def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dict:

@@ -10,7 +10,8 @@ What it models (``Camera``, one per object):
   evaluated (nor on the dropouts: sample k always carries the same n_k);
 - a fixed latency L: sample k becomes visible at t_k + L;
 - dropouts: a sample whose time falls in a window ``from ≤ t_k < to`` is never
-  delivered (the output keeps holding the last delivered sample);
+  delivered (the output keeps holding the last delivered sample); nor is a sample
+  taken before the object can be seen (``history.visible_from``: a throw's release);
 - the object was in view before the run (``prior_window`` W, with ``history``):
   given the object's true motion as a function of time, the camera has also taken
   the samples k = −1, −2, … with −W ≤ t_k < 0 (same rate, same latency, same
@@ -51,11 +52,14 @@ no integration step straddles a change of the output.
 import itertools
 import math
 from dataclasses import dataclass, field
+from typing import Optional
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-ESTIMATORS = ("none", "kalman_cv", "kalman_ca")
+ESTIMATORS = ("auto", "kalman_cv", "kalman_ca", "none")
+# the hand-set filters' process noise q when the scenario does not state one
+DEFAULT_PROCESS_NOISE = 0.01
 # Tolerance (s) on event times: a sample is visible at t when stamp + latency <= t + TIME_TOL.
 TIME_TOL = 1.0e-9
 # Size of the blocks of noise drawn at once (noise of sample k = row k of one stream).
@@ -64,23 +68,25 @@ _NOISE_BLOCK = 1024
 
 @dataclass
 class MeasurementConfig:
-    """How the target is observed (scenario key ``measurement``).
+    """How the target is observed (scenario key ``measurement``; absent: no camera, the
+    controller is given the analytic target, the paper's setting).
 
-    ``process_noise`` is the spectral density q of the white noise that drives the
-    filter's motion model: white acceleration for ``kalman_cv`` (m²/s³), white jerk
-    for ``kalman_ca`` (m²/s⁵).  The default 0.01 gave the smallest tracking error of
-    both models on the paper's curve at 30 Hz with 0.1–0.5 mm noise (``kalman``'s
-    docstring has the numbers); ``ptint`` scenarios may tune it.
+    ``estimator``: ``auto`` (default; ``imm.AdaptiveTargetEstimator``, nothing to tune),
+    or a hand-set Kalman filter ``kalman_cv`` / ``kalman_ca`` whose ``process_noise`` is
+    the spectral density q of its white acceleration (m²/s³) or jerk (m²/s⁵), default
+    DEFAULT_PROCESS_NOISE = 0.01 (``kalman``'s docstring has the numbers); ``none``: no
+    camera, only with a perfect one (noise, latency and dropouts all 0).
     """
 
     noise_std: float = 0.0  # m, per axis
     rate_hz: float = 30.0  # samples per second
     latency: float = 0.0  # s, from taking a sample to seeing it
-    compensate_latency: bool = False  # the filter predicts over the latency
+    compensate_latency: bool = True  # the filter predicts over the latency
     dropouts: list[list[float]] = field(default_factory=list)  # [from, to] windows, s
     seed: int = 0
-    estimator: str = "none"  # none | kalman_cv | kalman_ca
-    process_noise: float = 0.01  # q: m²/s³ (kalman_cv) or m²/s⁵ (kalman_ca)
+    estimator: str = "auto"  # auto | kalman_cv | kalman_ca | none
+    # q of the hand-set filters: m²/s³ (kalman_cv) or m²/s⁵ (kalman_ca); None: 0.01
+    process_noise: Optional[float] = None
     # s: how long the camera had each object in view before t = 0 (samples at
     # −prior_window ≤ t_k < 0); used when the camera is given the object's motion
     # before the run (the simulation does); 0: nothing is seen before t = 0
@@ -102,12 +108,12 @@ def validate_measurement(m: MeasurementConfig) -> None:
     rate = number("rate_hz")
     if not (math.isfinite(rate) and rate > 0.0):
         raise _field_error("rate_hz", f"must be > 0, got {m.rate_hz}")
-    for name in ("noise_std", "latency", "process_noise", "prior_window"):
+    names = ("noise_std", "latency", "prior_window")
+    for name in names + (("process_noise",) if m.process_noise is not None else ()):
         value = number(name)
         if not (math.isfinite(value) and value >= 0.0):
             raise _field_error(name, f"must be >= 0 and finite, got {getattr(m, name)}")
-    if m.estimator not in ESTIMATORS:
-        raise _field_error("estimator", f"must be one of {', '.join(ESTIMATORS)}, got {m.estimator!r}")
+    _check_estimator(m)
     if isinstance(m.seed, bool) or not isinstance(m.seed, int) or m.seed < 0:
         raise _field_error("seed", f"must be an integer >= 0, got {m.seed!r}")
     windows = []
@@ -130,6 +136,29 @@ def validate_measurement(m: MeasurementConfig) -> None:
             first, second = sorted((i0, i1))
             raise _field_error(f"dropouts[{second}]", f"overlaps dropouts[{first}] "
                                f"([{lo1}, {hi1}] and [{lo0}, {hi0}])")
+
+
+def _check_estimator(m: MeasurementConfig) -> None:
+    """The estimator and the options that go with it (the retired ones name what to write)."""
+    if m.estimator not in ESTIMATORS:
+        raise _field_error("estimator", f"must be one of {', '.join(ESTIMATORS)}, got {m.estimator!r}")
+    if m.estimator == "auto" and m.process_noise is not None:
+        raise _field_error("process_noise", "estimator auto tunes itself: remove process_noise "
+                           "(or choose estimator: kalman_cv / kalman_ca to set it by hand)")
+    if m.estimator == "none":
+        for name in ("noise_std", "latency"):
+            if getattr(m, name) != 0:
+                raise _field_error(name, f"the noisy target without a camera is retired: remove "
+                                   f"estimator: none to see the target through the camera "
+                                   f"(estimator auto), or remove {name}")
+        if m.dropouts:
+            raise _field_error("dropouts", "the noisy target without a camera is retired: remove "
+                               "estimator: none to see the target through the camera (estimator auto)")
+
+
+def process_noise(m: MeasurementConfig) -> float:
+    """q of a hand-set filter: ``process_noise``, or DEFAULT_PROCESS_NOISE when not stated."""
+    return DEFAULT_PROCESS_NOISE if m.process_noise is None else float(m.process_noise)
 
 
 class _NoiseTable:
@@ -170,6 +199,8 @@ class Camera(LeafSystem):
         super().__init__()
         validate_measurement(config)
         self._config = config
+        # a thrown object is seen from its release on (``visible_from`` of its history)
+        self._visible_from = float(getattr(history, "visible_from", -math.inf))
         self._period = 1.0 / config.rate_hz
         self._latency = float(config.latency) if config.latency > TIME_TOL else 0.0
         self._windows = [(float(a), float(b)) for a, b in config.dropouts]
@@ -230,7 +261,10 @@ class Camera(LeafSystem):
         return self._measurement_out
 
     def dropped(self, t: float) -> bool:
-        """Whether a sample taken at t falls in a dropout window [from, to)."""
+        """Whether a sample taken at t falls in a dropout window [from, to) or before the
+        object can be seen (a thrown object before its release)."""
+        if t < self._visible_from - TIME_TOL:
+            return True
         return any(lo - TIME_TOL <= t < hi - TIME_TOL for lo, hi in self._windows)
 
     def sample(self, k: int, x_true: np.ndarray) -> np.ndarray:

@@ -68,8 +68,10 @@ smooths more).  q = 0.001 or 0.1 raises the errors above by up to 1.7×; q = 1e-
 lags by millimetres on the curve.  Closed-loop
 tuning (what the interceptor tolerates) is left to the scenarios.
 
-The camera scenarios (30 Hz, 2 mm, 33 ms compensated) choose q per motion, closed loop
-over seeds 1–10 (``*_camera.yaml``; steady-state per-axis position std from the DARE):
+The best hand-set q per motion (30 Hz, 2 mm, 33 ms compensated), closed loop over seeds
+1–10 — what the camera scenarios used before ``estimator: auto`` (``imm``) made tuning
+unnecessary, and the hand-set rows the README compares ``auto`` with (steady-state per-axis
+position std from the DARE):
 
 - constant-speed conveyors, ``kalman_cv`` q = 1e-6 m²/s³ (the belt speed may wander
   √(q·1 s) = 1 mm/s per second): 0.55 mm per axis; q = 1e-5 → 0.72 mm and 1e-4 →
@@ -81,11 +83,13 @@ over seeds 1–10 (``*_camera.yaml``; steady-state per-axis position std from th
   axis; 0.003 lags, 0.1–0.3 is noisier (open-loop RMS 3.3–3.7 mm against 3.1 mm).
 
 ``ActiveTargetSelector`` passes on the estimate of the segment active at t, and
-``AddCameraEstimators`` wires a camera and a filter per object plus the selector.
+``AddCameraEstimators`` wires a camera and an estimator per object (``auto``: the IMM of
+``imm``; ``kalman_cv`` / ``kalman_ca``: this filter) plus the selector.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -96,8 +100,10 @@ from ptint_drake.systems.camera import (
     TIME_TOL,
     Camera,
     MeasurementConfig,
+    process_noise,
     validate_measurement,
 )
+from ptint_drake.systems.imm import AdaptiveTargetEstimator
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET_PORT_SIZE
 
@@ -155,11 +161,12 @@ class TargetKalmanFilter(LeafSystem):
 
     def __init__(self, *, config: MeasurementConfig, model: str, prior=None):
         super().__init__()
-        validate_measurement(config)
         self._n = n = model_order(model)
+        config = dataclasses.replace(config, estimator=f"kalman_{model}")  # this filter, whatever named
+        validate_measurement(config)
         self._model = model
         self._config = config
-        self._q = float(config.process_noise)
+        self._q = process_noise(config)
         self._R = measurement_variance(config)
         self._latency = float(config.latency)
         self._compensate = bool(config.compensate_latency)
@@ -321,6 +328,13 @@ class ActiveTargetSelector(LeafSystem):
         output.SetFromVector(self._inputs[i].Eval(context))
 
 
+def _estimator(config: MeasurementConfig, prior) -> LeafSystem:
+    """The estimator ``config.estimator`` names, primed with ``prior``."""
+    if config.estimator == "auto":
+        return AdaptiveTargetEstimator(config=config, prior=prior)
+    return TargetKalmanFilter(config=config, model=config.estimator.split("_", 1)[1], prior=prior)
+
+
 @dataclass
 class CameraEstimators:
     """What ``AddCameraEstimators`` added: wire ``target_port`` to a controller's target."""
@@ -344,11 +358,12 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     ``evaluate``): the objects' true motion, so that each camera has also seen its object
     for ``config.prior_window`` s before t = 0 and its filter starts from those samples
     (priming); without it the cameras start seeing at t = 0.
-    ``config.estimator`` must be ``kalman_cv`` or ``kalman_ca``.
+    ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object), or
+    ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
     """
     validate_measurement(config)
-    if config.estimator not in ("kalman_cv", "kalman_ca"):
-        raise ValueError("measurement.estimator: AddCameraEstimators needs kalman_cv or "
+    if config.estimator not in ("auto", "kalman_cv", "kalman_ca"):
+        raise ValueError("measurement.estimator: AddCameraEstimators needs auto, kalman_cv or "
                          f"kalman_ca, got {config.estimator!r}")
     if (true_position_ports is None) == (objects_port is None):
         raise ValueError("AddCameraEstimators: give true_position_ports or objects_port, not both")
@@ -357,7 +372,6 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
         builder.Connect(objects_port, split.get_input_port())
         true_position_ports = [split.get_output_port(i) for i in range(n)]
-    model = config.estimator.split("_", 1)[1]
     selector = builder.AddNamedSystem(
         "target_selector", ActiveTargetSelector(schedule=schedule, count=len(true_position_ports)))
     if histories is not None and len(histories) != len(true_position_ports):
@@ -368,8 +382,7 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         history = None if histories is None else histories[i]
         camera = builder.AddNamedSystem(f"camera_{i}", Camera(config=config, seed_offset=i,
                                                               history=history))
-        kf = builder.AddNamedSystem(f"target_filter_{i}", TargetKalmanFilter(
-            config=config, model=model, prior=camera.pre_run_samples()))
+        kf = builder.AddNamedSystem(f"target_filter_{i}", _estimator(config, camera.pre_run_samples()))
         builder.Connect(port, camera.get_x_true_input_port())
         builder.Connect(camera.get_measurement_output_port(), kf.get_measurement_input_port())
         builder.Connect(kf.get_target_output_port(), selector.get_input_port(i))

@@ -6,7 +6,10 @@ Both kinds are functions of absolute time t:
   (the paper's curve, eq. 28, is center (0.24, 0, 0.3), amplitude 0.1,
   ω = 1.5, phase (0, π/2, 0));
 - ``LinearTarget``: x_r = start + velocity · t (an object on a conveyor);
-- ``WaypointTarget``: a C² cubic spline through recorded samples (SPEC 5.4 ``waypoints``).
+- ``WaypointTarget``: a C² cubic spline through recorded samples (SPEC 5.4 ``waypoints``);
+- ``BallisticTarget``: a thrown object in free flight from its release time r,
+  x_r = start + velocity (t − r) + gravity (t − r)²/2 for t ≥ r (no drag); before r it is
+  held at ``start`` (and a camera does not see it).
 
 Any of them may carry an orientation (``orientation.OrientedTarget``, issue 19).
 """
@@ -74,6 +77,35 @@ class LinearTarget:
     def evaluate(self, t: float) -> np.ndarray:
         """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
         return np.array(self.values(t))
+
+
+@dataclass(frozen=True)
+class BallisticTarget:
+    start: np.ndarray
+    velocity: np.ndarray
+    gravity: np.ndarray
+    release: float = 0.0
+
+    def __post_init__(self):
+        for name in ("start", "velocity", "gravity"):
+            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
+
+    @property
+    def visible_from(self) -> float:
+        """The release time: a camera sees the object from then on."""
+        return float(self.release)
+
+    def values(self, t: float) -> list:
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 plain floats) at time t."""
+        return self.evaluate(t).tolist()
+
+    def evaluate(self, t: float) -> np.ndarray:
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t (held at ``start`` before release)."""
+        tau = t - self.release
+        if tau < 0.0:
+            return np.concatenate([self.start, np.zeros(9)])
+        return np.concatenate([self.start + self.velocity * tau + 0.5 * tau * tau * self.gravity,
+                               self.velocity + tau * self.gravity, self.gravity, np.zeros(3)])
 
 
 def target_values(target, t: float) -> list:

@@ -80,7 +80,7 @@ def test_pre_run_samples_follow_the_camera_rules():
 @pytest.mark.parametrize("name", CAMERA_SCENARIOS)
 def test_camera_scenarios_load_with_their_criteria(name):
     scenario = load_scenario(name)
-    assert scenario.measurement.estimator in ("kalman_cv", "kalman_ca")
+    assert scenario.measurement.estimator == "auto" and scenario.measurement.process_noise is None
     assert scenario.measurement.rate_hz == 30.0 and scenario.measurement.noise_std == 0.002
     assert scenario.criteria.e_tf >= 0.003
 

@@ -54,7 +54,8 @@ def _line_truth(t):
 @pytest.mark.parametrize("model", ["cv", "ca"])
 @pytest.mark.parametrize("latency, compensate", [(0.0, False), (0.07, True)])
 def test_converges_on_noiseless_constant_velocity_track(model, latency, compensate):
-    config = MeasurementConfig(latency=latency, compensate_latency=compensate, process_noise=0.01)
+    config = MeasurementConfig(latency=latency, compensate_latency=compensate, process_noise=0.01,
+                               estimator=f"kalman_{model}")
     sim, kf, ctx, _ = _filter_diagram(config, model)
     for t in (2.0, 3.0 + 0.3 / 30.0, 4.0 + 0.9 / 30.0):  # at, just after and just before updates
         sim.AdvanceTo(t)
@@ -100,7 +101,7 @@ def test_latency_compensation_removes_lag(model):
     errors = {}
     for compensate in (False, True):
         config = MeasurementConfig(noise_std=1e-4, latency=0.1, compensate_latency=compensate,
-                                   seed=2, process_noise=1e-4)  # a small q suits a straight track
+                                   seed=2, process_noise=1e-4, estimator=f"kalman_{model}")  # small q: a line
         sim, kf, ctx, _ = _filter_diagram(config, model)
         err = []
         for t in np.arange(4.0, 6.0, 0.0123):
@@ -137,7 +138,8 @@ def test_converged_gain_matches_drake_steady_state(model, q):
     """The time-varying filter's gain converges to the DARE gain (Drake's steady-state
     filter is the cross-check, not the filter)."""
     rate = 30.0
-    config = MeasurementConfig(noise_std=1e-3, rate_hz=rate, process_noise=q, seed=1)
+    config = MeasurementConfig(noise_std=1e-3, rate_hz=rate, process_noise=q, seed=1,
+                               estimator=f"kalman_{model}")
     sim, kf, ctx, _ = _filter_diagram(config, model, source=_curve)
     sim.AdvanceTo(8.0)
     _, _, P_post = kf.state(ctx)

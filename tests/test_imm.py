@@ -1,0 +1,165 @@
+"""estimator: auto — the IMM filter of systems/imm.py, and the retired measurement options."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from ptint_drake.scenario import ScenarioError, parse_scenario
+from ptint_drake.systems import imm
+from ptint_drake.systems.camera import MeasurementConfig, validate_measurement
+from ptint_drake.systems.imm import MODELS, AdaptiveTargetEstimator
+from ptint_drake.systems.kalman import AddCameraEstimators
+from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.targets import BallisticTarget, LinearTarget, SinusoidTarget, TargetSource
+
+CURVE = SinusoidTarget([0.24, 0.0, 0.3], [0.1] * 3, 1.5, [0.0, np.pi / 2, 0.0])  # paper eq. 28
+TRACKS = {
+    "cv": LinearTarget([0.3, -0.12, 0.2], [0.03, 0.08, -0.01]),
+    "turn": CURVE,
+    "fall": BallisticTarget([0.2, 0.0, 0.05], [0.05, 0.15, 2.5], [0.0, 0.0, -9.81]),
+}
+
+
+def _feed(target, config, t_end, t_start=0.0):
+    """Camera samples of ``target`` at the camera's rate, fed to ``step`` at their visibility
+    times; yields (t_est, state) after each update."""
+    f = AdaptiveTargetEstimator(config=config)
+    state = (np.zeros(4), None, None, None)
+    rng = np.random.default_rng(3)
+    for k in range(int(round(t_start * config.rate_hz)), int(t_end * config.rate_hz) + 1):
+        t_k = k / config.rate_hz
+        z = target.evaluate(t_k)[0:3] + rng.normal(0.0, config.noise_std, 3)
+        result = f.step(*state, t_k + config.latency, np.array([t_k, *z, 1.0]))
+        if result is not None:
+            state = result
+        yield state
+
+
+def _combined(state):
+    meta, X, _, mu = state
+    return meta[1], mu @ X
+
+
+@pytest.mark.parametrize("kind", sorted(TRACKS))
+def test_converges_on_noiseless_tracks(kind):
+    """No noise: the combined estimate of position, velocity, acceleration meets the track."""
+    target = TRACKS[kind]
+    config = MeasurementConfig(rate_hz=60.0 if kind == "fall" else 30.0, latency=0.02)
+    t_end = 0.4 if kind == "fall" else 6.0
+    for state in _feed(target, config, t_end):
+        pass
+    t_est, x = _combined(state)
+    truth = target.evaluate(t_est)
+    assert np.linalg.norm(x[0:3] - truth[0:3]) <= 1e-4
+    assert np.linalg.norm(x[3:6] - truth[3:6]) <= 1e-2
+
+
+@pytest.mark.parametrize("kind", sorted(TRACKS))
+def test_probabilities_sum_to_one_and_move_to_the_right_model(kind):
+    """A belt → cv, the paper's ellipse → turn, a throw → fall (from uniform μ at the start)."""
+    target = TRACKS[kind]
+    config = MeasurementConfig(noise_std=0.002, rate_hz=60.0 if kind == "fall" else 30.0, latency=0.02)
+    history = [state[3] for state in _feed(target, config, 0.4 if kind == "fall" else 6.0)]
+    for mu in history:
+        assert mu.sum() == pytest.approx(1.0, abs=1e-12) and (mu >= 0).all()
+    mu = history[-1]
+    assert mu.argmax() == MODELS.index(kind) and mu.max() > 0.8, mu
+    if kind == "turn":  # Ω learnt: ω = 1.5 rad/s
+        assert history and np.sqrt(_last_omega(target, config)) == pytest.approx(1.5, rel=0.1)
+
+
+def _last_omega(target, config):
+    for state in _feed(target, config, 6.0):
+        pass
+    return state[1][MODELS.index("turn"), 9]
+
+
+def test_covariances_stay_spd_through_dropouts():
+    """A Drake run with a 0.5 s dropout: every model's P symmetric positive definite at every
+    update, and the position variance grows while no sample comes."""
+    config = MeasurementConfig(noise_std=0.002, latency=0.033, dropouts=[[1.0, 1.5]])
+    builder = DiagramBuilder()
+    schedule = Schedule([Segment(0.0, 2.5, 0.75)])
+    truth = builder.AddSystem(TargetSource(schedule, [CURVE]))
+    handles = AddCameraEstimators(builder, objects_port=truth.get_objects_output_port(),
+                                  schedule=schedule, config=config, histories=[CURVE])
+    simulator = Simulator(builder.Build())
+    est = handles.filters[0]
+    assert isinstance(est, AdaptiveTargetEstimator)
+    context = est.GetMyContextFromRoot(simulator.get_mutable_context())
+    variances = {}
+    for t in np.arange(0.05, 2.5, 1 / 30):
+        simulator.AdvanceTo(t)
+        meta, X, Ps, mu = est.state(context)
+        for P in Ps:
+            np.testing.assert_allclose(P, P.T, atol=1e-15)
+            assert np.linalg.eigvalsh(P).min() > 0.0
+        variances[round(t, 3)] = mu @ Ps[:, 0, 0]
+    during = [v for t, v in variances.items() if 1.1 < t < 1.5]
+    assert all(b > a for a, b in zip(during, during[1:]))  # predict only: P grows
+    assert variances[min(variances, key=lambda t: abs(t - 2.4))] < during[-1]
+
+
+def test_state_is_named_and_output_layout_is_the_kalman_one():
+    est = AdaptiveTargetEstimator(config=MeasurementConfig(noise_std=0.002))
+    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities"}
+    context = est.CreateDefaultContext()
+    sizes = [context.get_discrete_state(est.groups[n]).size()
+             for n in ("meta", "estimates", "covariances", "probabilities")]
+    m = len(MODELS)
+    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m]
+    assert est.get_target_output_port().size() == 9
+    np.testing.assert_array_equal(est.get_target_output_port().Eval(context), np.zeros(9))
+
+
+@pytest.mark.parametrize("measurement, field, hint", [
+    ("{estimator: none, noise_std: 0.002}", "measurement.noise_std", "retired"),
+    ("{estimator: none, latency: 0.03}", "measurement.latency", "retired"),
+    ("{estimator: none, dropouts: [[0.1, 0.2]]}", "measurement.dropouts", "retired"),
+    ("{process_noise: 0.01}", "measurement.process_noise", "kalman_cv"),
+    ("{estimator: auto, process_noise: 0.01}", "measurement.process_noise", "remove process_noise"),
+])
+def test_retired_options_are_one_line_errors(measurement, field, hint):
+    text = _SCENARIO + f"measurement: {measurement}\n"
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, "x")
+    message = str(info.value)
+    assert message.startswith(field) and hint in message and "\n" not in message
+
+
+def test_measurement_defaults():
+    assert parse_scenario(_SCENARIO, "x").measurement is None  # the analytic target
+    m = parse_scenario(_SCENARIO + "measurement: {noise_std: 0.002}\n", "x").measurement
+    assert m.estimator == "auto" and m.compensate_latency and m.process_noise is None
+    validate_measurement(MeasurementConfig(estimator="kalman_cv", process_noise=1e-6))
+
+
+@pytest.mark.parametrize("throw, field", [
+    ("{start: [0.25, 0.0, 0.3], velocity: [0, 0, 0], release: 0.5}", "interceptions[0].start"),
+    ("{start: [0.25, 0.0, 0.3], velocity: [0, 0, 0]}", "interceptions[0].tf"),
+    ("{start: [0.25, 0.0], velocity: [0, 0, 0]}", "interceptions[0].target.ballistic.start"),
+])
+def test_bad_throws_are_one_line_errors(throw, field):
+    text = _SCENARIO.replace("{linear: {start: [0.3, -0.12, 0.2], velocity: [0.0, 0.08, 0.0]}}",
+                             f"{{ballistic: {throw}}}")
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, "x")
+    assert str(info.value).startswith(field) and "\n" not in str(info.value)
+
+
+def test_ballistic_target_is_held_before_release_and_unseen_by_the_camera():
+    b = BallisticTarget([0.2, 0.0, 0.1], [0.0, 0.1, 2.0], [0.0, 0.0, -9.81], release=0.5)
+    np.testing.assert_array_equal(b.evaluate(0.2), np.concatenate([[0.2, 0.0, 0.1], np.zeros(9)]))
+    np.testing.assert_allclose(b.evaluate(0.7)[0:3], [0.2, 0.02, 0.1 + 0.4 - 0.5 * 9.81 * 0.04])
+    from ptint_drake.systems.camera import Camera  # noqa: PLC0415
+    camera = Camera(config=MeasurementConfig(rate_hz=30.0), history=b)
+    assert camera.dropped(0.4) and not camera.dropped(0.5) and camera.pre_run_samples() == []
+
+
+_SCENARIO = """duration: 2.0
+robot: {model: rvm1, end_effector: tool, initial_q_deg: [22.5, 45.0, 30.0]}
+interceptions:
+  - {start: 0.0, tf: 1.0, beta: 0.75,
+     target: {linear: {start: [0.3, -0.12, 0.2], velocity: [0.0, 0.08, 0.0]}}}
+"""
