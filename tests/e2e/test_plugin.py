@@ -178,3 +178,29 @@ def test_dask_workers_find_the_plugin_beside_its_scenario_file(user_folder):
         result = run_compare(loaded, [TYPE], ["nominal"], dask=cluster.scheduler_address)
     row = result["rows"][0]
     assert row["controller"] == TYPE and row["status"] in ("ok", "missed"), row.get("reasons")
+
+
+def test_the_plugin_and_ptsmc_on_an_arm_the_package_has_never_seen(user_folder, monkeypatch):
+    from arms import OFFSET_ARM  # noqa: PLC0415
+
+    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+    from ptint_drake.studies.compare import run_compare  # noqa: PLC0415
+
+    (user_folder / "offset_arm.urdf").write_text(OFFSET_ARM)
+    (user_folder / "arm.yaml").write_text(f"""duration: 2.0
+robot: {{model: {user_folder / "offset_arm.urdf"}, end_effector: hand, initial_q_deg: [17.2, 28.6, 68.8]}}
+controller: {{type: "{TYPE}", params: {{Kp: 3000.0, Kd: 200.0}}}}
+interceptions:
+  - start: 0.0
+    tf: 1.0
+    beta: 0.75
+    target: {{linear: {{start: [0.45, 0.12, 0.75], velocity: [0, 0.02, 0]}}}}
+""")
+    monkeypatch.chdir(user_folder.parent)  # found beside the scenario file, not in the cwd
+    loaded = LoadedScenario.load(str(user_folder / "arm.yaml"))
+    result = run_compare(loaded, ["ptsmc", TYPE], ["nominal"], workers=1)
+    rows = {r["controller"]: r for r in result["rows"]}
+    assert set(rows) == {"ptsmc", TYPE}
+    assert rows["ptsmc"]["ok"], rows["ptsmc"]["reasons"]
+    mine = rows[TYPE]["segments"][0]
+    assert rows[TYPE]["status"] in ("ok", "missed") and mine["e_tf_norm"] < mine["e0_norm"]
