@@ -120,9 +120,14 @@ def robust_range(pair: str) -> tuple[str, tuple[float, float]]:
 @_option
 def controller_list(text: str) -> list[str]:
     """``--controllers`` of ``compare``: registered controllers and plugins' ``module:Class``."""
-    from ptint_drake.controllers import parse_types  # noqa: PLC0415
+    from ptint_drake.controllers import CONTROLLERS, known_type, plugin  # noqa: PLC0415
 
-    return parse_types(text, "--controllers")
+    items = names(text, "--controllers")
+    for item in items:
+        if not known_type(item):
+            raise ScenarioError(f"--controllers: unknown {item!r} (one of {', '.join(CONTROLLERS)}, "
+                                f"or {plugin.FORM})")
+    return items
 
 
 @_option

@@ -25,7 +25,7 @@ from ptint_drake.controllers.slot import (ControllerHandles, ControllerSlot, Tar
 
 __all__ = ["REGISTRY", "CONTROLLERS", "ControllerType", "ControllerHandles", "ControllerSlot",
            "TargetView", "AddController", "check_controller", "controller_targets", "target_view",
-           "uses_analytic_targets", "describe", "known_type", "parse_types"]
+           "uses_analytic_targets", "describe", "known_type"]
 
 
 @dataclass(frozen=True)
@@ -63,21 +63,6 @@ CONTROLLERS = tuple(REGISTRY)
 def known_type(type_: str) -> bool:
     """A registered name or a plugin's ``module:Class``."""
     return type_ in REGISTRY or plugin.is_plugin(type_)
-
-
-def parse_types(text: str, flag: str = "--controllers") -> list[str]:
-    """Comma-separated controller types (registered names, plugins' ``module:Class``); a
-    ScenarioError naming ``flag`` for an empty list or an unknown name."""
-    from ptint_drake.validation import ScenarioError  # noqa: PLC0415  (validation imports this package)
-
-    items = [v.strip() for v in text.split(",") if v.strip()]
-    if not items:
-        raise ScenarioError(f"{flag}: no values given")
-    for item in items:
-        if not known_type(item):
-            raise ScenarioError(f"{flag}: unknown {item!r} (one of {', '.join(CONTROLLERS)}, "
-                                f"or {plugin.FORM})")
-    return items
 
 
 def describe() -> str:

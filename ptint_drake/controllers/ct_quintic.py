@@ -33,4 +33,4 @@ def AddCtQuintic(slot: ControllerSlot, config: CtQuinticConfig, target: TargetVi
     port = slot.connect(system, target)
     notes = [f"ct_quintic: inverse dynamics of the nominal model, ω = {config.omega:g} rad/s, "
              f"target future {'exact (analytic)' if predict else 'extrapolated from the estimate'}"]
-    return telemetry_handles(NAME, system, port, notes, model_based=True)
+    return telemetry_handles(NAME, system, port, notes)  # model-based: MODEL_BASED, read by the registry
