@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.plant import ApplyMultibodyPlantConfig, MultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import (JointIndex, PrismaticJoint, RevoluteJoint, SpatialInertia,
                                     UnitInertia)
 
@@ -35,9 +35,10 @@ def resolve_model(model: str) -> Path:
     return path
 
 
-def parse_model(model: str) -> MultibodyPlant:
-    """The model file (``robot.model``) parsed into a continuous plant, not finalized."""
-    plant = MultibodyPlant(time_step=0.0)
+def parse_model(model: str, time_step: float = 0.0) -> MultibodyPlant:
+    """The model file (``robot.model``) parsed into a plant, not finalized: continuous
+    (``time_step`` 0) or discrete with that step (s)."""
+    plant = MultibodyPlant(time_step=time_step)
     path = resolve_model(model)
     try:
         Parser(plant).AddModels(str(path))
@@ -48,11 +49,14 @@ def parse_model(model: str) -> MultibodyPlant:
 
 
 def make_plant(scenario: Scenario) -> MultibodyPlant:
-    """The continuous plant of the scenario's robot as it is simulated: the model file with
-    the scenario's plant variants (``plant``) in its defaults — every link's mass and inertia
+    """The plant of the scenario's robot as it is simulated: the model file with the
+    scenario's plant variants (``plant``) in its defaults — every link's mass and inertia
     and every rotor inertia × ``mass_scale`` (``mass_scaling``), joint damping ×
-    ``damping_scale``, ``payload_kg`` welded at the end effector — finalized."""
-    plant = parse_model(scenario.robot.model)
+    ``damping_scale``, ``payload_kg`` welded at the end effector — with Drake's
+    ``MultibodyPlantConfig`` of ``multibody`` applied (time step, contact approximation;
+    continuous without one), finalized."""
+    config = scenario.multibody
+    plant = parse_model(scenario.robot.model, config.time_step if config is not None else 0.0)
     if scenario.plant.mass_scale != 1.0:
         plant = scaled_copy(plant, scenario.plant.mass_scale)
     for i in range(plant.num_joints()):
@@ -67,6 +71,8 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
         payload = plant.AddRigidBody("payload", frame.body().model_instance(), SpatialInertia(
             scenario.plant.payload_kg, np.zeros(3), UnitInertia.SolidSphere(0.03)))
         plant.WeldFrames(frame, payload.body_frame(), RigidTransform())
+    if config is not None:
+        _apply_config(config, plant)
     plant.Finalize()
     task, needed = scenario.controller.task, TASK_MIN_JOINTS[scenario.controller.task]
     if plant.num_velocities() < needed:
@@ -77,6 +83,16 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
             f"robot.initial_q_deg: the model has {plant.num_positions()} joints, "
             f"got {len(scenario.robot.initial_q_deg)} angles")
     return plant
+
+
+def _apply_config(config: MultibodyPlantConfig, plant: MultibodyPlant) -> None:
+    """Drake's ``ApplyMultibodyPlantConfig`` (the time step is the constructor's); a setting
+    Drake rejects is a ScenarioError naming ``multibody``."""
+    try:
+        ApplyMultibodyPlantConfig(config, plant)
+    except Exception as exc:  # noqa: BLE001  (Drake raises RuntimeError or ValueError)
+        detail = " ".join(str(exc).split())[:300]
+        raise ScenarioError(f"multibody: {detail}") from None
 
 
 def actuator_effort_limits(plant: MultibodyPlant) -> np.ndarray:

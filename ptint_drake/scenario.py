@@ -23,6 +23,11 @@ open, with their defaults:
 - ``controller.type``: ``ptsmc`` (the paper's), another controller of the registry
   (``controllers.REGISTRY``), or a user's own ``module:Class`` with its ``params``
   (``controllers.plugin``);
+- ``controller.control_period``: 0 s, continuous control; > 0 s runs the controller
+  sampled with its torque held between samples (``controllers.hold``), as on a real drive;
+- ``multibody``: absent, the continuous plant integrated with ``simulator``; Drake's own
+  ``MultibodyPlantConfig`` (``time_step``, ``discrete_contact_approximation``, …) builds the
+  plant with those settings (``robot.make_plant``); a discrete plant needs sampled control;
 - ``plant``: scale factors for link masses/inertias and joint damping, used
   to show that the model-free controller needs no retuning (all 1 by default);
   ``apply_variant`` gives the named plant variants (nominal, mass_xF, payload_Mkg);
@@ -38,6 +43,7 @@ from pathlib import Path
 from typing import Dict, List, Optional, Union
 
 from pydrake.common.yaml import yaml_load_typed
+from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
 from ptint_drake.controllers import REGISTRY, plugin
@@ -76,6 +82,8 @@ def _controller_config() -> type:
         ("type", str, field(default="ptsmc")),  # a name of controllers.REGISTRY, or "module:Class"
         ("implementation", str, field(default="fused")),  # ptsmc: "fused" one LeafSystem, or "blocks"
         ("params", Dict[str, ParamValue], field(default_factory=dict)),  # a plugin's settings
+        # s: > 0 runs the controller sampled, its torque held between samples (controllers.hold)
+        ("control_period", float, field(default=0.0)),
         *own], bases=(ControllerGains,), namespace={"__module__": __name__})
     cls.__doc__ = _controller_config.__doc__
     return cls
@@ -188,6 +196,7 @@ class Scenario:
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     interceptions: List[InterceptionConfig] = field(default_factory=list)
     plant: PlantConfig = field(default_factory=PlantConfig)
+    multibody: Optional[MultibodyPlantConfig] = None  # None: the continuous plant (robot.make_plant)
     measurement: Optional[MeasurementConfig] = None  # None: no camera, the analytic target
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)

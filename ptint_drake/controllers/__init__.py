@@ -20,6 +20,7 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.controllers import ct_quintic, pd, plugin, ptsmc, smc
+from ptint_drake.controllers.hold import AddActuationHold, held_telemetry
 from ptint_drake.controllers.slot import (ControllerHandles, ControllerSlot, TargetView, controller_targets,
                                           target_view, uses_analytic_targets)
 
@@ -78,19 +79,23 @@ def check_controller(scenario) -> None:
 
 
 def AddController(builder: DiagramBuilder, station_system, station, scenario) -> ControllerHandles:
-    """Add ``scenario.controller.type`` to ``builder`` and wire it to the station's ports."""
+    """Add ``scenario.controller.type`` to ``builder`` and wire it to the station's ports, through
+    the drive's zero-order hold when ``controller.control_period`` > 0 (``hold``)."""
     plant = station.plant
     frame = plant.GetFrameByName(scenario.robot.end_effector)
+    block = scenario.controller
+    actuation = station_system.GetInputPort("actuation")
+    held = AddActuationHold(builder, actuation, block.control_period) if block.control_period > 0 else None
     slot = ControllerSlot(builder=builder, plant=plant, frame=frame,
                           schedule=scenario.schedule(), state=station_system.GetOutputPort("state"),
-                          actuation=station_system.GetInputPort("actuation"),
+                          actuation=held.get_input_port() if held is not None else actuation,
                           initial_q=np.radians(scenario.robot.initial_q_deg), scenario=scenario)
     target = TargetView(builder, station_system, scenario)
-    block = scenario.controller
     entry = REGISTRY.get(block.type)
     if entry is None:
-        return plugin.AddPlugin(slot, block.params, target, block.type)
-    handles = entry.add(slot, entry.settings_of(block), target)
-    handles.model_based = entry.model_based
-    return handles
+        handles = plugin.AddPlugin(slot, block.params, target, block.type)
+    else:
+        handles = entry.add(slot, entry.settings_of(block), target)
+        handles.model_based = entry.model_based
+    return handles if held is None else held_telemetry(handles, held, plant.MakeActuationMatrix())
 
