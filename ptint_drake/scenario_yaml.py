@@ -15,6 +15,7 @@ import typing
 from typing import List, Optional
 
 from pydrake.common.yaml import yaml_dump_typed
+from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
 from ptint_drake.validation import ScenarioError
@@ -241,10 +242,10 @@ def _locate(raw, schema, path: str) -> Optional[str]:
                 return f"{path}: expected a number, got {raw!r}"
     if schema is str and not isinstance(raw, str):
         return f"{path}: expected a string, got {raw!r}"
-    if schema is SimulatorConfig and not isinstance(raw, dict):
+    if schema in (SimulatorConfig, MultibodyPlantConfig) and not isinstance(raw, dict):
         return f"{path}: expected a mapping, got {raw!r}"
-    if schema is SimulatorConfig:  # the installed Drake's fields
-        known = dump_dataclass(SimulatorConfig()).keys()
+    if schema in (SimulatorConfig, MultibodyPlantConfig):  # the installed Drake's fields
+        known = dump_dataclass(schema()).keys()
         for key in raw:
             if key not in known:
                 hint = (f" (a field of other Drake versions, not of the installed {drake_version()}: "
@@ -254,11 +255,11 @@ def _locate(raw, schema, path: str) -> Optional[str]:
 
 
 def dump_dataclass(obj) -> dict:
-    """A plain dict of a scenario (SimulatorConfig included, with every field the installed
-    Drake has, through Drake's ``yaml_dump_typed``), for reports."""
+    """A plain dict of a scenario (Drake's SimulatorConfig and MultibodyPlantConfig included, with
+    every field the installed Drake has, through Drake's ``yaml_dump_typed``), for reports."""
     if dataclasses.is_dataclass(obj):
         return {f.name: dump_dataclass(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
-    if isinstance(obj, SimulatorConfig):
+    if isinstance(obj, (SimulatorConfig, MultibodyPlantConfig)):
         import yaml  # noqa: PLC0415
 
         return yaml.safe_load(yaml_dump_typed(obj))

@@ -1,7 +1,10 @@
 """Build a scenario's diagram (station + controller), check it against the robot, run it.
 
 The plant is continuous (``time_step = 0``) so that the scenario's
-``SimulatorConfig`` (error-controlled by default) integrates the whole loop.
+``SimulatorConfig`` (error-controlled by default) integrates the whole loop; a scenario's
+``multibody`` block makes it discrete (Drake's ``MultibodyPlantConfig``), and
+``controller.control_period`` puts the drive's zero-order hold before it (``controllers.hold``):
+the simulator then also stops at every sample.
 The simulator is stopped at exactly every segment's start, start + tf/2 and
 start + tf: ``AdvanceTo`` lands on those times, no log is interpolated.
 Logging is per integrator step (it adds no step-size cap): the station's plant
@@ -26,7 +29,8 @@ from pydrake.systems.primitives import LogVectorOutput
 from ptint_drake.controllers import AddController, ControllerHandles
 from ptint_drake.metrics import run_metrics, verdict
 from ptint_drake.reachability import check_reachable
-from ptint_drake.run_warnings import joint_limit_warnings, singularity_warnings, torque_feasibility
+from ptint_drake.run_warnings import (joint_limit_warnings, sampled_control_warnings, singularity_warnings,
+                                     torque_feasibility)
 from ptint_drake.scenario import Scenario
 from ptint_drake.station import MakeStation, Station
 from ptint_drake.systems.kinematics import FrameKinematics
@@ -84,9 +88,10 @@ class RunResult:
 
 
 def pre_run_warnings(built: Built, scenario: Scenario) -> list[str]:
-    """Checks before simulating: reachability (raises ScenarioError) and torque feasibility."""
+    """Checks before simulating: reachability (raises ScenarioError), torque feasibility and the
+    control period."""
     check_reachable(built.plant, scenario)
-    return torque_feasibility(built.plant, scenario)
+    return torque_feasibility(built.plant, scenario) + sampled_control_warnings(scenario)
 
 
 def _stops(scenario: Scenario) -> list[float]:

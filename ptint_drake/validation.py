@@ -50,6 +50,7 @@ def validate(s) -> None:
         except ValueError as exc:
             raise ScenarioError(str(exc)) from None
     _validate_plant(s.plant)
+    _validate_multibody(s.multibody, s.controller.control_period)
     for name in ("max_error", "max_joint_speed"):
         _positive(getattr(s.limits, name), f"limits.{name}")
     _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")
@@ -83,6 +84,9 @@ def _validate_controller(c) -> None:
     if c.task != "position" and c.type != "ptsmc":
         raise ScenarioError(f"controller.task: {c.task!r} is implemented by ptsmc only, not {c.type!r}")
     _positive(c.rot_scale, "controller.rot_scale")
+    if not (math.isfinite(c.control_period) and c.control_period >= 0.0):
+        raise ScenarioError(f"controller.control_period: must be > 0 s (or 0 for continuous control), "
+                            f"got {c.control_period}")
     for entry in REGISTRY.values():  # each controller's own block: messages name it from "<name>." on
         if entry.config is not None and hasattr(entry.config, "validate"):
             try:
@@ -116,6 +120,22 @@ def _validate_plant(p) -> None:
         if not all(math.isfinite(v) for v in getattr(d, name)):
             raise ScenarioError(f"plant.disturbance.{name}: must be finite")
     _positive(d.frequency_hz, "plant.disturbance.frequency_hz")
+
+
+def _validate_multibody(m, control_period: float) -> None:
+    """``multibody`` (Drake's ``MultibodyPlantConfig``): a finite step >= 0 and positive contact
+    parameters; a discrete plant (time_step > 0) needs sampled control, because a continuous
+    controller read by a discrete plant is integrated against a state that moves in jumps.
+    Drake checks the names (contact model, approximation) when the plant is built."""
+    if m is None:
+        return
+    _nonnegative(m.time_step, "multibody.time_step")
+    for name in ("penetration_allowance", "stiction_tolerance"):
+        _positive(getattr(m, name), f"multibody.{name}")
+    if m.time_step > 0.0 and not control_period > 0.0:
+        raise ScenarioError(f"controller.control_period: a discrete plant (multibody.time_step "
+                            f"{m.time_step:g} s) needs sampled control: set controller.control_period > 0 "
+                            f"(e.g. {m.time_step:g})")
 
 
 def _validate_simulator(sim) -> None:
