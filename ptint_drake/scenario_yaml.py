@@ -245,12 +245,15 @@ def _locate(raw, schema, path: str) -> Optional[str]:
     if schema in (SimulatorConfig, MultibodyPlantConfig) and not isinstance(raw, dict):
         return f"{path}: expected a mapping, got {raw!r}"
     if schema in (SimulatorConfig, MultibodyPlantConfig):  # the installed Drake's fields
-        known = dump_dataclass(schema()).keys()
+        known = dump_dataclass(schema())
         for key in raw:
             if key not in known:
                 hint = (f" (a field of other Drake versions, not of the installed {drake_version()}: "
                         f"delete it)" if key in _VERSION_SPECIFIC_SIMULATOR else "")
                 return f"{path}.{key}: unknown field{hint} (known: {', '.join(known)})"
+            found = _locate(raw[key], type(known[key]), f"{path}.{key}")  # the default's type
+            if found:
+                return found
     return None
 
 

@@ -198,6 +198,8 @@ def _sim_info(scenario: Scenario, integrator, t_end: float, total: float, wall: 
         "switching": scenario.controller.switching,
         "implementation": scenario.controller.implementation,
         "controller": scenario.controller.type,
+        "control_period": scenario.controller.control_period,  # s; 0: continuous control
+        "plant_time_step": scenario.multibody.time_step if scenario.multibody is not None else 0.0,
         "simulated_s": t_end,
         "wall_time_s": total,
         "simulation_wall_time_s": wall,
