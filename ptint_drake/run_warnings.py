@@ -1,6 +1,7 @@
 """Warnings about a run: before it, whether the actuators can follow the prescribed time
-(``torque_feasibility``) and whether sampled control is too slow (``sampled_control_warnings``); after it, where the arm came near a singularity or went beyond
-its model's joint limits.  They may use the model: the controller never sees them.
+(``torque_feasibility``) and whether sampled control is too slow (``sampled_control_warnings``);
+after it, where the arm came near a singularity or went beyond its model's joint limits.  They
+may use the model: the controller never sees them.
 """
 
 from __future__ import annotations
