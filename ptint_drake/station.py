@@ -1,8 +1,8 @@
 """The simulated world of a scenario as one Drake diagram with exported ports.
 
 In the spirit of a hardware station: ``MakeStation`` builds everything the
-controller does *not* decide — the continuous plant with the scenario's
-deviations (``plant``: masses, damping, payload, friction, disturbance), the
+controller does *not* decide — the plant (continuous, or discrete with the scenario's
+``multibody`` settings) with the scenario's deviations (``plant``: masses, damping, payload, friction, disturbance), the
 torque saturation at the model's effort limits, and the true moving objects —
 and exports the ports a controller (or a user's own diagram) connects to.
 

@@ -61,7 +61,7 @@ class ControllerSlot:
     frame: Frame  # the end effector: its origin is the interception point
     schedule: Schedule
     state: OutputPort  # the arm's [q; v]
-    actuation: InputPort  # one torque per actuator, in the plant's actuator order
+    actuation: InputPort  # one torque per actuator, in actuator order (the hold's input when sampled)
     initial_q: np.ndarray  # the start posture (rad / m)
     scenario: "Scenario"
 
