@@ -1,10 +1,11 @@
 """The simulated world of a scenario as one Drake diagram with exported ports.
 
 In the spirit of a hardware station: ``MakeStation`` builds everything the
-controller does *not* decide — the plant (continuous, or discrete with the scenario's
-``multibody`` settings) with the scenario's deviations (``plant``: masses, damping, payload, friction, disturbance), the
-torque saturation at the model's effort limits, and the true moving objects —
-and exports the ports a controller (or a user's own diagram) connects to.
+controller does *not* decide — the plant (continuous, or discrete with the
+scenario's ``multibody`` settings) with the scenario's deviations (``plant``:
+masses, damping, payload, friction, disturbance), the torque saturation at the
+model's effort limits, and the true moving objects — and exports the ports a
+controller (or a user's own diagram) connects to.
 
 The station owns its world: the plant variants are in the plant's defaults
 (``robot.make_plant``) and its default pose is ``robot.initial_q_deg`` at rest, so
