@@ -5,9 +5,9 @@ World frame: the arm's base frame (z up).  A *belt* is a conveyor whose top surf
 riding a prismatic joint (``scene``); a *part* is a free box or cylinder resting on a belt; the
 *tray* is a welded plate whose *slots* are place poses.  ``PickWorldConfig`` gathers them with
 the plant's settings (Drake's ``MultibodyPlantConfig`` fields that matter here).
+(No ``from __future__ import annotations`` here: ``yaml_load_typed`` reads the field types.)
 """
 
-from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import List
@@ -29,7 +29,6 @@ class GripperConfig:
     speed: float = 0.05  # m/s, per finger: how fast each jaw closes or opens
     kp: float = 20000.0  # N/m, stiffness of each finger's position servo
     kd: float = 40.0  # N·s/m, damping of each finger's position servo
-    pad_friction: float = 1.0  # 1, Coulomb friction coefficient of the finger pads (static = dynamic)
     initial_opening: float = 0.06  # m, distance between the pads at t = 0 (0 … the stroke)
 
 
@@ -94,7 +93,7 @@ class PickWorldConfig:
     time_step: float = 0.001  # s, of the discrete plant
     # Drake's discrete contact approximation: "sap", "lagged" or "similar" (those of both
     # Drake 1.51 and 1.58; scripts/contact_bench.py measures them; "tamsi" only on Drake < 1.55)
-    contact_approximation: str = "lagged"
+    contact_approximation: str = "sap"
     contact_model: str = "point"  # Drake's contact model: "point", "hydroelastic", "hydroelastic_with_fallback"
     gripper: GripperConfig = field(default_factory=GripperConfig)
     belts: List[BeltConfig] = field(default_factory=list)

@@ -15,8 +15,11 @@ tray, added to a not yet finalized MultibodyPlant (``world.MakePickStation`` cal
   a thin marker visual (the place pose of a part's centre is ``slot_k`` raised by half its height).
 
 Contact: every collision geometry carries point-contact properties (friction, stiffness,
-Hunt–Crossley dissipation) and compliant-hydroelastic ones, so both Drake contact models work.
-The friction of a pair is Drake's combination 2 μ₁μ₂ / (μ₁ + μ₂).
+Hunt–Crossley dissipation) and hydroelastic ones — the parts compliant (modulus HYDRO_MODULUS),
+pads, belts and tray rigid, so every hydroelastic pair is rigid–compliant — and both Drake
+contact models work.  With point contact (``contact_model: point``) parts and pads also get small
+corner spheres (``AddPointContactNubs``).  The friction of a pair is Drake's combination
+2 μ₁μ₂ / (μ₁ + μ₂).
 """
 
 from __future__ import annotations
@@ -24,8 +27,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial, Box, Cylinder,
-                              ProximityProperties)
+from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial, AddRigidHydroelasticProperties,
+                              Box, Cylinder, ProximityProperties, Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
@@ -40,17 +43,41 @@ BELT_KD = 1e5  # N·s/m: the belt's velocity servo (implicit, so any stiffness i
 BELT_FORCE = 1e4  # N: the belt drive's force limit
 POINT_STIFFNESS = 1e5  # N/m: point-contact stiffness of parts, belts and tray
 DISSIPATION = 5.0  # s/m: Hunt–Crossley dissipation
-HYDRO_MODULUS = 1e7  # Pa: hydroelastic modulus of parts, belts and tray
+HYDRO_MODULUS = 1e7  # Pa: hydroelastic modulus of the parts (compliant; pads, belts, tray are rigid)
+NUB_RADIUS = 0.001  # m: the point-contact spheres at part and pad corners (``AddPointContactNubs``)
 FINGER_JOINTS = ("left_finger_joint", "right_finger_joint")
+PAD_EDGE = 0.01 - NUB_RADIUS  # m: the pad nubs' offset from the pad centre (models/rvm1_gripper.sdf: 20 mm pads)
+PAD_FRICTION = 1.0  # 1: the pads' friction (models/rvm1_gripper.sdf)
 
 
-def contact_properties(friction: float, resolution: float) -> ProximityProperties:
-    """Point-contact and compliant-hydroelastic properties with Coulomb friction μ (static = dynamic)."""
+def contact_properties(friction: float, resolution: float = 0.0) -> ProximityProperties:
+    """Point-contact properties with Coulomb friction μ (static = dynamic), and hydroelastic ones:
+    compliant with a mesh of ``resolution`` (m), or rigid when it is 0."""
     props = ProximityProperties()
     AddContactMaterial(dissipation=DISSIPATION, point_stiffness=POINT_STIFFNESS,
                        friction=CoulombFriction(friction, friction), properties=props)
-    AddCompliantHydroelasticProperties(resolution, HYDRO_MODULUS, props)
+    if resolution > 0.0:
+        AddCompliantHydroelasticProperties(resolution, HYDRO_MODULUS, props)
+    else:
+        AddRigidHydroelasticProperties(props)
     return props
+
+
+def box_corners(size, inset: float) -> list:
+    """The 8 corners of a centred box of ``size``, each moved ``inset`` inward along every axis."""
+    half = np.asarray(size, dtype=float) / 2 - inset
+    return [half * np.array([sx, sy, sz]) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+
+
+def AddPointContactNubs(plant: MultibodyPlant, body, points, friction: float, name: str) -> None:
+    """Spheres of radius NUB_RADIUS at ``points`` (body frame) for point contact: a box-on-box
+    point contact is one deepest point that wanders between corners (the part rocks and a grasp
+    swivels about the line between the pads); a few spheres at the corners give a contact polygon."""
+    props = ProximityProperties()
+    AddContactMaterial(dissipation=DISSIPATION, point_stiffness=POINT_STIFFNESS,
+                       friction=CoulombFriction(friction, friction), properties=props)
+    for i, p in enumerate(points):
+        plant.RegisterCollisionGeometry(body, RigidTransform(p), Sphere(NUB_RADIUS), f"{name}_nub{i}", props)
 
 
 def gripper_path(model: str) -> Path:
@@ -63,11 +90,17 @@ def gripper_path(model: str) -> Path:
     return Path(model)
 
 
-def AddGripper(plant: MultibodyPlant, end_effector, config: GripperConfig) -> ModelInstanceIndex:
+def AddGripper(plant: MultibodyPlant, end_effector, config: GripperConfig,
+               nubs: bool = False) -> ModelInstanceIndex:
     """Parses the gripper into ``plant`` and welds its ``fingertip_center`` onto the frame
     ``end_effector``; sets the finger actuators' PD gains and force limit and the default
-    opening.  Returns its model instance."""
+    opening; with ``nubs``, spheres at the 4 corners of each pad's inner face (point contact).
+    Returns its model instance."""
     (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(config.model)))
+    if nubs:
+        for name, side in (("left_finger", -1.0), ("right_finger", 1.0)):
+            corners = [np.array([side * NUB_RADIUS, y, z]) for y in (-PAD_EDGE, PAD_EDGE) for z in (-PAD_EDGE, PAD_EDGE)]
+            AddPointContactNubs(plant, plant.GetBodyByName(name, gripper), corners, PAD_FRICTION, name)
     plant.WeldFrames(end_effector, plant.GetFrameByName("fingertip_center", gripper), RigidTransform())
     stroke = 0.0
     for name in FINGER_JOINTS:
@@ -103,8 +136,7 @@ def AddBelt(plant: MultibodyPlant, belt: BeltConfig) -> PrismaticJoint:
     size = [belt.length, belt.width, belt.thickness]
     body = plant.AddRigidBody(belt.name, instance, SpatialInertia.SolidBoxWithMass(belt.mass, *size))
     X_BG = RigidTransform([0.0, 0.0, -belt.thickness / 2])
-    plant.RegisterCollisionGeometry(body, X_BG, Box(*size), "belt",
-                                    contact_properties(belt.friction, belt.width / 2))
+    plant.RegisterCollisionGeometry(body, X_BG, Box(*size), "belt", contact_properties(belt.friction))
     plant.RegisterVisualGeometry(body, X_BG, Box(*size), "belt", [0.15, 0.15, 0.17, 1.0])
     rail = plant.AddFrame(_fixed_frame(plant, f"{belt.name}_rail", belt_frame(belt)))
     joint = plant.AddJoint(PrismaticJoint(f"{belt.name}_drive", rail, body.body_frame(), [1.0, 0.0, 0.0]))
@@ -135,16 +167,26 @@ def part_start_pose(part: PartConfig, belt: BeltConfig) -> RigidTransform:
     return RigidTransform(RotationMatrix.MakeZRotation(np.radians(part.yaw_deg)), p)
 
 
-def AddPart(plant: MultibodyPlant, part: PartConfig, belt: BeltConfig):
-    """The part as a free body resting on ``belt`` (its default pose); returns the body."""
+def AddPart(plant: MultibodyPlant, part: PartConfig, belt: BeltConfig, nubs: bool = False):
+    """The part as a free body resting on ``belt`` (its default pose), with corner spheres for
+    point contact if ``nubs`` (a box's 8 corners, a cylinder's 8 rim points); returns the body."""
     instance = plant.AddModelInstance(part.name)
     body = plant.AddRigidBody(part.name, instance, part_inertia(part))
     shape, height = part_shape(part)
     props = contact_properties(part.friction, min(part.size) / 2)
     plant.RegisterCollisionGeometry(body, RigidTransform(), shape, part.name, props)
     plant.RegisterVisualGeometry(body, RigidTransform(), shape, part.name, [0.2, 0.5, 0.85, 1.0])
+    if nubs:
+        AddPointContactNubs(plant, body, _part_nub_points(part), part.friction, part.name)
     plant.SetDefaultFloatingBaseBodyPose(body, part_start_pose(part, belt))
     return body
+
+
+def _part_nub_points(part: PartConfig) -> list:
+    if part.shape == "box":
+        return box_corners(part.size, NUB_RADIUS)
+    r, h = part.size[0] / 2 - NUB_RADIUS, part.size[1] / 2 - NUB_RADIUS
+    return [np.array([r * np.cos(a), r * np.sin(a), z]) for a in np.arange(4) * np.pi / 2 for z in (-h, h)]
 
 
 def tray_pose(tray: TrayConfig) -> RigidTransform:
@@ -157,8 +199,7 @@ def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
     instance = plant.AddModelInstance("tray")
     body = plant.AddRigidBody("tray", instance, SpatialInertia.SolidBoxWithMass(1.0, *tray.size))
     X_TG = RigidTransform([0.0, 0.0, -tray.size[2] / 2])
-    plant.RegisterCollisionGeometry(body, X_TG, Box(*tray.size), "tray",
-                                    contact_properties(tray.friction, min(tray.size[:2]) / 4))
+    plant.RegisterCollisionGeometry(body, X_TG, Box(*tray.size), "tray", contact_properties(tray.friction))
     plant.RegisterVisualGeometry(body, X_TG, Box(*tray.size), "tray", [0.6, 0.45, 0.25, 1.0])
     plant.WeldFrames(plant.world_frame(), body.body_frame(), tray_pose(tray))
     slots = []

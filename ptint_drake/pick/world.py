@@ -104,7 +104,8 @@ def _parse_arm(plant: MultibodyPlant, config: PickWorldConfig) -> ModelInstanceI
 def _add_world(plant: MultibodyPlant, scene_graph: SceneGraph, config: PickWorldConfig):
     """Arm, gripper, belts, parts and tray in ``plant`` (not finalized); the handles."""
     arm = _parse_arm(plant, config)
-    gripper = AddGripper(plant, plant.GetFrameByName(config.end_effector, arm), config.gripper)
+    nubs = config.contact_model == "point"
+    gripper = AddGripper(plant, plant.GetFrameByName(config.end_effector, arm), config.gripper, nubs)
     stroke = gripper_stroke(plant, gripper)
     belts = [AddBelt(plant, b) for b in config.belts]
     by_name = {b.name: b for b in config.belts}
@@ -113,7 +114,7 @@ def _add_world(plant: MultibodyPlant, scene_graph: SceneGraph, config: PickWorld
         if grasp_width(part) >= stroke:
             raise ScenarioError(f"pick.parts[{k}].size: {grasp_width(part)} m across the fingers does not "
                                 f"fit the gripper's {stroke} m stroke")
-        parts.append(AddPart(plant, part, by_name[part.belt]))
+        parts.append(AddPart(plant, part, by_name[part.belt], nubs))
     slots = AddTray(plant, config.tray)
     fixed = GeometrySet([g for j in belts for g in plant.GetCollisionGeometriesForBody(j.child_body())]
                         + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("tray"))))
