@@ -18,7 +18,8 @@ from importlib.metadata import version
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
-from ptint_drake.pick.config import BeltConfig, GripperConfig, PartConfig, PickWorldConfig, contact_approximations
+from ptint_drake.pick.config import (BeltConfig, GripperConfig, PartConfig, PickWorldConfig,
+                                     contact_approximations)
 from ptint_drake.pick.holding import measure_hold
 
 CANDIDATES = ("sap", "tamsi", "lagged", "similar")

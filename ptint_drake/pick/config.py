@@ -40,7 +40,8 @@ class BeltConfig:
 
     name: str = "belt"  # model-instance name of the belt
     center: List[float] = field(default_factory=lambda: [0.3, 0.0, 0.1])  # m, top-surface centre at t = 0
-    direction: List[float] = field(default_factory=lambda: [0.0, 1.0, 0.0])  # 1, horizontal unit vector of travel
+    # 1, horizontal unit vector of travel
+    direction: List[float] = field(default_factory=lambda: [0.0, 1.0, 0.0])
     speed: float = 0.1  # m/s, along ``direction``
     length: float = 1.2  # m, along ``direction``
     width: float = 0.08  # m, across the belt
@@ -57,7 +58,8 @@ class PartConfig:
     name: str = "part"  # body and model-instance name
     belt: str = "belt"  # the belt it rests on at t = 0 (a BeltConfig.name)
     shape: str = "box"  # "box" or "cylinder" (axis vertical)
-    size: List[float] = field(default_factory=lambda: [0.03, 0.03, 0.03])  # m, box [x, y, z] or cylinder [diameter, height]
+    # m, box [x, y, z] (x: across the fingers when grasped) or cylinder [diameter, height]
+    size: List[float] = field(default_factory=lambda: [0.03, 0.03, 0.03])
     offset: float = 0.0  # m, along the belt from its centre at t = 0 (negative: upstream)
     yaw_deg: float = 0.0  # deg, rotation about the vertical at t = 0
     mass: float = 0.1  # kg
@@ -68,7 +70,7 @@ class PartConfig:
 class SlotConfig:
     """A place pose on the tray: where a part's centre should come to rest."""
 
-    offset: List[float] = field(default_factory=lambda: [0.0, 0.0])  # m, [x, y] from the tray's centre, tray frame
+    offset: List[float] = field(default_factory=lambda: [0.0, 0.0])  # m, [x, y] from the tray centre
     yaw_deg: float = 0.0  # deg, the part's wanted yaw relative to the tray
 
 
@@ -94,7 +96,8 @@ class PickWorldConfig:
     # Drake's discrete contact approximation: "sap", "lagged" or "similar" (those of both
     # Drake 1.51 and 1.58; scripts/contact_bench.py measures them; "tamsi" only on Drake < 1.55)
     contact_approximation: str = "sap"
-    contact_model: str = "point"  # Drake's contact model: "point", "hydroelastic", "hydroelastic_with_fallback"
+    # Drake's contact model: "point", "hydroelastic" or "hydroelastic_with_fallback"
+    contact_model: str = "point"
     gripper: GripperConfig = field(default_factory=GripperConfig)
     belts: List[BeltConfig] = field(default_factory=list)
     parts: List[PartConfig] = field(default_factory=list)
@@ -122,7 +125,8 @@ def _check_part(k: int, part: PartConfig, belts: dict) -> None:
     if part.shape not in SHAPE_SIZES:
         raise ScenarioError(f"{where}.shape: {part.shape!r} is not one of box, cylinder")
     if len(part.size) != SHAPE_SIZES[part.shape] or min(part.size) <= 0.0:
-        raise ScenarioError(f"{where}.size: a {part.shape} needs {SHAPE_SIZES[part.shape]} positive sizes (m)")
+        raise ScenarioError(f"{where}.size: a {part.shape} needs {SHAPE_SIZES[part.shape]} positive sizes "
+                            f"(m)")
     if not part.mass > 0.0 or not part.friction > 0.0:
         raise ScenarioError(f"{where}.{'mass' if not part.mass > 0.0 else 'friction'}: must be positive")
     if part.belt not in belts:
@@ -151,7 +155,8 @@ def check_pick_world(config: PickWorldConfig) -> None:
         raise ScenarioError(f"pick.contact_approximation: {config.contact_approximation!r} is not one of "
                             f"{', '.join(contact_approximations())}")
     if config.contact_model not in CONTACT_MODELS:
-        raise ScenarioError(f"pick.contact_model: {config.contact_model!r} is not one of {', '.join(CONTACT_MODELS)}")
+        raise ScenarioError(f"pick.contact_model: {config.contact_model!r} is not one of "
+                            f"{', '.join(CONTACT_MODELS)}")
     g = config.gripper
     if min(g.max_force, g.speed, g.kp) <= 0.0 or g.kd < 0.0:
         raise ScenarioError("pick.gripper: max_force, speed and kp must be positive, kd non-negative")

@@ -27,13 +27,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial, AddRigidHydroelasticProperties,
-                              Box, Cylinder, ProximityProperties, Sphere)
+from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial,
+                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties, Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
-from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelInstanceIndex, PdControllerGains, PrismaticJoint,
-                                    SpatialInertia)
+from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelInstanceIndex,
+                                    PdControllerGains, PrismaticJoint, SpatialInertia)
 
 from ptint_drake.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
 from ptint_drake.rvm1 import model_path
@@ -46,7 +46,7 @@ DISSIPATION = 5.0  # s/m: Hunt–Crossley dissipation
 HYDRO_MODULUS = 1e7  # Pa: hydroelastic modulus of the parts (compliant; pads, belts, tray are rigid)
 NUB_RADIUS = 0.001  # m: the point-contact spheres at part and pad corners (``AddPointContactNubs``)
 FINGER_JOINTS = ("left_finger_joint", "right_finger_joint")
-PAD_EDGE = 0.01 - NUB_RADIUS  # m: the pad nubs' offset from the pad centre (models/rvm1_gripper.sdf: 20 mm pads)
+PAD_EDGE = 0.01 - NUB_RADIUS  # m: pad nubs from the pad centre (models/rvm1_gripper.sdf: 20 mm pads)
 PAD_FRICTION = 1.0  # 1: the pads' friction (models/rvm1_gripper.sdf)
 
 
@@ -99,7 +99,8 @@ def AddGripper(plant: MultibodyPlant, end_effector, config: GripperConfig,
     (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(config.model)))
     if nubs:
         for name, side in (("left_finger", -1.0), ("right_finger", 1.0)):
-            corners = [np.array([side * NUB_RADIUS, y, z]) for y in (-PAD_EDGE, PAD_EDGE) for z in (-PAD_EDGE, PAD_EDGE)]
+            edges = (-PAD_EDGE, PAD_EDGE)
+            corners = [np.array([side * NUB_RADIUS, y, z]) for y in edges for z in edges]
             AddPointContactNubs(plant, plant.GetBodyByName(name, gripper), corners, PAD_FRICTION, name)
     plant.WeldFrames(end_effector, plant.GetFrameByName("fingertip_center", gripper), RigidTransform())
     stroke = 0.0

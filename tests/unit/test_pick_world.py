@@ -66,7 +66,8 @@ def test_part_pose_output_is_the_plant_body_pose(station):
     for k, body in enumerate(station.parts):
         X = plant.EvalBodyPoseInWorld(pc, body)
         V = plant.EvalBodySpatialVelocityInWorld(pc, body)
-        pose, rotation = d.GetOutputPort(f"part_{k}_pose").Eval(context), d.GetOutputPort(f"part_{k}_rotation").Eval(context)
+        pose = d.GetOutputPort(f"part_{k}_pose").Eval(context)
+        rotation = d.GetOutputPort(f"part_{k}_rotation").Eval(context)
         np.testing.assert_allclose(pose[:3], X.translation(), atol=1e-12)
         np.testing.assert_allclose(pose[3:6], V.translational(), atol=1e-12)
         np.testing.assert_allclose(rotation[:9], X.rotation().matrix().ravel(), atol=1e-12)
