@@ -1,0 +1,217 @@
+"""What a pick-and-place plant holds besides the arm: the gripper, the belts, the parts and the
+tray, added to a not yet finalized MultibodyPlant (``world.MakePickStation`` calls these).
+
+- **Gripper** (``AddGripper``): parsed from its SDFormat file into its own model instance and
+  welded so its frame ``fingertip_center`` coincides with the arm's end-effector frame; its two
+  finger joints become Drake PD-controlled actuators (gains ``kp``, ``kd``; effort limit =
+  ``max_force``), solved implicitly by the discrete (SAP-family) contact solver.
+- **Belt** (``AddBelt``): a slab in its own model instance on a prismatic joint along the belt's
+  direction, whose actuator is a PD-controlled *velocity servo* (kp = 0, kd = BELT_KD, desired
+  velocity = the belt speed): it keeps the speed under the parts' friction loads to within
+  load / BELT_KD (≈ 1e-5 m/s per newton).  Parts ride it by friction.
+- **Part** (``AddPart``): a free box or cylinder (size, mass, friction) in its own model instance,
+  whose default pose rests it on its belt.
+- **Tray** (``AddTray``): a welded plate; each slot is a frame ``slot_k`` on its top surface with
+  a thin marker visual (the place pose of a part's centre is ``slot_k`` raised by half its height).
+
+Contact: every collision geometry carries point-contact properties (friction, stiffness,
+Hunt–Crossley dissipation) and hydroelastic ones — the parts compliant (modulus HYDRO_MODULUS),
+pads, belts and tray rigid, so every hydroelastic pair is rigid–compliant — and both Drake
+contact models work.  With point contact (``contact_model: point``) parts and pads also get small
+corner spheres (``AddPointContactNubs``).  The friction of a pair is Drake's combination
+2 μ₁μ₂ / (μ₁ + μ₂).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial,
+                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties, Sphere)
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
+from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelInstanceIndex,
+                                    PdControllerGains, PrismaticJoint, SpatialInertia)
+
+from ptint_drake.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
+from ptint_drake.rvm1 import model_path
+from ptint_drake.validation import ScenarioError
+
+BELT_KD = 1e5  # N·s/m: the belt's velocity servo (implicit, so any stiffness is stable)
+BELT_FORCE = 1e4  # N: the belt drive's force limit
+POINT_STIFFNESS = 1e5  # N/m: point-contact stiffness of parts, belts and tray
+DISSIPATION = 5.0  # s/m: Hunt–Crossley dissipation
+HYDRO_MODULUS = 1e7  # Pa: hydroelastic modulus of the parts (compliant; pads, belts, tray are rigid)
+NUB_RADIUS = 0.001  # m: the point-contact spheres at part and pad corners (``AddPointContactNubs``)
+FINGER_JOINTS = ("left_finger_joint", "right_finger_joint")
+PAD_EDGE = 0.01 - NUB_RADIUS  # m: pad nubs from the pad centre (models/rvm1_gripper.sdf: 20 mm pads)
+PAD_FRICTION = 1.0  # 1: the pads' friction (models/rvm1_gripper.sdf)
+
+
+def contact_properties(friction: float, resolution: float = 0.0) -> ProximityProperties:
+    """Point-contact properties with Coulomb friction μ (static = dynamic), and hydroelastic ones:
+    compliant with a mesh of ``resolution`` (m), or rigid when it is 0."""
+    props = ProximityProperties()
+    AddContactMaterial(dissipation=DISSIPATION, point_stiffness=POINT_STIFFNESS,
+                       friction=CoulombFriction(friction, friction), properties=props)
+    if resolution > 0.0:
+        AddCompliantHydroelasticProperties(resolution, HYDRO_MODULUS, props)
+    else:
+        AddRigidHydroelasticProperties(props)
+    return props
+
+
+def box_corners(size, inset: float) -> list:
+    """The 8 corners of a centred box of ``size``, each moved ``inset`` inward along every axis."""
+    half = np.asarray(size, dtype=float) / 2 - inset
+    return [half * np.array([sx, sy, sz]) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+
+
+def AddPointContactNubs(plant: MultibodyPlant, body, points, friction: float, name: str) -> None:
+    """Spheres of radius NUB_RADIUS at ``points`` (body frame) for point contact: a box-on-box
+    point contact is one deepest point that wanders between corners (the part rocks and a grasp
+    swivels about the line between the pads); a few spheres at the corners give a contact polygon."""
+    props = ProximityProperties()
+    AddContactMaterial(dissipation=DISSIPATION, point_stiffness=POINT_STIFFNESS,
+                       friction=CoulombFriction(friction, friction), properties=props)
+    for i, p in enumerate(points):
+        plant.RegisterCollisionGeometry(body, RigidTransform(p), Sphere(NUB_RADIUS), f"{name}_nub{i}", props)
+
+
+def gripper_path(model: str) -> Path:
+    """A bundled gripper name (models/<name>.sdf) or an SDFormat file path; ScenarioError if neither."""
+    bundled = model_path(model).with_suffix(".sdf")
+    if bundled.is_file():
+        return bundled
+    if not Path(model).is_file():
+        raise ScenarioError(f"gripper.model: {model!r} is neither a bundled gripper nor an existing file")
+    return Path(model)
+
+
+def AddGripper(plant: MultibodyPlant, end_effector, config: GripperConfig,
+               nubs: bool = False) -> ModelInstanceIndex:
+    """Parses the gripper into ``plant`` and welds its ``fingertip_center`` onto the frame
+    ``end_effector``; sets the finger actuators' PD gains and force limit and the default
+    opening; with ``nubs``, spheres at the 4 corners of each pad's inner face (point contact).
+    Returns its model instance."""
+    (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(config.model)))
+    if nubs:
+        for name, side in (("left_finger", -1.0), ("right_finger", 1.0)):
+            edges = (-PAD_EDGE, PAD_EDGE)
+            corners = [np.array([side * NUB_RADIUS, y, z]) for y in edges for z in edges]
+            AddPointContactNubs(plant, plant.GetBodyByName(name, gripper), corners, PAD_FRICTION, name)
+    plant.WeldFrames(end_effector, plant.GetFrameByName("fingertip_center", gripper), RigidTransform())
+    stroke = 0.0
+    for name in FINGER_JOINTS:
+        joint = plant.GetJointByName(name, gripper)
+        stroke += joint.position_upper_limits()[0]
+        joint.set_default_translation(config.initial_opening / 2)
+    for index in map(JointActuatorIndex, range(plant.num_actuators())):  # (per-instance lists need Finalize)
+        actuator = plant.get_mutable_joint_actuator(index)
+        if actuator.model_instance() != gripper:
+            continue
+        actuator.set_controller_gains(PdControllerGains(p=config.kp, d=config.kd))
+        actuator.set_effort_limit(config.max_force)
+    if not 0.0 <= config.initial_opening <= stroke + 1e-12:
+        raise ScenarioError(f"gripper.initial_opening: {config.initial_opening} m is outside the "
+                            f"gripper's stroke 0 … {stroke} m")
+    return gripper
+
+
+def gripper_stroke(plant: MultibodyPlant, gripper: ModelInstanceIndex) -> float:
+    """The largest opening between the pads (m): the sum of the finger joints' upper limits."""
+    return float(sum(plant.GetJointByName(n, gripper).position_upper_limits()[0] for n in FINGER_JOINTS))
+
+
+def belt_frame(belt: BeltConfig) -> RigidTransform:
+    """Pose of the belt's top-surface centre at t = 0; its x axis = the direction of travel."""
+    d = np.asarray(belt.direction, dtype=float)
+    return RigidTransform(RotationMatrix.MakeZRotation(float(np.arctan2(d[1], d[0]))), belt.center)
+
+
+def AddBelt(plant: MultibodyPlant, belt: BeltConfig) -> PrismaticJoint:
+    """The belt's slab on its prismatic joint with a speed servo; returns the joint."""
+    instance = plant.AddModelInstance(belt.name)
+    size = [belt.length, belt.width, belt.thickness]
+    body = plant.AddRigidBody(belt.name, instance, SpatialInertia.SolidBoxWithMass(belt.mass, *size))
+    X_BG = RigidTransform([0.0, 0.0, -belt.thickness / 2])
+    plant.RegisterCollisionGeometry(body, X_BG, Box(*size), "belt", contact_properties(belt.friction))
+    plant.RegisterVisualGeometry(body, X_BG, Box(*size), "belt", [0.15, 0.15, 0.17, 1.0])
+    rail = plant.AddFrame(_fixed_frame(plant, f"{belt.name}_rail", belt_frame(belt)))
+    joint = plant.AddJoint(PrismaticJoint(f"{belt.name}_drive", rail, body.body_frame(), [1.0, 0.0, 0.0]))
+    actuator = plant.AddJointActuator(f"{belt.name}_motor", joint, BELT_FORCE)
+    actuator.set_controller_gains(PdControllerGains(p=0.0, d=BELT_KD))
+    return joint
+
+
+def part_shape(part: PartConfig):
+    """The part's Drake shape and its height (m)."""
+    if part.shape == "box":
+        return Box(*part.size), part.size[2]
+    return Cylinder(part.size[0] / 2, part.size[1]), part.size[1]
+
+
+def part_inertia(part: PartConfig) -> SpatialInertia:
+    """A solid box or vertical cylinder of the part's mass, about its centre."""
+    if part.shape == "box":
+        return SpatialInertia.SolidBoxWithMass(part.mass, *part.size)
+    return SpatialInertia.SolidCylinderWithMass(part.mass, part.size[0] / 2, part.size[1], [0.0, 0.0, 1.0])
+
+
+def part_start_pose(part: PartConfig, belt: BeltConfig) -> RigidTransform:
+    """The part's centre at t = 0: ``offset`` along its belt, resting on it, turned ``yaw_deg``."""
+    _, height = part_shape(part)
+    X_WB = belt_frame(belt)
+    p = X_WB.multiply(np.array([part.offset, 0.0, height / 2]))
+    return RigidTransform(RotationMatrix.MakeZRotation(np.radians(part.yaw_deg)), p)
+
+
+def AddPart(plant: MultibodyPlant, part: PartConfig, belt: BeltConfig, nubs: bool = False):
+    """The part as a free body resting on ``belt`` (its default pose), with corner spheres for
+    point contact if ``nubs`` (a box's 8 corners, a cylinder's 8 rim points); returns the body."""
+    instance = plant.AddModelInstance(part.name)
+    body = plant.AddRigidBody(part.name, instance, part_inertia(part))
+    shape, height = part_shape(part)
+    props = contact_properties(part.friction, min(part.size) / 2)
+    plant.RegisterCollisionGeometry(body, RigidTransform(), shape, part.name, props)
+    plant.RegisterVisualGeometry(body, RigidTransform(), shape, part.name, [0.2, 0.5, 0.85, 1.0])
+    if nubs:
+        AddPointContactNubs(plant, body, _part_nub_points(part), part.friction, part.name)
+    plant.SetDefaultFloatingBaseBodyPose(body, part_start_pose(part, belt))
+    return body
+
+
+def _part_nub_points(part: PartConfig) -> list:
+    if part.shape == "box":
+        return box_corners(part.size, NUB_RADIUS)
+    r, h = part.size[0] / 2 - NUB_RADIUS, part.size[1] / 2 - NUB_RADIUS
+    return [np.array([r * np.cos(a), r * np.sin(a), z]) for a in np.arange(4) * np.pi / 2 for z in (-h, h)]
+
+
+def tray_pose(tray: TrayConfig) -> RigidTransform:
+    """The tray's top-surface centre, turned ``yaw_deg`` about the vertical."""
+    return RigidTransform(RollPitchYaw(0.0, 0.0, np.radians(tray.yaw_deg)), tray.center)
+
+
+def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
+    """The welded plate with a frame ``slot_k`` per slot; returns the slot frames."""
+    instance = plant.AddModelInstance("tray")
+    body = plant.AddRigidBody("tray", instance, SpatialInertia.SolidBoxWithMass(1.0, *tray.size))
+    X_TG = RigidTransform([0.0, 0.0, -tray.size[2] / 2])
+    plant.RegisterCollisionGeometry(body, X_TG, Box(*tray.size), "tray", contact_properties(tray.friction))
+    plant.RegisterVisualGeometry(body, X_TG, Box(*tray.size), "tray", [0.6, 0.45, 0.25, 1.0])
+    plant.WeldFrames(plant.world_frame(), body.body_frame(), tray_pose(tray))
+    slots = []
+    for k, slot in enumerate(tray.slots):
+        X_TS = RigidTransform(RotationMatrix.MakeZRotation(np.radians(slot.yaw_deg)),
+                              [slot.offset[0], slot.offset[1], 0.0])
+        slots.append(plant.AddFrame(_fixed_frame(plant, f"slot_{k}", X_TS, body.body_frame())))
+        plant.RegisterVisualGeometry(body, X_TS.multiply(RigidTransform([0.0, 0.0, 0.0005])),
+                                     Box(0.03, 0.004, 0.001), f"slot_{k}", [0.1, 0.7, 0.2, 1.0])
+    return slots
+
+
+def _fixed_frame(plant: MultibodyPlant, name: str, X, parent=None) -> FixedOffsetFrame:
+    return FixedOffsetFrame(name, parent if parent is not None else plant.world_frame(), X)
