@@ -45,7 +45,10 @@ def hand_position(plant, q):
     return plant.GetFrameByName("hand").CalcPoseInWorld(context).translation()"""
 
 REPLAY = """\
-import base64, gzip, html
+import base64
+import gzip
+import html
+
 from IPython.display import HTML
 
 

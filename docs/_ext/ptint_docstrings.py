@@ -3,16 +3,17 @@
 The docstrings are plain text with reStructuredText's inline literals (````name````): norms
 written ``|e(tf)|``, equations and port tables indented under a paragraph, Markdown tables.
 Read as reStructuredText those are substitutions and unexpected indentation; this hook
-(``autodoc-process-docstring``, before napoleon) turns every indented block, every
-Markdown table and every simple table into a literal block and escapes the remaining ``|`` and ``*``, so that the
-text shows as written and the build (warnings as errors) passes.
+(``autodoc-process-docstring``, before napoleon) turns every indented block, every Markdown
+table and every simple table into a literal block and escapes the remaining ``|`` and ``*``,
+so that the text shows as written and the build (warnings as errors) passes.
 """
 
 from __future__ import annotations
 
 import re
 
-_SECTION = re.compile(r"^\s*(Args|Arguments|Parameters|Returns|Raises|Yields|Attributes|Examples?|Notes?):\s*$")
+_SECTION = re.compile(
+    r"^\s*(Args|Arguments|Parameters|Returns|Raises|Yields|Attributes|Examples?|Notes?):\s*$")
 
 
 def _indent(line: str) -> int:
