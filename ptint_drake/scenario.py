@@ -232,6 +232,7 @@ def make_target(config: TargetConfig):
 
 
 def bundled_scenarios() -> "list[str]":
+    """Names of the scenarios shipped in ``ptint_drake/scenarios`` (``ptint list``)."""
     return sorted(p.name[:-5] for p in resources.files("ptint_drake.scenarios").iterdir()
                   if p.name.endswith(".yaml"))
 
@@ -251,6 +252,7 @@ def scenario_text(name_or_file: str) -> "tuple[str, str]":
 
 
 def load_scenario(name_or_file: str) -> Scenario:
+    """The validated ``Scenario`` of a bundled name or a YAML file (``ScenarioError`` if bad)."""
     name, text = scenario_text(name_or_file)
     return parse_scenario(text, name)
 

@@ -87,6 +87,8 @@ def _camera(scenario, ranges: dict):
 
 
 def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dict:
+    """One Monte Carlo sample: the scenario drawn from ``seed`` within ``ranges``, simulated;
+    its parameters, metrics and verdict (a failed run is a result too)."""
     scenario, params = sample_scenario(text, name, seed, ranges)
     try:
         result = simulate(scenario)

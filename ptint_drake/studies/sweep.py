@@ -74,6 +74,7 @@ def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, wor
 
 
 def write_csv(rows, path: Path) -> None:
+    """sweep.csv (``COLUMNS``) written to a temporary file and moved to ``path``."""
     tmp = Path(path).with_suffix(".csv.tmp")
     with open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS)
