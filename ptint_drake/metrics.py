@@ -48,11 +48,15 @@ class Criteria:
     e_rot_tf_deg: float = 2.0  # deg: the angle at start + tf at most this ("orientation" otherwise)
     rot_hold_deg: float = 5.0  # deg: the angle while holding at most this ("orientation" otherwise)
     min_e_rot0_deg: float = 5.0  # deg: the early check of the angle applies only from this
+    # pick and place (issue 20): a part is placed when it rests within both of its slot
+    place_mm: float = 3.0  # mm: the part's centre from its place pose at the end
+    place_deg: float = 3.0  # deg: the part's orientation from its slot's at the end
 
 
 def validate_criteria(c: Criteria) -> None:
     """ValueError naming the field of a criterion that is not a positive number."""
-    for name in ("e_tf", "hold", "half_fraction", "min_e0", "e_rot_tf_deg", "rot_hold_deg", "min_e_rot0_deg"):
+    for name in ("e_tf", "hold", "half_fraction", "min_e0", "e_rot_tf_deg", "rot_hold_deg", "min_e_rot0_deg",
+                 "place_mm", "place_deg"):
         value = getattr(c, name)
         if not (math.isfinite(value) and value > 0.0):
             raise ValueError(f"criteria.{name}: must be > 0, got {value}")
@@ -129,6 +133,11 @@ def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str
     it; one ``Reason`` carrying its message)."""
     if metrics.get("failure"):
         return "failed", [Reason(None, "failed", metrics["failure"]["message"])]
+    if "picks" in metrics:  # a pick and place: its picks decide (pick.metrics)
+        from ptint_drake.pick.metrics import pick_reasons  # noqa: PLC0415
+
+        reasons = [Reason(None, code, f"pick {k}: {code}") for k, code in pick_reasons(metrics["picks"])]
+        return ("missed" if reasons else "ok"), reasons
     reasons = [Reason(i, code) for i, seg in enumerate(metrics["segments"])
                for code in segment_reasons(seg, criteria, margin)]
     return ("missed" if reasons else "ok"), reasons

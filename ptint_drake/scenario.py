@@ -48,6 +48,7 @@ from pydrake.systems.analysis import SimulatorConfig
 
 from ptint_drake.controllers import REGISTRY, plugin
 from ptint_drake.metrics import Criteria
+from ptint_drake.pick.tasks import PickConfig, pick_plan
 from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
 from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.gains import ControllerGains
@@ -201,9 +202,15 @@ class Scenario:
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)
     criteria: Criteria = field(default_factory=Criteria)
+    # a pick and place (``pick.tasks``): the world and the tasks, whose segments replace
+    # ``interceptions`` (None: an interception scenario)
+    pick: Optional[PickConfig] = None
     name: str = ""
 
     def schedule(self) -> Schedule:
+        """The interceptor's segments: ``interceptions``, or the pick tasks' (``pick_plan``)."""
+        if self.pick is not None:
+            return pick_plan(self.pick).schedule
         return Schedule([Segment(i.start, i.tf, i.beta) for i in self.interceptions])
 
     def targets(self) -> list:
