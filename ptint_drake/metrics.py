@@ -6,7 +6,7 @@ Everything here is measured against the *true* target from the plant's state
 alone — the controller may have seen a measured or estimated target, and its
 own telemetry is not trusted for the verdict.
 
-The metrics of one segment (README "Outputs"):
+The metrics of one segment (docs/results.md, docs/cli.md):
 
 - ``e0_norm`` |e| at the segment start, ``e_half_norm`` at start + tf/2,
   ``e_tf_norm`` and ``edot_tf_norm`` at exactly start + tf (the simulator stops
@@ -15,7 +15,7 @@ The metrics of one segment (README "Outputs"):
   start (or the end), last sample included;
 - ``t_arrive``: the first time after the start at which |e| ≤ 1 mm (None if never).
 
-The verdict (paper's prescribed-time property, README "What works means"):
+The verdict (paper's prescribed-time property, docs/results.md):
 a segment is ``late`` when |e(tf)| > ``criteria.e_tf``, ``early`` when it was
 already closer than ``half_fraction`` |e0| at tf/2 (only when |e0| ≥ ``min_e0``:
 a segment that starts on its target cannot arrive early), and ``hold`` when the
@@ -219,7 +219,7 @@ def rotation_metrics(schedule, duration: float, t: np.ndarray, angle: Optional[n
 
 
 def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> dict:
-    """The metrics of a run (README "Outputs"): segments, torque and joint-speed peaks with
+    """The metrics of a run (docs/results.md): segments, torque and joint-speed peaks with
     their times, the peaks after start-up, and the fraction of time the actuators saturate.
 
     ``series`` holds ``t``, ``x`` (gripper point from the plant state), ``objects`` (true

@@ -1,4 +1,4 @@
-"""Scenario files (README "Scenario files"): the typed schema and loading.
+"""Scenario files (docs/scenarios.md): the typed schema and loading.
 
 A scenario is one YAML mapping loaded with Drake's ``yaml_load_typed`` into
 ``Scenario``; unknown keys are rejected; the checks live in ``validation``, the
@@ -83,8 +83,7 @@ def _controller_config() -> type:
         ("type", str, field(default="ptsmc")),  # a name of controllers.REGISTRY, or "module:Class"
         ("implementation", str, field(default="fused")),  # ptsmc: "fused" one LeafSystem, or "blocks"
         ("params", Dict[str, ParamValue], field(default_factory=dict)),  # a plugin's settings
-        # s: > 0 runs the controller sampled, its torque held between samples (controllers.hold)
-        ("control_period", float, field(default=0.0)),
+        ("control_period", float, field(default=0.0)),  # s: > 0 sampled, torque held between samples
         *own], bases=(ControllerGains,), namespace={"__module__": __name__})
     cls.__doc__ = _controller_config.__doc__
     return cls

@@ -157,7 +157,7 @@ def main() -> None:
         text = replace(text, f"compare_{name}", compare_table(name, args.workers))
     from ptint_drake.controllers import plugin  # noqa: PLC0415
 
-    plugin.remember_folder(ROOT / "examples")  # the README's plugin example
+    plugin.remember_folder(ROOT / "examples")  # docs/own_controller.md's plugin example
     text = replace(text, "compare_plugin", compare_table(
         "curve_b075_tf15", args.workers, ["ptsmc", "task_space_pd:TaskSpacePD"]))
     if args.all:

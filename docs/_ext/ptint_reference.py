@@ -117,13 +117,23 @@ def _type_name(tp) -> str:
 
 
 def _comments(cls) -> dict:
-    """field name → the ``# comment`` written after it in ``cls``'s source (empty if none)."""
+    """field name → the ``# comment`` written after it in ``cls``'s source (empty if none): after
+    ``name: type = default`` in a class body, or after ``("name", type, field(...)),`` in the
+    module of a class made by ``make_dataclass`` (which has no class body to read)."""
     try:
         source = inspect.getsource(cls)
+        pattern = r"^\s+(\w+): [^\n#]*?(?:#\s*(.*))?$"
     except (OSError, TypeError):
-        return {}
+        if not dataclasses.is_dataclass(cls):
+            return {}
+        try:
+            source = inspect.getsource(inspect.getmodule(cls))
+        except (OSError, TypeError):
+            return {}
+        names = "|".join(sorted(f.name for f in dataclasses.fields(cls)))
+        pattern = r'^\s+\("(' + names + r')", [^\n#]*?(?:#\s*(.*))?$'
     found = {}
-    for m in re.finditer(r"^\s+(\w+): [^\n#]*?(?:#\s*(.*))?$", source, re.M):
+    for m in re.finditer(pattern, source, re.M):
         if m.group(2):
             found.setdefault(m.group(1), m.group(2).strip())
     return found

@@ -166,7 +166,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
 
 def histogram(result: dict, out_dir: Path) -> None:
     """|e(tf)| (log axis) and peak torque over the samples: integer counts, the 1 mm line
-    (README, Results), and how many samples intercepted, missed or failed."""
+    (docs/results.md), and how many samples intercepted, missed or failed."""
     from matplotlib.ticker import MaxNLocator  # noqa: PLC0415
 
     rows = [r for r in result["rows"] if r.get("e_tf_max") is not None]

@@ -126,7 +126,7 @@ def _metric_map(fig, ax, grid: np.ndarray, label: str, betas, tfs, fontsize: int
 
 def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
     """One heat map per metric over (tf, β), plus a map of which points intercepted (the
-    run's verdict, README: Results); returns the stems written.  The torque map shows the
+    run's verdict, docs/results.md); returns the stems written.  The torque map shows the
     peak after start-up (the first 5 % of tf, where the first step dominates, left out)."""
     from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: PLC0415
 
