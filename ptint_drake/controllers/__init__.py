@@ -25,7 +25,8 @@ from ptint_drake.controllers.slot import (ControllerHandles, ControllerSlot, Tar
                                           target_view, uses_analytic_targets)
 
 __all__ = ["REGISTRY", "CONTROLLERS", "ControllerType", "ControllerHandles", "ControllerSlot",
-           "TargetView", "AddController", "AddControllerTo", "check_controller", "controller_targets", "target_view",
+           "TargetView", "AddController", "AddControllerTo", "check_controller", "controller_targets",
+           "target_view",
            "uses_analytic_targets", "describe", "known_type"]
 
 

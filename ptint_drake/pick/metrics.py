@@ -116,7 +116,8 @@ def _one_pick(built, k: int, t: np.ndarray, probe: np.ndarray, grip: np.ndarray,
     rel = np.array([_quat_matrix(tool_q[j]).T @ (block[j, 0:3] - tool_p[j]) for j in np.flatnonzero(carried)])
     slip = float(np.max(np.linalg.norm(rel - rel[0], axis=1))) if len(rel) else None
     squeeze = -np.mean(grip[carried], axis=1) if np.any(carried) else np.zeros(1)
-    place = built.targets.places[next(i for i, p in enumerate(plan.segments) if p.task == k and p.phase == "place")]
+    i_place = next(i for i, p in enumerate(plan.segments) if p.task == k and p.phase == "place")
+    place = built.targets.places[i_place]
     place_yaw = segs[4][1].yaw
     R_end = _quat_matrix(block[-1, 3:7])
     return {"part": part.name, "slot": segs[4][1].index, "grasped": grasped,

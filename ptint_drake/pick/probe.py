@@ -3,7 +3,8 @@
 For every part k, 10 values: its centre (3, m), its orientation as a quaternion (4, w x y z), and
 three contact flags (1 or 0): its contact with the left pad, with the right pad, and with any other
 body of the arm or the gripper.  Then a flag: any contact of the arm or the gripper with a belt;
-and last the tool frame's pose (7: its origin, the fingertip centre, and quaternion).  Contacts are read from the plant's ``contact_results`` (point pairs and hydroelastic
+and last the tool frame's pose (7: its origin, the fingertip centre, and quaternion).
+Contacts are read from the plant's ``contact_results`` (point pairs and hydroelastic
 surfaces, through the model's geometry-to-body map), poses from ``body_poses``.
 
 ==================  ===========  ======================================================
@@ -43,7 +44,8 @@ class PickProbe(LeafSystem):
         self._robot = {int(b) for b in robot}
         self._geometry = body_of_geometry
         self._tool_body, self._X_BT = int(tool[0]), tool[1]
-        self._contacts = self.DeclareAbstractInputPort("contact_results", AbstractValue.Make(ContactResults()))
+        self._contacts = self.DeclareAbstractInputPort("contact_results",
+                                                       AbstractValue.Make(ContactResults()))
         self._poses = self.DeclareAbstractInputPort("body_poses", AbstractValue.Make([RigidTransform()]))
         self.DeclareVectorOutputPort("probe", PART_WIDTH * len(self._parts) + 8, self._calc)
 

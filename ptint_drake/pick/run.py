@@ -18,7 +18,6 @@ import dataclasses
 import time
 from dataclasses import dataclass
 
-import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, Saturation
@@ -233,7 +232,8 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
                       "simulation_realtime_factor": t_end / wall if wall > 0 else float("inf"),
                       "steps": int(simulator.get_integrator().get_num_steps_taken())}
     series = {"t": logs["probe"][0], "probe": logs["probe"][1], "grip_force": logs["grip_force"][1],
-              "gripper_state": logs["gripper_state"][1], "state": logs["state"][1], "target": logs["target"][1]}
+              "gripper_state": logs["gripper_state"][1], "state": logs["state"][1],
+              "target": logs["target"][1]}
     return RunResult(scenario, metrics, series)
 
 

@@ -18,7 +18,8 @@ contact chatter, not motion.  From a task's prescribed grasp time on (the descen
 part is in the hand) it aims at the part's motion as it was then, extrapolated at that velocity —
 a target read off a part in the hand would follow the hand and hold nothing.  A "latched" segment
 aims at where the part was at the segment's start + offset, at rest.  Discrete state ``latched``
-= [p, v, t₀, R] (m, m/s, s, row-major), updated at each "latched" segment's start and at each grasp time.  A "slot"
+= [p, v, t₀, R] (m, m/s, s, row-major), updated at each "latched" segment's start and at each
+grasp time.  A "slot"
 segment aims at the fixed place pose, turned to the slot's yaw about the vertical.
 
 ``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a

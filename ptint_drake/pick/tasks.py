@@ -172,5 +172,6 @@ def check_tasks(pick: PickConfig) -> None:
             raise ScenarioError(f"{where}.start: {task.start} s is before the previous task ends ({t:.3g} s)")
         t = max(t, task.start) + sum(getattr(task, p).tf for p in PHASES) + 2 * task.dwell
         if task.margin > 0.5 * task.descend.tf * pick.gripper.speed * 2:
-            raise ScenarioError(f"{where}.margin: the fingers need {task.margin / (2 * pick.gripper.speed):.3g} s "
+            need = task.margin / (2 * pick.gripper.speed)
+            raise ScenarioError(f"{where}.margin: the fingers need {need:.3g} s "
                                 f"to close {task.margin} m, longer than half the descend")
