@@ -120,7 +120,7 @@ def _one_pick(built, k: int, t: np.ndarray, probe: np.ndarray, grip: np.ndarray,
     place = built.targets.places[i_place]
     place_yaw = segs[4][1].yaw
     R_end = _quat_matrix(block[-1, 3:7])
-    return {"part": part.name, "slot": segs[4][1].index, "grasped": grasped,
+    return {"part": part.name, "part_index": part_index, "slot": segs[4][1].index, "grasped": grasped,
             "t_grasp": t_grasp, "t_grasp_prescribed": plan.grasp_times[k], "t_close_command": close,
             "slip_mm": None if slip is None else 1e3 * slip,
             "peak_grip_force_N": float(np.max(np.abs(squeeze))),

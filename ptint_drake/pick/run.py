@@ -32,6 +32,7 @@ from ptint_drake.pick.world import MakePickStation, PickStation
 from ptint_drake.scenario import PlantConfig, Scenario, ScenarioError
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
+REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
 DEFAULT_APPROXIMATION = "sap"  # measured by scripts/contact_bench.py: the most accurate, and fast
 
 
@@ -127,7 +128,8 @@ def build_pick(scenario: Scenario) -> PickBuilt:
                "grip_force": LogVectorOutput(st.GetOutputPort("grip_force"), builder, PROBE_PERIOD),
                "gripper_state": LogVectorOutput(st.GetOutputPort("gripper_state"), builder, PROBE_PERIOD),
                "state": LogVectorOutput(st.GetOutputPort("state"), builder, PROBE_PERIOD),
-               "target": LogVectorOutput(targets.GetOutputPort("target"), builder, PROBE_PERIOD)}
+               "target": LogVectorOutput(targets.GetOutputPort("target"), builder, PROBE_PERIOD),
+               "plant_state": LogVectorOutput(st.GetOutputPort("plant_state"), builder, REPLAY_PERIOD)}
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
     return PickBuilt(diagram, station, handles, plan, targets, loggers)
@@ -177,7 +179,7 @@ def _stops(scenario: Scenario, plan: PickPlan) -> list:
     stops = {scenario.duration, *plan.close_times}
     for seg in plan.schedule.segments:
         stops.update({seg.start, seg.end})
-    return sorted(t for t in stops if 0.0 < t <= scenario.duration)
+    return sorted(t for t in stops if 0.0 <= t <= scenario.duration)
 
 
 def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=None):
@@ -233,7 +235,8 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
                       "steps": int(simulator.get_integrator().get_num_steps_taken())}
     series = {"t": logs["probe"][0], "probe": logs["probe"][1], "grip_force": logs["grip_force"][1],
               "gripper_state": logs["gripper_state"][1], "state": logs["state"][1],
-              "target": logs["target"][1]}
+              "target": logs["target"][1], "replay_t": logs["plant_state"][0],
+              "plant_state": logs["plant_state"][1]}
     return RunResult(scenario, metrics, series)
 
 
