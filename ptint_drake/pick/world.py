@@ -140,6 +140,7 @@ def MakePickStation(config: PickWorldConfig) -> PickStation:
     driver = builder.AddNamedSystem("gripper_driver", GripperDriver(
         gripper_stroke(plant, gripper), g.speed, g.max_force, g.kp, g.initial_opening, config.time_step))
     builder.Connect(driver.GetOutputPort("desired_state"), plant.get_desired_state_input_port(gripper))
+    builder.Connect(plant.get_state_output_port(gripper), driver.GetInputPort("finger_state"))
     for joint, belt in zip(belts, config.belts):
         source = builder.AddNamedSystem(f"{belt.name}_speed", ConstantVectorSource([0.0, belt.speed]))
         builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(joint.model_instance()))
