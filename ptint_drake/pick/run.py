@@ -16,6 +16,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 import time
+
+import numpy as np
 from dataclasses import dataclass
 
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
@@ -175,6 +177,36 @@ def check_pick_plant(scenario: Scenario) -> None:
         raise ScenarioError("plant: a pick scenario takes mass_scale only")
 
 
+def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
+    """Before a run: every task's grasp (the part's nominal place on its belt at the prescribed grasp
+    time), its lift point and its slot (and the carry above it) must be reachable from above
+    (Drake's InverseKinematics, the model's joint limits); a ScenarioError naming the field."""
+    from ptint_drake.reachability import inverse_kinematics  # noqa: PLC0415
+
+    arm = _kinematic_plant(scenario)
+    frame = arm.GetFrameByName(scenario.robot.end_effector)
+    plan, config = built.plan, built.station.config
+    belts = {b.name: b for b in config.belts}
+    guess = np.radians(scenario.robot.initial_q_deg)
+    context = built.station.plant.CreateDefaultContext()
+    for k, task in enumerate(scenario.pick.tasks):
+        part_index = [p.name for p in config.parts].index(task.part)
+        belt = belts[config.parts[part_index].belt]
+        start = built.station.parts[part_index].EvalPoseInWorld(context).translation()
+        grasp = start + belt.speed * plan.grasp_times[k] * np.asarray(belt.direction)
+        i_place = next(i for i, s in enumerate(plan.segments) if s.task == k and s.phase == "place")
+        place = built.targets.places[i_place]
+        for where, x in ((f"pick.tasks[{k}].part", grasp), (f"pick.tasks[{k}].lift_height",
+                                                           grasp + [0, 0, task.lift_height]),
+                         (f"pick.tasks[{k}].slot", place), (f"pick.tasks[{k}].lift_height",
+                                                           place + [0, 0, task.lift_height])):
+            solution = inverse_kinematics(arm, frame, np.asarray(x), guess, down=True)
+            if solution is None:
+                raise ScenarioError(f"{where}: {np.round(x, 3).tolist()} m is outside what the arm reaches "
+                                    f"from above")
+            guess = solution
+
+
 def _stops(scenario: Scenario, plan: PickPlan) -> list:
     stops = {scenario.duration, *plan.close_times}
     for seg in plan.schedule.segments:
@@ -188,6 +220,8 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
 
     check_pick_plant(scenario)
     built = build_pick(scenario)
+    if check:
+        check_pick_reachable(scenario, built)
     t_start = time.perf_counter()
     simulator = Simulator(built.diagram)
     ApplySimulatorConfig(scenario.simulator, simulator)
