@@ -68,3 +68,22 @@ def test_targets_follow_the_simulated_part_then_latch_and_place():
     np.testing.assert_allclose(system.GetOutputPort("target").Eval(context), [0.1, 0.2, 0.115] + [0.0] * 6)
     rotation = system.GetOutputPort("target_rotation").Eval(context)
     np.testing.assert_allclose(rotation[0:9], R.ravel(), atol=1e-12)
+
+
+def test_robust_samples_a_pick_scenario_within_its_ranges():
+    from ptint_drake.scenario import scenario_text
+    from ptint_drake.studies.robust import RANGES, _pick_summary, sample_scenario
+
+    _, text = scenario_text("conveyor_pick_place")
+    for seed in range(5):
+        scenario, params = sample_scenario(text, "p", seed)
+        assert 0.7 <= scenario.plant.mass_scale <= 1.5 and scenario.plant.payload_kg == 0.0
+        part, belt = scenario.pick.parts[0], scenario.pick.belts[0]
+        assert RANGES["part_mass"][0] <= part.mass <= RANGES["part_mass"][1]
+        assert RANGES["part_friction"][0] <= part.friction <= RANGES["part_friction"][1]
+        assert 0.08 <= belt.speed <= 0.12 and params["belt_speed"] == [belt.speed]
+    rows = [{"picks": [{"placed": True}, {"placed": False}], "reasons": ["pick 1: dropped"]},
+            {"error": "boom", "ok": False}]
+    summary = _pick_summary(rows)
+    assert summary["pick_success_rate"] == 0.25
+    assert summary["failures_by_reason"] == {"dropped": 1, "error: boom": 1}
