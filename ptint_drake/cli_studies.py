@@ -79,7 +79,8 @@ def cmd_robust(args: argparse.Namespace) -> int:
           f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
     if "pick_success_rate" in result:
         reasons = ", ".join(f"{k} ×{v}" for k, v in result["failures_by_reason"].items()) or "none"
-        print(f"pick success rate {100 * result['pick_success_rate']:.1f} % of the parts; failures: {reasons}")
+        print(f"pick success rate {100 * result['pick_success_rate']:.1f} % of the parts; "
+              f"failures: {reasons}")
     return 0
 
 
