@@ -220,6 +220,8 @@ def histogram(result: dict, out_dir: Path) -> None:
     (docs/results.md), and how many samples intercepted, missed or failed."""
     from matplotlib.ticker import MaxNLocator  # noqa: PLC0415
 
+    if "pick_success_rate" in result:
+        return _pick_histogram(result, out_dir)
     rows = [r for r in result["rows"] if r.get("e_tf_max") is not None and "torque_peak" in r]
     n, n_ok = result["samples"], sum(1 for r in result["rows"] if r["ok"])
     n_failed = n - len(rows)
@@ -249,6 +251,23 @@ def histogram(result: dict, out_dir: Path) -> None:
     failed = f", {n_failed} failed before the end" if n_failed else ""
     fig.suptitle(f"{result['scenario']}: {n_ok} of {n} samples intercepted "
                  f"({100 * result['success_rate']:.1f} %){failed}")
+    save(fig, out_dir, "robust")
+
+
+def _pick_histogram(result: dict, out_dir: Path) -> None:
+    """A pick study's figure: every part's place error (mm and deg) over the samples."""
+    picks = [p for r in result["rows"] for p in r.get("picks", [])]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
+    for ax, key, label in ((axes[0], "place_error_mm", "place error [mm]"),
+                           (axes[1], "place_error_deg", "place error [deg]")):
+        values = [min(p[key], 50.0) for p in picks]
+        if values:
+            ax.hist(values, bins=int(np.clip(2 * np.sqrt(len(values)), 5, 30)), edgecolor="white")
+        ax.axvline(3.0, color="r", ls="--")
+        ax.set_xlabel(label + " (clipped at 50)")
+        ax.set_ylabel("parts")
+    fig.suptitle(f"{result['scenario']}: {100 * result['pick_success_rate']:.1f} % of "
+                 f"{len(picks)} parts placed over {result['samples']} samples")
     save(fig, out_dir, "robust")
 
 
