@@ -41,17 +41,19 @@ def table(metrics: dict) -> str:
              "| slip [mm] | peak grip [N] | realtime factor |", "|---|---|---|---|---|---|---|---|---|"]
     for name, m in metrics.items():
         for k, p in enumerate(m["picks"]):
-            grasp = "never" if p["t_grasp"] is None else f"{p['t_grasp']:.3f} ({p['t_grasp_prescribed']:.3f})"
+            prescribed = p["t_grasp_prescribed"]
+            grasp = "never" if p["t_grasp"] is None else f"{p['t_grasp']:.3f} ({prescribed:.3f})"
             rtf = f"{m['sim']['realtime_factor']:.2f}" if k == 0 else ""
             lines.append(f"| {name if k == 0 else ''} | {k} | {p['part']} → {p['slot']} | {grasp} | "
-                         f"{'yes' if p['placed'] else 'NO'} | {p['place_error_mm']:.2f}, {p['place_error_deg']:.2f} "
+                         f"{'yes' if p['placed'] else 'NO'} | "
+                         f"{p['place_error_mm']:.2f}, {p['place_error_deg']:.2f} "
                          f"| {p['slip_mm']:.2f} | {p['peak_grip_force_N']:.0f} | {rtf} |")
-    import pydrake  # noqa: PLC0415
+    from importlib.metadata import version  # noqa: PLC0415
 
     lines.append("")
     lines.append(f"Measured by `scripts/pick_table.py` on {platform.machine()}, Python "
-                 f"{platform.python_version()}, Drake {pydrake.__version__ if hasattr(pydrake, '__version__') else ''}"
-                 .rstrip() + "; the realtime factor (end to end) depends on the machine and its load.")
+                 f"{platform.python_version()}, Drake {version('drake')}; the realtime factor (end to "
+                 f"end) depends on the machine and its load.")
     return "\n".join(lines)
 
 
@@ -111,7 +113,7 @@ def main() -> None:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         base = args.runs or Path(tmp)
-        metrics = {n: (json.loads((base / n / "metrics.json").read_text()) if args.runs else run(n, base / n))
+        metrics = {n: json.loads((base / n / "metrics.json").read_text()) if args.runs else run(n, base / n)
                    for n in SCENARIOS}
         replace(table(metrics))
     if args.still:
