@@ -113,8 +113,8 @@ def main() -> None:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         base = args.runs or Path(tmp)
-        metrics = {n: json.loads((base / n / "metrics.json").read_text()) if args.runs else run(n, base / n)
-                   for n in SCENARIOS}
+        read = lambda n: json.loads((base / n / "metrics.json").read_text())  # noqa: E731
+        metrics = {n: read(n) if args.runs else run(n, base / n) for n in SCENARIOS}
         replace(table(metrics))
     if args.still:
         still(ROOT / "docs" / "_static" / "pick_grasp.png")
