@@ -57,13 +57,13 @@ def table(metrics: dict) -> str:
     return "\n".join(lines)
 
 
-def replace(block: str) -> None:
+def replace(block: str, name: str = "picks") -> None:
+    """Put ``block`` between the ``name`` markers of every file in FILES that has them."""
+    begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
     for path in FILES:
         text = path.read_text()
-        if "<!-- BEGIN picks -->" not in text:
-            continue
-        path.write_text(re.sub(r"<!-- BEGIN picks -->.*?<!-- END picks -->",
-                               lambda _: f"<!-- BEGIN picks -->\n{block}\n<!-- END picks -->", text, flags=re.S))
+        if begin in text:
+            path.write_text(re.sub(f"{begin}.*?{end}", lambda _: f"{begin}\n{block}\n{end}", text, flags=re.S))
 
 
 def still(path: Path) -> None:
