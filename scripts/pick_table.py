@@ -63,7 +63,8 @@ def replace(block: str, name: str = "picks") -> None:
     for path in FILES:
         text = path.read_text()
         if begin in text:
-            path.write_text(re.sub(f"{begin}.*?{end}", lambda _: f"{begin}\n{block}\n{end}", text, flags=re.S))
+            new = f"{begin}\n{block}\n{end}"
+            path.write_text(re.sub(f"{begin}.*?{end}", lambda _: new, text, flags=re.S))
 
 
 def still(path: Path) -> None:
