@@ -178,8 +178,9 @@ def pick_simulator(scenario: Scenario) -> SimulatorConfig:
 
     if repr(scenario.simulator) != repr(_default_simulator()):  # (config structs have no ==)
         return scenario.simulator
-    return SimulatorConfig(integration_scheme="explicit_euler", use_error_control=False,
-                           max_step_size=scenario.controller.control_period, accuracy=scenario.simulator.accuracy)
+    period = scenario.controller.control_period
+    return SimulatorConfig(integration_scheme="explicit_euler", use_error_control=False, max_step_size=period,
+                           accuracy=scenario.simulator.accuracy)
 
 
 def check_pick_plant(scenario: Scenario) -> None:
