@@ -227,31 +227,35 @@ def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> di
     """
     schedule = scenario.schedule()
     t = series["t"]
-    tau, applied = series["tau"], series["tau_applied"]
-    over = np.any(np.abs(tau) > limits * (1.0 + 1e-9), axis=1)
-    dt = np.diff(t, append=t[-1]) if len(t) else np.zeros(0)
-    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
-    steady = after_startup(t, schedule.segments)
-    torque, torque_late = _peak(applied, t), _peak(applied, t, steady)
-    speed = _peak(series["v"], t)
     segments = segment_metrics(schedule, scenario.duration, samples, t, series["x"], series["objects"])
     rotations = rotation_metrics(schedule, scenario.duration, t, series.get("rot_angle_deg"),
                                  series.get("rot_rate_deg_s"))
     for row, rot in zip(segments, rotations):
         row |= rot
+    return {"scenario": scenario.name, "duration": scenario.duration, "segments": segments} | drive_metrics(
+        schedule, t, series["tau"], series["tau_applied"], series["v"], limits) | {
+        # redundant arms: the start posture's offset in the null space of J at the end (rad)
+        "self_motion_final": float(series["self_motion"][-1]) if "self_motion" in series and len(t) else None}
+
+
+def drive_metrics(schedule, t: np.ndarray, tau: np.ndarray, applied: np.ndarray, v: np.ndarray,
+                  limits: np.ndarray) -> dict:
+    """The drives' side of a run: torque peaks (applied) with their times, the same after each
+    segment's start-up, the commanded peaks, joint-speed peaks, and the fraction of time any
+    commanded torque exceeds its limit (``saturated_fraction``)."""
+    over = np.any(np.abs(tau) > limits * (1.0 + 1e-9), axis=1)
+    dt = np.diff(t, append=t[-1]) if len(t) else np.zeros(0)
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    torque, torque_late = _peak(applied, t), _peak(applied, t, after_startup(t, schedule.segments))
+    speed = _peak(v, t)
     return {
-        "scenario": scenario.name,
-        "duration": scenario.duration,
-        "segments": segments,
         "torque_peak": torque["value"],
         "torque_peak_time": torque["time"],
         "torque_peak_after_startup": torque_late["value"],
         "torque_peak_after_startup_time": torque_late["time"],
         "torque_command_peak": np.max(np.abs(tau), axis=0).tolist() if len(t) else [],
         "joint_speed_peak": speed["value"],
-        "final_joint_speed": float(np.max(np.abs(series["v"][-1]))) if len(t) else 0.0,
-        # redundant arms: the start posture's offset in the null space of J at the end (rad)
-        "self_motion_final": float(series["self_motion"][-1]) if "self_motion" in series and len(t) else None,
+        "final_joint_speed": float(np.max(np.abs(v[-1]))) if len(t) else 0.0,
         "joint_speed_peak_time": speed["time"],
         "effort_limits": limits.tolist(),
         "saturated_fraction": float(np.sum(dt[over]) / span) if span > 0 else 0.0,

@@ -26,6 +26,7 @@ from pydrake.systems.primitives import LogVectorOutput, Saturation
 
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
 from ptint_drake.pick.config import PickWorldConfig
+from ptint_drake.metrics import drive_metrics
 from ptint_drake.pick.metrics import pick_metrics, segment_rows
 from ptint_drake.pick.probe import PickProbe
 from ptint_drake.pick.targets import GripperSequence, PickTargets
@@ -70,6 +71,8 @@ class PickBuilt:
     plan: PickPlan
     targets: PickTargets
     loggers: dict
+    arm: object  # the arm's model alone (continuous, nominal): the controller's kinematics
+    limits: np.ndarray  # the arm's effort limits (N·m)
 
 
 def _kinematic_plant(scenario: Scenario):
@@ -132,9 +135,11 @@ def build_pick(scenario: Scenario) -> PickBuilt:
                "state": LogVectorOutput(st.GetOutputPort("state"), builder, PROBE_PERIOD),
                "target": LogVectorOutput(targets.GetOutputPort("target"), builder, PROBE_PERIOD),
                "plant_state": LogVectorOutput(st.GetOutputPort("plant_state"), builder, REPLAY_PERIOD)}
+    loggers |= {f"controller/{name}": LogVectorOutput(port, builder, PROBE_PERIOD)
+                for name, port in handles.log_ports.items()}
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
-    return PickBuilt(diagram, station, handles, plan, targets, loggers)
+    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits)
 
 
 def _probe(station: PickStation) -> PickProbe:
@@ -260,7 +265,10 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
             progress(context.get_time(), scenario.duration, 0)
     logs = {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
             for name, logger in built.loggers.items()}
+    series = pick_series(built, logs)
     metrics = pick_metrics(scenario, built, logs, segment_rows(built, aims))
+    metrics |= drive_metrics(built.plan.schedule, series["t"], series["tau"], series["tau_applied"],
+                             series["v"], built.limits)
     if failure:
         metrics["failure"] = failure
     from ptint_drake.metrics import verdict  # noqa: PLC0415
@@ -282,11 +290,34 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
                       "realtime_factor": t_end / total if total > 0 else float("inf"),
                       "simulation_realtime_factor": t_end / wall if wall > 0 else float("inf"),
                       "steps": int(simulator.get_integrator().get_num_steps_taken())}
-    series = {"t": logs["probe"][0], "probe": logs["probe"][1], "grip_force": logs["grip_force"][1],
-              "gripper_state": logs["gripper_state"][1], "state": logs["state"][1],
-              "target": logs["target"][1], "replay_t": logs["plant_state"][0],
-              "plant_state": logs["plant_state"][1]}
     return RunResult(scenario, metrics, series)
+
+
+def pick_series(built: PickBuilt, logs: dict) -> dict:
+    """The run's time series (every ``PROBE_PERIOD``): the probe, the fingers, the arm's q, v, the
+    tool point x, ẋ (forward kinematics of the logged arm state), the target the controller aimed
+    at and the error against it (``e_true``: the target *is* the part's simulated pose), the
+    controller's telemetry (``tau`` commanded, ``tau_applied`` after the effort limits), and the
+    whole plant's state every ``REPLAY_PERIOD`` (``replay_t``, ``plant_state``) for the replay."""
+    from ptint_drake.systems.kinematics import FrameKinematics  # noqa: PLC0415
+
+    t, state = logs["state"]
+    nq = built.arm.num_positions()
+    kinematics = FrameKinematics(built.arm, built.arm.GetFrameByName(built.station.config.end_effector))
+    x, xdot = np.empty((len(t), 3)), np.empty((len(t), 3))
+    for k in range(len(t)):
+        x[k], xdot[k], _ = kinematics.compute(state[k, :nq], state[k, nq:])
+    target = logs["target"][1]
+    controller = {name.split("/", 1)[1]: data for name, (_, data) in logs.items()
+                  if name.startswith("controller/")}
+    series = dict(built.controller.telemetry(controller | {"t": t, "state": state}))
+    series |= {"t": t, "q": state[:, :nq], "v": state[:, nq:], "x": x, "xdot": xdot, "target": target,
+               "e_true": x - target[:, 0:3], "edot_true": xdot - target[:, 3:6],
+               "tau_applied": np.clip(series["tau"], -built.limits, built.limits),
+               "probe": logs["probe"][1], "grip_force": logs["grip_force"][1],
+               "gripper_state": logs["gripper_state"][1], "state": state,
+               "replay_t": logs["plant_state"][0], "plant_state": logs["plant_state"][1]}
+    return series
 
 
 def segment_aims(built: PickBuilt, context) -> dict:
