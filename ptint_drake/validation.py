@@ -142,6 +142,11 @@ def _validate_pick(s) -> None:
                             "needs sampled control: set it > 0 (e.g. 0.001)")
     check_pick_parts(s.pick)
     check_tasks(s.pick)
+    from ptint_drake.pick.tasks import pick_plan  # noqa: PLC0415
+
+    end = pick_plan(s.pick).end
+    if s.duration < end:
+        raise ScenarioError(f"duration: {s.duration:g} s ends before the pick tasks do ({end:.3g} s)")
 
 
 def _validate_multibody(m, control_period: float) -> None:

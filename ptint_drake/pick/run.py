@@ -240,8 +240,14 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
 
     check_pick_plant(scenario)
     built = build_pick(scenario)
+    warnings = []
     if check:
         check_pick_reachable(scenario, built)
+        from ptint_drake.run_warnings import sampled_control_warnings  # noqa: PLC0415
+
+        warnings = sampled_control_warnings(scenario)
+    for message in warnings if warn is not None else ():
+        warn(message)
     t_start = time.perf_counter()
     simulator = Simulator(built.diagram)
     ApplySimulatorConfig(pick_simulator(scenario), simulator)
@@ -276,7 +282,8 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
     metrics["status"], reasons = verdict(metrics, scenario.criteria)
     metrics["reasons"] = [str(r) for r in reasons]
     metrics["reason_codes"] = [r.as_dict() for r in reasons]
-    metrics |= {"criteria": dataclasses.asdict(scenario.criteria), "warnings": [], "warnings_before_run": 0,
+    metrics |= {"criteria": dataclasses.asdict(scenario.criteria), "warnings": warnings,
+                "warnings_before_run": len(warnings),
                 "controller": {"type": built.controller.name, "notes": built.controller.notes,
                                "model_based": built.controller.model_based}}
     total = time.perf_counter() - t_start
