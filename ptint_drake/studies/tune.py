@@ -175,6 +175,9 @@ def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=
     content of tune.json (plus ``scenario`` for tuned.yaml)."""
     t0 = time.perf_counter()
     text, name, scenario = loaded.text, loaded.name, loaded.scenario
+    if scenario.pick is not None:  # its verdict is the picks', not the segments' criteria tune reads
+        raise ScenarioError(f"scenario: {name} is a pick and place, which tune does not search; tune the "
+                            f"interception of its parts instead (e.g. conveyor_yaw) and use those gains")
     check_variants(scenario, settings.variants)
     check_gain(settings.gain, settings.bracket)
     lo, hi = settings.bracket or model_bracket(scenario, settings.gain)

@@ -55,3 +55,10 @@ def test_bad_pick_input_is_one_line_exit_2(tmp_path, capsys, override, field):
     assert code == 2, err
     assert field in err and "Traceback" not in err and len(err.splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_tune_refuses_a_pick_scenario_in_one_line(tmp_path, capsys):
+    code = main(["tune", "conveyor_pick_place", "--quiet", "--out", str(tmp_path / "t")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "pick and place" in err, err
+    assert not (tmp_path / "t").exists()
