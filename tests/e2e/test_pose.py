@@ -223,3 +223,15 @@ def test_conveyor_yaw_is_ok(run, overrides):
     for seg in m["segments"]:
         assert seg["e_tf_norm"] <= 1e-3 and seg["e_rot_tf_deg"] <= 2.0
         assert seg["e_rot_hold_max_deg"] <= 5.0
+
+
+def test_curve_pose_is_ok(run):
+    """The paper's curve with a tumbling object frame, task pose on the 6-joint rvm1_6dof with the
+    paper's gains: 1 mm and 2° at tf, early in neither, holding."""
+    m = run("curve_pose").metrics
+    assert m["status"] == "ok", m["reasons"]
+    seg = m["segments"][0]
+    assert seg["e_tf_norm"] <= 1e-3 and seg["e_rot_tf_deg"] <= 2.0, (seg["e_tf_norm"], seg["e_rot_tf_deg"])
+    assert seg["e0_norm"] > 0.05 and seg["e_rot0_deg"] > 45.0
+    assert seg["e_half_norm"] >= 0.25 * seg["e0_norm"] and seg["e_rot_half_deg"] >= 0.25 * seg["e_rot0_deg"]
+    assert seg["e_hold_max_norm"] <= 3e-3 and seg["e_rot_hold_max_deg"] <= 5.0
