@@ -154,14 +154,15 @@ def _add_design_parsers(sub) -> None:
     tn = sub.add_parser(
         "tune",
         help="the smallest gain that meets the prescribed time on every variant (docs/own_arm.md)",
-        description="1-D search of one gain (K or Lambda: the smallest that works; phi: the largest) so "
-                    "that every segment meets the criteria divided by --margin on every plant variant "
-                    "and the actuators saturate at most --max-saturation of the time. Writes tuned.yaml "
-                    "(only when a value works), tune.json and tune.png. Exit 0 when found, 1 when no "
-                    "value in the range works, 2 on bad input.")
+        description="1-D search of one gain (K, Lambda or rot_scale: the smallest that works; phi: the "
+                    "largest) so that every segment meets the criteria divided by --margin on every plant "
+                    "variant and the actuators saturate at most --max-saturation of the time. Writes "
+                    "tuned.yaml (only when a value works), tune.json and tune.png. Exit 0 when found, 1 "
+                    "when no value in the range works, 2 on bad input.")
     tn.add_argument("scenario", help="a bundled scenario name or a YAML file")
     tn.add_argument("--gain", type=opt.gain_name, default="K",
-                    help="K (default), Lambda or phi; params.NAME for a plugin controller (with --range)")
+                    help="K (default), Lambda, phi or rot_scale (pose and top_down tasks); params.NAME for a "
+                         "plugin controller (with --range)")
     tn.add_argument("--range", type=opt.gain_range, default=None, metavar="LO,HI",
                     help="the search range (default: derived from the model at the start pose)")
     tn.add_argument("--variants", type=opt.variant_list, default="nominal,mass_x0.7,mass_x1.5",

@@ -9,8 +9,9 @@ at most a fraction F of the time.  The search is 1-D:
 1. a bracket from the model (an offline design step may use it; the tuned
    controller stays model-free): for K, from M_max / tf (below it the arm's slowest
    velocity time constant M/K exceeds tf) to the gain at which a 1 cm/s surface error
-   asks the weakest actuator for its whole effort limit (τ = K J⁺ s_x); for Λ and φ,
-   a factor 30 either side of the scenario's value;
+   asks the weakest actuator for its whole effort limit (τ = K J⁺ s_x); for Λ, φ and
+   ``rot_scale`` (m per rad, only for ``controller.task`` pose or top_down), a factor 30
+   either side of the scenario's value;
 2. a coarse log-spaced grid over the bracket, every value × variant in parallel;
 3. bisection (in log) inside the first working bracket of the grid — for K and Λ the
    first failing → working step from below, for φ the last working → failing step —
@@ -36,7 +37,8 @@ from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, c
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 
-GAINS = ("K", "Lambda", "phi")
+GAINS = ("K", "Lambda", "phi", "rot_scale")
+POSE_GAINS = ("rot_scale",)  # only for a controller.task other than position
 # rad: a redundant arm whose null-space offset from the start posture ends above this drifts
 DRIFT_ANGLE = 0.5
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
@@ -69,6 +71,13 @@ def check_gain(gain: str, bracket) -> None:
         raise ScenarioError(f"--gain: must be one of {', '.join(GAINS)} or params.NAME, got {gain!r}")
 
 
+def check_task_gain(scenario, gain: str) -> None:
+    """``rot_scale`` weighs the orientation rows: a ``position`` task has none to tune."""
+    if gain in POSE_GAINS and scenario.controller.task == "position":
+        raise ScenarioError(f"--gain: {gain} weighs the orientation error, but controller.task of this "
+                            f"scenario is position (tune it on a pose or top_down scenario)")
+
+
 def gain_value(scenario, gain: str):
     """The scenario's current value of ``gain`` (None for a plugin parameter it does not set)."""
     if gain.startswith(PARAM_PREFIX):
@@ -90,7 +99,8 @@ def _all_gains(scenario, gain: str, value: float) -> dict:
     if gain.startswith(PARAM_PREFIX):
         own = {PARAM_PREFIX + k: v for k, v in scenario.controller.params.items()}
     else:
-        own = {g: getattr(scenario.controller, g) for g in GAINS}
+        own = {g: getattr(scenario.controller, g) for g in GAINS
+               if g not in POSE_GAINS or scenario.controller.task != "position"}
     return own | {gain: value}
 
 
@@ -180,6 +190,7 @@ def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=
                             f"interception of its parts instead (e.g. conveyor_yaw) and use those gains")
     check_variants(scenario, settings.variants)
     check_gain(settings.gain, settings.bracket)
+    check_task_gain(scenario, settings.gain)
     lo, hi = settings.bracket or model_bracket(scenario, settings.gain)
     grid = list(np.geomspace(lo, hi, settings.grid_points))
     smallest = settings.gain != "phi"
