@@ -216,10 +216,11 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str, formats=
 
 def run_figure(stem: str, series: dict, metrics: dict, out_dir: Path, title: str,
                formats=("png",)) -> str:
-    """The run figure ``stem`` (one of ``RUN_FIGURES``) written in ``out_dir``; returns ``stem``.
-    Module-level, so that a worker process can draw one figure while another draws the next."""
+    """The run figure ``stem`` (of ``RUN_FIGURES`` or ``ORIENTATION_FIGURES``) written in
+    ``out_dir``; returns ``stem``.  Module-level, so that a worker process can draw one figure
+    while another draws the next."""
     tfs = [s["start"] + s["tf"] for s in metrics["segments"]]
-    RUN_FIGURES[stem](series, metrics, tfs, out_dir, title, formats)
+    (RUN_FIGURES | ORIENTATION_FIGURES)[stem](series, metrics, tfs, out_dir, title, formats)
     return stem
 
 
@@ -337,5 +338,43 @@ def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, f
     save(fig, out_dir, "paths3d", formats)
 
 
+def _angle_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
+    """The orientation error angle per object (deg, log axis) from its segment's start to the end
+    of its hold, the angle at tf circled, the criteria and tf marked (tasks pose and top_down)."""
+    t, angle = series["t"], series["rot_angle_deg"]
+    fig = new_figure((10, 4.2), layout="constrained")
+    ax = fig.subplots()
+    width = _columns(fig)
+    for i in range(angle.shape[1]):
+        seen = np.isfinite(angle[:, i])
+        ax.semilogy(*envelope(t[seen], np.maximum(angle[seen, i], 1e-6), width), label=f"object {i}")
+    criteria = metrics.get("criteria", {})
+    bound, hold = criteria.get("e_rot_tf_deg", 2.0), criteria.get("rot_hold_deg", 5.0)
+    ax.axhline(bound, color="r", lw=0.8, label=f"{bound:g}° at $t_f$")
+    ax.axhline(hold, color="r", ls=":", lw=0.8, label=f"{hold:g}° holding")
+    at_tf = [(tf, max(s["e_rot_tf_deg"], 1e-6)) for tf, s in zip(tfs, metrics["segments"])
+             if s.get("e_rot_tf_deg") is not None]
+    if at_tf:
+        ax.plot(*zip(*at_tf), ls="none", marker="o", mfc="none", color="k", ms=7, label="angle at $t_f$")
+    values = ", ".join("n/a" if s.get("e_rot_tf_deg") is None else f"{s['e_rot_tf_deg']:.3g}"
+                       for s in metrics["segments"])
+    ax.set_title(f"angle($t_f$) = {values}° (criterion ≤ {bound:g}°)", fontsize=10)
+    _mark_times(ax, tfs)
+    ax.grid(alpha=0.3)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("orientation error [deg]")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.suptitle(f"{title}: angle between the gripper's orientation and the one its task asks for")
+    save(fig, out_dir, "angle", formats)
+
+
 RUN_FIGURES = {"axes": _axes_figure, "errors": _errors_figure, "joints": _joints_figure,
                "paths3d": _paths_figure}
+# a task with orientation (controller.task pose or top_down) adds these
+ORIENTATION_FIGURES = {"angle": _angle_figure}
+
+
+def run_figure_stems(task: str) -> list[str]:
+    """The figures of a run whose controller has ``task``: ``RUN_FIGURES``, and
+    ``ORIENTATION_FIGURES`` unless the task is position."""
+    return list(RUN_FIGURES) + ([] if task == "position" else list(ORIENTATION_FIGURES))

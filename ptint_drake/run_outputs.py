@@ -55,19 +55,20 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
 
 def run_metrics(scenario: Scenario, metrics: dict, figures: bool = True) -> dict:
     """metrics.json of a run: the simulation's metrics, the scenario as run, the figures' files."""
-    from ptint_drake.figures import RUN_FIGURES  # noqa: PLC0415  (no matplotlib import)
+    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
 
     metrics = dict(metrics)
     metrics["scenario_config"] = dump_dataclass(scenario)
     if figures and scenario.pick is not None:
         metrics["figures"] = ["picks.png"]
     elif figures:
-        metrics["figures"] = [f"{s}.png" for s in RUN_FIGURES]
+        metrics["figures"] = [f"{s}.png" for s in run_figure_stems(scenario.controller.task)]
     return metrics
 
 
-# the longest first: with two workers, the axes figure on one and the rest on the other
-VIEW_ORDER = ("axes", "errors", "paths3d", "joints", "replay")
+# the longest first: with two workers, the axes figure on one and the rest on the other;
+# "angle" only for a task with orientation (figures.run_figure_stems)
+VIEW_ORDER = ("axes", "errors", "paths3d", "joints", "angle", "replay")
 
 
 def view_task(name: str, series: dict, metrics: dict, stage: Path, title: str, replay_args: tuple):
@@ -106,7 +107,10 @@ def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, fig
     formats = ("png", "svg") if svg else ("png",)
     replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
                    scenario.robot.end_effector)
-    names = [n for n in VIEW_ORDER if (n == "replay" and replay) or (n != "replay" and figures)]
+    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415
+
+    stems = run_figure_stems(scenario.controller.task)
+    names = [n for n in VIEW_ORDER if (n == "replay" and replay) or (n in stems and figures)]
     return [(n, series, metrics, stage, scenario.name, replay_args if n == "replay" else (formats,))
             for n in names]
 
@@ -149,9 +153,9 @@ def write_views(scenario: Scenario, series: dict, metrics: dict, stage: Path, fi
     """The run's figures and replay in ``stage`` (``view_tasks``, ``draw_views``); returns
     the figure stems."""
     draw_views(view_tasks(scenario, series, metrics, stage, figures, replay, svg), workers)
-    from ptint_drake.figures import RUN_FIGURES  # noqa: PLC0415
+    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415
 
-    return list(RUN_FIGURES) if figures else []
+    return run_figure_stems(scenario.controller.task) if figures else []
 
 
 def normalize_graphviz_ids(text: str) -> str:
