@@ -14,6 +14,13 @@ moves with the gripper point for the rest of the run (the arm carries it).
 
 The floor is a light plate at z = 0 with a 10 cm grid under the working area
 (meshcat's own grid is hidden: in a recorded page it is drawn edge-on).
+
+A task with orientation (``controller.task`` pose or top_down, issue 19) adds two frame
+triads (x red, y green, z blue): a thin one on the gripper's tool frame (``triads/gripper``,
+forward kinematics of the replayed q) and a thicker, translucent one on the active object
+(``triads/object``) in the orientation the task asks the tool to take there — the object's
+own frame (``pose``) or its top-down grasp Rz(ψ)·Rx(π) on the branch nearest the tool's yaw
+(``top_down``).  At an interception the thin triad sits inside the thick one.
 """
 
 from __future__ import annotations
@@ -23,10 +30,12 @@ import logging
 import numpy as np
 from pydrake.geometry import (Box, Cylinder, Meshcat, MeshcatParams, MeshcatVisualizer,
                               MeshcatVisualizerParams, Rgba, Role, Sphere)
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
+
+from ptint_drake.systems.task import task_reference
 
 _MESHCAT = None
 COLORS = (Rgba(0.85, 0.15, 0.15, 1), Rgba(0.15, 0.55, 0.9, 1), Rgba(0.2, 0.7, 0.25, 1),
@@ -162,8 +171,38 @@ def object_positions(series: dict, starts, ends) -> np.ndarray:
     return objs
 
 
-def _record(meshcat, viz, plant, context, series: dict, objs: np.ndarray, ends, fps: float) -> None:
-    """The animation: the robot from the logged q, the objects, the intercept markers."""
+# (length m, radius m, opacity) of the gripper's and the object's triads
+TRIADS = {"gripper": (0.045, 0.002, 1.0), "object": (0.06, 0.004, 0.45)}
+TRIAD_AXES = (("x", (1.0, 0.0, 0.0), RotationMatrix.MakeYRotation(np.pi / 2)),
+              ("y", (0.0, 1.0, 0.0), RotationMatrix.MakeXRotation(-np.pi / 2)),
+              ("z", (0.0, 0.0, 1.0), RotationMatrix()))
+
+
+def draw_triads(meshcat: Meshcat) -> None:
+    """``triads/gripper`` and ``triads/object``: three cylinders each along the frame's x (red),
+    y (green) and z (blue) axes from its origin (placed per frame by ``_record``)."""
+    for name, (length, radius, alpha) in TRIADS.items():
+        for axis, rgb, R in TRIAD_AXES:
+            path = f"triads/{name}/{axis}"
+            meshcat.SetObject(path, Cylinder(radius, length), Rgba(*rgb, alpha))
+            meshcat.SetTransform(path, RigidTransform(R, 0.5 * length * np.asarray(rgb)))
+
+
+def _triad_poses(tool_pose: RigidTransform, orientation, k: int, active: int, p_obj) -> tuple:
+    """(gripper, object) poses of the triads: the tool frame, and at the active object's drawn
+    position ``p_obj`` the orientation its task asks for (``orientation`` = (task, rotations:
+    N × objects × 9, each object's true R_r row-major at the logged times), sample k)."""
+    task, rotations = orientation
+    rot_r = list(rotations[k, active]) + [0.0] * 6  # ω_r, ω̇_r: not drawn
+    R_tool = tool_pose.rotation().matrix()
+    R_task = np.reshape(task_reference(task, rot_r, R_tool)[0:9], (3, 3))
+    return tool_pose, RigidTransform(RotationMatrix(R_task), p_obj)
+
+
+def _record(meshcat, viz, plant, context, series: dict, objs: np.ndarray, ends, fps: float,
+            triads=None) -> None:
+    """The animation: the robot from the logged q, the objects, the intercept markers, and with
+    ``triads`` = (tool frame, starts, orientation) the frame triads (``_triad_poses``)."""
     t = series["t"]
     n_obj = objs.shape[1]
     plant_context = plant.GetMyMutableContextFromRoot(context)
@@ -180,6 +219,14 @@ def _record(meshcat, viz, plant, context, series: dict, objs: np.ndarray, ends, 
             meshcat.SetTransform(f"objects/object_{i}", RigidTransform(p), time_in_recording=tf_)
             meshcat.SetProperty(f"intercepts/point_{i}", "visible", bool(tf_ >= ends[i]),
                                 time_in_recording=tf_)
+        if triads is not None:
+            frame, starts, orientation = triads
+            active = max(int(np.searchsorted(starts, tf_, side="right")) - 1, 0)
+            p_obj = np.array([np.interp(tf_, t, objs[:, active, k]) for k in range(3)])
+            k = min(int(np.searchsorted(t, tf_)), len(t) - 1)
+            poses = _triad_poses(frame.CalcPoseInWorld(plant_context), orientation, k, active, p_obj)
+            for name, pose in zip(TRIADS, poses):
+                meshcat.SetTransform(f"triads/{name}", pose, time_in_recording=tf_)
 
 
 def _replay_diagram(model_file: str, meshcat: Meshcat):
@@ -219,11 +266,14 @@ def _draw_scene(meshcat: Meshcat, series: dict, raw: np.ndarray, ends, radius: f
 
 
 def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
-                 conveyors=None, end_effector: str | None = None) -> int:
+                 conveyors=None, end_effector: str | None = None, orientation=None) -> int:
     """Write a standalone replay HTML to ``path``; returns its size in bytes.
 
     ``conveyors``: optional list of (start_xyz, end_xyz) belts to draw as boxes.
     ``end_effector``: the frame whose body's size sets the objects' size (see module doc).
+    ``orientation``: (task, rotations) of a task with orientation — rotations (N × objects × 9)
+    each object's true R_r (row-major) at ``series["t"]`` — to draw the frame triads on
+    ``end_effector`` and the active object.
     """
     meshcat = shared_meshcat()
     meshcat.Delete()
@@ -236,7 +286,11 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
     radius = object_radius(end_effector_radius(plant, scene_graph, context, end_effector))
     belts = [(np.asarray(a, float), np.asarray(b, float)) for a, b in (conveyors or [])]
     _draw_scene(meshcat, series, raw, ends, radius, belts)
-    _record(meshcat, viz, plant, context, series, objs, ends, fps)
+    triads = None
+    if orientation is not None:
+        draw_triads(meshcat)
+        triads = (plant.GetFrameByName(end_effector), starts, orientation)
+    _record(meshcat, viz, plant, context, series, objs, ends, fps, triads)
     meshcat.StopRecording()
     meshcat.PublishRecording()
     html = with_camera(meshcat.StaticHtml(), CAMERA)

@@ -37,6 +37,18 @@ def conveyor_belts(scenario: Scenario):
     return belts
 
 
+def object_rotations(scenario: Scenario, series: dict):
+    """(task, rotations) for the replay's frame triads: each object's true orientation R_r
+    (row-major, N × objects × 9) at the logged times ``series["t"]``; None for a position task."""
+    from ptint_drake.systems.orientation import target_rotation_values  # noqa: PLC0415
+
+    if scenario.controller.task == "position":
+        return None
+    t, targets = series["t"], scenario.targets()
+    rotations = np.array([[target_rotation_values(tg, tk)[0:9] for tg in targets] for tk in t.tolist()])
+    return scenario.controller.task, rotations.reshape(len(t), len(targets), 9)
+
+
 def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figures: bool = True,
                   progress=None, warn=None, svg: bool = False, workers: int | None = None) -> dict:
     """Simulate ``scenario`` and write its outputs into ``out_dir``; returns the metrics.
@@ -73,7 +85,8 @@ VIEW_ORDER = ("axes", "errors", "paths3d", "joints", "angle", "replay")
 
 def view_task(name: str, series: dict, metrics: dict, stage: Path, title: str, replay_args: tuple):
     """One figure (``name`` in ``figures.RUN_FIGURES``, ``replay_args`` = (formats,)) or the
-    replay (``name == "replay"``, ``replay_args`` = (model file, belts, end effector)),
+    replay (``name == "replay"``, ``replay_args`` = (model file, belts, end effector,
+    ``object_rotations``)),
     written in ``stage``; module-level, so that a worker process can run it."""
     if name in ("picks", "pick_replay"):  # a pick and place (replay_args = (its YAML text,))
         from ptint_drake.pick.views import pick_figure, write_pick_replay  # noqa: PLC0415
@@ -87,9 +100,9 @@ def view_task(name: str, series: dict, metrics: dict, stage: Path, title: str, r
     if name == "replay":
         from ptint_drake.replay import write_replay  # noqa: PLC0415
 
-        model_file, belts, end_effector = replay_args
+        model_file, belts, end_effector, orientation = replay_args
         write_replay(series, metrics, model_file, stage / "replay.html", conveyors=belts,
-                     end_effector=end_effector)
+                     end_effector=end_effector, orientation=orientation)
         return name
     from ptint_drake.figures import run_figure  # noqa: PLC0415
 
@@ -106,7 +119,7 @@ def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, fig
         return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
     formats = ("png", "svg") if svg else ("png",)
     replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
-                   scenario.robot.end_effector)
+                   scenario.robot.end_effector, object_rotations(scenario, series) if replay else None)
     from ptint_drake.figures import run_figure_stems  # noqa: PLC0415
 
     stems = run_figure_stems(scenario.controller.task)

@@ -1,5 +1,6 @@
-"""The orientation error figure (issue 19): ``angle.png`` for a task with orientation, listed in
-metrics.json; a position run's figures stay the four they were."""
+"""The views of a run with orientation (issue 19): ``angle.png`` listed in metrics.json and the
+replay given the objects' orientations for its frame triads; a position run's figures stay the
+four they were and its replay gets no orientation."""
 
 import numpy as np
 
@@ -13,8 +14,9 @@ POSITION_FIGURES = ["axes.png", "errors.png", "joints.png", "paths3d.png"]
 def test_a_position_run_keeps_its_four_figures(tmp_path):
     scenario = load_scenario("curve_b075_tf15")
     assert run_metrics(scenario, {"segments": []})["figures"] == POSITION_FIGURES
-    names = [task[0] for task in view_tasks(scenario, {}, {}, tmp_path)]
-    assert names == ["axes", "errors", "paths3d", "joints", "replay"]
+    tasks = view_tasks(scenario, {"t": np.zeros(3)}, {}, tmp_path)
+    assert [task[0] for task in tasks] == ["axes", "errors", "paths3d", "joints", "replay"]
+    assert tasks[-1][-1][3] is None  # the replay draws no triads
 
 
 def test_an_orientation_run_adds_the_angle_figure(tmp_path):
@@ -23,6 +25,19 @@ def test_an_orientation_run_adds_the_angle_figure(tmp_path):
         assert run_metrics(scenario, {"segments": []})["figures"] == POSITION_FIGURES + ["angle.png"]
         names = [task[0] for task in view_tasks(scenario, {}, {}, tmp_path, replay=False)]
         assert names == ["axes", "errors", "paths3d", "joints", "angle"]
+
+
+def test_the_replay_gets_each_objects_true_orientation(tmp_path):
+    scenario = load_scenario("conveyor_yaw")
+    t = np.array([0.0, 1.0, 2.5])
+    replay = view_tasks(scenario, {"t": t}, {}, tmp_path, figures=False)
+    assert [task[0] for task in replay] == ["replay"]
+    task, rotations = replay[0][-1][3]
+    assert task == "top_down" and rotations.shape == (3, 3, 9)
+    c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    np.testing.assert_allclose(rotations[1, 1], [c, -s, 0, s, c, 0, 0, 0, 1], atol=1e-12)  # Rz(30°)
+    task, rotations = view_tasks(load_scenario("curve_pose"), {"t": t}, {}, tmp_path, figures=False)[0][-1][3]
+    assert task == "pose" and not np.allclose(rotations[0, 0], rotations[2, 0])  # tumbling
 
 
 def test_the_angle_figure_draws_each_objects_window(tmp_path):
