@@ -84,8 +84,9 @@ def _validate_controller(c) -> None:
         _positive(c.phi, "controller.phi")
     if c.task not in TASKS:
         raise ScenarioError(f"controller.task: must be one of {', '.join(TASKS)}, got {c.task!r}")
-    if c.task != "position" and c.type != "ptsmc":
-        raise ScenarioError(f"controller.task: {c.task!r} is implemented by ptsmc only, not {c.type!r}")
+    if c.task != "position" and c.type != "ptsmc" and not plugin.is_plugin(c.type):
+        raise ScenarioError(f"controller.task: {c.task!r} is implemented by ptsmc (and a plugin gets it in "
+                            f"params['task']), not {c.type!r}")
     _positive(c.rot_scale, "controller.rot_scale")
     if not (math.isfinite(c.control_period) and c.control_period >= 0.0):
         raise ScenarioError(f"controller.control_period: must be > 0 s (or 0 for continuous control), "
@@ -104,6 +105,9 @@ def _validate_params(c) -> None:
     if c.params and c.type in REGISTRY:
         raise ScenarioError(f"controller.params: only a plugin controller ({plugin.FORM}) takes params; "
                             f"{c.type!r} has its own settings")
+    if c.task != "position" and c.params.get("task", c.task) != c.task:
+        raise ScenarioError(f"controller.params.task: a plugin gets controller.task ({c.task!r}) as "
+                            f"params['task']; got {c.params['task']!r} as well")
     for key, value in c.params.items():
         values = value if isinstance(value, list) else [value]
         for v in values:

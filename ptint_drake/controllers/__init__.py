@@ -102,7 +102,7 @@ def AddControllerTo(builder: DiagramBuilder, *, plant, frame, schedule, state, a
                           initial_q=np.radians(scenario.robot.initial_q_deg), scenario=scenario)
     entry = REGISTRY.get(block.type)
     if entry is None:
-        handles = plugin.AddPlugin(slot, block.params, target, block.type)
+        handles = plugin.AddPlugin(slot, plugin.plugin_params(block), target, block.type)
     else:
         handles = entry.add(slot, entry.settings_of(block), target)
         handles.model_based = entry.model_based

@@ -6,6 +6,9 @@
     MyController(plant=<finalized MultibodyPlant of the nominal robot model>,
                  end_effector=<frame name>, params=<dict: numbers, lists of numbers, strings>)
 
+(``params`` also holds ``task``, the scenario's ``controller.task``, when that is ``pose`` or
+``top_down``: issue 19; a position scenario's params are exactly its own.)
+
 with input ports ``state`` (the arm's [q; v]) and ``target`` ([x_r, ẋ_r, ẍ_r] of the active
 segment, ``signals.TARGET``, 9 values), optionally an input ``segment`` ([index, start, tf] of
 the active segment, ``systems.active_segment``), and an output ``actuation`` (one torque per
@@ -103,6 +106,14 @@ def plain_params(params: dict) -> dict:
     return out
 
 
+def plugin_params(controller) -> dict:
+    """The ``params`` of the ``controller`` block's plugin as the scenario gives them (before
+    ``plain_params``): its own and, for a task with orientation, ``task`` (``controller.task``:
+    pose or top_down)."""
+    params = dict(controller.params)
+    return params if controller.task == "position" else params | {"task": controller.task}
+
+
 def make_plugin(type_: str, plant, end_effector: str, params: dict):
     """Construct the plugin and check its ports against ``plant``; returns the system."""
     cls = load_class(type_)
@@ -141,7 +152,7 @@ def check(type_: str, scenario) -> None:
     from ptint_drake.robot import make_plant  # noqa: PLC0415
 
     plant = make_plant(scenario)
-    make_plugin(type_, plant, scenario.robot.end_effector, plain_params(scenario.controller.params))
+    make_plugin(type_, plant, scenario.robot.end_effector, plain_params(plugin_params(scenario.controller)))
 
 
 def AddPlugin(slot: ControllerSlot, params: dict, target: TargetView, type_: str) -> ControllerHandles:

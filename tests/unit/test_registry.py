@@ -74,3 +74,58 @@ def test_params_are_plugin_only_and_reach_the_plugin():
                                                                 "v": [1.0, 2.0]}
     assert TYPE not in REGISTRY and plugin.is_plugin(TYPE) and not plugin.is_plugin("ptsmc")
     assert load_scenario("curve_b075_tf15").controller.params == {}
+
+
+RECORDING_PLUGIN = '''
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+SEEN = []
+
+
+class Recorder(LeafSystem):
+    """Zero torque; records the params it was built with; reads the object's orientation."""
+
+    def __init__(self, plant, end_effector, params):
+        super().__init__()
+        SEEN.append(dict(params))
+        self.DeclareVectorInputPort("state", plant.num_multibody_states())
+        self.DeclareVectorInputPort("target", 9)
+        if params.get("task") is not None:
+            self.DeclareVectorInputPort("target_rotation", 15)
+        self.DeclareVectorOutputPort("actuation", plant.num_actuators(),
+                                     lambda context, out: out.SetFromVector(np.zeros(out.size())))
+'''
+
+YAW_PLUGIN = """duration: 1.0
+robot: {model: rvm1_5dof, end_effector: tool, initial_q_deg: [22.5, 45.0, 30.0, 0.0, 0.0]}
+controller: {type: "recorder_plugin:Recorder", task: top_down, params: {Kp: 3.0}}
+interceptions:
+  - {start: 0.0, tf: 0.5, beta: 0.75,
+     target: {linear: {start: [0.20, -0.23, 0.25], velocity: [0.0, 0.1, 0.0]},
+              orientation: {rpy_deg: [0.0, 0.0, 30.0]}}}
+"""
+
+
+def test_a_plugin_gets_the_task_in_its_params(tmp_path, monkeypatch):
+    from ptint_drake.simulation import build  # noqa: PLC0415
+
+    (tmp_path / "recorder_plugin.py").write_text(RECORDING_PLUGIN)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import recorder_plugin  # noqa: PLC0415
+
+    scenario = parse_scenario(YAW_PLUGIN)
+    assert plugin.plugin_params(scenario.controller) == {"Kp": 3.0, "task": "top_down"}
+    built = build(scenario, log=False)
+    assert recorder_plugin.SEEN[-1] == {"Kp": 3.0, "task": "top_down"}
+    # it declared target_rotation: the slot connected the object's R_r (Rz(30°)) to it
+    system = built.controller.system
+    context = built.diagram.CreateDefaultContext()
+    R = system.GetInputPort("target_rotation").Eval(system.GetMyContextFromRoot(context))[0:9]
+    c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    np.testing.assert_allclose(R, [c, -s, 0, s, c, 0, 0, 0, 1], atol=1e-12)
+    # a position scenario's plugin gets exactly its own params
+    position = parse_scenario(SCENARIO % TYPE)
+    assert plugin.plugin_params(position.controller) == {"Kp": 2000.0, "Kd": 150.0}
+    with pytest.raises(ScenarioError, match=r"^controller\.params\.task: a plugin gets controller\.task"):
+        parse_scenario(YAW_PLUGIN.replace("Kp: 3.0", "Kp: 3.0, task: pose"))
