@@ -8,6 +8,7 @@ deselects them).  Helper modules shared by both (``arms.py``, ``heavy_arm.py``, 
 from __future__ import annotations
 
 import functools
+import subprocess
 
 import pytest
 
@@ -44,6 +45,28 @@ def assert_prescribed_time(metrics: dict, label: str = "") -> None:
 @pytest.fixture
 def run():
     return run_cached
+
+
+@pytest.fixture
+def ptint_here(capfd):
+    """``ptint ARGS`` run in this process (``cli.main``), its result as a CompletedProcess.
+
+    For bad-input checks (exit 2, one line, nothing written): the same code path as the
+    command without paying a pydrake import per case.  stdout and stderr are captured at the
+    file-descriptor level, so Drake's own C++ logging would show up too; an exception that
+    escapes ``main`` fails the test (the subprocess would print a traceback).  Each command
+    family keeps at least one real subprocess test for the process-level behaviour."""
+    from ptint_drake import cli  # noqa: PLC0415
+
+    def ptint(*args, **_ignored):
+        capfd.readouterr()  # drop what the test printed before
+        try:
+            code = cli.main([str(a) for a in args])
+        except SystemExit as exc:  # argparse: --help (0) and its usage errors (2)
+            code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+        out, err = capfd.readouterr()
+        return subprocess.CompletedProcess(["ptint", *args], code, out, err)
+    return ptint
 
 
 DYNAMICS = ("CalcMassMatrix", "CalcMassMatrixViaInverseDynamics", "CalcBiasTerm",

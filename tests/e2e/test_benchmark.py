@@ -50,8 +50,7 @@ def test_cli_floors_prints_json():
     assert set(result["floors"]) == {"curve_b075_tf12"} and result["machine"]["drake"]
 
 
-def test_cli_bad_repeats_is_one_line():
-    out = subprocess.run([sys.executable, "-m", "ptint_drake", "bench", "--pair", "{}", "{}",
-                          "--repeats", "0"], capture_output=True, text=True, check=False, timeout=120)
+def test_cli_bad_repeats_is_one_line(ptint_here):
+    out = ptint_here("bench", "--pair", "{}", "{}", "--repeats", "0")
     assert out.returncode == 2
     assert "Traceback" not in out.stderr and "--repeats: must be >= 1" in out.stderr

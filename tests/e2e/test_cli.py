@@ -101,13 +101,14 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
-def test_bad_input_fails_with_one_line(tmp_path, case):
+def test_bad_input_fails_with_one_line(tmp_path, case, ptint_here):
+    """In this process (``cli.main``); the subprocess tests below keep the process-level truth."""
     text, field = BAD[case]
     scenario = tmp_path / f"{case}.yaml"
     scenario.write_text(text)
     out_dir = tmp_path / "out"
-    out = ptint("run", str(scenario), "--out", str(out_dir), "--quiet")
-    assert out.returncode != 0
+    out = ptint_here("run", str(scenario), "--out", str(out_dir), "--quiet")
+    assert out.returncode == 2
     assert "Traceback" not in out.stderr
     lines = [line for line in out.stderr.splitlines() if line.strip()]
     assert len(lines) == 1, out.stderr

@@ -186,11 +186,11 @@ def ptint(*args):
      "interceptions[0].target.orientation.rpy_deg"),
     (["controller.rot_scale=0"], "controller.rot_scale"),
 ])
-def test_bad_orientation_input_is_one_line_exit_2(tmp_path, overrides, field):
+def test_bad_orientation_input_is_one_line_exit_2(tmp_path, overrides, field, ptint_here):
     args = ["run", "curve_b075_tf15", "--no-replay", "--no-figures", "--quiet", "--out", str(tmp_path / "o")]
     for o in overrides:
         args += ["--set", o]
-    out = ptint(*args)
+    out = ptint_here(*args)
     assert out.returncode == 2, out.stderr
     assert field in out.stderr and "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
