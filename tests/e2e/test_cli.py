@@ -53,6 +53,9 @@ def test_run_writes_spec_outputs(tmp_path):
     assert len(html) > 1_000_000  # self-contained: meshcat's JS is inlined
     for fig in m["figures"]:
         assert (tmp_path / fig).stat().st_size > 10_000
+    # PNG figures only without --svg (test_visuals.py: the SVGs with the flag)
+    assert {p.stem for p in tmp_path.glob("*.png")} >= {"axes", "errors", "joints", "paths3d"}
+    assert not list(tmp_path.glob("*.svg"))
     assert not list(tmp_path.glob(".ptint-stage-*"))
 
 
