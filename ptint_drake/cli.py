@@ -29,8 +29,8 @@ from ptint_drake.scenario import ScenarioError
 
 SET_HELP = ("override a scenario field (repeatable); KEY is a path with dots and list "
             "indices, VALUE is YAML, e.g. controller.K=40 or 'interceptions[0].tf=1.2' "
-            "(README: Scenario files)")
-RESULTS = "Criteria of an interception: README, Results (|e(tf)| <= 1 mm, hold <= 3 mm)."
+            "(docs/scenarios.md)")
+RESULTS = "Criteria of an interception: docs/results.md (|e(tf)| <= 1 mm, hold <= 3 mm)."
 
 
 def _study_arguments(parser, default_out: str, workers_default: str = "CPU count") -> None:
@@ -50,7 +50,7 @@ def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="ptint", description=__doc__.split("\n")[0],
         epilog="Paper: Flores-Campos et al., Robotics 2024, 13(10), 145. "
-               "README: Command line, Scenario files.")
+               "Documentation: docs/cli.md, docs/scenarios.md.")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_run_parsers(sub)
     _add_grid_parsers(sub)
@@ -62,8 +62,8 @@ def make_parser() -> argparse.ArgumentParser:
 def _add_run_parsers(sub) -> None:
     """list, run, diagram, paper."""
     sub.add_parser("list", help="names of the bundled scenarios",
-                   description="The bundled scenarios (paper section 3, Table 1; README: "
-                               "Scenario files).").set_defaults(func=cmd_list)
+                   description="The bundled scenarios (paper section 3, Table 1; "
+                               "docs/scenarios.md).").set_defaults(func=cmd_list)
 
     run = sub.add_parser(
         "run", help="run one scenario and write its outputs",
@@ -71,7 +71,7 @@ def _add_run_parsers(sub) -> None:
                     "(eqs. 11, 16, 17) and the controller (eq. 18) on the robot; writes "
                     "metrics.json, series.npz, figures and replay.html. Exit 0 when every segment "
                     "meets the scenario's criteria, 1 when one missed them (late, early, hold) or "
-                    "the run diverged, 2 on bad input (README: Command line, Results).", epilog=RESULTS)
+                    "the run diverged, 2 on bad input (docs/cli.md, docs/results.md).", epilog=RESULTS)
     run.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     run.add_argument("--out", help="output folder (default out/NAME)")
     run.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
@@ -96,7 +96,7 @@ def _add_run_parsers(sub) -> None:
         description="Run the five curve scenarios (paper Figs. 6-15) and the assembly task "
                     "(Figs. 16-19), draw the TBG and α families (Figs. 2-4), compare the "
                     "controllers on curve_b075_tf15 and assembly, and write DIR/index.html "
-                    "(README: Quick start).", epilog=RESULTS)
+                    "(docs/quickstart.md).", epilog=RESULTS)
     paper.add_argument("--out", default="out/paper", help="output folder (default out/paper)")
     paper.add_argument("--quiet", action="store_true", help="no progress on stderr")
     paper.add_argument("--svg", action="store_true", help="the run figures as SVG too (PNG always)")
@@ -109,7 +109,7 @@ def _add_grid_parsers(sub) -> None:
         "sweep", help="β × tf grid in parallel worker processes",
         description="Run the scenario on a grid of TBG shapes β and prescribed times tf "
                     "(paper eq. 6), every segment getting the grid's values; writes sweep.csv "
-                    "and heat maps (README: Sweeps).", epilog=RESULTS)
+                    "and heat maps (docs/sweeps.md).", epilog=RESULTS)
     sw.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     sw.add_argument("--beta", type=opt.betas, default="0.25,0.5,0.75",
                     help="comma-separated β values in (0, 1) (paper eq. 6; default %(default)s)")
@@ -121,8 +121,8 @@ def _add_grid_parsers(sub) -> None:
     rb = sub.add_parser(
         "robust", help="Monte Carlo study over unknown dynamics and disturbances",
         description="Monte Carlo over what the controller does not know: masses, friction, "
-                    "payload, the disturbance d of paper eq. 1, camera noise (README: "
-                    "Robustness and safety); writes robust.json, samples.json, worst.yaml and "
+                    "payload, the disturbance d of paper eq. 1, camera noise "
+                    "(docs/robustness.md); writes robust.json, samples.json, worst.yaml and "
                     "a histogram.", epilog=RESULTS)
     rb.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     rb.add_argument("--samples", type=opt.count("--samples"), default=100,
@@ -138,7 +138,7 @@ def _add_grid_parsers(sub) -> None:
 def _add_design_parsers(sub) -> None:
     """compare (controllers × plant variants) and tune (gains for an arm)."""
     cmp_ = sub.add_parser(
-        "compare", help="controllers side by side on plant variants (README: Controllers compared)",
+        "compare", help="controllers side by side on plant variants (docs/controllers.md)",
         description="Every controller × plant variant on the same scenario, in parallel; writes "
                     "compare.json, compare.csv, compare.md and compare.png. Exit 0 when every run "
                     "completed (a miss is a result), 2 on bad input.")
@@ -153,7 +153,7 @@ def _add_design_parsers(sub) -> None:
 
     tn = sub.add_parser(
         "tune",
-        help="the smallest gain that meets the prescribed time on every variant (README: Your own arm)",
+        help="the smallest gain that meets the prescribed time on every variant (docs/own_arm.md)",
         description="1-D search of one gain (K or Lambda: the smallest that works; phi: the largest) so "
                     "that every segment meets the criteria divided by --margin on every plant variant "
                     "and the actuators saturate at most --max-saturation of the time. Writes tuned.yaml "

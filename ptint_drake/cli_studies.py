@@ -77,6 +77,10 @@ def cmd_robust(args: argparse.Namespace) -> int:
           f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, "
           f"max {p.get('max', float('nan')) * 1e3:.4f} mm; "
           f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
+    if "pick_success_rate" in result:
+        reasons = ", ".join(f"{k} ×{v}" for k, v in result["failures_by_reason"].items()) or "none"
+        print(f"pick success rate {100 * result['pick_success_rate']:.1f} % of the parts; "
+              f"failures: {reasons}")
     return 0
 
 

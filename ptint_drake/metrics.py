@@ -6,7 +6,7 @@ Everything here is measured against the *true* target from the plant's state
 alone — the controller may have seen a measured or estimated target, and its
 own telemetry is not trusted for the verdict.
 
-The metrics of one segment (README "Outputs"):
+The metrics of one segment (docs/results.md, docs/cli.md):
 
 - ``e0_norm`` |e| at the segment start, ``e_half_norm`` at start + tf/2,
   ``e_tf_norm`` and ``edot_tf_norm`` at exactly start + tf (the simulator stops
@@ -15,7 +15,7 @@ The metrics of one segment (README "Outputs"):
   start (or the end), last sample included;
 - ``t_arrive``: the first time after the start at which |e| ≤ 1 mm (None if never).
 
-The verdict (paper's prescribed-time property, README "What works means"):
+The verdict (paper's prescribed-time property, docs/results.md):
 a segment is ``late`` when |e(tf)| > ``criteria.e_tf``, ``early`` when it was
 already closer than ``half_fraction`` |e0| at tf/2 (only when |e0| ≥ ``min_e0``:
 a segment that starts on its target cannot arrive early), and ``hold`` when the
@@ -48,11 +48,15 @@ class Criteria:
     e_rot_tf_deg: float = 2.0  # deg: the angle at start + tf at most this ("orientation" otherwise)
     rot_hold_deg: float = 5.0  # deg: the angle while holding at most this ("orientation" otherwise)
     min_e_rot0_deg: float = 5.0  # deg: the early check of the angle applies only from this
+    # pick and place (issue 20): a part is placed when it rests within both of its slot
+    place_mm: float = 3.0  # mm: the part's centre from its place pose at the end
+    place_deg: float = 3.0  # deg: the part's orientation from its slot's at the end
 
 
 def validate_criteria(c: Criteria) -> None:
     """ValueError naming the field of a criterion that is not a positive number."""
-    for name in ("e_tf", "hold", "half_fraction", "min_e0", "e_rot_tf_deg", "rot_hold_deg", "min_e_rot0_deg"):
+    for name in ("e_tf", "hold", "half_fraction", "min_e0", "e_rot_tf_deg", "rot_hold_deg", "min_e_rot0_deg",
+                 "place_mm", "place_deg"):
         value = getattr(c, name)
         if not (math.isfinite(value) and value > 0.0):
             raise ValueError(f"criteria.{name}: must be > 0, got {value}")
@@ -129,6 +133,11 @@ def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str
     it; one ``Reason`` carrying its message)."""
     if metrics.get("failure"):
         return "failed", [Reason(None, "failed", metrics["failure"]["message"])]
+    if "picks" in metrics:  # a pick and place: its picks decide (pick.metrics)
+        from ptint_drake.pick.metrics import pick_reasons  # noqa: PLC0415
+
+        reasons = [Reason(None, code, f"pick {k}: {code}") for k, code in pick_reasons(metrics["picks"])]
+        return ("missed" if reasons else "ok"), reasons
     reasons = [Reason(i, code) for i, seg in enumerate(metrics["segments"])
                for code in segment_reasons(seg, criteria, margin)]
     return ("missed" if reasons else "ok"), reasons
@@ -210,7 +219,7 @@ def rotation_metrics(schedule, duration: float, t: np.ndarray, angle: Optional[n
 
 
 def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> dict:
-    """The metrics of a run (README "Outputs"): segments, torque and joint-speed peaks with
+    """The metrics of a run (docs/results.md): segments, torque and joint-speed peaks with
     their times, the peaks after start-up, and the fraction of time the actuators saturate.
 
     ``series`` holds ``t``, ``x`` (gripper point from the plant state), ``objects`` (true
@@ -218,31 +227,35 @@ def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> di
     """
     schedule = scenario.schedule()
     t = series["t"]
-    tau, applied = series["tau"], series["tau_applied"]
-    over = np.any(np.abs(tau) > limits * (1.0 + 1e-9), axis=1)
-    dt = np.diff(t, append=t[-1]) if len(t) else np.zeros(0)
-    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
-    steady = after_startup(t, schedule.segments)
-    torque, torque_late = _peak(applied, t), _peak(applied, t, steady)
-    speed = _peak(series["v"], t)
     segments = segment_metrics(schedule, scenario.duration, samples, t, series["x"], series["objects"])
     rotations = rotation_metrics(schedule, scenario.duration, t, series.get("rot_angle_deg"),
                                  series.get("rot_rate_deg_s"))
     for row, rot in zip(segments, rotations):
         row |= rot
+    return {"scenario": scenario.name, "duration": scenario.duration, "segments": segments} | drive_metrics(
+        schedule, t, series["tau"], series["tau_applied"], series["v"], limits) | {
+        # redundant arms: the start posture's offset in the null space of J at the end (rad)
+        "self_motion_final": float(series["self_motion"][-1]) if "self_motion" in series and len(t) else None}
+
+
+def drive_metrics(schedule, t: np.ndarray, tau: np.ndarray, applied: np.ndarray, v: np.ndarray,
+                  limits: np.ndarray) -> dict:
+    """The drives' side of a run: torque peaks (applied) with their times, the same after each
+    segment's start-up, the commanded peaks, joint-speed peaks, and the fraction of time any
+    commanded torque exceeds its limit (``saturated_fraction``)."""
+    over = np.any(np.abs(tau) > limits * (1.0 + 1e-9), axis=1)
+    dt = np.diff(t, append=t[-1]) if len(t) else np.zeros(0)
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    torque, torque_late = _peak(applied, t), _peak(applied, t, after_startup(t, schedule.segments))
+    speed = _peak(v, t)
     return {
-        "scenario": scenario.name,
-        "duration": scenario.duration,
-        "segments": segments,
         "torque_peak": torque["value"],
         "torque_peak_time": torque["time"],
         "torque_peak_after_startup": torque_late["value"],
         "torque_peak_after_startup_time": torque_late["time"],
         "torque_command_peak": np.max(np.abs(tau), axis=0).tolist() if len(t) else [],
         "joint_speed_peak": speed["value"],
-        "final_joint_speed": float(np.max(np.abs(series["v"][-1]))) if len(t) else 0.0,
-        # redundant arms: the start posture's offset in the null space of J at the end (rad)
-        "self_motion_final": float(series["self_motion"][-1]) if "self_motion" in series and len(t) else None,
+        "final_joint_speed": float(np.max(np.abs(v[-1]))) if len(t) else 0.0,
         "joint_speed_peak_time": speed["time"],
         "effort_limits": limits.tolist(),
         "saturated_fraction": float(np.sum(dt[over]) / span) if span > 0 else 0.0,

@@ -214,7 +214,7 @@ td,th{{border:1px solid #bbb;padding:3px 7px;font-size:90%}}img{{margin:4px}}</s
 <h1>Prescribed-time interception: paper reproduction</h1>
 <p>Flores-Campos et al., Robotics 2024, 13(10), 145, reproduced with Drake on the RV-M1 model of
 this package (paper gains K = 50, Λ = 5, k = 3, ϵ = δ = 1e-6). Errors in mm. "Intercepted" applies the
-prescribed-time property (README, Results): |e(tf)| ≤ 1 mm, |e(tf/2)| ≥ |e0|/4, |e| ≤ 3 mm while holding.
+prescribed-time property (docs/results.md): |e(tf)| ≤ 1 mm, |e(tf/2)| ≥ |e0|/4, |e| ≤ 3 mm while holding.
 "hold max" uses this package's s_d decay after tf (k_hold = 50 1/s); "hold, paper's s_d" the paper's
 own formula (k_hold = k = 3 1/s), shown for comparison (the verdict uses the package's).
 Peak |τ| after start-up leaves out the first 5 % of each segment's tf (at a segment start the object
@@ -228,11 +228,11 @@ Generated in {elapsed:.0f} s.</p>
 <h2>Controllers compared</h2><p>The paper's controller (ptsmc) against a task-space PID (pd), a
 first-order sliding mode without the TBG (smc) and a model-based quintic plan tracked by inverse
 dynamics of the nominal model, given the target's future (ct_quintic), on the nominal plant and with
-every mass × 0.7 and × 1.5 (README, Controllers compared).</p>{compared}
+every mass × 0.7 and × 1.5 (docs/controllers.md).</p>{compared}
 <h2>What a camera sees</h2><p>Beyond the paper: {CAMERA_SCENARIO} with a 30 Hz camera (2 mm noise,
 33 ms latency) and the adaptive estimator (auto) in the loop; the controller sees only the
 estimate. Top: estimate − truth around each tf; bottom: the gripper against the truth (the metric)
-and against the estimate (README, What a camera sees; <code>ptint study camera</code> for the
+and against the estimate (docs/camera.md; <code>ptint study camera</code> for the
 noise × latency × estimator study).</p><p><a href='camera/estimate.png'><img src='camera/estimate.png'
 width='900'></a></p>
 {''.join(sections)}

@@ -17,15 +17,20 @@ from pydrake.solvers import Solve
 from ptint_drake.scenario import Scenario, ScenarioError
 
 POSITION_TOLERANCE = 1e-3  # m, per axis
+DOWN_TOLERANCE = np.radians(2.0)  # rad, of a top-down tool axis
 
 
 def inverse_kinematics(plant: MultibodyPlant, frame, x: np.ndarray,
-                       guess: np.ndarray) -> Optional[np.ndarray]:
+                       guess: np.ndarray, down: bool = False) -> Optional[np.ndarray]:
     """Joint positions within the model's limits that put ``frame``'s origin within
-    ``POSITION_TOLERANCE`` of ``x`` (world), solved from ``guess``; None if none was found."""
+    ``POSITION_TOLERANCE`` of ``x`` (world), solved from ``guess``; None if none was found.
+    ``down``: with the frame's z axis within ``DOWN_TOLERANCE`` of straight down (a top-down grasp)."""
     ik = InverseKinematics(plant, with_joint_limits=True)
     ik.AddPositionConstraint(frame, np.zeros(3), plant.world_frame(),
                              x - POSITION_TOLERANCE, x + POSITION_TOLERANCE)
+    if down:
+        ik.AddAngleBetweenVectorsConstraint(frame, [0.0, 0.0, 1.0], plant.world_frame(), [0.0, 0.0, -1.0],
+                                            0.0, DOWN_TOLERANCE)
     ik.prog().SetInitialGuess(ik.q(), guess)
     result = Solve(ik.prog())
     return result.GetSolution(ik.q()) if result.is_success() else None

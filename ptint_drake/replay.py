@@ -111,6 +111,8 @@ def floor_extent(points: np.ndarray, margin: float = 0.15, step: float = 0.1):
 
 
 def draw_floor(meshcat: Meshcat, extent, step: float = 0.1) -> None:
+    """A floor plate over ``extent`` (x0, x1, y0, y1, m) just below z = 0 with grid lines every
+    ``step`` m, in place of Meshcat's own grid."""
     x0, x1, y0, y1 = extent
     meshcat.SetProperty("/Grid", "visible", False)
     meshcat.SetObject("floor/plate", Box(x1 - x0, y1 - y0, 0.004), FLOOR_COLOR)

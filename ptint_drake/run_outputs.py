@@ -19,7 +19,7 @@ import numpy as np
 
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.robot import resolve_model
-from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
+from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass, dump_yaml
 from ptint_drake.simulation import build, simulate
 
 
@@ -59,7 +59,9 @@ def run_metrics(scenario: Scenario, metrics: dict, figures: bool = True) -> dict
 
     metrics = dict(metrics)
     metrics["scenario_config"] = dump_dataclass(scenario)
-    if figures:
+    if figures and scenario.pick is not None:
+        metrics["figures"] = ["picks.png"]
+    elif figures:
         metrics["figures"] = [f"{s}.png" for s in RUN_FIGURES]
     return metrics
 
@@ -72,6 +74,15 @@ def view_task(name: str, series: dict, metrics: dict, stage: Path, title: str, r
     """One figure (``name`` in ``figures.RUN_FIGURES``, ``replay_args`` = (formats,)) or the
     replay (``name == "replay"``, ``replay_args`` = (model file, belts, end effector)),
     written in ``stage``; module-level, so that a worker process can run it."""
+    if name in ("picks", "pick_replay"):  # a pick and place (replay_args = (its YAML text,))
+        from ptint_drake.pick.views import pick_figure, write_pick_replay  # noqa: PLC0415
+        from ptint_drake.scenario import parse_scenario  # noqa: PLC0415
+
+        if name == "picks":
+            pick_figure(series, metrics, stage / "picks.png")
+        else:
+            write_pick_replay(parse_scenario(replay_args[0], title), series, stage / "replay.html")
+        return name
     if name == "replay":
         from ptint_drake.replay import write_replay  # noqa: PLC0415
 
@@ -88,6 +99,10 @@ def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, fig
                replay: bool = True, svg: bool = False) -> list[tuple]:
     """``view_task`` arguments for a run's figures (PNG, and SVG when ``svg``) and its
     ``replay.html``, written in ``stage``."""
+    if scenario.pick is not None:
+        names = [n for n, on in (("pick_replay", replay), ("picks", figures)) if on]
+        text = dump_yaml(scenario)  # picklable, for a worker process
+        return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
     formats = ("png", "svg") if svg else ("png",)
     replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
                    scenario.robot.end_effector)

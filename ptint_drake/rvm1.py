@@ -43,6 +43,7 @@ def model_path(name: str = "rvm1") -> Path:
 
 
 def bundled_models() -> list[str]:
+    """Names of the robot models shipped in ``ptint_drake.models`` (URDF file stems)."""
     return sorted(p.name[:-5] for p in _models_dir().iterdir() if p.name.endswith(".urdf"))
 
 

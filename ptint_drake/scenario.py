@@ -1,4 +1,4 @@
-"""Scenario files (README "Scenario files"): the typed schema and loading.
+"""Scenario files (docs/scenarios.md): the typed schema and loading.
 
 A scenario is one YAML mapping loaded with Drake's ``yaml_load_typed`` into
 ``Scenario``; unknown keys are rejected; the checks live in ``validation``, the
@@ -48,6 +48,7 @@ from pydrake.systems.analysis import SimulatorConfig
 
 from ptint_drake.controllers import REGISTRY, plugin
 from ptint_drake.metrics import Criteria
+from ptint_drake.pick.tasks import PickConfig, pick_plan
 from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
 from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.gains import ControllerGains
@@ -82,8 +83,7 @@ def _controller_config() -> type:
         ("type", str, field(default="ptsmc")),  # a name of controllers.REGISTRY, or "module:Class"
         ("implementation", str, field(default="fused")),  # ptsmc: "fused" one LeafSystem, or "blocks"
         ("params", Dict[str, ParamValue], field(default_factory=dict)),  # a plugin's settings
-        # s: > 0 runs the controller sampled, its torque held between samples (controllers.hold)
-        ("control_period", float, field(default=0.0)),
+        ("control_period", float, field(default=0.0)),  # s: > 0 sampled, torque held between samples
         *own], bases=(ControllerGains,), namespace={"__module__": __name__})
     cls.__doc__ = _controller_config.__doc__
     return cls
@@ -201,9 +201,15 @@ class Scenario:
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     simulator: SimulatorConfig = field(default_factory=_default_simulator)
     criteria: Criteria = field(default_factory=Criteria)
+    # a pick and place (``pick.tasks``): the world and the tasks, whose segments replace
+    # ``interceptions`` (None: an interception scenario)
+    pick: Optional[PickConfig] = None
     name: str = ""
 
     def schedule(self) -> Schedule:
+        """The interceptor's segments: ``interceptions``, or the pick tasks' (``pick_plan``)."""
+        if self.pick is not None:
+            return pick_plan(self.pick).schedule
         return Schedule([Segment(i.start, i.tf, i.beta) for i in self.interceptions])
 
     def targets(self) -> list:
@@ -232,6 +238,7 @@ def make_target(config: TargetConfig):
 
 
 def bundled_scenarios() -> "list[str]":
+    """Names of the scenarios shipped in ``ptint_drake/scenarios`` (``ptint list``)."""
     return sorted(p.name[:-5] for p in resources.files("ptint_drake.scenarios").iterdir()
                   if p.name.endswith(".yaml"))
 
@@ -251,6 +258,7 @@ def scenario_text(name_or_file: str) -> "tuple[str, str]":
 
 
 def load_scenario(name_or_file: str) -> Scenario:
+    """The validated ``Scenario`` of a bundled name or a YAML file (``ScenarioError`` if bad)."""
     name, text = scenario_text(name_or_file)
     return parse_scenario(text, name)
 

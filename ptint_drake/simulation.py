@@ -142,8 +142,13 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
 
     ``progress(t, duration, steps)`` is called while it runs; ``warn(message)`` is called for
     each warning known before the simulation starts, as soon as it is known.  A run
-    stopped by the divergence watchdog returns normally with ``status == "failed"``.
+    stopped by the divergence watchdog returns normally with ``status == "failed"``.  A pick
+    scenario (``pick``) runs through ``pick.run.simulate_pick``.
     """
+    if scenario.pick is not None:
+        from ptint_drake.pick.run import simulate_pick  # noqa: PLC0415
+
+        return simulate_pick(scenario, check, progress, warn)
     built = build(scenario)
     warnings = pre_run_warnings(built, scenario) if check else []
     for message in warnings if warn is not None else ():

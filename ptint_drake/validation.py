@@ -55,6 +55,9 @@ def validate(s) -> None:
         _positive(getattr(s.limits, name), f"limits.{name}")
     _nonnegative(s.limits.singular_value_warning, "limits.singular_value_warning")
     _validate_simulator(s.simulator)
+    if s.pick is not None:
+        _validate_pick(s)
+        return
     if not s.interceptions:
         raise ScenarioError("interceptions: at least one interception is needed")
     for i, ic in enumerate(s.interceptions):
@@ -120,6 +123,25 @@ def _validate_plant(p) -> None:
         if not all(math.isfinite(v) for v in getattr(d, name)):
             raise ScenarioError(f"plant.disturbance.{name}: must be finite")
     _positive(d.frequency_hz, "plant.disturbance.frequency_hz")
+
+
+def _validate_pick(s) -> None:
+    """A pick and place: its segments come from ``pick.tasks`` (no ``interceptions``), grasped from
+    above (``controller.task: top_down``) under sampled control; the world and the tasks
+    (``pick.config.check_pick_world``, ``pick.tasks.check_tasks``)."""
+    from ptint_drake.pick.config import check_pick_parts  # noqa: PLC0415  (pick imports this module)
+    from ptint_drake.pick.tasks import check_tasks  # noqa: PLC0415
+
+    if s.interceptions:
+        raise ScenarioError("interceptions: a pick scenario's segments come from pick.tasks; leave "
+                            "interceptions out")
+    if s.controller.task != "top_down":
+        raise ScenarioError(f"controller.task: a pick grasps from above: top_down, got {s.controller.task!r}")
+    if not s.controller.control_period > 0.0:
+        raise ScenarioError("controller.control_period: a pick runs on a discrete plant with contact and "
+                            "needs sampled control: set it > 0 (e.g. 0.001)")
+    check_pick_parts(s.pick)
+    check_tasks(s.pick)
 
 
 def _validate_multibody(m, control_period: float) -> None:

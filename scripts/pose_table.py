@@ -1,11 +1,12 @@
-"""The README's table for intercepting a pose (issue 19): ``conveyor_yaw`` on the nominal plant
+"""The table of the documentation page on intercepting a pose (docs/pose.md, issue 19):
+``conveyor_yaw`` on the nominal plant
 and with every link's mass × 0.7 and × 1.5 — distance and angle at tf/2, at tf and the hold's
 largest, per segment.
 
     .venv/bin/python scripts/pose_table.py              # runs the three variants (~6 min, 2 at a time)
     .venv/bin/python scripts/pose_table.py --runs DIR   # reads DIR/<variant>/metrics.json instead
 
-The table is replaced in README.md between ``<!-- BEGIN pose -->`` and ``<!-- END pose -->``.
+The table is replaced in docs/pose.md between ``<!-- BEGIN pose -->`` and ``<!-- END pose -->``.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-README = ROOT / "README.md"
+PAGE = ROOT / "docs" / "pose.md"
 VARIANTS = {"nominal": [], "mass ×0.7": ["--set", "plant.mass_scale=0.7"],
             "mass ×1.5": ["--set", "plant.mass_scale=1.5"]}
 
@@ -64,9 +65,9 @@ def main() -> int:
         results = {v: f.result() for v, f in done.items()}
     text = table(results)
     print(text)
-    readme = README.read_text()
+    page = PAGE.read_text()
     block = f"<!-- BEGIN pose -->\n{text}\n<!-- END pose -->"
-    README.write_text(re.sub(r"<!-- BEGIN pose -->.*?<!-- END pose -->", lambda _: block, readme, flags=re.S))
+    PAGE.write_text(re.sub(r"<!-- BEGIN pose -->.*?<!-- END pose -->", lambda _: block, page, flags=re.S))
     return 0
 
 

@@ -1,10 +1,12 @@
-"""Regenerate the README's tables from the commands that produce them.
+"""Regenerate the tables of the README and the documentation pages from the commands behind them.
 
     .venv/bin/python scripts/readme_tables.py            # results + controllers compared (~1 min)
     .venv/bin/python scripts/readme_tables.py --all      # also tuning and the camera study (~8 min)
 
-Each table sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->`` in README.md and
-is replaced in place, with the command and the machine it was measured on.  Timings (realtime
+Each table sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->`` in README.md and/or
+the pages of docs/ (``results`` in both; the others in docs/results.md, controllers.md,
+own_controller.md, own_arm.md, camera.md) and is replaced in place in every file that has it,
+with the command and the machine it was measured on.  Timings (realtime
 factors, study wall times) depend on the machine; errors and verdicts do not (the runs are
 deterministic).
 """
@@ -23,6 +25,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
+PAGES = [README, *sorted((ROOT / "docs").glob("*.md"))]  # the files whose tables are filled in
 PAPER = ("curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12", "curve_b075_tf19",
          "assembly")
 
@@ -133,11 +136,14 @@ def camera_table(workers: int) -> str:
         f"\n`ptint study camera --workers {workers}`: {data['wall_time_s']:.0f} s on {machine()}.\n")
 
 
-def replace(text: str, name: str, table: str) -> str:
+def replace(texts: dict, name: str, table: str) -> dict:
+    """``texts`` (path → text) with the block ``name`` replaced by ``table`` wherever it is."""
     pattern = re.compile(rf"(<!-- BEGIN {name} -->\n).*?(<!-- END {name} -->)", re.S)
-    if not pattern.search(text):
-        raise SystemExit(f"README.md has no <!-- BEGIN {name} --> … <!-- END {name} --> block")
-    return pattern.sub(lambda m: m.group(1) + table + m.group(2), text)
+    found = [path for path, text in texts.items() if pattern.search(text)]
+    if not found:
+        raise SystemExit(f"no <!-- BEGIN {name} --> … <!-- END {name} --> block in README.md or docs/*.md")
+    return {path: pattern.sub(lambda m: m.group(1) + table + m.group(2), text) if path in found else text
+            for path, text in texts.items()}
 
 
 def main() -> None:
@@ -145,20 +151,22 @@ def main() -> None:
     parser.add_argument("--all", action="store_true", help="also the tuning and camera tables (slow)")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    text = README.read_text()
+    text = {path: path.read_text() for path in PAGES}
     text = replace(text, "results", results_table())
     for name in ("curve_b075_tf15", "assembly"):
         text = replace(text, f"compare_{name}", compare_table(name, args.workers))
     from ptint_drake.controllers import plugin  # noqa: PLC0415
 
-    plugin.remember_folder(ROOT / "examples")  # the README's plugin example
+    plugin.remember_folder(ROOT / "examples")  # docs/own_controller.md's plugin example
     text = replace(text, "compare_plugin", compare_table(
         "curve_b075_tf15", args.workers, ["ptsmc", "task_space_pd:TaskSpacePD"]))
     if args.all:
         text = replace(text, "tune", tune_table(args.workers))
         text = replace(text, "camera", camera_table(args.workers))
-    README.write_text(text)
-    print(f"README.md tables regenerated on {machine()}")
+    for path, content in text.items():
+        if content != path.read_text():
+            path.write_text(content)
+    print(f"README.md and docs/ tables regenerated on {machine()}")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Install everything ptint_drake needs on a fresh Debian machine, idempotently:
 #   system tools: graphviz (`ptint diagram`), chromium (the replay browser test)
-#   a virtual environment (default .venv) with the package and its test and cluster (Dask) extras.
+#   a virtual environment (default .venv) with the package and its test, docs (the Sphinx site:
+#   .venv/bin/sphinx-build -W -b html docs docs/_build/html) and cluster (Dask) extras.
 #
 # Python: the newest Python >= 3.10 found that has a Drake wheel on the package index
 # (python3.14 ... python3.10 and python3 on PATH, then ~/.pyenv/versions/*/bin/python), so a
@@ -72,10 +73,10 @@ fi
 "$VENV/bin/python" -m pip install -q --upgrade pip 2>&1 | quiet_pip
 drake=${DRAKE:-drake}
 if [ "${PTINT_EDITABLE:-0}" = 1 ]; then
-  "$VENV/bin/python" -m pip install -q -e ".[test,cluster]" "$drake" 2>&1 | quiet_pip
+  "$VENV/bin/python" -m pip install -q -e ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
 else
   "$VENV/bin/python" -m pip install -q --force-reinstall --no-deps . 2>&1 | quiet_pip
-  "$VENV/bin/python" -m pip install -q ".[test,cluster]" "$drake" 2>&1 | quiet_pip
+  "$VENV/bin/python" -m pip install -q ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
 fi
 # without DRAKE=, bring an existing environment up to the newest Drake its Python admits
 [ -n "${DRAKE:-}" ] || "$VENV/bin/python" -m pip install -q --upgrade --upgrade-strategy only-if-needed \

@@ -25,7 +25,8 @@ from ptint_drake.controllers.slot import (ControllerHandles, ControllerSlot, Tar
                                           target_view, uses_analytic_targets)
 
 __all__ = ["REGISTRY", "CONTROLLERS", "ControllerType", "ControllerHandles", "ControllerSlot",
-           "TargetView", "AddController", "check_controller", "controller_targets", "target_view",
+           "TargetView", "AddController", "AddControllerTo", "check_controller", "controller_targets",
+           "target_view",
            "uses_analytic_targets", "describe", "known_type"]
 
 
@@ -82,15 +83,23 @@ def AddController(builder: DiagramBuilder, station_system, station, scenario) ->
     """Add ``scenario.controller.type`` to ``builder`` and wire it to the station's ports, through
     the drive's zero-order hold when ``controller.control_period`` > 0 (``hold``)."""
     plant = station.plant
-    frame = plant.GetFrameByName(scenario.robot.end_effector)
+    return AddControllerTo(builder, plant=plant, frame=plant.GetFrameByName(scenario.robot.end_effector),
+                           schedule=scenario.schedule(), state=station_system.GetOutputPort("state"),
+                           actuation=station_system.GetInputPort("actuation"), scenario=scenario,
+                           target=TargetView(builder, station_system, scenario))
+
+
+def AddControllerTo(builder: DiagramBuilder, *, plant, frame, schedule, state, actuation, scenario,
+                    target: TargetView) -> ControllerHandles:
+    """Add ``scenario.controller.type`` between the ports ``state`` (the arm's [q; v]) and
+    ``actuation`` (its torques, through the drive's hold when sampled), aiming at ``target``;
+    ``plant`` and ``frame``: the arm's kinematics and end effector (``AddController`` for the
+    interception station, ``pick.run`` for the pick-and-place one)."""
     block = scenario.controller
-    actuation = station_system.GetInputPort("actuation")
     held = AddActuationHold(builder, actuation, block.control_period) if block.control_period > 0 else None
-    slot = ControllerSlot(builder=builder, plant=plant, frame=frame,
-                          schedule=scenario.schedule(), state=station_system.GetOutputPort("state"),
+    slot = ControllerSlot(builder=builder, plant=plant, frame=frame, schedule=schedule, state=state,
                           actuation=held.get_input_port() if held is not None else actuation,
                           initial_q=np.radians(scenario.robot.initial_q_deg), scenario=scenario)
-    target = TargetView(builder, station_system, scenario)
     entry = REGISTRY.get(block.type)
     if entry is None:
         handles = plugin.AddPlugin(slot, block.params, target, block.type)
@@ -98,4 +107,3 @@ def AddController(builder: DiagramBuilder, station_system, station, scenario) ->
         handles = entry.add(slot, entry.settings_of(block), target)
         handles.model_based = entry.model_based
     return handles if held is None else held_telemetry(handles, held, plant.MakeActuationMatrix())
-

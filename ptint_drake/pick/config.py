@@ -157,6 +157,12 @@ def check_pick_world(config: PickWorldConfig) -> None:
     if config.contact_model not in CONTACT_MODELS:
         raise ScenarioError(f"pick.contact_model: {config.contact_model!r} is not one of "
                             f"{', '.join(CONTACT_MODELS)}")
+    check_pick_parts(config)
+
+
+def check_pick_parts(config) -> None:
+    """ScenarioError naming the first bad field of the gripper, belts, parts and tray of ``config``
+    (a ``PickWorldConfig`` or the scenario's ``pick`` block)."""
     g = config.gripper
     if min(g.max_force, g.speed, g.kp) <= 0.0 or g.kd < 0.0:
         raise ScenarioError("pick.gripper: max_force, speed and kp must be positive, kd non-negative")

@@ -26,6 +26,7 @@ port                size     meaning
                              gripper's net actuation after the force limit
 ``contact_results`` —        output: the plant's ContactResults (finger–part forces for metrics)
 ``body_poses``      —        output: the plant's body poses (for logging parts, belts, fingers)
+``plant_state``     —        output: the whole plant's [q; v] (arm, fingers, belts, parts: a replay)
 ``query_object``    —        output: SceneGraph's QueryObject (Meshcat / replay illustration)
 ==================  =======  ================================================================
 
@@ -139,6 +140,7 @@ def MakePickStation(config: PickWorldConfig) -> PickStation:
     driver = builder.AddNamedSystem("gripper_driver", GripperDriver(
         gripper_stroke(plant, gripper), g.speed, g.max_force, g.kp, g.initial_opening, config.time_step))
     builder.Connect(driver.GetOutputPort("desired_state"), plant.get_desired_state_input_port(gripper))
+    builder.Connect(plant.get_state_output_port(gripper), driver.GetInputPort("finger_state"))
     for joint, belt in zip(belts, config.belts):
         source = builder.AddNamedSystem(f"{belt.name}_speed", ConstantVectorSource([0.0, belt.speed]))
         builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(joint.model_instance()))
@@ -156,6 +158,7 @@ def MakePickStation(config: PickWorldConfig) -> PickStation:
     builder.ExportOutput(plant.get_net_actuation_output_port(gripper), "grip_force")
     builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
     builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
+    builder.ExportOutput(plant.get_state_output_port(), "plant_state")
     builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
     diagram = builder.Build()
     diagram.set_name("pick_station")

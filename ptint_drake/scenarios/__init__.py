@@ -1,0 +1,1 @@
+"""The bundled scenario files (``*.yaml``; ``ptint list``, ``scenario.bundled_scenarios``)."""

@@ -46,6 +46,8 @@ def _run(name: str, overrides: str) -> dict:
 
 def benchmark(names=None, configs=("default", "blocks", "sign"), reference: bool = True,
               progress=None) -> dict:
+    """Time every bundled scenario (or ``names``) in each of ``configs`` (default, blocks,
+    sign) against a tight reference run; the JSON ``ptint bench`` prints."""
     names = list(names or bundled_scenarios())
     out = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
                        "cpus": __import__("os").cpu_count()},
@@ -305,6 +307,8 @@ def _studies(args, say) -> dict:
 
 
 def main(argv=None) -> int:
+    """``ptint bench ARGS``: parse ``argv`` with the benchmark's parser, print the JSON; the exit
+    code."""
     parser = _parser()
     args = parser.parse_args(argv)
     if args.repeats < 1:

@@ -109,6 +109,8 @@ def summarize(rows: list) -> dict:
 
 def grid_cases(text: str, name: str, seeds: int, noises=NOISES, latencies=LATENCIES,
                estimators=ESTIMATORS) -> list:
+    """The study's runs: one (text, name, measurement mapping, seed) case per estimator × noise ×
+    latency and seed."""
     cases = []
     for estimator in estimators:
         for noise in noises:
@@ -122,6 +124,7 @@ def grid_cases(text: str, name: str, seeds: int, noises=NOISES, latencies=LATENC
 
 
 def markdown(summary_rows: list, seeds: int, scenario: str) -> str:
+    """camera_study.md: the summary rows as a Markdown table with its heading and legend."""
     lines = [f"# Camera study: {scenario}, {seeds} seeds",
              "",
              "|e(tf)| against the true target over every segment of every seed (mm); hold = the "
@@ -182,6 +185,8 @@ def estimate_figure(text: str, name: str, out_dir: Path, window: float = 0.3) ->
 
 def run_study(seeds: int = DEFAULT_SEEDS, workers: int = 2, out: Path = Path("out/study_camera"),
               scenario: str = SCENARIO, progress=None) -> dict:
+    """``ptint study camera``: every grid case on ``workers`` processes, summarized per estimator
+    × noise × latency, written to ``out``; camera_study.json's content."""
     name, text = scenario_text(scenario)
     base = parse_scenario(text, name)  # validates before any worker starts
     t0 = time.perf_counter()

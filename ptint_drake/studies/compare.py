@@ -129,6 +129,7 @@ def table_rows(result: dict) -> list[dict]:
 
 
 def to_csv(result: dict) -> str:
+    """compare.csv: one row per controller × variant × segment (``table_rows``)."""
     rows = table_rows(result)
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=list(rows[0]) if rows else ["controller"])
@@ -198,6 +199,7 @@ def write_compare(result: dict, out_dir: Path) -> None:
 
 
 def summary_line(result: dict) -> str:
+    """The one line ``ptint compare`` prints: runs, wall time, how many meet the criteria."""
     rows = result["rows"]
     missed = [f"{r['controller']}/{r['variant']}" for r in rows if not r["ok"]]
     return (f"{len(rows)} runs in {result['wall_time_s']:.0f} s, {len(rows) - len(missed)} meet the "

@@ -16,6 +16,13 @@ Default ranges (uniform; ``--set``-style overrides through ``RANGES`` keys):
 | disturbance | [0, 0.5] N·m per joint | sine (0.5–3 Hz, random phase) + a step of ± that at a random t |
 | noise | [0, 1e-4] m | the camera's noise std (``measurement.noise_std``) |
 | latency | [0, 0] s | the camera's latency (compensated by the estimator) |
+| part_mass | [0.05, 0.3] kg | every part's mass (pick scenarios) |
+| part_friction | [0.5, 1.0] | every part's friction coefficient (pick scenarios) |
+| belt_speed | ×[0.8, 1.2] | every belt's speed (pick scenarios; the plan is not told) |
+
+A pick scenario (``pick``) draws ``mass`` and the three pick ranges only (its plant takes no
+other deviation; the part in the hand is the payload) and is judged by its picks: robust.json
+adds ``pick_success_rate`` (placed parts / all parts) and ``failures_by_reason``.
 
 The target is seen through a camera with ``estimator: auto`` (the scenario's own camera,
 or a 30 Hz one) unless both the noise and the latency ranges are [0, 0] (then the
@@ -43,6 +50,9 @@ RANGES = {
     "disturbance": (0.0, 0.5),
     "noise": (0.0, 1e-4),
     "latency": (0.0, 0.0),
+    "part_mass": (0.05, 0.3),
+    "part_friction": (0.5, 1.0),
+    "belt_speed": (0.8, 1.2),
 }
 
 
@@ -51,6 +61,8 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     scenario = parse_scenario(text, name)
     rng = np.random.default_rng(seed)
     u = lambda key, size=None: rng.uniform(*ranges[key], size)  # noqa: E731
+    if scenario.pick is not None:
+        return _pick_sample(scenario, name, seed, u)
     nv = len(scenario.robot.initial_q_deg)
     p = scenario.plant
     p.mass_scale = float(u("mass"))
@@ -76,6 +88,20 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     return scenario, params
 
 
+def _pick_sample(scenario, name: str, seed: int, u):
+    """A pick scenario's sample: link masses, every part's mass and friction, every belt's speed."""
+    scenario.plant.mass_scale = float(u("mass"))
+    pick = scenario.pick
+    for part in pick.parts:
+        part.mass, part.friction = float(u("part_mass")), float(u("part_friction"))
+    for belt in pick.belts:
+        belt.speed *= float(u("belt_speed"))
+    scenario.name = f"{name}_seed{seed}"
+    return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
+                      "part_friction": [p.friction for p in pick.parts],
+                      "belt_speed": [b.speed for b in pick.belts]}
+
+
 def _camera(scenario, ranges: dict):
     """The sample's camera (``estimator: auto``; the scenario's own if it has one), or None
     when the noise and latency ranges are both [0, 0]."""
@@ -87,6 +113,8 @@ def _camera(scenario, ranges: dict):
 
 
 def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dict:
+    """One Monte Carlo sample: the scenario drawn from ``seed`` within ``ranges``, simulated;
+    its parameters, metrics and verdict (a failed run is a result too)."""
     scenario, params = sample_scenario(text, name, seed, ranges)
     try:
         result = simulate(scenario)
@@ -94,6 +122,14 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
         return {"seed": seed, "params": params, "ok": False, "error": " ".join(str(exc).split())[:300]}
     m = result.metrics
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
+    if "picks" in m:
+        return {"seed": seed, "params": params, "ok": m["status"] == "ok", "status": m["status"],
+                "e_tf": e_tf,
+                "e_tf_max": max((v for v in e_tf if v is not None), default=None),
+                "picks": [{k: p[k] for k in ("part", "grasped", "placed", "place_error_mm", "place_error_deg",
+                                             "slip_mm", "t_grasp", "collision")} for p in m["picks"]],
+                "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
+                "warnings": m["warnings"]}
     return {
         "seed": seed, "params": params,
         "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
@@ -131,7 +167,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                      workers=workers or (None if executor or dask else 1), dask=dask,
                      executor=executor, progress=report, stats=stats)
     wall = time.perf_counter() - t0
-    finished = [r for r in rows if r.get("e_tf_max") is not None]
+    finished = [r for r in rows if r.get("e_tf_max") is not None and "torque_peak" in r]
     failed_first = sorted(rows, key=lambda r: (r["ok"], -(r.get("e_tf_max") or np.inf)))
     worst = failed_first[0]
     worst_scenario, _ = sample_scenario(text, name, worst["seed"], ranges)
@@ -159,15 +195,34 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                           "last": stats["worker_rss_mb_by_task"][-1]},
         "rows": rows,
         "worst_yaml": dump_yaml(worst_scenario),
-    }
+    } | _pick_summary(rows)
+
+
+def _pick_summary(rows: list) -> dict:
+    """``pick_success_rate`` (placed parts over all parts; a sample that could not run places none)
+    and ``failures_by_reason`` ({reason code: count}) of a pick study; {} otherwise."""
+    if not any("picks" in r for r in rows):
+        return {}
+    per_sample = [len(r["picks"]) for r in rows if "picks" in r]
+    parts = max(per_sample) if per_sample else 0
+    placed = sum(p["placed"] for r in rows for p in r.get("picks", []))
+    reasons = {}
+    for r in rows:
+        for reason in r.get("reasons", []) or ([f"error: {r['error']}"] if r.get("error") else []):
+            code = reason.split(": ", 1)[-1] if reason.startswith("pick ") else reason
+            reasons[code] = reasons.get(code, 0) + 1
+    return {"pick_success_rate": placed / (parts * len(rows)) if parts else 0.0,
+            "failures_by_reason": reasons}
 
 
 def histogram(result: dict, out_dir: Path) -> None:
     """|e(tf)| (log axis) and peak torque over the samples: integer counts, the 1 mm line
-    (README, Results), and how many samples intercepted, missed or failed."""
+    (docs/results.md), and how many samples intercepted, missed or failed."""
     from matplotlib.ticker import MaxNLocator  # noqa: PLC0415
 
-    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None]
+    if "pick_success_rate" in result:
+        return _pick_histogram(result, out_dir)
+    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None and "torque_peak" in r]
     n, n_ok = result["samples"], sum(1 for r in result["rows"] if r["ok"])
     n_failed = n - len(rows)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
@@ -196,6 +251,23 @@ def histogram(result: dict, out_dir: Path) -> None:
     failed = f", {n_failed} failed before the end" if n_failed else ""
     fig.suptitle(f"{result['scenario']}: {n_ok} of {n} samples intercepted "
                  f"({100 * result['success_rate']:.1f} %){failed}")
+    save(fig, out_dir, "robust")
+
+
+def _pick_histogram(result: dict, out_dir: Path) -> None:
+    """A pick study's figure: every part's place error (mm and deg) over the samples."""
+    picks = [p for r in result["rows"] for p in r.get("picks", [])]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
+    for ax, key, label in ((axes[0], "place_error_mm", "place error [mm]"),
+                           (axes[1], "place_error_deg", "place error [deg]")):
+        values = [min(p[key], 50.0) for p in picks]
+        if values:
+            ax.hist(values, bins=int(np.clip(2 * np.sqrt(len(values)), 5, 30)), edgecolor="white")
+        ax.axvline(3.0, color="r", ls="--")
+        ax.set_xlabel(label + " (clipped at 50)")
+        ax.set_ylabel("parts")
+    fig.suptitle(f"{result['scenario']}: {100 * result['pick_success_rate']:.1f} % of "
+                 f"{len(picks)} parts placed over {result['samples']} samples")
     save(fig, out_dir, "robust")
 
 

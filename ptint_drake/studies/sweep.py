@@ -6,6 +6,11 @@ replaced, run by a worker that builds its own diagram from the scenario *text*
 worker processes (default), a Dask scheduler (``dask=ADDRESS``) or any
 ``concurrent.futures.Executor``.  When a point makes the last interception fall after
 the scenario's end, the duration is extended to the last start + 2 tf.
+
+A pick scenario (``pick``): β of every segment of every task, and tf of each task's
+``approach`` (the interception of the moving part; the later segments move with it), the
+duration extended to the plan's end + 0.5 s; ``e_tf`` is the largest over the segments and a
+point is ``ok`` when every part is placed.
 """
 
 from __future__ import annotations
@@ -33,6 +38,8 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
     row = {"beta": beta, "tf": tf, "error": ""}
     try:
         scenario = parse_scenario(text, name)
+        if scenario.pick is not None:
+            return _pick_point(row, scenario, beta, tf)
         for ic in scenario.interceptions:
             ic.beta, ic.tf = beta, tf
         last = scenario.interceptions[-1]
@@ -61,6 +68,29 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
     return row
 
 
+def _pick_point(row: dict, scenario, beta: float, tf: float) -> dict:
+    """A pick scenario's grid point (module docstring)."""
+    from ptint_drake.pick.tasks import PHASES, pick_plan  # noqa: PLC0415
+
+    for task in scenario.pick.tasks:
+        for phase in PHASES:
+            getattr(task, phase).beta = beta
+        task.approach.tf = tf
+    try:
+        validate(scenario)
+        scenario.duration = max(scenario.duration, pick_plan(scenario.pick).end + 0.5)
+        result = simulate(scenario)
+    except (ScenarioError, RuntimeError) as exc:
+        return row | {"error": " ".join(str(exc).split())[:200], "ok": False}
+    m = result.metrics
+    e_tf = [s["e_tf_norm"] for s in m["segments"] if s["e_tf_norm"] is not None]
+    return row | {"e0": max((s["e0_norm"] or 0.0) for s in m["segments"]), "e_tf": max(e_tf, default=None),
+                  "peak_torque": float(np.max(m["torque_peak"])),
+                  "peak_torque_after_startup": float(np.max(m["torque_peak_after_startup"])),
+                  "realtime_factor": m["sim"]["realtime_factor"], "steps": m["sim"]["steps"],
+                  "ok": m["status"] == "ok"}
+
+
 def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, workers: int = None,
               progress=None, dask: str = None) -> list[dict]:
     """Rows for the grid betas × tfs of the scenario ``loaded``, in grid order (the workers
@@ -74,6 +104,7 @@ def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, wor
 
 
 def write_csv(rows, path: Path) -> None:
+    """sweep.csv (``COLUMNS``) written to a temporary file and moved to ``path``."""
     tmp = Path(path).with_suffix(".csv.tmp")
     with open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS)
@@ -125,7 +156,7 @@ def _metric_map(fig, ax, grid: np.ndarray, label: str, betas, tfs, fontsize: int
 
 def heatmaps(rows, betas, tfs, out_dir: Path, title: str) -> list[str]:
     """One heat map per metric over (tf, β), plus a map of which points intercepted (the
-    run's verdict, README: Results); returns the stems written.  The torque map shows the
+    run's verdict, docs/results.md); returns the stems written.  The torque map shows the
     peak after start-up (the first 5 % of tf, where the first step dominates, left out)."""
     from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: PLC0415
 

@@ -21,6 +21,8 @@ A task sequencer closes the fingers at a prescribed time by switching ``command`
 port               size  meaning
 =================  ====  =================================================================
 ``command``        1     input: wanted opening (m); ≤ 0: close with the force limit
+``finger_state``   4     input: the fingers' [q_left, q_right, v_left, v_right] (m, m/s): when
+                         opening, a reference behind a finger (stalled on a part) starts from it
 ``desired_state``  4     output: [q_d_left, q_d_right, v_d_left, v_d_right] (m, m/s): the
                          gripper model instance's desired-state input
 =================  ====  =================================================================
@@ -31,7 +33,6 @@ Discrete state ``reference`` = [q_d_left, q_d_right, v_d_left, v_d_right], updat
 
 from __future__ import annotations
 
-import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 CLOSE_MARGIN = 1.5  # the closing reference lies this many force-limit deflections behind the centre
@@ -47,6 +48,7 @@ class GripperDriver(LeafSystem):
         self._closed = -CLOSE_MARGIN * max_force / kp
         q0 = initial_opening / 2
         self.DeclareVectorInputPort("command", 1)
+        self._fingers = self.DeclareVectorInputPort("finger_state", 4)
         self._reference = self.DeclareDiscreteState(BasicVector([q0, q0, 0.0, 0.0]))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         self.DeclareStateOutputPort("desired_state", self._reference)
@@ -58,8 +60,17 @@ class GripperDriver(LeafSystem):
         return min(command, 2 * self._half_stroke) / 2
 
     def _update(self, context, state):
-        q = context.get_discrete_state(self._reference).get_value()[:2]
+        # plain floats: this runs every millisecond (numpy's small-array calls cost ~10× more)
+        q = context.get_discrete_state(self._reference).get_value()
         goal = self.goal(float(self.get_input_port(0).Eval(context)[0]))
-        q_next = q + np.clip(goal - q, -self._step, self._step)
-        state.get_mutable_vector(self._reference).SetFromVector(
-            np.concatenate([q_next, (q_next - q) / self._period]))
+        fingers = self._fingers.Eval(context)
+        out = [0.0, 0.0, 0.0, 0.0]
+        for i in (0, 1):
+            qi = float(q[i])
+            # a drive that stalled on a part opens from where its fingers are, not from its
+            # reference deep behind them (which would keep squeezing while it travels back)
+            if goal > qi:
+                qi = max(qi, float(fingers[i]))
+            step = min(max(goal - qi, -self._step), self._step)
+            out[i], out[2 + i] = qi + step, step / self._period
+        state.get_mutable_vector(self._reference).SetFromVector(out)

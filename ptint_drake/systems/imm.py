@@ -33,7 +33,7 @@ Output ``target`` (9) = [p̂ + v̂Δt + âΔt²/2, v̂ + âΔt, â] of the combi
 
 Why these models and constants (chosen by measurement: open loop on camera samples of the
 bundled motions, the filter floor of ``study camera --filter-floor``, and closed loop over
-seeds 1–10 at 2 mm / 30 Hz / 33 ms; the README's camera section has the tables).  The hand-set
+seeds 1–10 at 2 mm / 30 Hz / 33 ms; docs/camera.md has the tables).  The hand-set
 scenarios needed one q per motion (1e-6 on belts, 3e-4 on a speed-up, 0.03 on the curve);
 an IMM runs such models side by side and weighs them by how well each predicted the last
 sample.  Measured against the best hand-set filter of each motion (median over seeds of

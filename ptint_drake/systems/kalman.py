@@ -70,7 +70,7 @@ tuning (what the interceptor tolerates) is left to the scenarios.
 
 The best hand-set q per motion (30 Hz, 2 mm, 33 ms compensated), closed loop over seeds
 1–10 — what the camera scenarios used before ``estimator: auto`` (``imm``) made tuning
-unnecessary, and the hand-set rows the README compares ``auto`` with (steady-state per-axis
+unnecessary, and the hand-set rows docs/camera.md compares ``auto`` with (steady-state per-axis
 position std from the DARE):
 
 - constant-speed conveyors, ``kalman_cv`` q = 1e-6 m²/s³ (the belt speed may wander

@@ -44,7 +44,7 @@ def test_help_of_every_subcommand_exits_0(command, ptint_here):
     out = ptint_here(*([command] if command else []), "--help")
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith("usage: ptint"), out.stdout[:200]
-    assert "SPEC" not in out.stdout  # users get the README and the paper, not SPEC
+    assert "SPEC" not in out.stdout  # users get the docs and the paper, not SPEC
 
 
 def test_help_as_a_command_exits_0():

@@ -1,6 +1,6 @@
 """A user's own controller in the slot: ``controller: {type: "module:Class", params: {...}}``.
 
-The README's example plugin (``examples/task_space_pd.py``) runs through ``ptint run`` and
+The example plugin of docs/own_controller.md (``examples/task_space_pd.py``) runs through ``ptint run`` and
 ``ptint compare`` from a folder of its own; broken plugins are one line and exit 2; a plugin
 that raises while simulating fails its run, nothing else.
 """

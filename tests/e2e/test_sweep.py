@@ -42,7 +42,7 @@ def test_run_sweep_with_a_process_pool_keeps_grid_order():
         rows = run_sweep(LoadedScenario.parse(TEXT, NAME), [0.5, 0.75], [1.5], executor=pool)
     assert [(r["beta"], r["tf"]) for r in rows] == [(0.5, 1.5), (0.75, 1.5)]
     assert all(r["ok"] for r in rows)
-    # β changes the run: β = 0.75 has a larger e(tf) than β = 0.5 at the same tf (see README)
+    # β changes the run: β = 0.75 has a larger e(tf) than β = 0.5 at the same tf (see docs/results.md)
     assert rows[1]["e_tf"] > rows[0]["e_tf"]
 
 

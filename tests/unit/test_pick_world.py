@@ -79,6 +79,7 @@ def test_gripper_driver_closes_at_its_speed_and_past_the_centre():
     driver = GripperDriver(stroke=0.06, speed=0.05, max_force=30.0, kp=20000.0, initial_opening=0.06)
     context = driver.CreateDefaultContext()
     driver.get_input_port(0).FixValue(context, [0.0])
+    driver.GetInputPort("finger_state").FixValue(context, [0.014, 0.014, 0.0, 0.0])  # stalled on a part
     simulator = Simulator(driver, context)
     simulator.AdvanceTo(0.1)
     ref = driver.GetOutputPort("desired_state").Eval(context)
@@ -86,6 +87,11 @@ def test_gripper_driver_closes_at_its_speed_and_past_the_centre():
     simulator.AdvanceTo(1.0)
     np.testing.assert_allclose(driver.GetOutputPort("desired_state").Eval(context),
                                [-1.5 * 30.0 / 20000.0] * 2 + [0.0, 0.0], atol=1e-12)
+    # opening again: the reference starts from the stalled fingers, not from deep behind them
+    driver.get_input_port(0).FixValue(context, [0.04])
+    simulator.AdvanceTo(1.001)
+    np.testing.assert_allclose(driver.GetOutputPort("desired_state").Eval(context)[:2], [0.014 + 5e-5] * 2,
+                               atol=1e-9)
 
 
 def test_config_loads_from_yaml():

@@ -1,0 +1,137 @@
+"""What the interceptor aims at during a pick and place, and when the fingers close and open.
+
+``PickTargets`` — the target of the active segment of a ``pick.tasks.PickPlan``, in the layout of
+the station's ``target`` and ``target_rotation`` ports, so any controller of the slot chases it:
+
+=====================  ====  ================================================================
+port                   size  meaning
+=====================  ====  ================================================================
+``part_k_pose``        9     input: part k's simulated [x, ẋ, ẍ] (``pick.part_pose``)
+``part_k_rotation``    15    input: part k's [R, ω, ω̇]
+``target``             9     output: [x_r, ẋ_r, ẍ_r] of the active segment (m, m/s, m/s²)
+``target_rotation``    15    output: [R_r, ω_r, ω̇_r] of the active segment
+=====================  ====  ================================================================
+
+A "part" segment aims at the part's simulated centre + offset, with its velocity; ẍ_r and ω̇_r
+are set to 0: a belt runs at constant speed, and the discrete plant's one-step accelerations are
+contact chatter, not motion.  From a task's prescribed grasp time on (the descend's hold: the
+part is in the hand) it aims at the part's motion as it was then, extrapolated at that velocity —
+a target read off a part in the hand would follow the hand and hold nothing.  A "latched" segment
+aims at where the part was at the segment's start + offset, at rest.  Discrete state ``latched``
+= [p, v, t₀, R] (m, m/s, s, row-major), updated at each "latched" segment's start and at each
+grasp time.  A "slot"
+segment aims at the fixed place pose, turned to the slot's yaw about the vertical.
+
+``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a
+function of time: the plan's commands, piecewise constant (output ``command``).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from typing import Sequence
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from ptint_drake.pick.tasks import PickPlan
+from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
+
+
+def _yaw_rotation(yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+class PickTargets(LeafSystem):
+    """The active segment's target of a pick plan (module docstring).  ``places[i]`` is the world
+    position of segment i's place pose for "slot" segments (None otherwise)."""
+
+    def __init__(self, plan: PickPlan, num_parts: int, places: Sequence):
+        super().__init__()
+        self._plan, self.places = plan, list(places)
+        self._poses = [self.DeclareVectorInputPort(f"part_{k}_pose", 9) for k in range(num_parts)]
+        self._rotations = [self.DeclareVectorInputPort(f"part_{k}_rotation", 15) for k in range(num_parts)]
+        self._latched = self.DeclareDiscreteState(BasicVector(np.zeros(16)))
+        DeclareSegmentStartEvents(self, plan.schedule, self._latch)
+        for k, t in enumerate(plan.grasp_times):
+            self.DeclarePeriodicUnrestrictedUpdateEvent(ONE_SHOT_PERIOD, t, self._grasp_latch(k))
+        self.DeclareVectorOutputPort("target", 9, self._calc_target)
+        self.DeclareVectorOutputPort("target_rotation", 15, self._calc_rotation)
+
+    def _active(self, context) -> int:
+        return max(self._plan.schedule.active(context.get_time()), 0)
+
+    def _latch(self, context, state) -> None:
+        seg = self._plan.segments[self._active(context)]
+        if seg.kind == "latched":
+            position = self._poses[seg.index].Eval(context)[0:3]
+            R = self._rotations[seg.index].Eval(context)[0:9]
+            state.get_mutable_discrete_state(self._latched).SetFromVector(
+                np.r_[position, 0.0, 0.0, 0.0, context.get_time(), R])
+
+    def _grasp_latch(self, task: int):
+        def update(context, state) -> None:
+            if abs(context.get_time() - self._plan.grasp_times[task]) > 1e-9:
+                return  # a one-shot event: only its first occurrence
+            part = next(s.index for s in self._plan.segments if s.task == task and s.kind == "part")
+            pose, R = self._poses[part].Eval(context), self._rotations[part].Eval(context)[0:9]
+            state.get_mutable_discrete_state(self._latched).SetFromVector(
+                np.r_[pose[0:6], context.get_time(), R])
+        return update
+
+    def _holding(self, context, i: int) -> bool:
+        """Segment i is a descend past its prescribed time whose grasp has been latched (the part
+        in the hand)."""
+        seg = self._plan.schedule.segments[i]
+        t0 = context.get_discrete_state(self._latched).get_value()[6]
+        return self._plan.segments[i].phase == "descend" and abs(t0 - seg.end) < 1e-9
+
+    def _calc_target(self, context, output) -> None:
+        i = self._active(context)
+        seg = self._plan.segments[i]
+        offset = np.asarray(seg.offset)
+        value = np.zeros(9)
+        latched = context.get_discrete_state(self._latched).get_value()
+        if seg.kind == "part" and self._holding(context, i):
+            value[0:3] = latched[0:3] + latched[3:6] * (context.get_time() - latched[6]) + offset
+            value[3:6] = latched[3:6]
+        elif seg.kind == "part":
+            pose = self._poses[seg.index].Eval(context)
+            value[0:3], value[3:6] = pose[0:3] + offset, pose[3:6]
+        elif seg.kind == "latched":
+            value[0:3] = latched[0:3] + offset
+        else:
+            value[0:3] = np.asarray(self.places[i]) + offset
+        output.SetFromVector(value)
+
+    def _calc_rotation(self, context, output) -> None:
+        i = self._active(context)
+        seg = self._plan.segments[i]
+        value = np.zeros(15)
+        if seg.kind == "slot":
+            value[0:9] = _yaw_rotation(seg.yaw).ravel()
+        elif seg.kind == "latched" or self._holding(context, i):
+            value[0:9] = context.get_discrete_state(self._latched).get_value()[7:16]
+        else:
+            value[0:12] = self._rotations[seg.index].Eval(context)[0:12]
+        output.SetFromVector(value)
+
+
+class GripperSequence(LeafSystem):
+    """The plan's gripper commands as a piecewise-constant signal of time (module docstring)."""
+
+    def __init__(self, commands: Sequence):
+        super().__init__()
+        commands = sorted(commands, key=lambda c: c[0])
+        self._times = [float(t) for t, _ in commands]
+        self._values = [float(v) for _, v in commands]
+        self.DeclareVectorOutputPort("command", 1, self._calc, prerequisites_of_calc={self.time_ticket()})
+
+    def opening(self, t: float) -> float:
+        """The commanded opening at time t (m; 0: close)."""
+        return self._values[max(bisect.bisect_right(self._times, t) - 1, 0)]
+
+    def _calc(self, context, output) -> None:
+        output.SetAtIndex(0, self.opening(context.get_time()))

@@ -1,0 +1,177 @@
+"""A pick and place as prescribed-time segments: the scenario's ``pick`` block and its plan.
+
+A scenario with a ``pick`` block (``PickConfig``: the world of ``pick.config`` — gripper, belts,
+parts, tray — and the ``tasks``) has no ``interceptions`` of its own: each task (``PickTaskConfig``:
+one part to one tray slot) becomes six segments of the interceptor's schedule, one after the
+other, each a prescribed-time interception (SPEC 2.1) of its own target:
+
+1. ``approach`` — the pre-grasp pose ``clearance`` above the part's *simulated* centre as it
+   rides its belt (a moving target), grasped from above (task ``top_down``: the tool's approach
+   axis down, the fingers across the part's x axis);
+2. ``descend`` — the part's centre itself (moving).  The fingers are commanded to close
+   ``(opening − width) / (2 · speed)`` before this segment's tf, so that they reach the part at
+   its prescribed time; the arm holds on the moving part for ``dwell`` while the grip builds up;
+3. ``lift`` — ``lift_height`` straight above where the part was when the lift started (latched
+   at the segment's start: a target that moved with the hand would never be reached);
+4. ``carry`` — ``lift_height`` above the slot, turned to the slot's yaw (an unknown payload in
+   the hand: the model-free controller is not told);
+5. ``place`` — the slot pose (the part's centre ``height / 2`` above the tray's top); the fingers
+   open at this segment's tf + ``dwell``;
+6. ``retreat`` — ``clearance`` above the slot, starting ``dwell`` after the fingers opened.
+
+Times: the approach starts at the task's ``start``; each later segment starts at the previous
+one's prescribed time, the lift and the retreat ``dwell`` later.  A task starts after the previous
+task's retreat (``start`` = 0: right after it).  ``pick_plan`` turns the block into the schedule,
+one ``PlanSegment`` per segment (what ``pick.targets.PickTargets`` aims at) and the gripper's
+commands (``pick.targets.GripperSequence``).
+"""
+
+from dataclasses import dataclass, field
+from typing import List
+
+import numpy as np
+
+from ptint_drake.pick.config import (BeltConfig, GripperConfig, PartConfig, TrayConfig, grasp_width)
+from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.validation import ScenarioError
+
+PHASES = ("approach", "descend", "lift", "carry", "place", "retreat")
+
+
+@dataclass
+class MoveConfig:
+    """One prescribed-time segment of a task: its duration tf (s) and TBG shape β."""
+
+    tf: float = 1.0  # s
+    beta: float = 0.75  # 1, in (0, 1)
+
+
+@dataclass
+class PickTaskConfig:
+    """One part picked off its belt and placed in one tray slot (see the module docstring)."""
+
+    part: str = ""  # the part's name (pick.parts[*].name)
+    slot: int = 0  # index into pick.tray.slots
+    start: float = 0.0  # s, the approach's start (0: right after the previous task)
+    approach: MoveConfig = field(default_factory=lambda: MoveConfig(1.2))
+    descend: MoveConfig = field(default_factory=lambda: MoveConfig(0.5))
+    lift: MoveConfig = field(default_factory=lambda: MoveConfig(0.4))
+    carry: MoveConfig = field(default_factory=lambda: MoveConfig(1.2))
+    place: MoveConfig = field(default_factory=lambda: MoveConfig(0.5))
+    retreat: MoveConfig = field(default_factory=lambda: MoveConfig(0.4))
+    clearance: float = 0.04  # m, of the pre-grasp pose above the part and of the retreat
+    lift_height: float = 0.05  # m, of the lift and the carry
+    dwell: float = 0.15  # s, the grip building up after the close, and the fingers opening
+    margin: float = 0.012  # m, the open fingers' clearance around the part (opening − width)
+
+
+@dataclass
+class PickConfig:
+    """The scenario's ``pick`` block: the physical world and the tasks."""
+
+    gripper: GripperConfig = field(default_factory=GripperConfig)
+    belts: List[BeltConfig] = field(default_factory=list)
+    parts: List[PartConfig] = field(default_factory=list)
+    tray: TrayConfig = field(default_factory=TrayConfig)
+    tasks: List[PickTaskConfig] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class PlanSegment:
+    """What one segment aims at: ``kind`` "part" (part ``index``'s simulated centre + ``offset``),
+    "latched" (where part ``index`` was at the segment's start + ``offset``) or "slot" (slot
+    ``index``'s place pose + ``offset``, yaw ``yaw`` rad); ``task`` and ``phase`` name it."""
+
+    task: int
+    phase: str
+    kind: str
+    index: int
+    offset: tuple
+    yaw: float = 0.0
+
+
+@dataclass(frozen=True)
+class PickPlan:
+    """The schedule, one ``PlanSegment`` per segment, the gripper's commands [(t, opening)], and
+    per task the close command's time and the prescribed grasp time (descend's start + tf)."""
+
+    schedule: Schedule
+    segments: tuple
+    commands: tuple
+    close_times: tuple
+    grasp_times: tuple
+    end: float
+
+
+def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float):
+    up = lambda h: (0.0, 0.0, h)  # noqa: E731
+    aims = [("approach", "part", part, up(task.clearance), 0.0), ("descend", "part", part, up(0.0), 0.0),
+            ("lift", "latched", part, up(task.lift_height), 0.0),
+            ("carry", "slot", task.slot, up(task.lift_height), slot_yaw),
+            ("place", "slot", task.slot, up(0.0), slot_yaw),
+            ("retreat", "slot", task.slot, up(task.clearance), slot_yaw)]
+    segments, plans, t = [], [], start
+    for phase, kind, index, offset, yaw in aims:
+        move = getattr(task, phase)
+        if phase in ("lift", "retreat"):
+            t += task.dwell
+        segments.append(Segment(t, move.tf, move.beta))
+        plans.append(PlanSegment(k, phase, kind, index, offset, yaw))
+        t += move.tf
+    return segments, plans, t
+
+
+def pick_plan(pick: PickConfig) -> PickPlan:
+    """The plan of the ``pick`` block (``check_tasks`` first for one-line errors)."""
+    names = [p.name for p in pick.parts]
+    segments, plans, commands, closes, grasps = [], [], [], [], []
+    t = 0.0
+    commands.append((0.0, pick.gripper.initial_opening))
+    for k, task in enumerate(pick.tasks):
+        part = names.index(task.part)
+        slot_yaw = np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg)
+        start = task.start if task.start > 0.0 else t
+        segs, plan, t = _task_segments(k, task, part, float(slot_yaw), start)
+        width = grasp_width(pick.parts[part])
+        opening = width + task.margin
+        grasp = segs[1].end
+        close = grasp - 0.5 * task.margin / pick.gripper.speed
+        commands += [(segs[0].start, opening), (close, 0.0), (segs[4].end, opening)]
+        segments += segs
+        plans += plan
+        closes.append(close)
+        grasps.append(grasp)
+    return PickPlan(Schedule(segments), tuple(plans), tuple(commands), tuple(closes), tuple(grasps), t)
+
+
+def check_tasks(pick: PickConfig) -> None:
+    """ScenarioError naming the first bad field of the tasks."""
+    names = [p.name for p in pick.parts]
+    if not pick.tasks:
+        raise ScenarioError("pick.tasks: at least one task is needed")
+    if len(set(names)) != len(names):
+        raise ScenarioError("pick.parts: part names must be unique")
+    t = 0.0
+    for k, task in enumerate(pick.tasks):
+        where = f"pick.tasks[{k}]"
+        if task.part not in names:
+            raise ScenarioError(f"{where}.part: no part named {task.part!r} (parts: {', '.join(names)})")
+        if not 0 <= task.slot < len(pick.tray.slots):
+            raise ScenarioError(f"{where}.slot: {task.slot} is not a slot of the tray "
+                                f"({len(pick.tray.slots)} slots)")
+        for phase in PHASES:
+            move = getattr(task, phase)
+            if not (move.tf > 0.0 and np.isfinite(move.tf)):
+                raise ScenarioError(f"{where}.{phase}.tf: must be positive, got {move.tf}")
+            if not 0.0 < move.beta < 1.0:
+                raise ScenarioError(f"{where}.{phase}.beta: must be in (0, 1), got {move.beta}")
+        for name in ("clearance", "lift_height", "dwell", "margin"):
+            if not getattr(task, name) > 0.0:
+                raise ScenarioError(f"{where}.{name}: must be positive, got {getattr(task, name)}")
+        if 0.0 < task.start < t:
+            raise ScenarioError(f"{where}.start: {task.start} s is before the previous task ends ({t:.3g} s)")
+        t = max(t, task.start) + sum(getattr(task, p).tf for p in PHASES) + 2 * task.dwell
+        if task.margin > 0.5 * task.descend.tf * pick.gripper.speed * 2:
+            need = task.margin / (2 * pick.gripper.speed)
+            raise ScenarioError(f"{where}.margin: the fingers need {need:.3g} s "
+                                f"to close {task.margin} m, longer than half the descend")

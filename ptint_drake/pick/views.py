@@ -1,0 +1,95 @@
+"""What ``ptint run`` draws for a pick and place: a figure of the picks and a replay of the world.
+
+``pick_figure`` — ``picks.png``: per pick (a row), over the task's time: the tool's distance to
+the part (mm, log scale) and its angle from the top-down grasp (deg), the finger opening (mm),
+the grip force (N), and the part's height (mm); the prescribed grasp time and the close command
+marked.
+
+``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
+from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
+recording, saved standalone with ``StaticHtml()`` (``replay``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
+    """Draw ``picks.png`` (module docstring) from a pick run's series and metrics."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    from ptint_drake.pick.metrics import _quat_matrix  # noqa: PLC0415
+    from ptint_drake.pick.probe import PART_WIDTH  # noqa: PLC0415
+
+    t, probe = series["t"], series["probe"]
+    picks = metrics["picks"]
+    fig, axes = plt.subplots(len(picks), 4, figsize=(14, 3.0 * len(picks)), squeeze=False)
+    for row, pick in enumerate(picks):
+        k = pick["part_index"]
+        block = probe[:, PART_WIDTH * k: PART_WIDTH * (k + 1)]
+        distance = 1e3 * np.linalg.norm(block[:, 0:3] - probe[:, -7:-4], axis=1)
+        angle = np.array([np.degrees(np.arccos(np.clip(
+            (_quat_matrix(probe[j, -4:]) @ [1.0, 0.0, 0.0]) @ (_quat_matrix(block[j, 3:7]) @ [1.0, 0.0, 0.0]),
+            -1.0, 1.0))) for j in range(len(t))])
+        angle = np.minimum(angle, 180.0 - angle)  # the fingers' axis: a half turn is the same grasp
+        opening = 1e3 * (series["gripper_state"][:, 0] + series["gripper_state"][:, 1])
+        force = -np.mean(series["grip_force"], axis=1)
+        panels = [(distance, "tool to part (mm)", True), (opening, "finger opening (mm)", False),
+                  (force, "grip force (N)", False), (1e3 * block[:, 2], "part height (mm)", False)]
+        for ax, (values, label, log) in zip(axes[row], panels):
+            ax.plot(t, np.maximum(values, 1e-3) if log else values, lw=1.2)
+            if log:
+                ax.set_yscale("log")
+                twin = ax.twinx()
+                twin.plot(t, angle, color="tab:orange", lw=0.8)
+                twin.set_ylabel("angle (deg)", color="tab:orange")
+            ax.axvline(pick["t_grasp_prescribed"], color="k", ls="--", lw=0.8)
+            ax.axvline(pick["t_close_command"], color="tab:red", ls=":", lw=0.8)
+            ax.set_title(f"pick {row} ({pick['part']}): {label}", fontsize=9)
+            ax.set_xlabel("t (s)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def write_pick_replay(scenario, series: dict, path: Path) -> int:
+    """Write ``replay.html`` (module docstring); returns its size in bytes."""
+    from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role  # noqa: PLC0415
+    from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig  # noqa: PLC0415
+    from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
+
+    from ptint_drake.pick.run import world_config  # noqa: PLC0415
+    from ptint_drake.pick.world import _add_world  # noqa: PLC0415
+    from ptint_drake.replay import CAMERA, shared_meshcat, with_camera  # noqa: PLC0415
+
+    config = world_config(scenario)
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(time_step=config.time_step), builder)
+    _add_world(plant, scene_graph, config)
+    plant.Finalize()
+    meshcat = shared_meshcat()
+    meshcat.Delete()
+    meshcat.DeleteRecording()
+    viz = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat,
+                                         MeshcatVisualizerParams(role=Role.kIllustration))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    times, states = series["replay_t"], series["plant_state"]
+    meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
+    for t, x in zip(times, states):
+        plant.SetPositions(plant_context, x[:plant.num_positions()])
+        context.SetTime(float(t))
+        viz.ForcedPublish(viz.GetMyContextFromRoot(context))
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    html = with_camera(meshcat.StaticHtml(), CAMERA)
+    Path(path).write_text(html, encoding="utf-8")
+    return len(html.encode("utf-8"))
