@@ -8,6 +8,7 @@ deselects them).  Helper modules shared by both (``arms.py``, ``heavy_arm.py``, 
 from __future__ import annotations
 
 import functools
+import subprocess
 
 import pytest
 
@@ -44,6 +45,28 @@ def assert_prescribed_time(metrics: dict, label: str = "") -> None:
 @pytest.fixture
 def run():
     return run_cached
+
+
+@pytest.fixture
+def ptint_here(capfd):
+    """``ptint ARGS`` run in this process (``cli.main``), its result as a CompletedProcess.
+
+    For bad-input checks (exit 2, one line, nothing written): the same code path as the
+    command without paying a pydrake import per case.  stdout and stderr are captured at the
+    file-descriptor level, so Drake's own C++ logging would show up too; an exception that
+    escapes ``main`` fails the test (the subprocess would print a traceback).  Each command
+    family keeps at least one real subprocess test for the process-level behaviour."""
+    from ptint_drake import cli  # noqa: PLC0415
+
+    def ptint(*args, **_ignored):
+        capfd.readouterr()  # drop what the test printed before
+        try:
+            code = cli.main([str(a) for a in args])
+        except SystemExit as exc:  # argparse: --help (0) and its usage errors (2)
+            code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+        out, err = capfd.readouterr()
+        return subprocess.CompletedProcess(["ptint", *args], code, out, err)
+    return ptint
 
 
 DYNAMICS = ("CalcMassMatrix", "CalcMassMatrixViaInverseDynamics", "CalcBiasTerm",
@@ -87,8 +110,24 @@ interceptions:
 """
 
 
+# The longest files first (pyproject.toml runs the files on two processes, a whole file to one,
+# in this order: a long file started last would keep one process busy while the other idles),
+# then the other end-to-end files, then tests/unit.  Measured with --durations; order only.
+LONGEST_FIRST = ("test_notebooks.py", "test_visuals.py", "test_pick_place.py", "test_pose.py",
+                 "test_tune.py", "test_controllers.py", "test_cli_hygiene.py", "test_runner.py",
+                 "test_robustness.py", "test_plugin.py", "test_sweep.py", "test_benchmark.py")
+
+
+def _run_order(item) -> tuple:
+    name = item.path.name
+    e2e = "e2e" in item.path.parts
+    return (not e2e, LONGEST_FIRST.index(name) if e2e and name in LONGEST_FIRST else len(LONGEST_FIRST))
+
+
 def pytest_collection_modifyitems(config, items):
-    """Mark every test under tests/e2e as ``e2e``."""
+    """Mark every test under tests/e2e as ``e2e``; order the files (a stable sort: a file's tests
+    keep their order)."""
     for item in items:
         if "e2e" in item.path.parts:
             item.add_marker(pytest.mark.e2e)
+    items.sort(key=_run_order)

@@ -1,6 +1,7 @@
 """``ptint bench``: the bundled integrator setting against the tight reference, and the
 per-evaluation cost floors (structure only: timings are for the benchmark's JSON, not tests)."""
 
+import functools
 import json
 import subprocess
 import sys
@@ -9,25 +10,28 @@ import pytest
 
 from ptint_drake.studies import benchmark
 
+# the benchmark's runs, each once per session (deterministic; the tests only read the metrics)
+_run = functools.lru_cache(maxsize=None)(benchmark._run)
+
 
 @pytest.mark.parametrize("name", ["curve_b075_tf15", "assembly"])
 def test_bundled_setting_is_within_tolerance_of_the_reference(name):
     """Every SPEC 5.3 metric (e0, e(tf/2), e(tf), ė(tf), hold max per segment, torque peaks)
     within max(1 %, 1 µm) of RK5 at accuracy 1e-10.  Assembly's ė(tf) of segment 1 missed this
     (1.6×) before the bundled scenarios capped RK3's step at 2.2 ms."""
-    reference = benchmark._run(name, benchmark.REFERENCE)
-    bundled = benchmark._run(name, "{}")
+    reference = _run(name, benchmark.REFERENCE)
+    bundled = _run(name, "{}")
     assert bundled["sim"]["integration_scheme"] == "runge_kutta3"
     errors = benchmark.metric_errors(bundled, reference)
     assert errors["worst_ratio"] <= 1.0, errors["worst"]
-    before = benchmark.metric_errors(benchmark._run(name, benchmark.BEFORE), reference)
+    before = benchmark.metric_errors(_run(name, benchmark.BEFORE), reference)
     if name == "assembly":
         assert before["worst_ratio"] > 1.0 and before["worst"] == "1.edot_tf_norm"
 
 
 def test_step_cap_saves_evaluations():
-    capped = benchmark._run("curve_b075_tf15", "{}")["sim"]
-    before = benchmark._run("curve_b075_tf15", benchmark.BEFORE)["sim"]
+    capped = _run("curve_b075_tf15", "{}")["sim"]
+    before = _run("curve_b075_tf15", benchmark.BEFORE)["sim"]
     assert capped["derivative_evaluations"] < 0.9 * before["derivative_evaluations"]
     # no rejected attempts left: RK3 takes 3 evaluations per step
     assert capped["derivative_evaluations"] <= 3.05 * capped["steps"]
@@ -50,8 +54,7 @@ def test_cli_floors_prints_json():
     assert set(result["floors"]) == {"curve_b075_tf12"} and result["machine"]["drake"]
 
 
-def test_cli_bad_repeats_is_one_line():
-    out = subprocess.run([sys.executable, "-m", "ptint_drake", "bench", "--pair", "{}", "{}",
-                          "--repeats", "0"], capture_output=True, text=True, check=False, timeout=120)
+def test_cli_bad_repeats_is_one_line(ptint_here):
+    out = ptint_here("bench", "--pair", "{}", "{}", "--repeats", "0")
     assert out.returncode == 2
     assert "Traceback" not in out.stderr and "--repeats: must be >= 1" in out.stderr

@@ -53,6 +53,9 @@ def test_run_writes_spec_outputs(tmp_path):
     assert len(html) > 1_000_000  # self-contained: meshcat's JS is inlined
     for fig in m["figures"]:
         assert (tmp_path / fig).stat().st_size > 10_000
+    # PNG figures only without --svg (test_visuals.py: the SVGs with the flag)
+    assert {p.stem for p in tmp_path.glob("*.png")} >= {"axes", "errors", "joints", "paths3d"}
+    assert not list(tmp_path.glob("*.svg"))
     assert not list(tmp_path.glob(".ptint-stage-*"))
 
 
@@ -101,13 +104,14 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
-def test_bad_input_fails_with_one_line(tmp_path, case):
+def test_bad_input_fails_with_one_line(tmp_path, case, ptint_here):
+    """In this process (``cli.main``); the subprocess tests below keep the process-level truth."""
     text, field = BAD[case]
     scenario = tmp_path / f"{case}.yaml"
     scenario.write_text(text)
     out_dir = tmp_path / "out"
-    out = ptint("run", str(scenario), "--out", str(out_dir), "--quiet")
-    assert out.returncode != 0
+    out = ptint_here("run", str(scenario), "--out", str(out_dir), "--quiet")
+    assert out.returncode == 2
     assert "Traceback" not in out.stderr
     lines = [line for line in out.stderr.splitlines() if line.strip()]
     assert len(lines) == 1, out.stderr

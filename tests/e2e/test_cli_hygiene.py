@@ -39,11 +39,17 @@ def _subcommands():
 
 
 @pytest.mark.parametrize("command", [None] + _subcommands())
-def test_help_of_every_subcommand_exits_0(command):
-    out = ptint(*([command] if command else []), "--help")
+def test_help_of_every_subcommand_exits_0(command, ptint_here):
+    """In this process; ``ptint --help`` also as a real command (the next test)."""
+    out = ptint_here(*([command] if command else []), "--help")
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith("usage: ptint"), out.stdout[:200]
     assert "SPEC" not in out.stdout  # users get the docs and the paper, not SPEC
+
+
+def test_help_as_a_command_exits_0():
+    out = ptint("--help")
+    assert out.returncode == 0 and out.stdout.startswith("usage: ptint"), out.stderr
 
 
 def test_every_subcommand_is_tested():
@@ -68,13 +74,13 @@ def test_closed_pipe_ends_quietly(reader):
     ["robust", "curve_b075_tf15", "--samples", "1", "--workers", "1"],
     ["paper"],
 ])
-def test_out_naming_a_file_is_one_line_exit_2(tmp_path, command):
+def test_out_naming_a_file_is_one_line_exit_2(tmp_path, command, ptint_here):
     afile = tmp_path / "afile"
     afile.write_text("keep me\n")
     expected = {afile: f"ptint: error: --out: {afile} is a file",
                 afile / "sub": f"ptint: error: --out: {afile} (in {afile / 'sub'}) is a file"}
     for out_arg, message in expected.items():
-        out = ptint(*command, "--out", str(out_arg), "--quiet")
+        out = ptint_here(*command, "--out", str(out_arg), "--quiet")
         assert out.returncode == 2, out.stderr
         assert _one_error_line(out) == message
     assert afile.read_text() == "keep me\n"
@@ -122,8 +128,8 @@ def test_bad_set_path_names_it(pair):
 
 
 @pytest.mark.parametrize("pair", ["interceptions[1].tf=1.2", "controller.K[0]=1"])
-def test_bad_set_path_on_the_command_line(tmp_path, pair):
-    out = ptint("run", "curve_b075_tf15", "--set", pair, "--out", str(tmp_path / "o"), "--quiet")
+def test_bad_set_path_on_the_command_line(tmp_path, pair, ptint_here):
+    out = ptint_here("run", "curve_b075_tf15", "--set", pair, "--out", str(tmp_path / "o"), "--quiet")
     assert out.returncode == 2
     assert BAD_SETS.get(pair, pair.split("=")[0]) in _one_error_line(out)
     assert not (tmp_path / "o" / "metrics.json").exists()

@@ -72,8 +72,8 @@ interceptions:
     (("--variants", "nominal,heavy"), "ptint: error: variant: unknown plant variant 'heavy'"),
     (("--workers", "0"), "ptint: error: --workers: must be >= 1, got 0"),
 ])
-def test_bad_compare_input_is_one_line(tmp_path, args, message):
-    out = ptint("compare", "curve_b075_tf15", *args, "--out", str(tmp_path / "out"), "--quiet")
+def test_bad_compare_input_is_one_line(tmp_path, args, message, ptint_here):
+    out = ptint_here("compare", "curve_b075_tf15", *args, "--out", str(tmp_path / "out"), "--quiet")
     assert out.returncode == 2
     assert out.stderr.startswith(message) and out.stderr.count("\n") == 1, out.stderr
     assert not (tmp_path / "out").exists()

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 from arms import OFFSET_ARM
+from conftest import run_cached
 
 from ptint_drake.metrics import Criteria, Reason, segment_reasons, verdict
 from ptint_drake.robot import make_plant
@@ -52,7 +53,7 @@ def test_ct_quintic_with_the_exact_model_meets_a_moving_target_at_tf():
 
 def test_metrics_come_from_the_plant_state_not_the_controller():
     """The fused interceptor's own x is its business; the metrics compute x from q."""
-    result = simulate(load_scenario("curve_b075_tf15"), check=False)
+    result = run_cached("curve_b075_tf15")  # the session's run of it (runs are deterministic)
     series = result.series
     # the error is against the true target, recomputed independently here
     from ptint_drake.systems.targets import SinusoidTarget  # noqa: PLC0415

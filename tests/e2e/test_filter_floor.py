@@ -107,8 +107,8 @@ def ptint(*args):
     (["--scenario", "curve_b075_tf15"], "ptint: error: measurement: the filter floor needs a camera "
                                         "scenario, curve_b075_tf15 has no camera"),
 ])
-def test_cli_bad_value_is_one_line_exit_2(tmp_path, args, message):
-    out = ptint("study", "camera", "--filter-floor", *args, "--out", str(tmp_path / "o"), "--quiet")
+def test_cli_bad_value_is_one_line_exit_2(tmp_path, args, message, ptint_here):
+    out = ptint_here("study", "camera", "--filter-floor", *args, "--out", str(tmp_path / "o"), "--quiet")
     assert out.returncode == 2, out.stderr
     assert "Traceback" not in out.stderr
     assert [line for line in out.stderr.splitlines() if line.strip()] == [message]

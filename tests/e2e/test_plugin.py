@@ -121,8 +121,12 @@ def test_compare_runs_the_plugin_beside_ptsmc_named_by_its_type_string(user_fold
     ("broken_plugins:WrongSize", r"controller broken_plugins:WrongSize: output port 'actuation' has 7 "
                                  r"values, needs 3"),
 ])
-def test_a_broken_plugin_is_one_line_exit_2_and_writes_nothing(user_folder, type_, message):
+def test_a_broken_plugin_is_one_line_exit_2_and_writes_nothing(user_folder, type_, message, ptint_here,
+                                                              monkeypatch):
+    """``run`` as a real command, ``compare`` in this process (the same check before any run)."""
     import re  # noqa: PLC0415
+
+    from ptint_drake.controllers import plugin  # noqa: PLC0415
 
     (user_folder / "bad.yaml").write_text(SCENARIO % type_)
     out = user_folder / "out_bad"
@@ -131,8 +135,9 @@ def test_a_broken_plugin_is_one_line_exit_2_and_writes_nothing(user_folder, type
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and re.search(message, lines[0]), done.stderr
     assert not out.exists()
-    compare = ptint("compare", "curve_b075_tf15", "--controllers", f"ptsmc,{type_}", "--out", str(out),
-                    cwd=user_folder)
+    monkeypatch.setattr(plugin, "_folders", [])  # this process's module search, as a fresh one
+    monkeypatch.chdir(user_folder)
+    compare = ptint_here("compare", "curve_b075_tf15", "--controllers", f"ptsmc,{type_}", "--out", str(out))
     assert compare.returncode == 2 and len(compare.stderr.strip().splitlines()) == 1, compare.stderr
 
 
@@ -148,7 +153,7 @@ def test_a_plugin_that_raises_fails_its_run_with_one_line_and_saw_its_segment(us
     del system  # the module stays importable; the instance lives in the run's diagram
 
 
-def test_tune_takes_a_plugin_parameter_with_its_range(user_folder):
+def test_tune_takes_a_plugin_parameter_with_its_range(user_folder, ptint_here, monkeypatch):
     from ptint_drake.studies import tune  # noqa: PLC0415
 
     scenario = parse_scenario((user_folder / "pd_scenario.yaml").read_text())
@@ -158,8 +163,8 @@ def test_tune_takes_a_plugin_parameter_with_its_range(user_folder):
     assert tune.gain_value(tuned, "params.Kp") == 3000.0
     with pytest.raises(ScenarioError, match=r"^--range: params\.Kp needs --range LO,HI"):
         tune.check_gain("params.Kp", ())
-    done = ptint("tune", "pd_scenario.yaml", "--gain", "params.Kp", "--out", str(user_folder / "t"),
-                 cwd=user_folder)
+    monkeypatch.chdir(user_folder)
+    done = ptint_here("tune", "pd_scenario.yaml", "--gain", "params.Kp", "--out", str(user_folder / "t"))
     assert done.returncode == 2, done.stderr
     assert done.stderr.startswith("ptint: error: --range: params.Kp needs"), done.stderr
     assert not (user_folder / "t").exists()

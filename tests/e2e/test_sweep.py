@@ -77,8 +77,6 @@ def test_cli_sweep_writes_csv_and_heatmaps(tmp_path):
 
 @pytest.mark.parametrize("args, field", [(["--beta", "0.5,1.5"], "--beta"), (["--tf", "0,1"], "--tf"),
                                          (["--beta", "a,b"], "--beta"), (["--workers", "0"], "--workers")])
-def test_cli_sweep_bad_arguments(args, field, tmp_path):
-    done = subprocess.run([sys.executable, "-m", "ptint_drake", "sweep", "curve_b075_tf15", *args,
-                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=120,
-                          cwd=Path(__file__).parent)
+def test_cli_sweep_bad_arguments(args, field, tmp_path, ptint_here):
+    done = ptint_here("sweep", "curve_b075_tf15", *args, "--out", str(tmp_path))
     assert done.returncode == 2 and field in done.stderr and "Traceback" not in done.stderr
