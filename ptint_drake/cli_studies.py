@@ -74,9 +74,8 @@ def cmd_robust(args: argparse.Namespace) -> int:
     p = result["e_tf_percentiles"]
     print(f"{result['samples']} samples in {result['wall_time_s']:.1f} s "
           f"({result['samples_per_s']:.2f} samples/s), success rate {100 * result['success_rate']:.1f} %, "
-          f"e(tf) p50 {p.get('p50', float('nan')) * 1e3:.4f} mm, "
-          f"max {p.get('max', float('nan')) * 1e3:.4f} mm; "
-          f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
+          + (f"e(tf) p50 {p['p50'] * 1e3:.4f} mm, max {p['max'] * 1e3:.4f} mm; " if p else "")
+          + f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
     if "pick_success_rate" in result:
         reasons = ", ".join(f"{k} ×{v}" for k, v in result["failures_by_reason"].items()) or "none"
         print(f"pick success rate {100 * result['pick_success_rate']:.1f} % of the parts; "
