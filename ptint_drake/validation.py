@@ -139,6 +139,9 @@ def _validate_pick(s) -> None:
     if s.interceptions:
         raise ScenarioError("interceptions: a pick scenario's segments come from pick.tasks; leave "
                             "interceptions out")
+    if s.measurement is not None:
+        raise ScenarioError("measurement: a pick scenario aims at the parts' simulated poses; a camera "
+                            "is not modelled there (leave measurement out)")
     if s.controller.task != "top_down":
         raise ScenarioError(f"controller.task: a pick grasps from above: top_down, got {s.controller.task!r}")
     if not s.controller.control_period > 0.0:

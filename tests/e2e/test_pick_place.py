@@ -46,6 +46,8 @@ def test_assembly_pick_place_places_three_turned_parts(run):
     ("pick.parts[0].size=[0.07,0.03,0.03]", "pick.parts[0].size"),  # wider than the gripper opens
     ("controller.control_period=0", "controller.control_period"),
     ("controller.control_period=-0.001", "controller.control_period"),
+    ("measurement={rate_hz: 30.0}", "measurement"),  # no camera in the pick world: not silently ignored
+    ("duration=2.0", "duration"),  # ends before the task does
 ])
 def test_bad_pick_input_is_one_line_exit_2(tmp_path, capsys, override, field):
     out = tmp_path / "o"
