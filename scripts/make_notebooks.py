@@ -2,10 +2,11 @@
 their outputs (the documentation site shows those; ``tests/e2e/test_notebooks.py`` re-executes
 them and compares the numbers of the cells tagged ``table``).
 
-    .venv/bin/python scripts/make_notebooks.py              # all three (~1-2 min)
+    .venv/bin/python scripts/make_notebooks.py              # all five (~2 min)
     .venv/bin/python scripts/make_notebooks.py camera       # one
 
-The cells are below, one list per notebook: Markdown strings start with ``md:``.
+The cells are below, one list per notebook (the pose and pick-and-place ones in
+``task_notebooks.py``): Markdown strings start with ``md:``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 sys.path.insert(0, str(ROOT / "tests"))
 from notebook_kernel import kernel_env, kernel_name  # noqa: E402
+from task_notebooks import pick_and_place, pose  # noqa: E402
 
 SETUP = """\
 # Drake's deprecation warnings are errors here, as in the test suite
@@ -283,9 +285,11 @@ tune_figure(tuned, out)
 Image(filename=str(out / "tune.png"), width=520)""",
 ]
 
-NOTEBOOKS = {"your_diagram": YOUR_DIAGRAM, "camera": CAMERA, "which_controller": WHICH_CONTROLLER}
+NOTEBOOKS = {"your_diagram": YOUR_DIAGRAM, "camera": CAMERA, "which_controller": WHICH_CONTROLLER,
+             "pose": pose(SETUP), "pick_and_place": pick_and_place(SETUP)}
 # the cells whose printed numbers the test compares with the committed outputs
-TABLE_MARKERS = ('print(f"|e(0)|', "rows = []", 'print("controller', "tried K")
+TABLE_MARKERS = ('print(f"|e(0)|', "rows = []", 'print("controller', "tried K",
+                 'print("         | distance', 'print("t_grasp [s]')
 
 
 def notebook(cells: list) -> nbformat.NotebookNode:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
-NOTEBOOKS = ("your_diagram", "camera", "which_controller")
+NOTEBOOKS = ("your_diagram", "camera", "which_controller", "pose", "pick_and_place")
 
 
 def kernel_name() -> str:
