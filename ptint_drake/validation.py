@@ -147,6 +147,13 @@ def _validate_pick(s) -> None:
     if not s.controller.control_period > 0.0:
         raise ScenarioError("controller.control_period: a pick runs on a discrete plant with contact and "
                             "needs sampled control: set it > 0 (e.g. 0.001)")
+    if s.multibody is not None:
+        from ptint_drake.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS,  # noqa: PLC0415
+                                             check_plant_settings)
+
+        m = s.multibody
+        check_plant_settings(m.time_step, m.discrete_contact_approximation or DEFAULT_APPROXIMATION,
+                             m.contact_model, SCENARIO_PLANT_FIELDS)
     check_pick_parts(s.pick)
     check_tasks(s.pick)
     from ptint_drake.pick.tasks import pick_plan  # noqa: PLC0415

@@ -70,28 +70,16 @@ def replace(block: str, name: str = "picks") -> None:
 def still(path: Path) -> None:
     """The assembly's world at its second pick's prescribed grasp time, as a PNG."""
     import numpy as np  # noqa: PLC0415
-    from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role  # noqa: PLC0415
-    from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig  # noqa: PLC0415
-    from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
-    from ptint_drake.pick.run import world_config  # noqa: PLC0415
-    from ptint_drake.pick.world import _add_world  # noqa: PLC0415
-    from ptint_drake.replay import CAMERA, shared_meshcat, with_camera  # noqa: PLC0415
+    from ptint_drake.pick.views import replay_world  # noqa: PLC0415
+    from ptint_drake.replay import CAMERA, with_camera  # noqa: PLC0415
     from ptint_drake.scenario import load_scenario  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
 
     scenario = load_scenario("assembly_pick_place")
     result = simulate(scenario)
     t_grasp = result.metrics["picks"][1]["t_grasp_prescribed"]
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(time_step=0.001), builder)
-    _add_world(plant, scene_graph, world_config(scenario))
-    plant.Finalize()
-    meshcat = shared_meshcat()
-    viz = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat,
-                                         MeshcatVisualizerParams(role=Role.kIllustration))
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
+    plant, viz, meshcat, context = replay_world(scenario)
     j = int(np.argmin(np.abs(result.series["replay_t"] - t_grasp)))
     plant.SetPositions(plant.GetMyMutableContextFromRoot(context),
                        result.series["plant_state"][j, :plant.num_positions()])

@@ -105,6 +105,7 @@ class PickWorldConfig:
 
 
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
+DEFAULT_APPROXIMATION = "sap"  # measured by scripts/contact_bench.py: the most accurate, and fast
 SHAPE_SIZES = {"box": 3, "cylinder": 2}
 
 
@@ -149,15 +150,27 @@ def _check_belt(k: int, belt: BeltConfig) -> None:
 
 def check_pick_world(config: PickWorldConfig) -> None:
     """ScenarioError naming the first bad field of ``config`` (the checks that need no plant)."""
-    if not config.time_step > 0.0:
-        raise ScenarioError(f"pick.time_step: must be positive, got {config.time_step}")
-    if config.contact_approximation not in contact_approximations():
-        raise ScenarioError(f"pick.contact_approximation: {config.contact_approximation!r} is not one of "
-                            f"{', '.join(contact_approximations())}")
-    if config.contact_model not in CONTACT_MODELS:
-        raise ScenarioError(f"pick.contact_model: {config.contact_model!r} is not one of "
-                            f"{', '.join(CONTACT_MODELS)}")
+    check_plant_settings(config.time_step, config.contact_approximation, config.contact_model)
     check_pick_parts(config)
+
+
+PLANT_FIELDS = ("pick.time_step", "pick.contact_approximation", "pick.contact_model")
+SCENARIO_PLANT_FIELDS = ("multibody.time_step", "multibody.discrete_contact_approximation",
+                         "multibody.contact_model")
+
+
+def check_plant_settings(time_step: float, approximation: str, model: str, names=PLANT_FIELDS) -> None:
+    """ScenarioError unless the pick world's plant is discrete with a contact approximation and a
+    contact model of the installed Drake; ``names``: the fields to name (``PLANT_FIELDS`` of a
+    ``PickWorldConfig``, ``SCENARIO_PLANT_FIELDS`` of a scenario's ``multibody`` block)."""
+    if not time_step > 0.0:
+        raise ScenarioError(f"{names[0]}: a pick world's plant is discrete: must be positive, "
+                            f"got {time_step}")
+    if approximation not in contact_approximations():
+        raise ScenarioError(f"{names[1]}: {approximation!r} is not one of "
+                            f"{', '.join(contact_approximations())}")
+    if model not in CONTACT_MODELS:
+        raise ScenarioError(f"{names[2]}: {model!r} is not one of {', '.join(CONTACT_MODELS)}")
 
 
 def check_pick_parts(config) -> None:

@@ -28,6 +28,8 @@ prescribed grasp time, the descend's start + tf, or never).
 from __future__ import annotations
 
 import numpy as np
+from pydrake.common.eigen_geometry import Quaternion
+from pydrake.math import RotationMatrix
 
 from ptint_drake.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_reference
@@ -35,16 +37,10 @@ from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_r
 LATE_GRASP = 0.05  # s after the prescribed grasp time
 
 
-def _quat_matrix(q) -> np.ndarray:
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
-def _yaw(yaw: float) -> np.ndarray:
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+def rotation_of(wxyz) -> np.ndarray:
+    """The 3 × 3 rotation of a logged quaternion (w, x, y, z), through Drake's ``RotationMatrix``."""
+    q = np.asarray(wxyz, dtype=float)
+    return RotationMatrix(Quaternion(q / np.linalg.norm(q))).matrix()
 
 
 def _aim(built, i: int, aims: dict, at_start: bool):
@@ -53,7 +49,7 @@ def _aim(built, i: int, aims: dict, at_start: bool):
     offset = np.asarray(seg.offset)
     if seg.kind == "slot":
         rot = np.zeros(15)
-        rot[0:9] = _yaw(seg.yaw).ravel()
+        rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
         return built.targets.places[i] + offset, rot
     pose, rot = aims["parts"][seg.index]
     if seg.kind == "latched":
@@ -86,7 +82,8 @@ def segment_rows(built, aims: dict) -> list:
 def _place_angle(R: np.ndarray, yaw: float, shape: str) -> float:
     if shape == "cylinder":  # its turn about its own axis does not matter: the tilt only
         return float(np.degrees(np.arccos(np.clip(R[2, 2], -1.0, 1.0))))
-    return float(min(np.degrees(rotation_angle(R, _yaw(yaw + turn))) for turn in (0.0, np.pi)))
+    return float(min(np.degrees(rotation_angle(R, RotationMatrix.MakeZRotation(yaw + turn).matrix()))
+                     for turn in (0.0, np.pi)))
 
 
 def _first(t: np.ndarray, mask: np.ndarray):
@@ -113,13 +110,12 @@ def _one_pick(built, k: int, t: np.ndarray, probe: np.ndarray, grip: np.ndarray,
     grasped = bool(both[i_lift] and block[i_lift, 2] > block[i_grasp, 2] + 0.5 * lift)
     carried = (t >= lift_start) & (t <= place_end)
     tool_p, tool_q = probe[:, -7:-4], probe[:, -4:]
-    rel = np.array([_quat_matrix(tool_q[j]).T @ (block[j, 0:3] - tool_p[j]) for j in np.flatnonzero(carried)])
+    rel = np.array([rotation_of(tool_q[j]).T @ (block[j, 0:3] - tool_p[j]) for j in np.flatnonzero(carried)])
     slip = float(np.max(np.linalg.norm(rel - rel[0], axis=1))) if len(rel) else None
     squeeze = -np.mean(grip[carried], axis=1) if np.any(carried) else np.zeros(1)
-    i_place = next(i for i, p in enumerate(plan.segments) if p.task == k and p.phase == "place")
-    place = built.targets.places[i_place]
+    place = built.targets.places[plan.segment_index(k, "place")]
     place_yaw = segs[4][1].yaw
-    R_end = _quat_matrix(block[-1, 3:7])
+    R_end = rotation_of(block[-1, 3:7])
     return {"part": part.name, "part_index": part_index, "slot": segs[4][1].index, "grasped": grasped,
             "t_grasp": t_grasp, "t_grasp_prescribed": plan.grasp_times[k], "t_close_command": close,
             "slip_mm": None if slip is None else 1e3 * slip,

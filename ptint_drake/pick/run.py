@@ -25,7 +25,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, Saturation
 
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
-from ptint_drake.pick.config import PickWorldConfig
+from ptint_drake.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
 from ptint_drake.metrics import drive_metrics
 from ptint_drake.pick.metrics import pick_metrics, segment_rows
 from ptint_drake.pick.probe import PickProbe
@@ -36,7 +36,6 @@ from ptint_drake.scenario import PlantConfig, Scenario, ScenarioError
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
-DEFAULT_APPROXIMATION = "sap"  # measured by scripts/contact_bench.py: the most accurate, and fast
 
 
 def world_config(scenario: Scenario) -> PickWorldConfig:
@@ -93,14 +92,10 @@ def place_positions(station: PickStation, plan: PickPlan) -> list:
         if seg.kind != "slot":
             out.append(None)
             continue
-        part = station.config.parts[_task_part(station, plan, seg.task)]
+        part = station.config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
         height = part.size[2] if part.shape == "box" else part.size[1]
         out.append(station.slots[seg.index].CalcPoseInWorld(context).translation() + [0.0, 0.0, height / 2])
     return out
-
-
-def _task_part(station: PickStation, plan: PickPlan, task: int) -> int:
-    return next(s.index for s in plan.segments if s.task == task and s.kind == "part")
 
 
 def build_pick(scenario: Scenario) -> PickBuilt:
@@ -214,8 +209,7 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
         belt = belts[config.parts[part_index].belt]
         start = built.station.parts[part_index].EvalPoseInWorld(context).translation()
         grasp = start + belt.speed * plan.grasp_times[k] * np.asarray(belt.direction)
-        i_place = next(i for i, s in enumerate(plan.segments) if s.task == k and s.phase == "place")
-        place = built.targets.places[i_place]
+        place = built.targets.places[plan.segment_index(k, "place")]
         for where, x in ((f"pick.tasks[{k}].part", grasp), (f"pick.tasks[{k}].lift_height",
                                                            grasp + [0, 0, task.lift_height]),
                          (f"pick.tasks[{k}].slot", place), (f"pick.tasks[{k}].lift_height",

@@ -29,19 +29,14 @@ function of time: the plan's commands, piecewise constant (output ``command``).
 from __future__ import annotations
 
 import bisect
-import math
 from typing import Sequence
 
 import numpy as np
+from pydrake.math import RotationMatrix
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from ptint_drake.pick.tasks import PickPlan
 from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
-
-
-def _yaw_rotation(yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 class PickTargets(LeafSystem):
@@ -75,7 +70,7 @@ class PickTargets(LeafSystem):
         def update(context, state) -> None:
             if abs(context.get_time() - self._plan.grasp_times[task]) > 1e-9:
                 return  # a one-shot event: only its first occurrence
-            part = next(s.index for s in self._plan.segments if s.task == task and s.kind == "part")
+            part = self._plan.segments[self._plan.segment_index(task, "approach")].index
             pose, R = self._poses[part].Eval(context), self._rotations[part].Eval(context)[0:9]
             state.get_mutable_discrete_state(self._latched).SetFromVector(
                 np.r_[pose[0:6], context.get_time(), R])
@@ -111,7 +106,7 @@ class PickTargets(LeafSystem):
         seg = self._plan.segments[i]
         value = np.zeros(15)
         if seg.kind == "slot":
-            value[0:9] = _yaw_rotation(seg.yaw).ravel()
+            value[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
         elif seg.kind == "latched" or self._holding(context, i):
             value[0:9] = context.get_discrete_state(self._latched).get_value()[7:16]
         else:

@@ -102,6 +102,10 @@ class PickPlan:
     grasp_times: tuple
     end: float
 
+    def segment_index(self, task: int, phase: str) -> int:
+        """The index in the schedule of task ``task``'s segment ``phase`` (one of PHASES)."""
+        return next(i for i, s in enumerate(self.segments) if s.task == task and s.phase == phase)
+
 
 def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float):
     up = lambda h: (0.0, 0.0, h)  # noqa: E731

@@ -24,7 +24,7 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
-    from ptint_drake.pick.metrics import _quat_matrix  # noqa: PLC0415
+    from ptint_drake.pick.metrics import rotation_of  # noqa: PLC0415
     from ptint_drake.pick.probe import PART_WIDTH  # noqa: PLC0415
 
     t, probe = series["t"], series["probe"]
@@ -35,7 +35,7 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
         block = probe[:, PART_WIDTH * k: PART_WIDTH * (k + 1)]
         distance = 1e3 * np.linalg.norm(block[:, 0:3] - probe[:, -7:-4], axis=1)
         angle = np.array([np.degrees(np.arccos(np.clip(
-            (_quat_matrix(probe[j, -4:]) @ [1.0, 0.0, 0.0]) @ (_quat_matrix(block[j, 3:7]) @ [1.0, 0.0, 0.0]),
+            (rotation_of(probe[j, -4:]) @ [1.0, 0.0, 0.0]) @ (rotation_of(block[j, 3:7]) @ [1.0, 0.0, 0.0]),
             -1.0, 1.0))) for j in range(len(t))])
         angle = np.minimum(angle, 180.0 - angle)  # the fingers' axis: a half turn is the same grasp
         opening = 1e3 * (series["gripper_state"][:, 0] + series["gripper_state"][:, 1])
@@ -59,15 +59,17 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
     return path
 
 
-def write_pick_replay(scenario, series: dict, path: Path) -> int:
-    """Write ``replay.html`` (module docstring); returns its size in bytes."""
+def replay_world(scenario):
+    """The scenario's whole pick world (arm, gripper, belts, parts, tray) in a plant with a
+    MeshcatVisualizer on the shared Meshcat, cleared: (plant, visualizer, Meshcat, root context) —
+    no dynamics, a logged plant state is set into it."""
     from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role  # noqa: PLC0415
     from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig  # noqa: PLC0415
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
     from ptint_drake.pick.run import world_config  # noqa: PLC0415
     from ptint_drake.pick.world import _add_world  # noqa: PLC0415
-    from ptint_drake.replay import CAMERA, shared_meshcat, with_camera  # noqa: PLC0415
+    from ptint_drake.replay import shared_meshcat  # noqa: PLC0415
 
     config = world_config(scenario)
     builder = DiagramBuilder()
@@ -79,8 +81,14 @@ def write_pick_replay(scenario, series: dict, path: Path) -> int:
     meshcat.DeleteRecording()
     viz = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat,
                                          MeshcatVisualizerParams(role=Role.kIllustration))
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
+    return plant, viz, meshcat, builder.Build().CreateDefaultContext()
+
+
+def write_pick_replay(scenario, series: dict, path: Path) -> int:
+    """Write ``replay.html`` (module docstring); returns its size in bytes."""
+    from ptint_drake.replay import CAMERA, with_camera  # noqa: PLC0415
+
+    plant, viz, meshcat, context = replay_world(scenario)
     plant_context = plant.GetMyMutableContextFromRoot(context)
     times, states = series["replay_t"], series["plant_state"]
     meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)

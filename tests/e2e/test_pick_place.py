@@ -48,6 +48,8 @@ def test_assembly_pick_place_places_three_turned_parts(run):
     ("controller.control_period=-0.001", "controller.control_period"),
     ("measurement={rate_hz: 30.0}", "measurement"),  # no camera in the pick world: not silently ignored
     ("duration=2.0", "duration"),  # ends before the task does
+    ("multibody.time_step=0", "multibody.time_step"),  # a continuous plant: no contact solver
+    ("multibody.discrete_contact_approximation=bogus", "multibody.discrete_contact_approximation"),
 ])
 def test_bad_pick_input_is_one_line_exit_2(tmp_path, capsys, override, field):
     out = tmp_path / "o"

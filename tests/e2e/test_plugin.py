@@ -17,18 +17,7 @@ import pytest
 from ptint_drake.scenario import ScenarioError, parse_scenario
 from ptint_drake.simulation import simulate
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "task_space_pd.py"
-TYPE = "task_space_pd:TaskSpacePD"
-
-SCENARIO = """duration: 1.6
-controller: {type: "%s", params: {Kp: 2000.0, Kd: 150.0}}
-interceptions:
-  - start: 0.0
-    tf: 1.0
-    beta: 0.75
-    target: {linear: {start: [0.30, -0.05, 0.25], velocity: [0.0, 0.05, 0.0]}}
-"""
+from plugin_case import EXAMPLE, ROOT, SCENARIO, TYPE
 
 BROKEN = '''
 import numpy as np

@@ -7,15 +7,7 @@ import pytest
 from ptint_drake.controllers import REGISTRY, plugin
 from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario, scenario_text
 
-TYPE = "task_space_pd:TaskSpacePD"
-SCENARIO = """duration: 1.6
-controller: {type: "%s", params: {Kp: 2000.0, Kd: 150.0}}
-interceptions:
-  - start: 0.0
-    tf: 1.0
-    beta: 0.75
-    target: {linear: {start: [0.30, -0.05, 0.25], velocity: [0.0, 0.05, 0.0]}}
-"""
+from plugin_case import SCENARIO, TYPE
 
 
 def load_scenario_text() -> str:
