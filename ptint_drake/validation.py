@@ -65,6 +65,7 @@ def validate(s) -> None:
         _validate_target(ic.target, f"interceptions[{i}].target")
         if ic.target.ballistic is not None:
             _validate_throw(ic, f"interceptions[{i}]")
+    _validate_rotation_noise(s)
 
 
 def _validate_controller(c) -> None:
@@ -270,3 +271,14 @@ def _validate_throw(ic, where: str) -> None:
     if z < 0.0:
         raise ScenarioError(f"{where}.tf: the thrown object is below the floor at tf "
                             f"(z = {z:.3f} m at t = {ic.start + ic.tf:g} s)")
+
+
+def _validate_rotation_noise(s) -> None:
+    """``measurement.rot_noise_deg`` only where the camera measures an orientation: some target
+    has one (``orientation`` or waypoints' ``rpy_deg``)."""
+    if s.measurement is None or s.measurement.rot_noise_deg is None:
+        return
+    if not any(t.target.orientation is not None or (t.target.waypoints is not None and t.target.waypoints.rpy_deg)
+               for t in s.interceptions):
+        raise ScenarioError("measurement.rot_noise_deg: no target has an orientation, so the camera measures "
+                            "none (give a target an orientation, or remove rot_noise_deg)")
