@@ -103,9 +103,7 @@ class MeasurementConfig:
     # −prior_window ≤ t_k < 0); used when the camera is given the object's motion
     # before the run (the simulation does); 0: nothing is seen before t = 0
     prior_window: float = 1.0
-    # deg, std per axis of the small rotation that perturbs each orientation sample (objects
-    # with an orientation only); None: DEFAULT_ROT_NOISE_DEG = 1
-    rot_noise_deg: Optional[float] = None
+    rot_noise_deg: Optional[float] = None  # deg per axis of an orientation sample's noise; None: 1
 
 
 def _field_error(name: str, message: str) -> ValueError:
