@@ -9,6 +9,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from ptint_drake.controllers import CONTROLLERS, REGISTRY, known_type, plugin
 from ptint_drake.metrics import validate_criteria
 from ptint_drake.systems.camera import validate_measurement
+from ptint_drake.systems.orientation import has_orientation
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import WaypointTarget
 from ptint_drake.systems.task import TASKS
@@ -278,7 +279,6 @@ def _validate_rotation_noise(s) -> None:
     has one (``orientation`` or waypoints' ``rpy_deg``)."""
     if s.measurement is None or s.measurement.rot_noise_deg is None:
         return
-    if not any(t.target.orientation is not None or (t.target.waypoints is not None and t.target.waypoints.rpy_deg)
-               for t in s.interceptions):
+    if not any(has_orientation(target) for target in s.targets()):
         raise ScenarioError("measurement.rot_noise_deg: no target has an orientation, so the camera measures "
                             "none (give a target an orientation, or remove rot_noise_deg)")

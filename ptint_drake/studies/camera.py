@@ -109,7 +109,8 @@ def summarize(rows: list) -> dict:
     rot = [s.get("e_rot_tf") for r in done for s in r["segments"]]
     if rot and None not in rot:  # a task with orientation: the angle at tf (deg) too
         per_segment = list(zip(*[[s["e_rot_tf"] for s in r["segments"]] for r in done]))
-        out.update({"e_rot_tf_median_deg": float(np.median(rot)), "e_rot_tf_p90_deg": float(np.percentile(rot, 90)),
+        out.update({"e_rot_tf_median_deg": float(np.median(rot)),
+                    "e_rot_tf_p90_deg": float(np.percentile(rot, 90)),
                     "e_rot_tf_median_per_segment_deg": [float(np.median(v)) for v in per_segment]})
     return out
 
