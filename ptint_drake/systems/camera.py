@@ -87,7 +87,8 @@ class MeasurementConfig:
     or a hand-set Kalman filter ``kalman_cv`` / ``kalman_ca`` whose ``process_noise`` is
     the spectral density q of its white acceleration (m²/s³) or jerk (m²/s⁵), default
     DEFAULT_PROCESS_NOISE = 0.01 (``kalman``'s docstring has the numbers); ``none``: no
-    camera, only with a perfect one (noise, latency and dropouts all 0).
+    camera, only with a perfect one (noise, latency and dropouts all 0).  ``rot_noise_deg``: the
+    orientation samples' noise, for objects with an orientation (``Camera(rotation=True)``).
     """
 
     noise_std: float = 0.0  # m, per axis
