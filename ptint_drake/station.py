@@ -12,15 +12,17 @@ The station owns its world: the plant variants are in the plant's defaults
 the station added to any diagram and simulated from that diagram's default context
 by any ``Simulator`` is the world ``ptint run`` simulates.
 
-=================  ======  ================================================
-port               size    meaning
-=================  ======  ================================================
-``actuation``      nu      input: commanded actuation (saturated if
-                           ``limits.saturate``), in the plant's actuator order
-``state``          nq+nv   output: the plant's [q; v]
-``target``         9       output: true [x_r, ẋ_r, ẍ_r] of the active segment's object
-``objects``        3·n     output: true position of every object
-=================  ======  ================================================
+=====================  ======  ================================================
+port                   size    meaning
+=====================  ======  ================================================
+``actuation``          nu      input: commanded actuation (saturated if
+                               ``limits.saturate``), in the plant's actuator order
+``state``              nq+nv   output: the plant's [q; v]
+``target``             9       output: true [x_r, ẋ_r, ẍ_r] of the active segment's object
+``objects``            3·n     output: true position of every object
+``object_rotations``   9·n     output: true orientation of every object (row-major;
+                               an unturned frame for an object without one)
+=====================  ======  ================================================
 
 The station may use the model (it *is* the model); the model-free controllers
 only see ``state`` (through the kinematics) and a target.
@@ -38,6 +40,7 @@ from pydrake.systems.primitives import Saturation
 from ptint_drake.robot import actuator_effort_limits, effort_limits, make_plant
 from ptint_drake.scenario import Scenario, ScenarioError
 from ptint_drake.systems.disturbance import JointDisturbance
+from ptint_drake.systems.orientation import ObjectRotations
 from ptint_drake.systems.targets import TargetSource
 
 
@@ -79,6 +82,8 @@ def MakeStation(scenario: Scenario) -> Station:
     builder.ExportOutput(plant.get_state_output_port(), "state")
     builder.ExportOutput(truth.GetOutputPort("target"), "target")
     builder.ExportOutput(truth.GetOutputPort("objects"), "objects")
+    rotations = builder.AddNamedSystem("object_rotations", ObjectRotations(targets))
+    builder.ExportOutput(rotations.get_output_port(), "object_rotations")
     diagram = builder.Build()
     diagram.set_name("station")
     return Station(diagram, plant, targets, effort_limits(plant), scenario.limits.saturate)

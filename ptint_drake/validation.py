@@ -9,6 +9,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from ptint_drake.controllers import CONTROLLERS, REGISTRY, known_type, plugin
 from ptint_drake.metrics import validate_criteria
 from ptint_drake.systems.camera import validate_measurement
+from ptint_drake.systems.orientation import has_orientation
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
 from ptint_drake.systems.targets import WaypointTarget
 from ptint_drake.systems.task import TASKS
@@ -65,6 +66,7 @@ def validate(s) -> None:
         _validate_target(ic.target, f"interceptions[{i}].target")
         if ic.target.ballistic is not None:
             _validate_throw(ic, f"interceptions[{i}]")
+    _validate_rotation_noise(s)
 
 
 def _validate_controller(c) -> None:
@@ -270,3 +272,13 @@ def _validate_throw(ic, where: str) -> None:
     if z < 0.0:
         raise ScenarioError(f"{where}.tf: the thrown object is below the floor at tf "
                             f"(z = {z:.3f} m at t = {ic.start + ic.tf:g} s)")
+
+
+def _validate_rotation_noise(s) -> None:
+    """``measurement.rot_noise_deg`` only where the camera measures an orientation: some target
+    has one (``orientation`` or waypoints' ``rpy_deg``)."""
+    if s.measurement is None or s.measurement.rot_noise_deg is None:
+        return
+    if not any(has_orientation(target) for target in s.targets()):
+        raise ScenarioError("measurement.rot_noise_deg: no target has an orientation, so the camera measures "
+                            "none (give a target an orientation, or remove rot_noise_deg)")

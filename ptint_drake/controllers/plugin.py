@@ -11,7 +11,9 @@
 
 with input ports ``state`` (the arm's [q; v]) and ``target`` ([x_r, ẋ_r, ẍ_r] of the active
 segment, ``signals.TARGET``, 9 values), optionally an input ``segment`` ([index, start, tf] of
-the active segment, ``systems.active_segment``), and an output ``actuation`` (one torque per
+the active segment, ``systems.active_segment``) and an input ``target_rotation`` ([R_r row-major,
+ω_r, ω̇_r], 15 values: the object's orientation, or with a camera the rotation estimator's
+estimate of it, as the paper's controller gets it), and an output ``actuation`` (one torque per
 actuator of the arm, in the plant's actuator order).  ``plant`` is for the plugin's
 kinematics; a plugin that uses its dynamics is model-based and should say so.
 

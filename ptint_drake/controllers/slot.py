@@ -8,7 +8,9 @@ controller is *allowed* to see it:
 - no ``measurement`` (or ``estimator: none``): the analytic targets, as objects in
   ``analytic`` and, when a controller asks for it, as a ``TargetSource`` port;
 - with a camera: only what one camera and one estimator per object (``auto`` or a
-  hand-set Kalman filter) make of the station's true object positions (``analytic`` is None).
+  hand-set Kalman filter) make of the station's true object positions (``analytic`` is None),
+  and, for objects with an orientation, what ``rotation_estimator`` makes of the camera's
+  orientation samples (the station's ``object_rotations``).
 
 The station's true target never reaches a controller directly.  The port is built on first
 use, so a controller that evaluates the analytic targets itself (the fused interceptor) adds
@@ -29,7 +31,9 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Frame
 from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
 
-from ptint_drake.systems.kalman import AddCameraEstimators
+from ptint_drake.systems.kalman import AddCameraEstimators, CameraEstimators
+from ptint_drake.systems.orientation import has_orientation
+from ptint_drake.systems.rotation_estimator import AddRotationEstimators
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.targets import TargetSource
@@ -92,25 +96,40 @@ class ControllerSlot:
 class TargetView:
     """The target as the controller may see it: ``analytic`` (the target objects, or None with
     a camera), ``port()`` ([x_r, ẋ_r, ẍ_r] of the active segment, built on first use) and
-    ``rotation_port()`` ([R_r, ω_r, ω̇_r], ``signals.TARGET_ROTATION``: the object's orientation,
-    not measured — the camera estimates positions only)."""
+    ``rotation_port()`` ([R_r, ω_r, ω̇_r], ``signals.TARGET_ROTATION``: the analytic
+    orientation, or with a camera what ``rotation_estimator`` makes of the camera's
+    orientation samples when a target has an orientation).  With a camera both ports come
+    from one set of cameras (``camera_estimators``)."""
 
     def __init__(self, builder: DiagramBuilder, station_system, scenario: "Scenario"):
         self._builder, self._station, self._scenario = builder, station_system, scenario
         self.analytic = controller_targets(scenario) if uses_analytic_targets(scenario) else None
         self._port: Optional[OutputPort] = None
         self._rotation_port: Optional[OutputPort] = None
+        self._cameras: Optional[CameraEstimators] = None
 
     def port(self) -> OutputPort:
         if self._port is None:
-            self._port = target_view(self._builder, self._station, self._scenario, self.analytic)
+            self._port = (target_view(self._builder, self._station, self._scenario, self.analytic)
+                          if self.analytic is not None else self.camera_estimators().target_port)
         return self._port
+
+    def camera_estimators(self) -> CameraEstimators:
+        """The cameras and position estimators (built on first use; camera mode only)."""
+        if self._cameras is None:
+            self._cameras = camera_estimators(self._builder, self._station, self._scenario)
+        return self._cameras
 
     def rotation_port(self) -> OutputPort:
         if self._rotation_port is None:
-            source = self._builder.AddNamedSystem("target_rotation_view", TargetSource(
-                self._scenario.schedule(), self.analytic or self._scenario.targets()))
-            self._rotation_port = source.GetOutputPort("target_rotation")
+            if self.analytic is None and measures_orientation(self._scenario):
+                self._rotation_port = AddRotationEstimators(
+                    self._builder, cameras=self.camera_estimators().cameras,
+                    schedule=self._scenario.schedule(), config=self._scenario.measurement).rotation_port
+            else:  # the analytic orientation (with a camera: no target has one, a fixed frame)
+                source = self._builder.AddNamedSystem("target_rotation_view", TargetSource(
+                    self._scenario.schedule(), self.analytic or self._scenario.targets()))
+                self._rotation_port = source.GetOutputPort("target_rotation")
         return self._rotation_port
 
 
@@ -119,9 +138,24 @@ def uses_analytic_targets(scenario: "Scenario") -> bool:
     return scenario.measurement is None or scenario.measurement.estimator == "none"
 
 
+def measures_orientation(scenario: "Scenario") -> bool:
+    """True when a camera is in the loop and a target carries an orientation: the cameras then
+    measure the objects' orientations too (``measurement.rot_noise_deg``)."""
+    return not uses_analytic_targets(scenario) and any(has_orientation(t) for t in scenario.targets())
+
+
 def controller_targets(scenario: "Scenario") -> list:
     """The analytic view: the true targets."""
     return scenario.targets()
+
+
+def camera_estimators(builder: DiagramBuilder, station_system, scenario: "Scenario") -> CameraEstimators:
+    """One camera + position estimator per object fed by the station's true object positions
+    (and orientations when ``measures_orientation``), in view before t = 0."""
+    rotations = station_system.GetOutputPort("object_rotations") if measures_orientation(scenario) else None
+    return AddCameraEstimators(builder, objects_port=station_system.GetOutputPort("objects"),
+                               schedule=scenario.schedule(), config=scenario.measurement,
+                               histories=scenario.targets(), rotations_port=rotations)
 
 
 def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",
@@ -133,9 +167,7 @@ def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",
         source = builder.AddNamedSystem("target_view", TargetSource(
             scenario.schedule(), analytic if analytic is not None else controller_targets(scenario)))
         return source.GetOutputPort("target")
-    return AddCameraEstimators(builder, objects_port=station_system.GetOutputPort("objects"),
-                               schedule=scenario.schedule(), config=scenario.measurement,
-                               histories=scenario.targets()).target_port  # in view before t = 0
+    return camera_estimators(builder, station_system, scenario).target_port
 
 
 def target_columns(target_log: np.ndarray) -> dict:

@@ -82,6 +82,8 @@ def run_case(text: str, name: str, measurement: dict, seed: int) -> dict:
     row["status"] = m["status"]
     row["segments"] = [{"e0": s["e0_norm"], "e_half": s["e_half_norm"], "e_tf": s["e_tf_norm"],
                         "hold": s["e_hold_max_norm"],
+                        # deg, against the true orientation (None for a position task)
+                        "e_rot_tf": s.get("e_rot_tf_deg"), "rot_hold": s.get("e_rot_hold_max_deg"),
                         "reasons": segment_reasons(s, scenario.criteria)} for s in m["segments"]]
     row["wall_s"] = m["sim"]["wall_time_s"]
     return row
@@ -104,6 +106,12 @@ def summarize(rows: list) -> dict:
                     "hold_median": float(np.median(hold)), "hold_p90": float(np.percentile(hold, 90))})
         per_segment = list(zip(*[[s["e_tf"] for s in r["segments"]] for r in done]))
         out["e_tf_median_per_segment"] = [float(np.median(v)) for v in per_segment]
+    rot = [s.get("e_rot_tf") for r in done for s in r["segments"]]
+    if rot and None not in rot:  # a task with orientation: the angle at tf (deg) too
+        per_segment = list(zip(*[[s["e_rot_tf"] for s in r["segments"]] for r in done]))
+        out.update({"e_rot_tf_median_deg": float(np.median(rot)),
+                    "e_rot_tf_p90_deg": float(np.percentile(rot, 90)),
+                    "e_rot_tf_median_per_segment_deg": [float(np.median(v)) for v in per_segment]})
     return out
 
 
@@ -125,13 +133,17 @@ def grid_cases(text: str, name: str, seeds: int, noises=NOISES, latencies=LATENC
 
 def markdown(summary_rows: list, seeds: int, scenario: str) -> str:
     """camera_study.md: the summary rows as a Markdown table with its heading and legend."""
+    angle = any("e_rot_tf_median_deg" in row["summary"] for row in summary_rows)
     lines = [f"# Camera study: {scenario}, {seeds} seeds",
              "",
              "|e(tf)| against the true target over every segment of every seed (mm); hold = the "
-             "largest |e| after tf (mm, median); early = segments that arrived early.",
+             "largest |e| after tf (mm, median); early = segments that arrived early"
+             + ("; angle = the orientation error at tf against the true object (deg, median / p90)."
+                if angle else "."),
              "",
-             "| estimator | noise (mm) | latency (ms) | e(tf) median | e(tf) p90 | hold median | early |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+             "| estimator | noise (mm) | latency (ms) | e(tf) median | e(tf) p90 | hold median | early |"
+             + (" angle |" if angle else ""),
+             "|---|---:|---:|---:|---:|---:|---:|" + ("---:|" if angle else "")]
     for row in summary_rows:
         s = row["summary"]
         if "e_tf_median" not in s:
@@ -140,7 +152,9 @@ def markdown(summary_rows: list, seeds: int, scenario: str) -> str:
             continue
         lines.append(f"| {row['estimator']} | {row['noise_std'] * 1e3:g} | {row['latency'] * 1e3:g} | "
                      f"{s['e_tf_median'] * 1e3:.2f} | {s['e_tf_p90'] * 1e3:.2f} | "
-                     f"{s['hold_median'] * 1e3:.2f} | {s['early']} |")
+                     f"{s['hold_median'] * 1e3:.2f} | {s['early']} |"
+                     + (f" {s['e_rot_tf_median_deg']:.2f} / {s['e_rot_tf_p90_deg']:.2f} |"
+                        if "e_rot_tf_median_deg" in s else (" |" if angle else "")))
     return "\n".join(lines) + "\n"
 
 

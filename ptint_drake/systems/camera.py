@@ -26,6 +26,14 @@ at time t, held between samples (zero-order hold); ``stamp`` = t_k is the time i
 was taken, ``valid`` = 0 until the first sample is visible (then [0, 0, 0, 0, 0]); with a
 pre-run history the newest pre-run sample (stamp < 0) is visible from t = 0.
 
+Orientation (``rotation=True``: the object carries one, issue 19).  Sample k also holds
+the object's measured orientation Z_k = exp([n_k^R]×) R_true(t_k), a world-frame
+perturbation by a rotation vector n_k^R ~ N(0, σ_R² I₃), σ_R = ``rot_noise_deg`` (default
+DEFAULT_ROT_NOISE_DEG) in radians, drawn from the streams [seed + seed_offset, 2] (k ≥ 0)
+and [seed + seed_offset, 3] (k < 0), so the position samples are the same with or without
+it.  Same instants, latency and dropouts as the position; output ``measured_rotation`` =
+[stamp, Z_k (row-major), valid] (11) of the same newest visible sample.
+
 What it does not model: the optics (projection, field of view, occlusion by the
 arm, calibration or hand–eye bias), noise that is correlated in time or
 between axes, outliers, jitter of the sample times or of the latency, rolling
@@ -57,9 +65,13 @@ from typing import Optional
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from ptint_drake.systems.orientation import rotation_from_vector
+
 ESTIMATORS = ("auto", "kalman_cv", "kalman_ca", "none")
 # the hand-set filters' process noise q when the scenario does not state one
 DEFAULT_PROCESS_NOISE = 0.01
+# deg, per axis: the orientation noise of a camera that measures one, when not stated
+DEFAULT_ROT_NOISE_DEG = 1.0
 # Tolerance (s) on event times: a sample is visible at t when stamp + latency <= t + TIME_TOL.
 TIME_TOL = 1.0e-9
 # Size of the blocks of noise drawn at once (noise of sample k = row k of one stream).
@@ -75,7 +87,8 @@ class MeasurementConfig:
     or a hand-set Kalman filter ``kalman_cv`` / ``kalman_ca`` whose ``process_noise`` is
     the spectral density q of its white acceleration (m²/s³) or jerk (m²/s⁵), default
     DEFAULT_PROCESS_NOISE = 0.01 (``kalman``'s docstring has the numbers); ``none``: no
-    camera, only with a perfect one (noise, latency and dropouts all 0).
+    camera, only with a perfect one (noise, latency and dropouts all 0).  ``rot_noise_deg``: the
+    orientation samples' noise, for objects with an orientation (``Camera(rotation=True)``).
     """
 
     noise_std: float = 0.0  # m, per axis
@@ -91,6 +104,7 @@ class MeasurementConfig:
     # −prior_window ≤ t_k < 0); used when the camera is given the object's motion
     # before the run (the simulation does); 0: nothing is seen before t = 0
     prior_window: float = 1.0
+    rot_noise_deg: Optional[float] = None  # deg per axis of an orientation sample's noise; None: 1
 
 
 def _field_error(name: str, message: str) -> ValueError:
@@ -109,7 +123,8 @@ def validate_measurement(m: MeasurementConfig) -> None:
     if not (math.isfinite(rate) and rate > 0.0):
         raise _field_error("rate_hz", f"must be > 0, got {m.rate_hz}")
     names = ("noise_std", "latency", "prior_window")
-    for name in names + (("process_noise",) if m.process_noise is not None else ()):
+    optional = tuple(n for n in ("process_noise", "rot_noise_deg") if getattr(m, n) is not None)
+    for name in names + optional:
         value = number(name)
         if not (math.isfinite(value) and value >= 0.0):
             raise _field_error(name, f"must be >= 0 and finite, got {getattr(m, name)}")
@@ -146,14 +161,19 @@ def _check_estimator(m: MeasurementConfig) -> None:
         raise _field_error("process_noise", "estimator auto tunes itself: remove process_noise "
                            "(or choose estimator: kalman_cv / kalman_ca to set it by hand)")
     if m.estimator == "none":
-        for name in ("noise_std", "latency"):
-            if getattr(m, name) != 0:
+        for name in ("noise_std", "latency", "rot_noise_deg"):
+            if getattr(m, name) not in (0, None):
                 raise _field_error(name, f"the noisy target without a camera is retired: remove "
                                    f"estimator: none to see the target through the camera "
                                    f"(estimator auto), or remove {name}")
         if m.dropouts:
             raise _field_error("dropouts", "the noisy target without a camera is retired: remove "
                                "estimator: none to see the target through the camera (estimator auto)")
+
+
+def rotation_noise(m: MeasurementConfig) -> float:
+    """σ_R (rad): the orientation samples' noise per axis (``rot_noise_deg`` or its default)."""
+    return math.radians(DEFAULT_ROT_NOISE_DEG if m.rot_noise_deg is None else float(m.rot_noise_deg))
 
 
 def process_noise(m: MeasurementConfig) -> float:
@@ -186,16 +206,22 @@ class Camera(LeafSystem):
 
     Input port ``x_true`` (3): the object's true position.
     Output port ``measurement`` (5): [stamp, x, y, z, valid] of the newest visible sample.
-    Discrete state (one group, 5·N): N slots [stamp, x, y, z, valid], newest first, of
-    the last N delivered samples (``valid`` = 0 marks an empty slot); its default
+    Discrete state (one group, W·N): N slots [stamp, x, y, z, valid] (W = 5), newest first,
+    of the last N delivered samples (``valid`` = 0 marks an empty slot); its default
     value holds the newest pre-run samples when there is a ``history``.
 
+    ``rotation=True`` (an object with an orientation) adds the input port ``R_true`` (9: its
+    true orientation, row-major), the output port ``measured_rotation`` (11: [stamp, Z
+    row-major, valid]) and Z to each slot (W = 14: [stamp, x, y, z, valid, Z]).
+
     ``history``: the object's true position as a function of time (a callable
-    t → [x, y, z], or an object whose ``evaluate(t)`` starts with it), used only
+    t → [x, y, z], or an object whose ``evaluate(t)`` starts with it, and whose
+    ``rotation_values(t)`` starts with its orientation when it has one), used only
     for the pre-run samples t_k < 0 (``config.prior_window``).
     """
 
-    def __init__(self, *, config: MeasurementConfig, seed_offset: int = 0, history=None):
+    def __init__(self, *, config: MeasurementConfig, seed_offset: int = 0, history=None,
+                 rotation: bool = False):
         super().__init__()
         validate_measurement(config)
         self._config = config
@@ -204,14 +230,19 @@ class Camera(LeafSystem):
         self._period = 1.0 / config.rate_hz
         self._latency = float(config.latency) if config.latency > TIME_TOL else 0.0
         self._windows = [(float(a), float(b)) for a, b in config.dropouts]
-        self._noise = _NoiseTable(config.noise_std, config.seed + seed_offset)
+        seed = config.seed + seed_offset
+        self._noise = _NoiseTable(config.noise_std, seed)
+        self._rotation = bool(rotation)
+        self._rot_noise = _NoiseTable(rotation_noise(config), [seed, 2]) if rotation else None
+        self._width = 14 if rotation else 5
         self._slots = math.ceil(self._latency * config.rate_hz - TIME_TOL) + 2
-        self._pre_run = self._take_pre_run(history, config.seed + seed_offset)
+        self._pre_run = self._take_pre_run(history, seed)
 
         self._x_in = self.DeclareVectorInputPort("x_true", 3)
-        buffer = np.zeros((self._slots, 5))
-        for slot, (t_k, z_k) in zip(buffer, reversed(self._pre_run)):
-            slot[:] = [t_k, *z_k, 1.0]
+        self._R_in = self.DeclareVectorInputPort("R_true", 9) if rotation else None
+        buffer = np.zeros((self._slots, self._width))
+        for slot, (t_k, z_k, Z_k) in zip(buffer, reversed(self._pre_run)):
+            slot[:] = [t_k, *z_k, 1.0, *Z_k]
         self._buffer_index = self.DeclareDiscreteState(buffer.ravel())
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._take_sample)
         if self._latency > 0.0:
@@ -219,9 +250,12 @@ class Camera(LeafSystem):
             self.DeclarePeriodicPublishEvent(self._period, self._latency, lambda context: None)
             prerequisites = {self.time_ticket(), self.xd_ticket()}
         else:
-            prerequisites = {self.time_ticket(), self.xd_ticket(), self._x_in.ticket()}
+            prerequisites = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         self._measurement_out = self.DeclareVectorOutputPort(
-            "measurement", 5, lambda c, o: o.SetFromVector(self._visible(c)),
+            "measurement", 5, lambda c, o: o.SetFromVector(self._visible(c)[0:5]),
+            prerequisites_of_calc=prerequisites)
+        self._rotation_out = None if not rotation else self.DeclareVectorOutputPort(
+            "measured_rotation", 11, lambda c, o: o.SetFromVector(self._visible_rotation(c)),
             prerequisites_of_calc=prerequisites)
 
     @property
@@ -233,32 +267,54 @@ class Camera(LeafSystem):
         """N, the number of samples the delay buffer holds."""
         return self._slots
 
+    @property
+    def measures_rotation(self) -> bool:
+        """Whether the camera also measures the object's orientation (``rotation``)."""
+        return self._rotation
+
     def pre_run_samples(self, visible_by: float = 0.0) -> list:
         """[(t_k, z_k), …], oldest first: the delivered pre-run samples (t_k < 0) that are
         visible at ``visible_by`` (t_k + latency ≤ visible_by); empty without a history."""
-        return [(t_k, z_k.copy()) for t_k, z_k in self._pre_run
+        return [(t_k, z_k.copy()) for t_k, z_k, _ in self._pre_run
+                if t_k + self._latency <= visible_by + TIME_TOL]
+
+    def pre_run_rotations(self, visible_by: float = 0.0) -> list:
+        """[(t_k, Z_k as 3×3), …] of the same pre-run samples (empty without ``rotation``)."""
+        if not self._rotation:
+            return []
+        return [(t_k, np.reshape(Z_k, (3, 3)).copy()) for t_k, _, Z_k in self._pre_run
                 if t_k + self._latency <= visible_by + TIME_TOL]
 
     def _take_pre_run(self, history, seed) -> list:
+        """[(t_k, z_k, Z_k row-major or []), …] of the pre-run samples, oldest first."""
         window = float(self._config.prior_window)
         if history is None or window <= 0.0:
             return []
         position = history if callable(history) else (lambda t: history.evaluate(t)[0:3])
+        turn = getattr(history, "rotation_values", lambda t: np.eye(3).ravel())
         noise = _NoiseTable(self._config.noise_std, [seed, 1])  # second stream: k < 0
+        rot_noise = _NoiseTable(rotation_noise(self._config), [seed, 3]) if self._rotation else None
         count = math.floor(window * self._config.rate_hz + TIME_TOL)
         samples = []
         for j in range(count, 0, -1):  # k = −j, oldest first
             t_k = -j * self._period
             if not self.dropped(t_k):
                 z = np.asarray(position(t_k), dtype=float)[0:3] + noise(j - 1)
-                samples.append((t_k, z))
+                Z = [] if rot_noise is None else self._perturb(rot_noise(j - 1), turn(t_k)[0:9])
+                samples.append((t_k, z, Z))
         return samples
 
     def get_x_true_input_port(self):
         return self._x_in
 
+    def get_R_true_input_port(self):
+        return self._R_in
+
     def get_measurement_output_port(self):
         return self._measurement_out
+
+    def get_measured_rotation_output_port(self):
+        return self._rotation_out
 
     def dropped(self, t: float) -> bool:
         """Whether a sample taken at t falls in a dropout window [from, to) or before the
@@ -271,30 +327,51 @@ class Camera(LeafSystem):
         """z_k = x_true + n_k (3 values); n_k is fixed by k and the seed."""
         return np.asarray(x_true, dtype=float) + self._noise(k)
 
+    def sample_rotation(self, k: int, R_true) -> list:
+        """Z_k = exp([n_k^R]×) R_true (9 values, row-major); n_k^R is fixed by k and the seed."""
+        return self._perturb(self._rot_noise(k), R_true)
+
+    @staticmethod
+    def _perturb(n, R_true) -> list:
+        R = np.asarray(R_true, dtype=float).reshape(3, 3)
+        return (rotation_from_vector(n).matrix() @ R).ravel().tolist()
+
     def _sample_index(self, t: float) -> int:
         return round(t * self._config.rate_hz)
+
+    def _new_slot(self, context, t: float) -> np.ndarray:
+        """[t, z_k, 1(, Z_k)] of the sample taken at t from the inputs."""
+        k = self._sample_index(t)
+        row = [t, *self.sample(k, self._x_in.Eval(context)), 1.0]
+        if self._rotation:
+            row += self.sample_rotation(k, self._R_in.Eval(context))
+        return np.array(row)
 
     def _take_sample(self, context, discrete_state) -> None:
         t = context.get_time()
         if self.dropped(t):
             return
-        z = self.sample(self._sample_index(t), self._x_in.Eval(context))
         buffer = discrete_state.get_mutable_vector(self._buffer_index)
         old = context.get_discrete_state(self._buffer_index).value()
-        buffer.SetFromVector(np.concatenate([[t], z, [1.0], old[:-5]]))
+        buffer.SetFromVector(np.concatenate([self._new_slot(context, t), old[:-self._width]]))
 
     def _visible(self, context) -> np.ndarray:
+        """The slot (W values) of the newest sample visible at the context's time (zeros: none)."""
         t = context.get_time()
-        slots = context.get_discrete_state(self._buffer_index).value().reshape(self._slots, 5)
+        slots = context.get_discrete_state(self._buffer_index).value().reshape(self._slots, self._width)
         if self._latency == 0.0:
             # the sample taken now is visible now, even before this instant's update stores it
-            k = self._sample_index(t)
-            t_k = k * self._period
+            t_k = self._sample_index(t) * self._period
             newest = slots[0]
             stored = newest[4] > 0.5 and newest[0] >= t_k - TIME_TOL
             if abs(t - t_k) <= TIME_TOL and not stored and not self.dropped(t_k):
-                return np.concatenate([[t], self.sample(k, self._x_in.Eval(context)), [1.0]])
+                return self._new_slot(context, t)
         for slot in slots:
             if slot[4] > 0.5 and slot[0] + self._latency <= t + TIME_TOL:
                 return slot.copy()
-        return np.zeros(5)
+        return np.zeros(self._width)
+
+    def _visible_rotation(self, context) -> np.ndarray:
+        """[stamp, Z row-major, valid] of the newest visible sample."""
+        slot = self._visible(context)
+        return np.concatenate([slot[0:1], slot[5:14], slot[4:5]])

@@ -305,19 +305,19 @@ class TargetKalmanFilter(LeafSystem):
 
 
 class ActiveTargetSelector(LeafSystem):
-    """Input ports ``target_0`` … ``target_{count-1}`` (9 each); output ``target`` (9): the
-    input of the segment active at t (``schedule.active(t)``; the first before any start)."""
+    """Input ports ``target_0`` … ``target_{count-1}`` (``size`` each, default 9); output
+    ``target``: the input of the segment active at t (``schedule.active(t)``; the first
+    before any start).  ``size`` 15 selects orientations (``signals.TARGET_ROTATION``)."""
 
-    def __init__(self, *, schedule: Schedule, count: int):
+    def __init__(self, *, schedule: Schedule, count: int, size: int = TARGET_PORT_SIZE):
         super().__init__()
         if count != len(schedule):
             raise ValueError(f"count: one target per segment is needed, got {count} "
                              f"for {len(schedule)} segments")
         self._schedule = schedule
-        self._inputs = [self.DeclareVectorInputPort(f"target_{i}", TARGET_PORT_SIZE)
-                        for i in range(count)]
+        self._inputs = [self.DeclareVectorInputPort(f"target_{i}", size) for i in range(count)]
         self._target_out = self.DeclareVectorOutputPort(
-            "target", TARGET_PORT_SIZE, self._select,
+            "target", size, self._select,
             prerequisites_of_calc={self.time_ticket(), self.all_input_ports_ticket()})
 
     def get_target_output_port(self):
@@ -347,7 +347,8 @@ class CameraEstimators:
 
 def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | None = None,
                         objects_port: OutputPort | None = None, schedule: Schedule,
-                        config: MeasurementConfig, histories=None) -> CameraEstimators:
+                        config: MeasurementConfig, histories=None,
+                        rotations_port: OutputPort | None = None) -> CameraEstimators:
     """Add, per object i, ``camera_i`` (seed_offset i) observing ``true_position_ports[i]``
     and ``target_filter_i``; and ``target_selector`` choosing the active one.  The handles
     returned hold every camera and filter (index i: object i).
@@ -359,7 +360,9 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     for ``config.prior_window`` s before t = 0 and its filter starts from those samples
     (priming); without it the cameras start seeing at t = 0.
     ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object), or
-    ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
+    ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).  ``rotations_port`` (9 per
+    object, row-major, e.g. the station's ``object_rotations``): the cameras also measure the
+    orientations (``rotation_estimator.AddRotationEstimators`` tracks them).
     """
     validate_measurement(config)
     if config.estimator not in ("auto", "kalman_cv", "kalman_ca"):
@@ -372,6 +375,9 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         split = builder.AddNamedSystem("object_positions", Demultiplexer([3] * n))
         builder.Connect(objects_port, split.get_input_port())
         true_position_ports = [split.get_output_port(i) for i in range(n)]
+    if rotations_port is not None:
+        rotations = builder.AddNamedSystem("object_rotations", Demultiplexer([9] * len(schedule)))
+        builder.Connect(rotations_port, rotations.get_input_port())
     selector = builder.AddNamedSystem(
         "target_selector", ActiveTargetSelector(schedule=schedule, count=len(true_position_ports)))
     if histories is not None and len(histories) != len(true_position_ports):
@@ -380,8 +386,10 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     cameras, filters = [], []
     for i, port in enumerate(true_position_ports):
         history = None if histories is None else histories[i]
-        camera = builder.AddNamedSystem(f"camera_{i}", Camera(config=config, seed_offset=i,
-                                                              history=history))
+        camera = builder.AddNamedSystem(f"camera_{i}", Camera(config=config, seed_offset=i, history=history,
+                                                              rotation=rotations_port is not None))
+        if rotations_port is not None:
+            builder.Connect(rotations.get_output_port(i), camera.get_R_true_input_port())
         kf = builder.AddNamedSystem(f"target_filter_{i}", _estimator(config, camera.pre_run_samples()))
         builder.Connect(port, camera.get_x_true_input_port())
         builder.Connect(camera.get_measurement_output_port(), kf.get_measurement_input_port())

@@ -21,8 +21,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from pydrake.common.eigen_geometry import Quaternion
+from pydrake.common.eigen_geometry import AngleAxis, Quaternion
 from pydrake.math import RollPitchYaw, RotationMatrix
+from pydrake.systems.framework import LeafSystem
 from pydrake.trajectories import PiecewiseQuaternionSlerp
 
 from ptint_drake.systems.signals import IDENTITY_ROTATION
@@ -57,6 +58,14 @@ def rotation_exp(w) -> np.ndarray:
         return np.eye(3) + skew(w)
     K = skew(w / th)
     return np.eye(3) + math.sin(th) * K + (1.0 - math.cos(th)) * K @ K
+
+
+def rotation_from_vector(w) -> RotationMatrix:
+    """exp([w]×) as Drake's ``RotationMatrix`` (through ``AngleAxis``): the rotation by |w| rad
+    about w/|w| (the identity for w = 0)."""
+    w = np.asarray(w, dtype=float)
+    angle = math.sqrt(float(w @ w))
+    return RotationMatrix() if angle == 0.0 else RotationMatrix(AngleAxis(angle, w / angle))
 
 
 def rpy_matrix(rpy_deg) -> np.ndarray:
@@ -175,3 +184,23 @@ def orientation_error_angle(task: str, R, rot_r) -> float:
     object's orientation (``pose``), or the nearer of the two top-down grasps (``top_down``)."""
     ref = top_down_reference(rot_r, tool_yaw(R)) if task == "top_down" else rot_r
     return rotation_angle(np.asarray(R, dtype=float).reshape(3, 3), np.asarray(ref[0:9]).reshape(3, 3))
+
+
+def has_orientation(target) -> bool:
+    """Whether a target carries an orientation (``OrientedTarget``)."""
+    return getattr(target, "rotation_values", None) is not None
+
+
+class ObjectRotations(LeafSystem):
+    """Output port ``object_rotations`` (9 × number of targets, time only): every target's true
+    orientation R_r(t), row-major (an unturned frame for a target without one) — what a camera
+    that measures orientations looks at."""
+
+    def __init__(self, targets):
+        super().__init__()
+        self._targets = tuple(targets)
+        self.DeclareVectorOutputPort(
+            "object_rotations", 9 * len(self._targets),
+            lambda c, o: o.SetFromVector([v for tg in self._targets
+                                          for v in target_rotation_values(tg, c.get_time())[0:9]]),
+            prerequisites_of_calc={self.time_ticket()})

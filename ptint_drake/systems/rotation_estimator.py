@@ -1,0 +1,204 @@
+"""Tracking an object's orientation from its camera (issue 21): ``RotationEstimator``.
+
+It sees only the camera's orientation samples [stamp, Z (row-major), valid]
+(``camera.Camera`` with ``rotation``) and the camera's stated ``rot_noise_deg``, rate and
+latency — never the target's kind, orientation or rate.  Every camera estimator setting
+(``auto`` and the hand-set position filters alike) gets it: there is nothing to choose.
+
+Model: an error-state (multiplicative) Kalman filter on SO(3).  The state is a reference
+rotation R̂ (world frame) and the world-frame angular velocity ω̂; the object's rotation is
+R = exp([δθ]×) R̂ with a small world-frame error δθ.  The motion is a constant angular
+velocity driven by white angular acceleration of spectral density Q_SPIN (rad²/s³), per
+axis and identical on the three axes, so the error state per axis is χ = [δθ, ω] with
+``kalman``'s constant-velocity F(Δ) and Q(Δ) and one 2×2 covariance P shared by the axes
+(the camera's noise is isotropic: R_θ = σ_R² per axis, σ_R = rot_noise_deg in rad).
+
+    predict over Δ:  R̂ ← exp([ω̂ Δ]×) R̂   (exact for a constant world-frame ω),
+                     P ← F P Fᵀ + Q
+    correct with Z:  y = log(Z R̂ᵀ)^∨ (the shorter rotation), K = P Hᵀ / (P₀₀ + R_θ),
+                     [δθ; ω̂] ← K y (per axis), R̂ ← exp([δθ]×) R̂, δθ ← 0,
+                     P ← (I − K H) P (I − K H)ᵀ + R_θ K Kᵀ   (Joseph form)
+
+The rotation math is Drake's (``RotationMatrix``, ``AngleAxis``; ``orientation.rotation_log``
+through its quaternion); R̂ is re-projected onto SO(3) at every update.  The timing — update
+instants at the camera's rate offset by its latency, the latency compensated by
+predicting from the sample's stamp, predict-only during dropouts, priming with the pre-run
+samples — is ``kalman.TargetKalmanFilter``'s.  The first sample sets R̂ = Z, ω̂ = 0,
+P₀ = diag(R_θ, W0²).
+
+Output ``target_rotation`` (15, ``signals.TARGET_ROTATION``) = [exp([ω̂ Δt]×) R̂ (row-major),
+ω̂, 0] with Δt = t − t_est: continuous between updates, the interceptor's layout (ω̇_r = 0:
+the model's); an unturned, fixed frame before the first sample.
+
+Why constant angular velocity and Q_SPIN (chosen by measurement, camera and estimator alone:
+30 Hz, 1°, 33 ms; docs/camera.md has the table): a part at rest on a belt (conveyor_yaw) and
+a frame turning at a constant rate (curve_pose, 36°/s about a tilted axis) are both exactly
+this model, so neither lags; Q_SPIN only weighs how fast a change of rate is followed
+against how much noise passes.  A constant-angular-acceleration model passed more noise on
+both for no gain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.math import RotationMatrix
+from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
+
+from ptint_drake.systems.camera import TIME_TOL, MeasurementConfig, rotation_noise, validate_measurement
+from ptint_drake.systems.kalman import ActiveTargetSelector, process_covariance, transition
+from ptint_drake.systems.orientation import rotation_from_vector, rotation_log
+from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.signals import IDENTITY_ROTATION, TARGET_ROTATION_SIZE
+
+Q_SPIN = 1.0e-3  # rad²/s³, white angular acceleration
+W0 = 1.0  # rad/s, initial angular-velocity standard deviation
+R_MIN = 1.0e-12  # rad², floor of the measurement variance
+_H = np.array([1.0, 0.0])
+MEASURED_ROTATION_SIZE = 11  # [stamp, Z row-major, valid]
+
+
+def _turned(R: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """exp([φ]×) R (3×3 arrays)."""
+    return rotation_from_vector(phi).matrix() @ R
+
+
+class RotationEstimator(LeafSystem):
+    """The orientation filter of one object (see the module docstring).
+
+    Input port ``measured_rotation`` (11): [stamp, Z row-major, valid] from a ``Camera``.
+    Output port ``target_rotation`` (15): [R, ω, ω̇] predicted to t.
+    Discrete state groups (``groups``): ``meta`` = [initialised, t_est, last stamp consumed,
+    t of the last update], ``rotation`` = R̂ (row-major), ``rate`` = ω̂ (3), ``covariance`` =
+    P (2×2 row-major) at t_est.
+    ``prior``: the camera's pre-run orientation samples [(t_k, Z_k), …]
+    (``Camera.pre_run_rotations()``), consumed as ``TargetKalmanFilter`` consumes its prior.
+    """
+
+    def __init__(self, *, config: MeasurementConfig, prior=None, q: float = Q_SPIN):
+        super().__init__()
+        validate_measurement(config)
+        self._R = max(rotation_noise(config) ** 2, R_MIN)
+        self._q = float(q)
+        self._latency = float(config.latency)
+        self._compensate = bool(config.compensate_latency)
+        self._z_in = self.DeclareVectorInputPort("measured_rotation", MEASURED_ROTATION_SIZE)
+        state = self._prior_state(prior)
+        self.groups = {name: self.DeclareDiscreteState(np.ravel(value))
+                       for name, value in zip(("meta", "rotation", "rate", "covariance"), state)}
+        self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
+        self._out = self.DeclareVectorOutputPort(
+            "target_rotation", TARGET_ROTATION_SIZE, lambda c, o: o.SetFromVector(self._predict_output(c)),
+            prerequisites_of_calc={self.time_ticket(), self.xd_ticket()})
+
+    @property
+    def measurement_variance(self) -> float:
+        """R_θ (rad²) per axis."""
+        return self._R
+
+    def get_measured_rotation_input_port(self):
+        return self._z_in
+
+    def get_target_rotation_output_port(self):
+        return self._out
+
+    def state(self, context) -> tuple:
+        """(meta, R̂ as 3×3, ω̂, P as 2×2) from a context (copies)."""
+        meta, R, w, P = (context.get_discrete_state(self.groups[name]).value().copy()
+                         for name in ("meta", "rotation", "rate", "covariance"))
+        return meta, R.reshape(3, 3), w, P.reshape(2, 2)
+
+    def _initial(self) -> tuple:
+        return np.eye(3), np.zeros(3), np.diag([self._R, W0 * W0])
+
+    def _predict(self, R, w, P, dt: float) -> tuple:
+        F = transition("cv", dt)
+        P = F @ P @ F.T + process_covariance("cv", dt, self._q)
+        return _turned(R, w * dt), w, 0.5 * (P + P.T)
+
+    def _correct(self, R, w, P, Z) -> tuple:
+        y = rotation_log(Z @ R.T)
+        K = P[:, 0] / (P[0, 0] + self._R)
+        R = RotationMatrix.ProjectToRotationMatrix(_turned(R, K[0] * y)).matrix()
+        A = np.eye(2) - np.outer(K, _H)
+        P = A @ P @ A.T + self._R * np.outer(K, K)
+        return R, w + K[1] * y, 0.5 * (P + P.T)
+
+    def step(self, meta, R, w, P, t: float, z: np.ndarray):
+        """One update at time t with the camera's output z: (meta, R̂, ω̂, P) after it, or None
+        when nothing changes (no sample seen yet).  ``TargetKalmanFilter.step``'s timing."""
+        initialised, t_est, last_stamp, _ = meta
+        stamp = z[0]
+        if z[10] > 0.5 and (initialised < 0.5 or stamp > last_stamp + TIME_TOL):
+            t_meas = stamp if self._compensate else t
+            Z = np.reshape(z[1:10], (3, 3))
+            if initialised < 0.5:
+                R, w, P = self._initial()
+                R = RotationMatrix.ProjectToRotationMatrix(Z).matrix()
+            else:
+                R, w, P = self._correct(*self._predict(R, w, P, max(t_meas - t_est, 0.0)), Z)
+            return np.array([1.0, t_meas, stamp, t]), R, w, P
+        if initialised < 0.5:
+            return None
+        t_pred = t - self._latency if self._compensate else t
+        R, w, P = self._predict(R, w, P, max(t_pred - t_est, 0.0))
+        return np.array([1.0, max(t_pred, t_est), last_stamp, t]), R, w, P
+
+    def _update(self, context, discrete_state) -> None:
+        result = self.step(*self.state(context), context.get_time(), self._z_in.Eval(context))
+        if result is None:
+            return
+        for name, value in zip(("meta", "rotation", "rate", "covariance"), result):
+            discrete_state.get_mutable_vector(self.groups[name]).SetFromVector(np.ravel(value))
+
+    def _prior_state(self, prior) -> tuple:
+        """The state at t = 0 after the pre-run samples, each consumed when it became visible."""
+        state = (np.zeros(4), *self._initial())
+        for t_k, Z_k in prior or []:
+            t_seen = t_k + self._latency
+            if t_seen > TIME_TOL:
+                raise ValueError(f"prior: a sample taken at {t_k} s is not visible before t = 0")
+            result = self.step(*state, t_seen, np.array([t_k, *np.ravel(Z_k), 1.0]))
+            if result is not None:
+                state = result
+        return state
+
+    def _predict_output(self, context) -> np.ndarray:
+        """[exp([ω̂ Δt]×) R̂, ω̂, 0], Δt = t − t_est (a fixed, unturned frame before a sample)."""
+        meta = context.get_discrete_state(self.groups["meta"]).value()
+        if meta[0] < 0.5:
+            return np.array(IDENTITY_ROTATION)
+        R = context.get_discrete_state(self.groups["rotation"]).value().reshape(3, 3)
+        w = context.get_discrete_state(self.groups["rate"]).value()
+        dt = context.get_time() - meta[1]
+        return np.concatenate([_turned(R, w * dt).ravel(), w, np.zeros(3)])
+
+
+@dataclass
+class RotationEstimators:
+    """What ``AddRotationEstimators`` added: wire ``rotation_port`` to a controller's
+    ``target_rotation``."""
+
+    rotation_port: OutputPort
+    filters: list
+    selector: ActiveTargetSelector
+
+
+def AddRotationEstimators(builder: DiagramBuilder, *, cameras: list, schedule: Schedule,
+                          config: MeasurementConfig) -> RotationEstimators:
+    """Add, per camera i (one per object, measuring orientations: ``Camera(rotation=True)``,
+    e.g. ``kalman.AddCameraEstimators``' with ``rotations_port``), ``rotation_filter_i`` primed
+    with its pre-run samples, and ``rotation_selector`` passing on the active segment's."""
+    if not all(camera.measures_rotation for camera in cameras):
+        raise ValueError("cameras: every camera must measure the orientation (Camera(rotation=True))")
+    selector = builder.AddNamedSystem("rotation_selector", ActiveTargetSelector(
+        schedule=schedule, count=len(cameras), size=TARGET_ROTATION_SIZE))
+    filters = []
+    for i, camera in enumerate(cameras):
+        f = builder.AddNamedSystem(f"rotation_filter_{i}", RotationEstimator(
+            config=config, prior=camera.pre_run_rotations()))
+        builder.Connect(camera.get_measured_rotation_output_port(), f.get_measured_rotation_input_port())
+        builder.Connect(f.get_target_rotation_output_port(), selector.get_input_port(i))
+        filters.append(f)
+    return RotationEstimators(selector.get_target_output_port(), filters, selector)
