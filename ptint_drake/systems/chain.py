@@ -42,9 +42,10 @@ def _axis_rotation(a, angle, out):
     """``out`` ← the rotation by ``angle`` (rad) about the unit axis a (Rodrigues' formula)."""
     c, s = np.cos(angle), np.sin(angle)
     t = 1.0 - c
-    out[0, 0], out[0, 1], out[0, 2] = c + t * a[0] * a[0], t * a[0] * a[1] - s * a[2], t * a[0] * a[2] + s * a[1]
-    out[1, 0], out[1, 1], out[1, 2] = t * a[0] * a[1] + s * a[2], c + t * a[1] * a[1], t * a[1] * a[2] - s * a[0]
-    out[2, 0], out[2, 1], out[2, 2] = t * a[0] * a[2] - s * a[1], t * a[1] * a[2] + s * a[0], c + t * a[2] * a[2]
+    x, y, z = a[0], a[1], a[2]
+    out[0, 0], out[0, 1], out[0, 2] = c + t * x * x, t * x * y - s * z, t * x * z + s * y
+    out[1, 0], out[1, 1], out[1, 2] = t * x * y + s * z, c + t * y * y, t * y * z - s * x
+    out[2, 0], out[2, 1], out[2, 2] = t * x * z - s * y, t * y * z + s * x, c + t * z * z
 
 
 @njit(cache=True)
@@ -59,7 +60,8 @@ def chain_kinematics(q, kinds, q_index, v_index, fixed, axes, nv):
     R = fixed[0, :3].copy()
     p = fixed[0, 3].copy()
     work = np.empty((2 * n + 4, 3))  # axes and origins in the world, a rotation, a row
-    axes_w, origins, M, tmp, zero = work[:n], work[n:2 * n], work[2 * n:2 * n + 3], work[2 * n + 3], np.zeros(3)
+    axes_w, origins, M, tmp = work[:n], work[n:2 * n], work[2 * n:2 * n + 3], work[2 * n + 3]
+    zero = np.zeros(3)
     for k in range(n):
         a = axes[k]
         for i in range(3):

@@ -20,7 +20,9 @@ from ptint_drake.systems.task import TASK_DIM
 def _solve3(A, b, out) -> None:
     """``out`` ← A⁻¹ b for a 3 × 3 A by Cramer's rule; the least-squares solution when A is
     numerically singular."""
-    a, b_, c, d, e, f, g, h, i = A[0, 0], A[0, 1], A[0, 2], A[1, 0], A[1, 1], A[1, 2], A[2, 0], A[2, 1], A[2, 2]
+    a, b_, c = A[0, 0], A[0, 1], A[0, 2]
+    d, e, f = A[1, 0], A[1, 1], A[1, 2]
+    g, h, i = A[2, 0], A[2, 1], A[2, 2]
     co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * co0 + b_ * co1 + c * co2
     scale = np.abs(A).max()
@@ -162,7 +164,8 @@ class SlidingModeController(LeafSystem):
 
     def torque(self, s_x: np.ndarray, J: np.ndarray) -> np.ndarray:
         """τ = −K J⁺ s_x (``sliding_mode_torque``) for an n × nv Jacobian J."""
-        return sliding_mode_torque(self._K, np.ascontiguousarray(J), np.asarray(s_x, dtype=float), self._damping)
+        return sliding_mode_torque(self._K, np.ascontiguousarray(J), np.asarray(s_x, dtype=float),
+                                   self._damping)
 
     def _tau(self, context) -> np.ndarray:
         J = self._J_in.Eval(context).reshape(self._dim, self._nv)

@@ -4,8 +4,9 @@
 
 x is the position in the world of the origin of a frame (the interception
 point), J its translational Jacobian with respect to the plant's generalized
-velocities.  A serial chain of revolute and prismatic joints is computed by compiled code
-(``chain.KinematicChain``, equal to Drake's to rounding); anything else by the plant.  Kinematics only: no mass matrix, Coriolis or gravity term is ever
+velocities.  A serial chain of revolute and prismatic joints is computed by
+compiled code (``chain.KinematicChain``, equal to Drake's to rounding); anything
+else by the plant.  Kinematics only: no mass matrix, Coriolis or gravity term is ever
 evaluated here, which is what keeps the controller model-free.
 """
 

@@ -16,18 +16,21 @@ from ptint_drake.systems.kinematics import FrameKinematics
 TWISTED = """<?xml version="1.0"?><robot name="twisted">
   <link name="base"/><joint name="weld" type="fixed"><parent link="world"/><child link="base"/>
     <origin xyz="0.1 -0.2 0.05" rpy="0.1 0.2 0.3"/></joint>
-  <link name="a"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
-    </inertial></link>
-  <link name="b"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
-    </inertial></link>
-  <link name="c"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
-    </inertial></link>
-  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0 0 0.3" rpy="0.4 0 -0.2"/>
-    <axis xyz="0.6 0 0.8"/><limit effort="10" lower="-3" upper="3" velocity="5"/></joint>
-  <joint name="j2" type="prismatic"><parent link="a"/><child link="b"/><origin xyz="0.2 0.1 0" rpy="0 0.5 0"/>
-    <axis xyz="1 0 0"/><limit effort="10" lower="-1" upper="1" velocity="5"/></joint>
-  <joint name="j3" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0 0 0.25" rpy="-0.3 0.1 0.7"/>
-    <axis xyz="0 1 0"/><limit effort="10" lower="-3" upper="3" velocity="5"/></joint>
+  <link name="a"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="b"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="c"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="0 0 0.3" rpy="0.4 0 -0.2"/><axis xyz="0.6 0 0.8"/>
+    <limit effort="10" lower="-3" upper="3" velocity="5"/></joint>
+  <joint name="j2" type="prismatic"><parent link="a"/><child link="b"/>
+    <origin xyz="0.2 0.1 0" rpy="0 0.5 0"/><axis xyz="1 0 0"/>
+    <limit effort="10" lower="-1" upper="1" velocity="5"/></joint>
+  <joint name="j3" type="revolute"><parent link="b"/><child link="c"/>
+    <origin xyz="0 0 0.25" rpy="-0.3 0.1 0.7"/><axis xyz="0 1 0"/>
+    <limit effort="10" lower="-3" upper="3" velocity="5"/></joint>
   <link name="tool"/><joint name="tool_fix" type="fixed"><parent link="c"/><child link="tool"/>
     <origin xyz="0.15 0.02 -0.03" rpy="0.2 -0.4 1.0"/></joint>
 </robot>"""
@@ -48,7 +51,8 @@ def _bundled(model: str) -> MultibodyPlant:
 
 @pytest.mark.parametrize("make, frame", [
     (lambda: _bundled("rvm1"), rvm1.END_EFFECTOR), (lambda: _bundled("rvm1_5dof"), rvm1.END_EFFECTOR),
-    (lambda: _bundled("rvm1_6dof"), rvm1.END_EFFECTOR), (lambda: _plant(heavy_arm_urdf()), "tool"),
+    (lambda: _bundled("rvm1_6dof"), rvm1.END_EFFECTOR),
+    (lambda: _plant(heavy_arm_urdf()), "tool"),
     (lambda: _plant(TWISTED), "tool")])
 def test_chain_equals_drakes_kinematics(make, frame):
     """x, R, J_v, J_ω at random q equal the plant's (CalcPoseInWorld, CalcJacobianSpatialVelocity)."""
