@@ -219,7 +219,10 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
     monitor).  µs per derivative evaluation = the fastest of ``repeats`` wall times / the
     evaluations (the uncontrolled arms take other steps; the cost of an evaluation hardly
     depends on them).  ``needed_for_3x_us``: what an evaluation may cost for the controlled
-    run to take a third of its time at the same number of evaluations.
+    run to take a third of its time at the same number of evaluations.  ``kernels_us``: what
+    one call of the fused interceptor's row (its compiled kernels and the Python around them,
+    ``kernel_cost``) costs on its own.  A pick scenario (its own world, ``pick.world``) is
+    skipped with a note.
     """
     names = list(names or bundled_scenarios())
     out = {}
@@ -228,6 +231,9 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
             progress(f"{name} floors")
         _, text = scenario_text(name)
         scenario = parse_with_overrides(text, "{}", name)
+        if scenario.pick is not None:
+            out[name] = {"skipped": "a pick scenario: its world (pick.world) has no floor diagrams"}
+            continue
         row = {}
         for kind in ("controller", "python", "cpp"):
             built = _floor_diagram(scenario, kind)
@@ -247,8 +253,31 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
         row["controller_work_us"] = round(
             row["controller"]["us_per_evaluation"] - row["python"]["us_per_evaluation"], 2)
         row["needed_for_3x_us"] = round(row["controller"]["us_per_evaluation"] / 3.0, 2)
+        row["kernels_us"] = kernel_cost(scenario)
         out[name] = row
     return out
+
+
+def kernel_cost(scenario, calls: int = 2000) -> "float | None":
+    """µs per call of the fused interceptor's row (``InterceptorLaw.row``: the compiled kernels
+    and the Python around them) at the start state, best of 3; None for another controller."""
+    built = build(scenario, log=False)
+    law = getattr(built.controller.system, "law", None)
+    if law is None:
+        return None
+    context = built.diagram.CreateDefaultContext()
+    built.diagram.ExecuteInitializationEvents(context)
+    ctx = law.GetMyContextFromRoot(context)
+    args = (0.5 * scenario.duration, law.get_input_port(0).Eval(ctx), law.GetInputPort("sigma").Eval(ctx),
+            ctx.get_discrete_state(0).value(),
+            law.GetInputPort("target").Eval(ctx) if law.HasInputPort("target") else None)
+    best = float("inf")
+    for _ in range(3):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            law.row(*args)
+        best = min(best, time.perf_counter() - t0)
+    return round(1e6 * best / calls, 2)
 
 
 def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),

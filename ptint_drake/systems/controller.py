@@ -9,60 +9,105 @@ Jᵀ (J Jᵀ)⁻¹ s_x.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.task import TASK_DIM
 
 
-def solve3(A: list, b: list) -> list:
-    """A⁻¹ b for a 3 × 3 A (3 rows of plain floats) and b (3 plain floats) by Cramer's rule
-    (numpy's solve costs ~15 µs here); a least-squares solution when A is numerically singular."""
-    (a, b_, c), (d, e, f), (g, h, i) = A
+@njit(cache=True)
+def _solve3(A, b, out) -> None:
+    """``out`` ← A⁻¹ b for a 3 × 3 A by Cramer's rule; the least-squares solution when A is
+    numerically singular."""
+    a, b_, c = A[0, 0], A[0, 1], A[0, 2]
+    d, e, f = A[1, 0], A[1, 1], A[1, 2]
+    g, h, i = A[2, 0], A[2, 1], A[2, 2]
     co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * co0 + b_ * co1 + c * co2
-    scale = max(abs(a), abs(b_), abs(c), abs(d), abs(e), abs(f), abs(g), abs(h), abs(i)) or 1.0
+    scale = np.abs(A).max()
+    if scale == 0.0:
+        scale = 1.0
     if abs(det) <= 1e-12 * scale**3:
-        return np.linalg.lstsq(np.array(A), np.array(b), rcond=None)[0].tolist()
-    x, y, z = b
-    return [(co0 * x + (c * h - b_ * i) * y + (b_ * f - c * e) * z) / det,
-            (co1 * x + (a * i - c * g) * y + (c * d - a * f) * z) / det,
-            (co2 * x + (b_ * g - a * h) * y + (a * e - b_ * d) * z) / det]
+        out[:] = np.linalg.lstsq(A, b.copy())[0]
+        return
+    x, y, z = b[0], b[1], b[2]
+    out[0] = (co0 * x + (c * h - b_ * i) * y + (b_ * f - c * e) * z) / det
+    out[1] = (co1 * x + (a * i - c * g) * y + (c * d - a * f) * z) / det
+    out[2] = (co2 * x + (b_ * g - a * h) * y + (a * e - b_ * d) * z) / det
 
 
-def pinv_apply(J, b, damping: float = 0.0) -> list:
-    """J⁺ b for a 3 × nv J and a 3-vector b (lists of plain floats, the fast form, or arrays),
-    as a list: a solve for square J, the minimum-norm solution Jᵀ(JJᵀ)⁻¹ b otherwise.
-    For a task of another dimension (6 rows: position and orientation, ``systems.task``) it is
-    the minimum-norm least-squares solution (``lstsq``): J⁻¹ b for a square J, the least-squares
-    fit for fewer joints than rows (a 5-joint wrist), the minimum-norm one for more.
+@njit(cache=True)
+def pinv_solve(J, b, damping: float):
+    """J⁺ b for an n × nv Jacobian J and an n-vector b (the pseudo-inverse of eq. 18).
 
-    With ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which
-    stays bounded through singular configurations at the cost of a small bias near them.
-    """
-    if len(J) != 3:
-        Ja = np.asarray(J, dtype=float)
-        if damping > 0.0:
-            return (Ja.T @ np.linalg.solve(Ja @ Ja.T + damping * damping * np.eye(len(Ja)), b)).tolist()
-        return np.linalg.lstsq(Ja, np.asarray(b, dtype=float), rcond=None)[0].tolist()
-    if damping > 0.0:
-        Ja = np.asarray(J, dtype=float)  # an array keeps its memory order: BLAS's rounding does too
-        return (Ja.T @ solve3((Ja @ Ja.T + damping * damping * np.eye(3)).tolist(), _floats(b))).tolist()
-    if len(J[0]) == 3:
-        return solve3(J if type(J) is list else J.tolist(), _floats(b))
-    Ja = np.asarray(J, dtype=float)
-    return (Ja.T @ np.linalg.solve(Ja @ Ja.T, b)).tolist()
+    3 rows: a 3 × 3 solve (Cramer's rule, ``_solve3``) for a square J, the minimum-norm solution
+    Jᵀ(JJᵀ)⁻¹ b for more joints.  6 rows (position and orientation, ``systems.task``): the
+    minimum-norm least-squares solution (``lstsq``): J⁻¹ b for a square J, the least-squares fit
+    for fewer joints than rows (a 5-joint wrist), the minimum-norm one for more.  With
+    ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which stays
+    bounded through singular configurations at the cost of a small bias near them."""
+    n, nv = J.shape
+    if damping <= 0.0 and n != 3:
+        return np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
+    if damping <= 0.0 and nv == 3:
+        x = np.empty(3)
+        _solve3(J, b, x)
+        return x
+    A = J @ J.T if nv > 8 else _gram(J)
+    for i in range(n):
+        A[i, i] += damping * damping
+    y = np.empty(n)
+    if n == 3:
+        _solve3(A, b, y)
+    else:
+        y[:] = np.linalg.solve(A, b.copy())
+    return J.T @ y if nv > 8 else _transpose_times(J, y)
 
 
-def _floats(values) -> list:
-    """A 3-vector (list or array) as a list of plain floats."""
-    return values if type(values) is list else np.asarray(values, dtype=float).tolist()
+@njit(cache=True)
+def _gram(J):
+    """J Jᵀ by loops (BLAS costs more than it saves on a few rows)."""
+    n, nv = J.shape
+    A = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for k in range(nv):
+                acc += J[i, k] * J[j, k]
+            A[i, j] = acc
+    return A
 
 
-def smc_torque(K, J, s_x, damping: float = 0.0) -> list:
-    """τ = −K J⁺ s_x (paper eq. 18) as a list of plain floats: K a sequence of nv gains (N·m·s/rad),
-    J (n × nv) and s_x (n; n = 3, or 6 with orientation) as ``pinv_apply`` takes them."""
-    return [-k * a for k, a in zip(K, pinv_apply(J, s_x, damping))]
+@njit(cache=True)
+def _transpose_times(J, y):
+    """Jᵀ y by loops."""
+    n, nv = J.shape
+    x = np.zeros(nv)
+    for k in range(nv):
+        for i in range(n):
+            x[k] += J[i, k] * y[i]
+    return x
+
+
+@njit(cache=True)
+def sliding_mode_torque(K, J, s_x, damping: float):
+    """τ = −K J⁺ s_x (paper eq. 18): K the nv gains (N·m·s/rad), J (n × nv) and s_x (n; n = 3,
+    or 6 with orientation) as ``pinv_solve`` takes them."""
+    return -K * pinv_solve(J, s_x, damping)
+
+
+def pinv_apply(J, b, damping: float = 0.0) -> np.ndarray:
+    """``pinv_solve`` on any array-like J (n × nv) and b (n)."""
+    return pinv_solve(np.ascontiguousarray(J, dtype=float), np.ascontiguousarray(b, dtype=float),
+                      float(damping))
+
+
+def smc_torque(K, J, s_x, damping: float = 0.0) -> np.ndarray:
+    """``sliding_mode_torque`` on any array-likes: K (nv, or a scalar), J (n × nv), s_x (n)."""
+    Ja = np.ascontiguousarray(J, dtype=float)
+    K = np.broadcast_to(np.asarray(K, dtype=float), (Ja.shape[1],)).copy()
+    return sliding_mode_torque(K, Ja, np.ascontiguousarray(s_x, dtype=float), float(damping))
 
 
 def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.ndarray,
@@ -103,7 +148,6 @@ class SlidingModeController(LeafSystem):
         self._dim = dim
         self._damping = float(pinv_damping)
         self._K = np.broadcast_to(np.asarray(K, dtype=float), (nv,)).copy()
-        self._K_floats = tuple(self._K.tolist())
         self._BT = None if actuation_matrix is None else np.asarray(actuation_matrix).T
         nu = nv if actuation_matrix is None else self._BT.shape[0]
         self._s_x_in = self.DeclareVectorInputPort("s_x", dim)
@@ -119,8 +163,9 @@ class SlidingModeController(LeafSystem):
             prerequisites_of_calc=deps)
 
     def torque(self, s_x: np.ndarray, J: np.ndarray) -> np.ndarray:
-        """τ = −K J⁺ s_x (``smc_torque``) for an n × nv Jacobian J."""
-        return np.array(smc_torque(self._K_floats, J, s_x, self._damping))
+        """τ = −K J⁺ s_x (``sliding_mode_torque``) for an n × nv Jacobian J."""
+        return sliding_mode_torque(self._K, np.ascontiguousarray(J), np.asarray(s_x, dtype=float),
+                                   self._damping)
 
     def _tau(self, context) -> np.ndarray:
         J = self._J_in.Eval(context).reshape(self._dim, self._nv)

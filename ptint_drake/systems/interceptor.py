@@ -1,16 +1,22 @@
-"""The whole interceptor in one LeafSystem: the fast path for simulation.
+"""The whole interceptor as one system: the fast path for simulation.
 
-``PrescribedTimeInterceptor`` computes exactly what the five blocks wired by
-``AddPrescribedTimeInterceptor(fused=False)`` compute — it calls the same
-functions (``tbg_state``, ``active_target_values``, ``FrameKinematics``,
-``SurfaceLaw``, ``smc_torque``) — but as one cache entry per context, so each
-derivative evaluation crosses from C++ into Python three times instead of about
-sixteen.  Its ``telemetry`` port carries every intermediate signal (layout in
-``telemetry_layout``).  Logging it at every step would cost one more full
-evaluation per step, so a run logs only states (the plant's, and ``sigma`` and
-``captured`` here, all C++ state ports) and ``telemetry_at`` recomputes the
-telemetry of each logged sample afterwards — the same function on the same
-state, so the values are identical.
+``PrescribedTimeInterceptor`` computes what the five blocks wired by
+``AddPrescribedTimeInterceptor(fused=False)`` compute, with the same compiled kernels
+(``interceptor_row``: the TBG, the surface law, the torque and, for the position task, the
+kinematic chain and the target, in one call).  It is a small Diagram:
+
+    state ─> InterceptorLaw ─[τ; σ̇]─> Demultiplexer ─τ─> (Bᵀ) ─> u
+                  ↑ σ                               └σ̇─> Integrator (σ) ─┘
+
+so each derivative evaluation enters Python once (the law's one output; Drake's Integrator
+holds σ and Drake's cache hands the same output to the plant and to the integrator).  Its
+``telemetry`` port carries every intermediate signal (layout in ``telemetry_layout``).  A run
+logs only C++ ports (the plant's state, ``sigma`` and ``captured``) and ``telemetry_at``
+recomputes the telemetry of each logged sample afterwards — the same kernel on the same state,
+so the values are identical.
+
+``sigma_policy = "reset"``: the Integrator keeps integrating; the capture at a segment start
+stores its value σ0 beside s(t0), and the law uses σ − σ0.
 
 Model-free like the blocks: it reads the plant's state and kinematics only.
 """
@@ -20,28 +26,21 @@ from __future__ import annotations
 from typing import Optional, Sequence
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain
 
-from ptint_drake.systems.cache import DeclareVectorCache
-from ptint_drake.systems.controller import null_space_terms, null_space_torque, smc_torque
+from ptint_drake.systems.controller import null_space_terms, null_space_torque
 from ptint_drake.systems.gains import ControllerGains
+from ptint_drake.systems.interceptor_row import law_row, pack_chain, pack_gains, position_row
 from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.orientation import active_rotation_values
-from ptint_drake.systems.signals import (
-    TARGET,
-    TARGET_PORT,
-    TARGET_PORT_SIZE,
-    TBG,
-    TBG_OUT,
-    TARGET_ROTATION_SIZE,
-    Slots,
-    surface_slots,
-)
-from ptint_drake.systems.sliding_surface import DeclareSegmentCapture, SurfaceLaw
-from ptint_drake.systems.targets import active_target_values
-from ptint_drake.systems.task import TASK_DIM, position_error, task_error, task_jacobian
-from ptint_drake.systems.tbg import tbg_state
+from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
+from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE, TARGET_ROTATION_SIZE, Slots
+from ptint_drake.systems.sliding_surface import SurfaceLaw
+from ptint_drake.systems.targets import active_target_values, compiled_targets
+from ptint_drake.systems.task import TASK_DIM, task_error, task_jacobian
+
+_NO_TARGET = np.empty(0)
 
 
 def telemetry_layout(nv: int, task: str = "position") -> dict:
@@ -54,14 +53,142 @@ def telemetry_layout(nv: int, task: str = "position") -> dict:
                  ("sigma", n), ("tau", nv), *extra).slices()
 
 
-class PrescribedTimeInterceptor(LeafSystem):
-    """Input ``state`` ([q; v] of the plant); outputs ``u`` (actuation), ``tau`` (joint
-    torques) and ``telemetry``.  State: σ (continuous, n), [index, s(t0)] (discrete), n the
-    dimension of ``gains.task`` (``systems.task``: 3 for ``position``, 6 with orientation).
+class InterceptorLaw(LeafSystem):
+    """Inputs ``state`` ([q; v]), ``sigma`` (σ, n), and ``target`` / ``target_rotation`` without
+    target objects; outputs ``tau_sigma_dot`` ([τ; σ̇], nv + n), ``telemetry`` and ``captured``
+    (its discrete state [index, s(t0), σ0], 1 + 2n).  See ``PrescribedTimeInterceptor``."""
+
+    def __init__(self, *, plant, frame, schedule: Schedule, gains: ControllerGains,
+                 targets: Optional[Sequence] = None, posture: Optional[np.ndarray] = None):
+        super().__init__()
+        nq, nv = plant.num_positions(), plant.num_velocities()
+        self._nq, self._nv, self._schedule = nq, nv, schedule
+        self._targets = None if targets is None else tuple(targets)
+        self._task, self._rot_scale = gains.task, float(gains.rot_scale)
+        self._n = n = TASK_DIM[gains.task]
+        self._law = SurfaceLaw(gains.Lambda, gains.k, gains.switching, gains.phi,
+                               gains.sigma_policy, gains.k_hold, n)  # validates the gains
+        K = np.broadcast_to(np.asarray(gains.K, dtype=float), (nv,)).copy()
+        self._gains = pack_gains(gains, n, K)
+        self._kinematics = FrameKinematics(plant, frame)
+        self._null_space = null_space_terms(gains, plant, posture)  # redundant arms only
+        compiled = None if self._targets is None else compiled_targets(self._targets)
+        self._compiled = compiled if compiled is not None else np.zeros((1, 38))
+        self._python_targets = self._targets is not None and compiled is None
+        chain = self._kinematics.chain
+        self._fast = gains.task == "position" and chain is not None
+        self._chain = pack_chain(chain) if chain is not None else None
+        self.layout = telemetry_layout(nv, gains.task)
+        self._size = size = max(part.stop for part in self.layout.values())
+        self._tau = self.layout["tau"]
+        self._sigma_dot = slice(size + 5, size + 5 + n)
+
+        self._state_in = self.DeclareVectorInputPort("state", nq + nv)
+        self._sigma_in = self.DeclareVectorInputPort("sigma", n)
+        self._target_in = None if targets is not None else self.DeclareVectorInputPort(
+            "target", TARGET_PORT_SIZE)
+        self._rotation_in = None if targets is not None or gains.task == "position" else \
+            self.DeclareVectorInputPort("target_rotation", TARGET_ROTATION_SIZE)
+        self._capture_index = self.DeclareDiscreteState(np.r_[-1.0, np.zeros(2 * n)])
+        DeclareSegmentStartEvents(self, schedule, self._capture)
+        self.DeclareStateOutputPort("captured", self._capture_index)
+        deps = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
+        self._out = np.empty(nv + n)
+        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_output, prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("telemetry", size,
+                                     lambda c, o: o.SetFromVector(self._eval(c)[:size]),
+                                     prerequisites_of_calc=deps)
+
+    @property
+    def num_tasks(self) -> int:
+        return self._n
+
+    @property
+    def telemetry_size(self) -> int:
+        return self._size
+
+    def _eval(self, context) -> np.ndarray:
+        """The row (telemetry, active segment, σ̇) at ``context``."""
+        rotation = None if self._rotation_in is None else self._rotation_in.Eval(context)
+        return self.row(context.get_time(), self._state_in.EvalBasicVector(context).value(),
+                        self._sigma_in.EvalBasicVector(context).value(),
+                        context.get_discrete_state(self._capture_index).value(),
+                        None if self._target_in is None else self._target_in.Eval(context), rotation)
+
+    def _calc_output(self, context, output) -> None:
+        row = self._eval(context)
+        out = self._out
+        out[:self._nv], out[self._nv:] = row[self._tau], row[self._sigma_dot]
+        output.SetFromVector(out)
+
+    def _capture(self, context, state) -> None:
+        """Store [index, s(t0), σ0] at a segment start (σ0: σ then, with ``sigma_policy`` reset)."""
+        row = self._eval(context)
+        index = row[self._size]
+        if index < 0:
+            return
+        sigma = self._sigma_in.Eval(context) if self._law.reset_sigma else np.zeros(self._n)
+        state.get_mutable_discrete_state(self._capture_index).SetFromVector(
+            np.concatenate([[index], row[self.layout["s"]], sigma]))
+
+    def row(self, t: float, qv: np.ndarray, sigma: np.ndarray, captured: np.ndarray,
+            target: Optional[np.ndarray], rotation: Optional[np.ndarray] = None) -> np.ndarray:
+        """The row (telemetry, active segment [index, t0, tf, β, phase], σ̇) from the time, the
+        plant state [q; v], the integrator's σ, [index, s(t0), σ0] and the ``target`` (and
+        ``target_rotation``) inputs' values (None: the system's own targets)."""
+        n = self._n
+        if self._law.reset_sigma:
+            sigma = sigma - captured[1 + n:]
+        if target is None:
+            target = np.array(active_target_values(self._schedule, self._targets, t)[TARGET_PORT]) \
+                if self._python_targets else _NO_TARGET
+        if self._fast:
+            row = np.empty(self._size + 5 + n)
+            position_row(t, qv, sigma, captured, target, self._schedule.table, self._gains, *self._chain,
+                         self._compiled, row)
+        else:
+            row = self._pose_row(t, qv, sigma, captured, target, rotation)
+        if self._null_space is not None:  # redundant arms, optional (off by default)
+            D, rate, q_start = self._null_space
+            J = self._kinematics.compute(qv[:self._nq], qv[self._nq:])[2]
+            row[self._tau] += null_space_torque(J, qv[:self._nq], qv[self._nq:], q_start, D, rate)
+        return row
+
+    def _pose_row(self, t, qv, sigma, captured, target, rotation) -> np.ndarray:
+        """The row of any other task or plant (the pose task, a plant the chain cannot describe):
+        kinematics and task error in Python, the law (``law_row``) compiled."""
+        nq, n = self._nq, self._n
+        if len(target) == 0:
+            target = np.array(active_target_values(self._schedule, self._targets, t)[TARGET_PORT])
+        target = np.asarray(target, dtype=float)
+        if self._task == "position":
+            x, xdot, J = self._kinematics.compute(qv[:nq], qv[nq:])
+            e, edot = task_error("position", self._rot_scale, x, xdot, target[0:3], target[3:6])
+            extra = []
+        else:
+            x, xdot, R, omega, J_v, J_w = self._kinematics.compute_pose(qv[:nq], qv[nq:])
+            J = task_jacobian(J_v, J_w, self._rot_scale)
+            if rotation is None:
+                rotation = active_rotation_values(self._schedule, self._targets, t)
+            e, edot = task_error(self._task, self._rot_scale, x.tolist(), xdot.tolist(), target[0:3].tolist(),
+                                 target[3:6].tolist(), R.ravel().tolist(), omega.tolist(), list(rotation))
+            extra = [R.ravel(), omega, np.asarray(rotation, dtype=float)]
+        tbg, surface = np.empty(10), np.empty(6 * n)
+        tau = law_row(float(t), np.asarray(e, dtype=float), np.asarray(edot, dtype=float),
+                      np.ascontiguousarray(J), np.ascontiguousarray(sigma, dtype=float),
+                      np.asarray(captured, dtype=float), self._schedule.table, self._gains, tbg, surface)
+        return np.concatenate([x, xdot, target[:9], tbg[:5], surface[:5 * n], sigma, tau, *extra,
+                               tbg[5:10], surface[5 * n:]])
+
+
+class PrescribedTimeInterceptor(Diagram):
+    """Input ``state`` ([q; v] of the plant); outputs ``u`` (actuation), ``tau`` (joint torques),
+    ``sigma`` (σ, the Integrator's state, n), ``captured`` ([index, s(t0), σ0]) and ``telemetry``;
+    n the dimension of ``gains.task`` (``systems.task``: 3 for ``position``, 6 with orientation).
 
     With ``targets`` (one per segment, ``evaluate(t)`` → [x, ẋ, ẍ, …]) the target is
-    computed inside (the fast path for analytic targets); with ``targets=None`` the
-    system has an input port ``target`` ([x_r, ẋ_r, ẍ_r] of the active segment,
+    computed inside (compiled for sinusoid, linear and ballistic targets); with ``targets=None``
+    the system has an input port ``target`` ([x_r, ẋ_r, ẍ_r] of the active segment,
     e.g. a Kalman filter's estimate) and holds no target object at all; with an orientation
     task it then has an input ``target_rotation`` too ([R_r, ω_r, ω̇_r], 15).
     """
@@ -72,126 +199,58 @@ class PrescribedTimeInterceptor(LeafSystem):
         if targets is not None and len(targets) != len(schedule):
             raise ValueError(f"targets: one target per segment is needed, got {len(targets)} "
                              f"for {len(schedule)} segments")
-        nq, nv = plant.num_positions(), plant.num_velocities()
-        self._nq, self._nv = nq, nv
-        self._schedule = schedule
-        self._targets = None if targets is None else tuple(targets)
-        self._tbg_args = (gains.epsilon, gains.delta, gains.alpha_hold)
-        self._kinematics = FrameKinematics(plant, frame)
-        self._task, self._rot_scale = gains.task, float(gains.rot_scale)
-        self._n = n = TASK_DIM[gains.task]
-        self._law = SurfaceLaw(gains.Lambda, gains.k, gains.switching, gains.phi,
-                               gains.sigma_policy, gains.k_hold, n)
-        self._K = np.broadcast_to(np.asarray(gains.K, dtype=float), (nv,)).copy()
-        self._K_floats = tuple(self._K.tolist())
-        self._damping = float(gains.pinv_damping)
-        self._null_space = null_space_terms(gains, plant, posture)  # redundant arms only
-        self._BT = plant.MakeActuationMatrix().T
-        self.layout = telemetry_layout(nv, gains.task)
-        size = max(part.stop for part in self.layout.values())
-
-        self._state_in = self.DeclareVectorInputPort("state", nq + nv)
-        self._target_in = None if targets is not None else self.DeclareVectorInputPort(
-            "target", TARGET_PORT_SIZE)
-        self._rotation_in = None if targets is not None or gains.task == "position" else \
-            self.DeclareVectorInputPort("target_rotation", TARGET_ROTATION_SIZE)
-        # the cache holds the telemetry, then the active segment (5), then σ̇ (n)
-        self._segment = slice(size, size + 5)
-        self._sigma_dot = slice(size + 5, size + 5 + n)
-        self._parts = surface_slots(n)
-        sigma_index, capture_index = DeclareSegmentCapture(
-            self, schedule, self._law,
-            lambda c: (self._eval(c)[self._segment], self._eval(c)[self.layout["s"]]))
-        self.DeclareStateOutputPort("sigma", sigma_index)
-        self.DeclareStateOutputPort("captured", capture_index)
-        self._capture_index = capture_index
-        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
-        self._eval = DeclareVectorCache(self, "interceptor", size + 5 + n, self._calc, deps)
-        tau = self.layout["tau"]
-        if self._BT.shape[0] == nv and np.array_equal(self._BT, np.eye(nv)):
-            calc_u = lambda c, o: o.SetFromVector(self._eval(c)[tau])  # noqa: E731
-        else:
-            calc_u = lambda c, o: o.SetFromVector(self._BT @ self._eval(c)[tau])  # noqa: E731
-        self.DeclareVectorOutputPort("u", self._BT.shape[0], calc_u, prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("tau", nv, lambda c, o: o.SetFromVector(self._eval(c)[tau]),
-                                     prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("telemetry", size,
-                                     lambda c, o: o.SetFromVector(self._eval(c)[:size]),
-                                     prerequisites_of_calc=deps)
+        builder = DiagramBuilder()
+        law = builder.AddNamedSystem("law", InterceptorLaw(
+            plant=plant, frame=frame, schedule=schedule, gains=gains, targets=targets, posture=posture))
+        nv, n = plant.num_velocities(), law.num_tasks
+        split = builder.AddNamedSystem("split", Demultiplexer([nv, n]))
+        sigma = builder.AddNamedSystem("sigma", Integrator(n))
+        builder.Connect(law.GetOutputPort("tau_sigma_dot"), split.get_input_port())
+        builder.Connect(split.get_output_port(1), sigma.get_input_port())
+        builder.Connect(sigma.get_output_port(), law.GetInputPort("sigma"))
+        for name in ("state", "target", "target_rotation"):
+            if law.HasInputPort(name):
+                builder.ExportInput(law.GetInputPort(name), name)
+        BT = plant.MakeActuationMatrix().T
+        tau = split.get_output_port(0)
+        u = tau if BT.shape[0] == nv and np.array_equal(BT, np.eye(nv)) else None
+        if u is None:
+            gain = builder.AddNamedSystem("actuation", MatrixGain(BT))
+            builder.Connect(tau, gain.get_input_port())
+            u = gain.get_output_port()
+        builder.ExportOutput(u, "u")
+        builder.ExportOutput(tau, "tau")
+        builder.ExportOutput(sigma.get_output_port(), "sigma")
+        builder.ExportOutput(law.GetOutputPort("captured"), "captured")
+        builder.ExportOutput(law.GetOutputPort("telemetry"), "telemetry")
+        builder.BuildInto(self)
+        self.law = law
+        self.layout = law.layout
+        self._targets = law._targets
 
     @property
     def has_target_input(self) -> bool:
-        return self._target_in is not None
+        return self.HasInputPort("target")
 
     @property
     def has_rotation_input(self) -> bool:
-        return self._rotation_in is not None
-
-    def _calc(self, context) -> np.ndarray:
-        # the cheapest reads of the context (views and single values, no copies): ~3 µs less
-        # per evaluation than CopyToVector and Eval
-        sigma = context.get_continuous_state_vector()
-        rotation = None if self._rotation_in is None else self._rotation_in.Eval(context).tolist()
-        return np.array(self._row(
-            context.get_time(), self._state_in.EvalBasicVector(context).value(),
-            [sigma.GetAtIndex(i) for i in range(self._n)],
-            context.get_discrete_state(self._capture_index).value().tolist(),
-            None if self._target_in is None else self._target_in.Eval(context).tolist(), rotation))
-
-    def _row(self, t: float, qv: np.ndarray, sigma: list, captured: list,
-             target: Optional[list], rotation: Optional[list] = None) -> list:
-        """The cache vector (telemetry, active segment, σ̇) as a list of plain floats, from the
-        time, the plant state [q; v] (an array), σ, [index, s(t0)] and the ``target`` (and
-        ``target_rotation``) inputs' values (None: the system's own targets)."""
-        nq = self._nq
-        if target is None:
-            target = active_target_values(self._schedule, self._targets, t)
-        if self._task == "position":
-            x, xdot, J = self._kinematics.compute(qv[:nq], qv[nq:])
-            x, xdot, J = x.tolist(), xdot.tolist(), J.tolist()
-            e, edot = position_error(x, xdot, target[TARGET.x], target[TARGET.xdot])
-            extra = []
-        else:
-            x, xdot, R, omega, J_v, J_w = self._kinematics.compute_pose(qv[:nq], qv[nq:])
-            x, xdot, R, omega = x.tolist(), xdot.tolist(), R.ravel().tolist(), omega.tolist()
-            J = task_jacobian(J_v, J_w, self._rot_scale)
-            if rotation is None:
-                rotation = active_rotation_values(self._schedule, self._targets, t)
-            e, edot = task_error(self._task, self._rot_scale, x, xdot, target[TARGET.x],
-                                 target[TARGET.xdot], R, omega, rotation)
-            extra = R + omega + list(rotation)
-        tbg = tbg_state(self._schedule, t, *self._tbg_args)
-        parts = self._law.values(t, e, edot, tbg[TBG.alpha], tbg[TBG.segment], captured, sigma)
-        slots = self._parts
-        tau = smc_torque(self._K_floats, J, parts[slots.s_x], self._damping)
-        if self._null_space is not None:  # redundant arms, optional (off by default)
-            D, rate, q_start = self._null_space
-            extra_tau = null_space_torque(np.array(J), qv[:nq], qv[nq:], q_start, D, rate)
-            tau = (np.array(tau) + extra_tau).tolist()
-        return (x + xdot + target[TARGET_PORT] + tbg[TBG_OUT] + parts[slots.out] + sigma + tau + extra
-                + tbg[TBG.segment] + parts[slots.sigma_dot])
+        return self.HasInputPort("target_rotation")
 
     def telemetry_at(self, t: np.ndarray, plant_state: np.ndarray, sigma: np.ndarray,
                      captured: np.ndarray, target: Optional[np.ndarray] = None,
                      rotation: Optional[np.ndarray] = None) -> np.ndarray:
-        """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0)], and the
-        ``target`` / ``target_rotation`` inputs' values when the system has those ports).
-
-        The same ``_row`` as a context's cache entry, called directly on the logged values
-        (no context, no cache entry, no crossing into Drake but the kinematics).
-        """
-        size = self._segment.start
-        n = len(t)
-        if n == 0:
+        """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0), σ0], and the
+        ``target`` / ``target_rotation`` inputs' values when the system has those ports): the
+        law's ``row`` called directly on the logged values (no context, no cache entry)."""
+        size = self.law.telemetry_size
+        k = len(t)
+        if k == 0:
             return np.empty((0, size))
-        targets = [None] * n if self._target_in is None else np.asarray(target).tolist()
-        rotations = [None] * n if self._rotation_in is None else np.asarray(rotation).tolist()
-        row = self._row
+        targets = [None] * k if not self.has_target_input else np.asarray(target, dtype=float)
+        rotations = [None] * k if not self.has_rotation_input else np.asarray(rotation, dtype=float)
+        row = self.law.row
+        f64 = lambda a: np.ascontiguousarray(a, dtype=float)  # noqa: E731
         rows = np.array([row(tk, qv, sg, cap, tg, rt) for tk, qv, sg, cap, tg, rt in zip(
-            np.asarray(t, dtype=float).tolist(), np.asarray(plant_state, dtype=float),
-            np.asarray(sigma, dtype=float).tolist(), np.asarray(captured, dtype=float).tolist(),
+            np.asarray(t, dtype=float).tolist(), f64(plant_state), f64(sigma), f64(captured),
             targets, rotations)])
         return rows[:, :size]
-
-    def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self._sigma_dot])

@@ -4,7 +4,9 @@
 
 x is the position in the world of the origin of a frame (the interception
 point), J its translational Jacobian with respect to the plant's generalized
-velocities.  Kinematics only: no mass matrix, Coriolis or gravity term is ever
+velocities.  A serial chain of revolute and prismatic joints is computed by
+compiled code (``chain.KinematicChain``, equal to Drake's to rounding); anything
+else by the plant.  Kinematics only: no mass matrix, Coriolis or gravity term is ever
 evaluated here, which is what keeps the controller model-free.
 """
 
@@ -15,6 +17,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.chain import KinematicChain
 from ptint_drake.systems.task import task_jacobian
 
 
@@ -22,9 +25,11 @@ _ORIGIN = np.zeros(3)
 
 
 class FrameKinematics:
-    """x, ẋ, J of one frame's origin (paper eq. 5), computed on a private plant context."""
+    """x, ẋ, J of one frame's origin (paper eq. 5): by the compiled ``chain`` when the frame ends a
+    serial revolute/prismatic chain, otherwise by the plant on a private context."""
 
     def __init__(self, plant, frame):
+        self.chain = KinematicChain.of(plant, frame)
         self._plant = plant
         self._frame = frame
         self._world = plant.world_frame()
@@ -33,6 +38,9 @@ class FrameKinematics:
 
     def compute(self, q, v) -> tuple:
         """(x, ẋ, J) at joint positions q and velocities v: arrays of 3, 3 and 3 × nv."""
+        if self.chain is not None:
+            x, _, J, _ = self.chain.evaluate(q)
+            return x, J @ v, J
         plant, pc = self._plant, self._plant_context
         plant.SetPositions(pc, q)
         x = self._frame.CalcPoseInWorld(pc).translation()
@@ -43,6 +51,9 @@ class FrameKinematics:
     def compute_pose(self, q, v) -> tuple:
         """(x, ẋ, R, ω, J_v, J_ω) at q, v: the frame's position, velocity, orientation (3 × 3),
         angular velocity (world frame) and the translational and rotational Jacobians (3 × nv)."""
+        if self.chain is not None:
+            x, R, J_v, J_w = self.chain.evaluate(q)
+            return x, J_v @ v, R, J_w @ v, J_v, J_w
         plant, pc = self._plant, self._plant_context
         plant.SetPositions(pc, q)
         X = self._frame.CalcPoseInWorld(pc)

@@ -14,6 +14,8 @@ import bisect
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
+import numpy as np
+
 from ptint_drake.systems.tbg import gamma_gain
 
 
@@ -53,6 +55,9 @@ class Schedule:
         self.segments = tuple(segments)
         self.starts = tuple(s.start for s in segments)
         self._gammas = tuple(gamma_gain(s.tf, s.beta) for s in segments)  # once per segment
+        # rows start, tf, β, γ: the schedule as compiled code reads it (``tbg.tbg_row``)
+        self.table = np.array([self.starts, [s.tf for s in segments], [s.beta for s in segments],
+                               self._gammas], dtype=float)
 
     def __len__(self) -> int:
         return len(self.segments)

@@ -33,45 +33,79 @@ paper's formula.  ``alpha_hold`` (TBG) adds position feedback in the hold.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
-from ptint_drake.systems.signals import CAPTURED, SEGMENT, TARGET_ROTATION_SIZE, surface_slots
+from ptint_drake.systems.signals import SEGMENT, TARGET_ROTATION_SIZE, surface_slots
 from ptint_drake.systems.task import TASK_DIM, task_error
 
-SWITCHING_LAWS = ("sign", "tanh", "sat")
+SWITCHING_LAWS = ("sign", "tanh", "sat")  # their codes in compiled code: the index
 SIGMA_POLICIES = ("keep", "reset")
 
 
-def _sign(w: float) -> float:
-    """The sign of one float (0 stays 0, NaN stays NaN)."""
-    return 1.0 if w > 0.0 else (-1.0 if w < 0.0 else w)
+@njit(cache=True)
+def switch(law: int, phi: float, w: np.ndarray, out: np.ndarray) -> None:
+    """``out`` ← switch(w) of eq. 17 elementwise: ``law`` 0 the paper's sign, 1 tanh(w/φ),
+    2 sat(w/φ) = clip(w/φ, −1, 1) (codes: the index in ``SWITCHING_LAWS``; NaN stays NaN)."""
+    for i in range(len(w)):
+        a = w[i]
+        if law == 0:
+            out[i] = 1.0 if a > 0.0 else (-1.0 if a < 0.0 else a)
+        elif law == 1:
+            out[i] = np.tanh(a / phi)
+        else:
+            out[i] = min(max(a / phi, -1.0), 1.0) if a == a else a
 
 
 def switching_law(law: str, phi: float):
-    """σ̇ = switch(w) of a vector w (a list of plain floats → a list): the paper's ``sign``,
-    ``tanh(w/φ)`` or ``sat(w/φ)`` = clip(w/φ, −1, 1).  Raises ValueError for another law."""
-    if law == "sign":
-        return lambda w: [_sign(a) for a in w]
-    if law == "tanh":
-        # numpy's tanh, not math.tanh: they differ in the last bit for about a quarter of
-        # the arguments, and the run (step sizes, sampled peaks) should not move with it
-        tanh = np.tanh
-        return lambda w: [float(tanh(a / phi)) for a in w]
-    if law == "sat":
-        return lambda w: [min(max(a / phi, -1.0), 1.0) if a == a else a for a in w]
-    raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
+    """σ̇ = switch(w) of a vector w (a sequence → an array): ``switch`` with the paper's
+    ``sign``, ``tanh(w/φ)`` or ``sat(w/φ)``.  Raises ValueError for another law."""
+    if law not in SWITCHING_LAWS:
+        raise ValueError(f"controller.switching: unknown law {law!r}, use one of {SWITCHING_LAWS}")
+    code, phi = SWITCHING_LAWS.index(law), float(phi)
+
+    def apply(w) -> np.ndarray:
+        w = np.asarray(w, dtype=float)
+        out = np.empty_like(w)
+        switch(code, phi, w, out)
+        return out
+    return apply
+
+
+@njit(cache=True)
+def surface_law(t: float, e, edot, alpha: float, segment, captured, sigma, Lambda, k: float,
+                k_hold: float, law: int, phi: float, out) -> None:
+    """``out`` ← [s_x, e, ė, s, s_d, σ̇] (``signals.surface_slots(n)``) of paper eqs. 16, 17 for
+    a task error e, ė of dimension n: s = ė + α e; s_d = s(t0) e^(−k τ) while τ = t − t0 < tf,
+    s(t0) e^(−k tf − k_hold (τ − tf)) in the hold (s_d = s at the switch instant, before the
+    capture: ``captured`` [index, s(t0)] holds another segment); s_x = s − s_d + Λ σ;
+    σ̇ = switch(s − s_d) (``switch``, ``law``, φ).  ``segment`` = [index, t0, tf, …]."""
+    n = len(e)
+    index = segment[0]
+    hold = index < 0 or captured[0] != index
+    f = 0.0
+    if not hold:
+        tau, tf = t - segment[1], segment[2]
+        f = np.exp(-k * tau) if tau < tf else np.exp(-k * tf - k_hold * (tau - tf))
+    w = out[5 * n:6 * n]  # s − s_d, until σ̇ replaces it
+    for i in range(n):
+        s = edot[i] + alpha * e[i]
+        s_d = s if hold else captured[1 + i] * f
+        out[n + i], out[2 * n + i], out[3 * n + i], out[4 * n + i] = e[i], edot[i], s, s_d
+        w[i] = s - s_d
+        out[i] = w[i] + Lambda[i] * sigma[i]
+    switch(law, phi, w, w)
 
 
 class SurfaceLaw:
-    """The surface equations above (paper eqs. 16, 17) in plain floats, on a task error of
-    dimension ``dim`` (3: position; 6: position and orientation, ``systems.task``): the one
-    implementation that ``SlidingSurface`` and the fused ``PrescribedTimeInterceptor`` call."""
+    """The surface equations (paper eqs. 16, 17, ``surface_law``) with their gains, on a task
+    error of dimension ``dim`` (3: position; 6: position and orientation, ``systems.task``)."""
 
     def __init__(self, Lambda=5.0, k: float = 3.0, switching: str = "tanh", phi: float = 0.01,
                  sigma_policy: str = "keep", k_hold: float = 50.0, dim: int = 3):
-        self._switch = switching_law(switching, float(phi))  # validates the law
+        switching_law(switching, float(phi))  # validates the law
         if sigma_policy not in SIGMA_POLICIES:
             raise ValueError(f"controller.sigma_policy: use one of {SIGMA_POLICIES}, got {sigma_policy!r}")
         if switching != "sign" and not phi > 0.0:
@@ -81,32 +115,20 @@ class SurfaceLaw:
         self.k = float(k)
         self.k_hold = float(k_hold)
         self.law = switching
+        self.code = SWITCHING_LAWS.index(switching)
         self.phi = float(phi)
         self.reset_sigma = sigma_policy == "reset"
-        self._Lambda = tuple(self.Lambda.tolist())
 
-    def values(self, t: float, e: list, edot: list, alpha: float, segment, captured, sigma) -> list:
-        """[s_x, e, ė, s, s_d, σ̇] (``signals.surface_slots(dim)``, 6·dim plain floats) from the
-        task error e, ė (``systems.task``) and plain-float sequences (lists).
-
-        ``segment`` = [index, t0, tf, ...] of the active segment (TBG output),
-        ``captured`` = [index, s(t0)] (the discrete state), ``sigma`` = σ.
-        """
-        s = [d + alpha * a for a, d in zip(e, edot)]
-        index = segment[SEGMENT.index]
-        if index < 0 or captured[CAPTURED.index] != index:
-            s_d = s  # at the switch instant s(t0) is s itself
-        else:
-            tau, tf = t - segment[SEGMENT.t0], segment[SEGMENT.tf]
-            # numpy's exp, not math.exp: they differ in the last bit, and the run would move
-            if tau < tf:
-                f = float(np.exp(-self.k * tau))
-            else:
-                f = float(np.exp(-self.k * tf - self.k_hold * (tau - tf)))
-            s_d = [c * f for c in captured[1:]]
-        w = [a - d for a, d in zip(s, s_d)]
-        return ([a + L * g for a, L, g in zip(w, self._Lambda, sigma)]
-                + e + edot + s + list(s_d) + self._switch(w))
+    def values(self, t: float, e, edot, alpha: float, segment, captured, sigma) -> np.ndarray:
+        """[s_x, e, ė, s, s_d, σ̇] (``signals.surface_slots(dim)``, 6·dim) from the task error
+        e, ė (``systems.task``), α, ``segment`` = [index, t0, tf, ...] of the active segment (TBG
+        output), ``captured`` = [index, s(t0)] (the discrete state) and ``sigma`` = σ."""
+        out = np.empty(6 * self.dim)
+        f64 = np.asarray
+        surface_law(float(t), f64(e, float), f64(edot, float), float(alpha), f64(segment, float),
+                    f64(captured, float), f64(sigma, float), self.Lambda, self.k, self.k_hold,
+                    self.code, self.phi, out)
+        return out
 
 
 def DeclareSegmentCapture(system, schedule: Schedule, law: SurfaceLaw, segment_and_s):
@@ -180,11 +202,10 @@ class SlidingSurface(LeafSystem):
         e, edot = task_error(self._task, self._rot_scale, self._x_in.Eval(context).tolist(),
                              self._xdot_in.Eval(context).tolist(), self._x_r_in.Eval(context).tolist(),
                              self._xdot_r_in.Eval(context).tolist(), **rotation)
-        return np.array(self._law.values(
+        return self._law.values(
             context.get_time(), e, edot, float(self._alpha_in.Eval(context)[0]),
-            self._segment_in.Eval(context).tolist(),
-            context.get_discrete_state_vector().value().tolist(),
-            context.get_continuous_state_vector().CopyToVector().tolist()))
+            self._segment_in.Eval(context), context.get_discrete_state_vector().value(),
+            context.get_continuous_state_vector().CopyToVector())
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self._slots.sigma_dot])

@@ -17,11 +17,11 @@ Any of them may carry an orientation (``orientation.OrientedTarget``, issue 19).
 from __future__ import annotations
 
 import bisect
-import math
 from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
+from numba import njit
 from pydrake.systems.framework import LeafSystem
 from pydrake.trajectories import PiecewisePolynomial
 
@@ -29,6 +29,54 @@ from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.orientation import active_rotation_values
 from ptint_drake.systems.signals import TARGET, TARGET_PORT, TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
+
+
+# Compiled targets: a row [kind, coefficients…] of ``COMPILED_WIDTH`` floats per target.
+SINUSOID, LINEAR, BALLISTIC = 1.0, 2.0, 3.0
+COMPILED_WIDTH = 38
+
+
+@njit(cache=True)
+def target_row(c, t: float, out) -> None:
+    """``out[:12]`` ← [x_r, ẋ_r, ẍ_r, x⃛_r] at time t of the target whose row is c (the
+    ``compiled`` row of a ``SinusoidTarget``, ``LinearTarget`` or ``BallisticTarget``)."""
+    kind = c[0]
+    if kind == SINUSOID:  # c = [kind, offset (12), gain (12), shift (12), ω]
+        wt = c[37] * t
+        for k in range(12):
+            out[k] = c[1 + k] + c[13 + k] * np.sin(wt + c[25 + k])
+    elif kind == LINEAR:  # c = [kind, start (3), velocity (3)]
+        for i in range(3):
+            out[i], out[3 + i], out[6 + i], out[9 + i] = c[1 + i] + c[4 + i] * t, c[4 + i], 0.0, 0.0
+    else:  # BALLISTIC: c = [kind, start (3), velocity (3), gravity (3), release]
+        tau = t - c[10]
+        for i in range(3):
+            if tau < 0.0:
+                out[i], out[3 + i], out[6 + i] = c[1 + i], 0.0, 0.0
+            else:
+                out[i] = c[1 + i] + c[4 + i] * tau + 0.5 * tau * tau * c[7 + i]
+                out[3 + i], out[6 + i] = c[4 + i] + tau * c[7 + i], c[7 + i]
+            out[9 + i] = 0.0
+
+
+def _compiled_row(kind: float, *parts) -> np.ndarray:
+    row = np.zeros(COMPILED_WIDTH)
+    values = np.concatenate([np.ravel(p) for p in parts])
+    row[0], row[1:1 + len(values)] = kind, values
+    return row
+
+
+def _evaluate(row: np.ndarray, t: float) -> np.ndarray:
+    out = np.empty(12)
+    target_row(row, float(t), out)
+    return out
+
+
+def compiled_targets(targets: Sequence):
+    """The targets' ``compiled`` rows stacked (count × ``COMPILED_WIDTH``), or None when one of
+    them has none (a waypoint or oriented target: evaluated in Python)."""
+    rows = [getattr(tg, "compiled", None) for tg in targets]
+    return None if any(r is None for r in rows) else np.array(rows)
 
 
 @dataclass(frozen=True)
@@ -42,21 +90,15 @@ class SinusoidTarget:
         for name in ("center", "amplitude", "phase"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
         # the k-th derivative of a sin(ωt + φ) is a ωᵏ sin(ωt + φ + kπ/2), for k = 0..3:
-        # (offset, gain, shift) of the 12 values as plain floats
+        # offset, gain and shift of the 12 values (``target_row``)
         a, w = self.amplitude, self.omega
-        offset = np.concatenate([self.center, np.zeros(9)]).tolist()
-        gain = np.concatenate([a, a * w, a * w**2, a * w**3]).tolist()
-        shift = np.concatenate([self.phase + k * np.pi / 2 for k in range(4)]).tolist()
-        object.__setattr__(self, "_terms", tuple(zip(offset, gain, shift)))
-
-    def values(self, t: float) -> list:
-        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 plain floats) at time t."""
-        wt, sin = self.omega * t, math.sin
-        return [c + g * sin(wt + p) for c, g, p in self._terms]
+        object.__setattr__(self, "compiled", _compiled_row(
+            SINUSOID, self.center, np.zeros(9), a, a * w, a * w**2, a * w**3,
+            *[self.phase + k * np.pi / 2 for k in range(4)], float(w)))
 
     def evaluate(self, t: float) -> np.ndarray:
-        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
-        return np.array(self.values(t))
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t (``target_row``)."""
+        return _evaluate(self.compiled, t)
 
 
 @dataclass(frozen=True)
@@ -67,16 +109,11 @@ class LinearTarget:
     def __post_init__(self):
         for name in ("start", "velocity"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
-        object.__setattr__(self, "_floats", (self.start.tolist(), self.velocity.tolist()))
-
-    def values(self, t: float) -> list:
-        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 plain floats) at time t."""
-        start, velocity = self._floats
-        return [x0 + vi * t for x0, vi in zip(start, velocity)] + velocity + [0.0] * 6
+        object.__setattr__(self, "compiled", _compiled_row(LINEAR, self.start, self.velocity))
 
     def evaluate(self, t: float) -> np.ndarray:
-        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t."""
-        return np.array(self.values(t))
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t (``target_row``)."""
+        return _evaluate(self.compiled, t)
 
 
 @dataclass(frozen=True)
@@ -89,23 +126,18 @@ class BallisticTarget:
     def __post_init__(self):
         for name in ("start", "velocity", "gravity"):
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
+        object.__setattr__(self, "compiled", _compiled_row(
+            BALLISTIC, self.start, self.velocity, self.gravity, float(self.release)))
 
     @property
     def visible_from(self) -> float:
         """The release time: a camera sees the object from then on."""
         return float(self.release)
 
-    def values(self, t: float) -> list:
-        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 plain floats) at time t."""
-        return self.evaluate(t).tolist()
-
     def evaluate(self, t: float) -> np.ndarray:
-        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t (held at ``start`` before release)."""
-        tau = t - self.release
-        if tau < 0.0:
-            return np.concatenate([self.start, np.zeros(9)])
-        return np.concatenate([self.start + self.velocity * tau + 0.5 * tau * tau * self.gravity,
-                               self.velocity + tau * self.gravity, self.gravity, np.zeros(3)])
+        """[x_r, ẋ_r, ẍ_r, x⃛_r] stacked (12 values) at time t (held at ``start`` before release;
+        ``target_row``)."""
+        return _evaluate(self.compiled, t)
 
 
 def target_values(target, t: float) -> list:

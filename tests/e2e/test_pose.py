@@ -135,7 +135,8 @@ def test_blocks_and_fused_agree_with_orientation(urdf, q, task):
         plant.SetPositionsAndVelocities(plant.GetMyMutableContextFromRoot(ctx), np.r_[q, v])
         sub = (h.fused if fused else h.surface).GetMyMutableContextFromRoot(ctx)
         sub.SetContinuousState(sigma)
-        sub.SetDiscreteState(np.r_[0.0, s0])
+        # [index, s(t0)], and the fused law's σ0 (0: σ kept across segments)
+        sub.SetDiscreteState(np.r_[0.0, s0, np.zeros(len(s0))] if fused else np.r_[0.0, s0])
         row = []
         for t in (0.4, 1.3):
             ctx.SetTime(t)

@@ -59,7 +59,7 @@ def test_surface_hold_decay_and_capture_instant():
 @pytest.mark.parametrize("law", ["sign", "tanh", "sat"])
 def test_switching_laws(law):
     switch = switching_law(law, 0.01)
-    out = np.array(switch([-1.0, -1e-3, 0.0]) + switch([1e-3, 1.0, 2.0])[:2])
+    out = np.concatenate([switch([-1.0, -1e-3, 0.0]), switch([1e-3, 1.0, 2.0])[:2]])
     assert out[0] == -1.0 or out[0] == pytest.approx(-1.0)
     assert out[-1] == pytest.approx(1.0)
     assert out[2] == 0.0
@@ -130,28 +130,41 @@ def test_schedule_validation():
     assert TimeBaseGenerator(SCHED).schedule is SCHED
 
 
-def test_solve3_matches_numpy_and_survives_singular():
-    from ptint_drake.systems.controller import solve3
+def test_square_solve_matches_numpy_and_survives_singular():
+    """The compiled 3 × 3 solve (Cramer's rule) against numpy; least squares when singular."""
+    from ptint_drake.systems.controller import pinv_apply
 
     rng = np.random.default_rng(5)
     for _ in range(200):
         J = rng.normal(size=(3, 3))
         b = rng.normal(size=3)
-        np.testing.assert_allclose(solve3(J.tolist(), b.tolist()), np.linalg.solve(J, b),
-                                   rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(pinv_apply(J, b), np.linalg.solve(J, b), rtol=1e-9, atol=1e-9)
     singular = np.array([[1.0, 2, 3], [2, 4, 6], [0, 1, 1]])
-    assert np.all(np.isfinite(solve3(singular.tolist(), [1.0, 1.0, 1.0])))
+    np.testing.assert_allclose(pinv_apply(singular, [1.0, 1.0, 1.0]),
+                               np.linalg.lstsq(singular, np.ones(3), rcond=None)[0], atol=1e-12)
+
+
+@pytest.mark.parametrize("nv, damping", [(5, 0.0), (6, 0.0), (7, 0.0), (6, 0.05)])
+def test_six_row_pinv_is_numpys_least_squares(nv, damping):
+    """6-row tasks: the minimum-norm least-squares solution (damped: Jᵀ(JJᵀ + λ²I)⁻¹ b)."""
+    from ptint_drake.systems.controller import pinv_apply
+
+    rng = np.random.default_rng(nv)
+    J, b = rng.normal(size=(6, nv)), rng.normal(size=6)
+    expected = (J.T @ np.linalg.solve(J @ J.T + damping**2 * np.eye(6), b) if damping
+                else np.linalg.lstsq(J, b, rcond=None)[0])
+    np.testing.assert_allclose(pinv_apply(J, b, damping), expected, rtol=1e-9, atol=1e-12)
 
 
 @pytest.mark.parametrize("law", ["sign", "tanh", "sat"])
-def test_switching_law_is_numpys_to_the_last_bit(law):
-    """The plain-float law equals numpy's array form exactly (sign, tanh, clip)."""
+def test_switching_law_is_numpys(law):
+    """The compiled law equals numpy's array form (sign, clip exactly; tanh to the last bits)."""
     reference = {"sign": np.sign, "tanh": lambda w: np.tanh(w / 0.01),
                  "sat": lambda w: np.clip(w / 0.01, -1.0, 1.0)}[law]
     switch = switching_law(law, 0.01)
     w = np.random.default_rng(3).normal(scale=0.02, size=(500, 3))
     for row in w:
-        assert switch(row.tolist()) == reference(row).tolist()
+        np.testing.assert_allclose(switch(row.tolist()), reference(row), rtol=4e-16, atol=0)
     with pytest.raises(ValueError, match="controller.switching"):
         switching_law("relay", 0.01)
 
@@ -182,7 +195,7 @@ def test_surface_law_matches_the_paper_equations():
 def test_smc_torque_is_minus_K_pinv_J_s_x(nv, damping):
     """``smc_torque`` (fused system, block and SMC baseline) against τ = −K J⁺ s_x (eq. 18) with
     numpy: J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ (λ = 0: the inverse or the minimum-norm pseudoinverse); it takes
-    lists (the fast form) and arrays alike and gives the same floats."""
+    lists and arrays alike and gives the same floats."""
     from ptint_drake.systems.controller import smc_torque
 
     rng = np.random.default_rng(nv + int(100 * damping))
@@ -193,4 +206,4 @@ def test_smc_torque_is_minus_K_pinv_J_s_x(nv, damping):
         pinv = J.T @ np.linalg.inv(J @ J.T + damping**2 * np.eye(3))
         tau = smc_torque(K.tolist(), J.tolist(), s_x.tolist(), damping)
         np.testing.assert_allclose(tau, -K * (pinv @ s_x), rtol=1e-9, atol=1e-12)
-        assert smc_torque(K.tolist(), J, s_x, damping) == tau
+        np.testing.assert_array_equal(smc_torque(K, J, s_x, damping), tau)

@@ -1,0 +1,86 @@
+"""One evaluation of the fused interceptor as compiled code (numba): the whole row at once.
+
+``law_row`` chains the equation kernels — the TBG and α (``tbg.tbg_row``, paper eqs. 6-10,
+13), the surface (``sliding_surface.surface_law``, eqs. 16-17) and the torque
+(``controller.sliding_mode_torque``, eq. 18) — from a task error; ``position_row`` adds the
+position task end to end: the compiled kinematic chain (``chain.chain_kinematics``, eq. 5), the
+target (``targets.target_row``, or a given one) and e = x − x_r (eq. 11).  The blocks call the
+same kernels one by one, so there is one implementation of each equation.
+
+The parameters travel as a few arrays (each argument costs the call ~0.15 µs):
+``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
+(``pack_gains``), ``segments`` = ``Schedule.table``, ``joints`` = [kinds; q index; v index] and
+``geometry`` = the chain's fixed transforms with each joint's axis (``pack_chain``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ptint_drake.systems.chain import chain_kinematics
+from ptint_drake.systems.controller import sliding_mode_torque
+from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
+from ptint_drake.systems.targets import target_row
+from ptint_drake.systems.tbg import tbg_row
+
+GAINS_HEAD = 8  # ϵ, δ, α_hold, k, k_hold, law, φ, λ; then Λ (n) and K (nv)
+
+
+def pack_gains(gains, n: int, K: np.ndarray) -> np.ndarray:
+    """``gains`` (a ``ControllerGains``) as the ``gains`` array of the kernels."""
+    head = [gains.epsilon, gains.delta, gains.alpha_hold, gains.k, gains.k_hold,
+            SWITCHING_LAWS.index(gains.switching), gains.phi, gains.pinv_damping]
+    Lambda = np.broadcast_to(np.asarray(gains.Lambda, dtype=float), (n,))
+    return np.concatenate([np.asarray(head, dtype=float), Lambda, K])
+
+
+def pack_chain(chain) -> tuple:
+    """(joints, geometry) of a ``KinematicChain``: [kinds; q index; v index] (3 × n) and the
+    fixed transforms X_0 … X_n as [R; pᵀ] with row 4 = the next joint's axis ((n + 1) × 5 × 3)."""
+    joints = np.array([chain.kinds, chain.q_index, chain.v_index], dtype=np.int64).reshape(3, -1)
+    geometry = np.zeros((len(chain.fixed), 5, 3))
+    geometry[:, :4] = chain.fixed
+    geometry[:-1, 4] = chain.axes
+    return joints, geometry
+
+
+@njit(cache=True)
+def law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface):
+    """τ (nv) of eq. 18 for the task error e, ė (n) and Jacobian J (n × nv), with σ and the
+    captured [index, s(t0)]; fills ``tbg`` (10, ``signals.TBG``) and ``surface`` (6n,
+    ``signals.surface_slots``) on the way."""
+    n = len(e)
+    tbg_row(t, segments, gains[0], gains[1], gains[2], tbg)
+    surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
+                gains[3], gains[4], int(gains[5]), gains[6], surface)
+    return sliding_mode_torque(gains[GAINS_HEAD + n:], J, surface[:n], gains[7])
+
+
+@njit(cache=True)
+def position_row(t, qv, sigma, captured, target, segments, gains, joints, geometry, targets, out):
+    """``out`` ← the fused interceptor's row for the position task (``interceptor.telemetry_layout``
+    then [index, t0, tf, β, phase] then σ̇): x, ẋ, x_r, ẋ_r, ẍ_r, ξ…ξ⃛, α, s_x, e, ė, s, s_d,
+    σ, τ.  ``target``: [x_r, ẋ_r, ẍ_r] (9), or empty to evaluate ``targets`` (one compiled row
+    per segment, ``targets.compiled_targets``) at t."""
+    nv = len(gains) - GAINS_HEAD - 3
+    nq = len(qv) - nv
+    x, _, J, _ = chain_kinematics(qv[:nq], joints[0], joints[1], joints[2], geometry[:, :4],
+                                  geometry[:-1, 4], nv)
+    v = qv[nq:]
+    xdot = np.zeros(3)
+    for i in range(3):
+        for k in range(nv):
+            xdot[i] += J[i, k] * v[k]
+    ref = np.empty(12)
+    if len(target) == 0:
+        i = max(np.searchsorted(segments[0], t, side="right") - 1, 0)
+        target_row(targets[i], t, ref)
+    else:
+        ref[:9] = target[:9]
+    e, edot = x - ref[0:3], xdot - ref[3:6]
+    tbg, surface = np.empty(10), np.empty(18)
+    tau = law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface)
+    out[0:3], out[3:6], out[6:15], out[15:20] = x, xdot, ref[:9], tbg[:5]
+    out[20:35], out[35:38], out[38:38 + nv] = surface[:15], sigma, tau
+    out[38 + nv:43 + nv], out[43 + nv:46 + nv] = tbg[5:10], surface[15:18]

@@ -1,0 +1,54 @@
+"""Compile (or load from numba's cache) every compiled kernel once: ``python -m
+ptint_drake.systems.warm_up`` (``scripts/setup.sh`` runs it after installing).
+
+numba compiles a kernel at its first call for the argument types of that call and, with
+``cache=True``, stores the machine code beside the module (or in ``NUMBA_CACHE_DIR``, or the
+user's cache directory when the install is read-only).  Short runs of the bundled scenarios
+exercise the kernels with the very types a ``ptint run`` passes: the fused position task with a
+curve, a line and a thrown object, a target from a filter, the pose task and the five blocks.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+# scenario, ``--set`` overrides: each reaches kernels (or argument types) the others do not
+_RUNS = (
+    ("curve_b075_tf15", []),
+    ("curve_b075_tf15", ["controller.implementation=blocks"]),
+    ("conveyor_pair", ["controller.switching=sat", "controller.pinv_damping=0.01"]),
+    ("conveyor_pair_camera", []),
+    ("throw_camera", []),
+    ("curve_pose", []),
+    ("curve_b075_tf15", ["controller.type=smc"]),
+)
+
+
+def warm_up(duration: float = 0.05) -> float:
+    """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
+    telemetry of the last state, as a run's outputs do); the wall time in s."""
+    from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation import build, prepared_simulator  # noqa: PLC0415
+    from ptint_drake.systems.tbg import alpha_peak, tbg_profile  # noqa: PLC0415
+
+    t0 = time.perf_counter()
+    for name, overrides in _RUNS:
+        _, text = scenario_text(name)
+        scenario = parse_with_overrides(text, overrides, name)
+        built = build(scenario, log=False)
+        simulator = prepared_simulator(built, scenario)
+        simulator.AdvanceTo(duration)
+        law = getattr(built.controller.system, "law", None)
+        if law is not None and not law.HasInputPort("target"):
+            context = law.GetMyContextFromRoot(simulator.get_context())
+            inputs = [law.GetInputPort(p).Eval(context)[None] for p in ("state", "sigma")]
+            built.controller.system.telemetry_at(
+                [duration], *inputs, context.get_discrete_state(0).value()[None])
+    alpha_peak(1.5, 0.75)
+    tbg_profile(0.5, 1.5, 0.75)
+    return time.perf_counter() - t0
+
+
+if __name__ == "__main__":
+    print(f"warm-up: compiled kernels ready in {warm_up():.1f} s", file=sys.stderr)
