@@ -54,15 +54,68 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
     """Simulate ``scenario`` and write its outputs into ``out_dir``; returns the metrics.
     ``warn(message)`` gets the warnings known before the simulation, before it starts.
     ``svg``: the figures as SVG too; ``workers``: processes drawing the figures and the
-    replay (default: one per CPU; see ``draw_views``)."""
-    result = simulate(scenario, progress=progress, warn=warn)
-    metrics = run_metrics(scenario, result.metrics, figures)
+    replay (default: one per CPU; see ``draw_views``).  With figures to draw and a second
+    CPU, the simulation runs in a forked process while this one prepares the figures
+    (``simulate_beside``)."""
+    prepare = None
+    if figures and (workers or os.cpu_count() or 1) > 1:
+        from ptint_drake.figures import preload as prepare  # noqa: PLC0415
+    metrics, series = simulate_beside(scenario, prepare, progress=progress, warn=warn)
+    run_json = run_metrics(scenario, metrics, figures)
     with staged_output(out_dir) as stage:
-        save_series(stage / SERIES, result.series)
-        draw_views(view_tasks(scenario, result.series, result.metrics, stage, figures=figures,
+        save_series(stage / SERIES, series)
+        draw_views(view_tasks(scenario, series, metrics, stage, figures=figures,
                               replay=replay, svg=svg), workers)
-        write_json_atomic(stage / METRICS, metrics)
-    return metrics
+        write_json_atomic(stage / METRICS, run_json)
+    return run_json
+
+
+def _simulate_child(conn, scenario: Scenario, progress, warn) -> None:
+    """The forked process of ``simulate_beside``: (True, (metrics, series)) or (False, the
+    exception) on ``conn``."""
+    import signal  # noqa: PLC0415
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    try:
+        result = simulate(scenario, progress=progress, warn=warn)
+        reply = (True, (result.metrics, result.series))
+    except BaseException as exc:  # noqa: BLE001  (re-raised in the parent)
+        reply = (False, exc)
+    try:
+        conn.send(reply)
+    except Exception as exc:  # noqa: BLE001  (an unpicklable exception)
+        conn.send((False, RuntimeError(f"simulation: {reply[1]!r} ({exc!r})"[:500])))
+
+
+def simulate_beside(scenario: Scenario, prepare=None, **kwargs) -> tuple[dict, dict]:
+    """(metrics, series) of ``simulate(scenario, **kwargs)``; when ``prepare`` is given and
+    this process may fork (``can_fork``), the simulation runs in a forked process while this
+    one calls ``prepare()`` (e.g. importing matplotlib: 1-2 s that then overlap the
+    simulation instead of following it).  Its exceptions are raised here; Ctrl-C stops it."""
+    if prepare is None or not can_fork():
+        result = simulate(scenario, **kwargs)
+        return result.metrics, result.series
+    ctx = multiprocessing.get_context("fork")
+    conn, child_conn = ctx.Pipe(duplex=False)
+    child = ctx.Process(target=_simulate_child, args=(child_conn, scenario, kwargs.get("progress"),
+                                                      kwargs.get("warn")), daemon=True)
+    child.start()
+    child_conn.close()
+    try:
+        prepare()
+        ok, value = conn.recv()
+        child.join(5.0)
+    except EOFError:
+        child.join(1.0)
+        raise RuntimeError(f"the simulation's process died (exit code {child.exitcode})") from None
+    finally:
+        if child.is_alive():
+            child.terminate()
+            child.join()
+        conn.close()
+    if not ok:
+        raise value
+    return value
 
 
 def run_metrics(scenario: Scenario, metrics: dict, figures: bool = True) -> dict:
