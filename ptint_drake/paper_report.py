@@ -11,7 +11,7 @@ from pathlib import Path
 from ptint_drake.figures import preload, tbg_family_figure
 from ptint_drake.metrics import segment_reasons
 from ptint_drake.outputs import staged_output
-from ptint_drake.run_outputs import run_and_write
+from ptint_drake.run_outputs import frozen_heap, run_and_write
 from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
 
@@ -96,7 +96,8 @@ def _parallel_part(out_dir: Path, tbg_stage: Path, svg: bool, workers=None,
             progress_factory(runs[index])(result["duration"], result["duration"])
 
     t0 = time.perf_counter()
-    results = run_tasks(paper_task, tasks, workers=workers, progress=report)
+    with frozen_heap():  # every worker is forked from here
+        results = run_tasks(paper_task, tasks, workers=workers, progress=report)
     wall = time.perf_counter() - t0
     compared = results[first:]
     comparisons = {name: compare.comparison(load_scenario(name), name, controllers, variants,
