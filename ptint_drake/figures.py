@@ -51,12 +51,11 @@ _PRELOADED: set = set()
 
 def preload(studies: bool = False) -> None:
     """Import what drawing a run's figures needs (matplotlib's figure, Agg and 3D axes,
-    Pillow, SciPy's spline) and draw one small figure with what the run figures use
-    (constrained layout, a log axis, mathtext, legends, each font size, 3D axes), so the
-    font lookups and the mathtext parser are made once: worker processes forked afterwards
-    share all of it.  ``studies``: pyplot and ``scipy.signal`` too (≈ 0.8 s, for the axes
-    figure's filter: a single run leaves it to the worker drawing that figure, where it
-    overlaps the other figures).  Once per process."""
+    Pillow, SciPy's spline) and draw the kinds of text the run figures show (mathtext, each
+    font size), so the font lookups and the mathtext parser are made once: worker processes
+    forked afterwards share all of it.  ``studies``: pyplot and ``scipy.signal`` too (≈ 0.8 s,
+    for the axes figure's filter: a single run leaves it to the worker drawing that figure,
+    where it overlaps the other figures).  Once per process."""
     if studies and "studies" not in _PRELOADED:
         _PRELOADED.add("studies")
         __getattr__("plt")
@@ -70,14 +69,9 @@ def preload(studies: bool = False) -> None:
     import PIL.Image  # noqa: F401, PLC0415
     import scipy.interpolate  # noqa: F401, PLC0415
 
-    fig = new_figure((4, 2), layout="constrained")
-    ax = fig.add_subplot(1, 2, 1)
-    ax.semilogy([0.0, 1.0], [1e-3, 1.0], label="$t_f$ −")
-    for size in (7, 8, 9, 10):
-        ax.legend(fontsize=size, loc="best")
-        ax.set_title("|e($t_f$)| m/s² ξ̇ τ θ°", fontsize=size)
-    fig.add_subplot(1, 2, 2, projection="3d").set_zlabel("Z [m]")
-    fig.suptitle("preload")
+    fig = new_figure((2, 1))
+    for size in (7, 8, 9, 10, 12):
+        fig.text(0.0, 0.0, "|e($t_f$)| $\\mathdefault{10^{-3}}$ m/s² ξ̇ τ θ° −", fontsize=size)
     matplotlib.backends.backend_agg.FigureCanvasAgg(fig).draw()
 
 
