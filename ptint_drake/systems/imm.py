@@ -206,7 +206,8 @@ class AdaptiveTargetEstimator(LeafSystem):
     before the first sample); ``probabilities`` (3): μ of ``MODELS``.
     Discrete state groups (``groups`` maps the names to indices): ``meta`` = [initialised,
     t_est, last stamp consumed, t of the last update], ``estimates`` = χⱼ (3×10 row-major),
-    ``covariances`` = Pⱼ (3×10×10), ``probabilities`` = μ (3).
+    ``covariances`` = Pⱼ (3×10×10), ``probabilities`` = μ (3), ``combined`` = χ̂ = Σ μⱼ χⱼ (10,
+    stored at each update so that the output only extrapolates it).
     ``prior``: pre-run samples [(t_k, z_k), …] consumed as in ``TargetKalmanFilter``.
     """
 
@@ -221,6 +222,7 @@ class AdaptiveTargetEstimator(LeafSystem):
         self.groups = {name: self.DeclareDiscreteState(value.ravel())
                        for name, value in zip(("meta", "estimates", "covariances", "probabilities"),
                                               state)}
+        self.groups["combined"] = self.DeclareDiscreteState(state[3] @ state[1])
         self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
         ticket = {self.time_ticket(), self.xd_ticket()}
         self._target_out = self.DeclareVectorOutputPort(
@@ -271,6 +273,7 @@ class AdaptiveTargetEstimator(LeafSystem):
             return
         for name, value in zip(("meta", "estimates", "covariances", "probabilities"), result):
             discrete_state.get_mutable_vector(self.groups[name]).SetFromVector(value.ravel())
+        discrete_state.get_mutable_vector(self.groups["combined"]).SetFromVector(result[3] @ result[1])
 
     def _prior_state(self, prior) -> tuple:
         """The state at t = 0 after the pre-run samples, each consumed when it became visible."""
@@ -291,7 +294,6 @@ class AdaptiveTargetEstimator(LeafSystem):
         if meta[0] < 0.5:
             return np.zeros(9)
         dt = context.get_time() - meta[1]
-        mu = context.get_discrete_state(self.groups["probabilities"]).value()
-        x = mu @ context.get_discrete_state(self.groups["estimates"]).value().reshape(len(MODELS), N)
+        x = context.get_discrete_state(self.groups["combined"]).value()
         p, v, a = x[0:3], x[3:6], x[6:9]
         return np.concatenate([p + dt * v + (0.5 * dt * dt) * a, v + dt * a, a])

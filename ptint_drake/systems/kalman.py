@@ -324,7 +324,7 @@ class ActiveTargetSelector(LeafSystem):
         return self._target_out
 
     def _select(self, context, output) -> None:
-        i = max(self._schedule.active(context.get_time()), 0)
+        i = max(self._schedule.active(context.get_time()), 0) if len(self._inputs) > 1 else 0
         output.SetFromVector(self._inputs[i].Eval(context))
 
 

@@ -103,14 +103,34 @@ def test_covariances_stay_spd_through_dropouts():
 
 def test_state_is_named_and_output_layout_is_the_kalman_one():
     est = AdaptiveTargetEstimator(config=MeasurementConfig(noise_std=0.002))
-    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities"}
+    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities", "combined"}
     context = est.CreateDefaultContext()
     sizes = [context.get_discrete_state(est.groups[n]).size()
-             for n in ("meta", "estimates", "covariances", "probabilities")]
+             for n in ("meta", "estimates", "covariances", "probabilities", "combined")]
     m = len(MODELS)
-    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m]
+    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m, imm.N]
     assert est.get_target_output_port().size() == 9
     np.testing.assert_array_equal(est.get_target_output_port().Eval(context), np.zeros(9))
+
+
+def test_output_extrapolates_the_stored_combined_estimate():
+    """``combined`` = Σ μⱼ χⱼ after every update (and after priming); the output is its
+    polynomial to t."""
+    config = MeasurementConfig(noise_std=0.002, latency=0.02)
+    prior = [(t, CURVE.evaluate(t)[0:3]) for t in (-0.2, -0.1667, -0.1333, -0.1)]
+    est = AdaptiveTargetEstimator(config=config, prior=prior)
+    context = est.CreateDefaultContext()
+    est.get_measurement_input_port().FixValue(context, [0.01, *CURVE.evaluate(0.01)[0:3], 1.0])
+    simulator = Simulator(est, context)
+    for t in (0.0, 0.05):
+        simulator.AdvanceTo(t)
+        meta, X, _, mu = est.state(context)
+        combined = context.get_discrete_state(est.groups["combined"]).value()
+        np.testing.assert_array_equal(combined, mu @ X)
+        dt = t - meta[1]
+        p, v, a = combined[0:3], combined[3:6], combined[6:9]
+        np.testing.assert_array_equal(est.get_target_output_port().Eval(context),
+                                      np.concatenate([p + dt * v + (0.5 * dt * dt) * a, v + dt * a, a]))
 
 
 @pytest.mark.parametrize("measurement, field, hint", [
