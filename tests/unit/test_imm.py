@@ -103,19 +103,19 @@ def test_covariances_stay_spd_through_dropouts():
 
 def test_state_is_named_and_output_layout_is_the_kalman_one():
     est = AdaptiveTargetEstimator(config=MeasurementConfig(noise_std=0.002))
-    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities", "combined"}
+    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities", "polynomial"}
     context = est.CreateDefaultContext()
     sizes = [context.get_discrete_state(est.groups[n]).size()
-             for n in ("meta", "estimates", "covariances", "probabilities", "combined")]
+             for n in ("meta", "estimates", "covariances", "probabilities", "polynomial")]
     m = len(MODELS)
-    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m, imm.N]
+    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m, 28]
     assert est.get_target_output_port().size() == 9
     np.testing.assert_array_equal(est.get_target_output_port().Eval(context), np.zeros(9))
 
 
-def test_output_extrapolates_the_stored_combined_estimate():
-    """``combined`` = Σ μⱼ χⱼ after every update (and after priming); the output is its
-    polynomial to t."""
+def test_output_extrapolates_the_combined_estimate():
+    """The output is [p + vΔt + aΔt²/2, v + aΔt, a] of χ̂ = Σ μⱼ χⱼ, bit for bit, from the
+    ``polynomial`` stored at each update (and after priming)."""
     config = MeasurementConfig(noise_std=0.002, latency=0.02)
     prior = [(t, CURVE.evaluate(t)[0:3]) for t in (-0.2, -0.1667, -0.1333, -0.1)]
     est = AdaptiveTargetEstimator(config=config, prior=prior)
@@ -125,9 +125,9 @@ def test_output_extrapolates_the_stored_combined_estimate():
     for t in (0.0, 0.05):
         simulator.AdvanceTo(t)
         meta, X, _, mu = est.state(context)
-        combined = context.get_discrete_state(est.groups["combined"]).value()
-        np.testing.assert_array_equal(combined, mu @ X)
+        assert context.get_discrete_state(est.groups["polynomial"]).value()[0] == meta[1]
         dt = t - meta[1]
+        combined = mu @ X
         p, v, a = combined[0:3], combined[3:6], combined[6:9]
         np.testing.assert_array_equal(est.get_target_output_port().Eval(context),
                                       np.concatenate([p + dt * v + (0.5 * dt * dt) * a, v + dt * a, a]))
