@@ -203,7 +203,8 @@ class AdaptiveTargetEstimator(LeafSystem):
 
     Input port ``measurement`` (5): [stamp, x, y, z, valid] from a ``Camera``.
     Output ports ``target`` (9): [p, v, a] of the combined estimate predicted to t (zeros
-    before the first sample); ``probabilities`` (3): μ of ``MODELS``.
+    before the first sample); ``probabilities`` (3): μ of ``MODELS``; ``polynomial`` (28): the
+    state of that name (``target_prediction.PolynomialTargetSelector`` evaluates it in C++).
     Discrete state groups (``groups`` maps the names to indices): ``meta`` = [initialised,
     t_est, last stamp consumed, t of the last update], ``estimates`` = χⱼ (3×10 row-major),
     ``covariances`` = Pⱼ (3×10×10), ``probabilities`` = μ (3), ``polynomial`` = [t_est, c₀, c₁,
@@ -229,6 +230,7 @@ class AdaptiveTargetEstimator(LeafSystem):
         self._target_out = self.DeclareVectorOutputPort(
             "target", 9, lambda c, o: o.SetFromVector(self._predict_target(c)),
             prerequisites_of_calc=ticket)
+        self._polynomial_out = self.DeclareStateOutputPort("polynomial", self.groups["polynomial"])
         self._mu_out = self.DeclareVectorOutputPort(
             "probabilities", len(MODELS),
             lambda c, o: o.SetFromVector(c.get_discrete_state(self.groups["probabilities"]).value()),
@@ -239,6 +241,10 @@ class AdaptiveTargetEstimator(LeafSystem):
 
     def get_target_output_port(self):
         return self._target_out
+
+    def get_polynomial_output_port(self):
+        """The ``polynomial`` state on a C++ port (``target_prediction``)."""
+        return self._polynomial_out
 
     def get_probabilities_output_port(self):
         return self._mu_out
