@@ -203,10 +203,13 @@ class AdaptiveTargetEstimator(LeafSystem):
 
     Input port ``measurement`` (5): [stamp, x, y, z, valid] from a ``Camera``.
     Output ports ``target`` (9): [p, v, a] of the combined estimate predicted to t (zeros
-    before the first sample); ``probabilities`` (3): μ of ``MODELS``.
+    before the first sample); ``probabilities`` (3): μ of ``MODELS``; ``polynomial`` (28): the
+    state of that name (``target_prediction.PolynomialTargetSelector`` evaluates it in C++).
     Discrete state groups (``groups`` maps the names to indices): ``meta`` = [initialised,
     t_est, last stamp consumed, t of the last update], ``estimates`` = χⱼ (3×10 row-major),
-    ``covariances`` = Pⱼ (3×10×10), ``probabilities`` = μ (3).
+    ``covariances`` = Pⱼ (3×10×10), ``probabilities`` = μ (3), ``polynomial`` = [t_est, c₀, c₁,
+    c₂] (1 + 3·9: the output is c₀ + Δt c₁ + Δt² c₂, zeros before the first sample), stored at
+    each update from χ̂ = Σ μⱼ χⱼ so that an evaluation of the output only extrapolates.
     ``prior``: pre-run samples [(t_k, z_k), …] consumed as in ``TargetKalmanFilter``.
     """
 
@@ -221,11 +224,13 @@ class AdaptiveTargetEstimator(LeafSystem):
         self.groups = {name: self.DeclareDiscreteState(value.ravel())
                        for name, value in zip(("meta", "estimates", "covariances", "probabilities"),
                                               state)}
+        self.groups["polynomial"] = self.DeclareDiscreteState(_polynomial(state[0], state[3] @ state[1]))
         self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
         ticket = {self.time_ticket(), self.xd_ticket()}
         self._target_out = self.DeclareVectorOutputPort(
             "target", 9, lambda c, o: o.SetFromVector(self._predict_target(c)),
             prerequisites_of_calc=ticket)
+        self._polynomial_out = self.DeclareStateOutputPort("polynomial", self.groups["polynomial"])
         self._mu_out = self.DeclareVectorOutputPort(
             "probabilities", len(MODELS),
             lambda c, o: o.SetFromVector(c.get_discrete_state(self.groups["probabilities"]).value()),
@@ -236,6 +241,10 @@ class AdaptiveTargetEstimator(LeafSystem):
 
     def get_target_output_port(self):
         return self._target_out
+
+    def get_polynomial_output_port(self):
+        """The ``polynomial`` state on a C++ port (``target_prediction``)."""
+        return self._polynomial_out
 
     def get_probabilities_output_port(self):
         return self._mu_out
@@ -271,6 +280,8 @@ class AdaptiveTargetEstimator(LeafSystem):
             return
         for name, value in zip(("meta", "estimates", "covariances", "probabilities"), result):
             discrete_state.get_mutable_vector(self.groups[name]).SetFromVector(value.ravel())
+        discrete_state.get_mutable_vector(self.groups["polynomial"]).SetFromVector(
+            _polynomial(result[0], result[3] @ result[1]))
 
     def _prior_state(self, prior) -> tuple:
         """The state at t = 0 after the pre-run samples, each consumed when it became visible."""
@@ -287,11 +298,16 @@ class AdaptiveTargetEstimator(LeafSystem):
 
     def _predict_target(self, context) -> np.ndarray:
         """[p + vΔt + aΔt²/2, v + aΔt, a] of Σ μⱼ χⱼ, Δt = t − t_est (zeros before a sample)."""
-        meta = context.get_discrete_state(self.groups["meta"]).value()
-        if meta[0] < 0.5:
-            return np.zeros(9)
-        dt = context.get_time() - meta[1]
-        mu = context.get_discrete_state(self.groups["probabilities"]).value()
-        x = mu @ context.get_discrete_state(self.groups["estimates"]).value().reshape(len(MODELS), N)
-        p, v, a = x[0:3], x[3:6], x[6:9]
-        return np.concatenate([p + dt * v + (0.5 * dt * dt) * a, v + dt * a, a])
+        c = context.get_discrete_state(self.groups["polynomial"]).value()
+        dt = context.get_time() - c[0]
+        return c[1:10] + dt * c[10:19] + (dt * dt) * c[19:28]
+
+
+def _polynomial(meta: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """[t_est, c₀, c₁, c₂] of the output c₀ + Δt c₁ + Δt² c₂ = [p + vΔt + aΔt²/2, v + aΔt, a]
+    for the combined estimate x = χ̂ (all zeros before the first sample, meta[0] = 0).  The
+    same floating-point numbers as the formula: a halved is exact, and the added zeros are."""
+    if meta[0] < 0.5:
+        return np.zeros(28)
+    p, v, a = x[0:3], x[3:6], x[6:9]
+    return np.concatenate([[meta[1]], p, v, a, v, a, np.zeros(3), 0.5 * a, np.zeros(6)])

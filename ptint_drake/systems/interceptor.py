@@ -94,7 +94,11 @@ class InterceptorLaw(LeafSystem):
         self.DeclareStateOutputPort("captured", self._capture_index)
         deps = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         self._out = np.empty(nv + n)
-        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_output, prerequisites_of_calc=deps)
+        self._row = np.empty(size + 5 + n)  # the fast path's row, reused by every evaluation
+        self._row_args = None if not self._fast or self._null_space is not None else (
+            self._schedule.table, self._gains, *self._chain, self._compiled)
+        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_output if self._row_args is None
+                                     else self._calc_position_output, prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("telemetry", size,
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
                                      prerequisites_of_calc=deps)
@@ -118,6 +122,20 @@ class InterceptorLaw(LeafSystem):
     def _calc_output(self, context, output) -> None:
         row = self._eval(context)
         out = self._out
+        out[:self._nv], out[self._nv:] = row[self._tau], row[self._sigma_dot]
+        output.SetFromVector(out)
+
+    def _calc_position_output(self, context, output) -> None:
+        """[τ; σ̇] of the compiled position path (no null-space term): the inputs read once, the
+        kernel writes into a reused row — the same numbers as ``row``."""
+        captured = context.get_discrete_state(self._capture_index).value()
+        sigma = self._sigma_in.EvalBasicVector(context).value()
+        if self._law.reset_sigma:
+            sigma = sigma - captured[1 + self._n:]
+        target = _NO_TARGET if self._target_in is None else self._target_in.EvalBasicVector(context).value()
+        row, out = self._row, self._out
+        position_row(context.get_time(), self._state_in.EvalBasicVector(context).value(), sigma, captured,
+                     target, *self._row_args, row)
         out[:self._nv], out[self._nv:] = row[self._tau], row[self._sigma_dot]
         output.SetFromVector(out)
 

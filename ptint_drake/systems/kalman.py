@@ -82,9 +82,9 @@ position std from the DARE):
 - the paper's curve, ``kalman_ca`` q = 0.03 m²/s⁵ (jerk ≤ 0.34 m/s³): 1.27 mm per
   axis; 0.003 lags, 0.1–0.3 is noisier (open-loop RMS 3.3–3.7 mm against 3.1 mm).
 
-``ActiveTargetSelector`` passes on the estimate of the segment active at t, and
-``AddCameraEstimators`` wires a camera and an estimator per object (``auto``: the IMM of
-``imm``; ``kalman_cv`` / ``kalman_ca``: this filter) plus the selector.
+``ActiveTargetSelector`` passes on the estimate of the segment active at t; ``AddCameraEstimators``
+wires a camera and an estimator per object (``auto``: the IMM of ``imm``, whose polynomials
+``target_prediction.PolynomialTargetSelector`` selects in C++; ``kalman_cv`` / ``kalman_ca``: this filter).
 """
 
 from __future__ import annotations
@@ -105,6 +105,7 @@ from ptint_drake.systems.camera import (
 )
 from ptint_drake.systems.imm import AdaptiveTargetEstimator
 from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.target_prediction import PolynomialTargetSelector
 from ptint_drake.systems.signals import TARGET_PORT_SIZE
 
 MODELS = ("cv", "ca")
@@ -324,7 +325,7 @@ class ActiveTargetSelector(LeafSystem):
         return self._target_out
 
     def _select(self, context, output) -> None:
-        i = max(self._schedule.active(context.get_time()), 0)
+        i = max(self._schedule.active(context.get_time()), 0) if len(self._inputs) > 1 else 0
         output.SetFromVector(self._inputs[i].Eval(context))
 
 
@@ -342,7 +343,7 @@ class CameraEstimators:
     target_port: OutputPort
     cameras: list
     filters: list
-    selector: ActiveTargetSelector
+    selector: "ActiveTargetSelector | PolynomialTargetSelector"
 
 
 def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | None = None,
@@ -353,16 +354,14 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     and ``target_filter_i``; and ``target_selector`` choosing the active one.  The handles
     returned hold every camera and filter (index i: object i).
 
-    Instead of ``true_position_ports``, ``objects_port`` (3 per object, e.g. the station's
-    ``objects``) is split into one port per object of ``schedule`` by ``object_positions``.
+    Or ``objects_port`` (3 per object, e.g. the station's ``objects``), split by ``object_positions``.
     ``histories`` (optional, one per object: a callable t → position or an object with
     ``evaluate``): the objects' true motion, so that each camera has also seen its object
     for ``config.prior_window`` s before t = 0 and its filter starts from those samples
     (priming); without it the cameras start seeing at t = 0.
-    ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object), or
-    ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).  ``rotations_port`` (9 per
-    object, row-major, e.g. the station's ``object_rotations``): the cameras also measure the
-    orientations (``rotation_estimator.AddRotationEstimators`` tracks them).
+    ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object, selected in C++
+    by a ``PolynomialTargetSelector``), or ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
+    ``rotations_port`` (9 per object, e.g. the station's ``object_rotations``): measured too.
     """
     validate_measurement(config)
     if config.estimator not in ("auto", "kalman_cv", "kalman_ca"):
@@ -378,8 +377,9 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     if rotations_port is not None:
         rotations = builder.AddNamedSystem("object_rotations", Demultiplexer([9] * len(schedule)))
         builder.Connect(rotations_port, rotations.get_input_port())
-    selector = builder.AddNamedSystem(
-        "target_selector", ActiveTargetSelector(schedule=schedule, count=len(true_position_ports)))
+    kind = PolynomialTargetSelector if config.estimator == "auto" else ActiveTargetSelector
+    count = len(true_position_ports)
+    selector = builder.AddNamedSystem("target_selector", kind(schedule=schedule, count=count))
     if histories is not None and len(histories) != len(true_position_ports):
         raise ValueError(f"histories: one per object is needed, got {len(histories)} "
                          f"for {len(true_position_ports)} objects")
@@ -393,7 +393,8 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         kf = builder.AddNamedSystem(f"target_filter_{i}", _estimator(config, camera.pre_run_samples()))
         builder.Connect(port, camera.get_x_true_input_port())
         builder.Connect(camera.get_measurement_output_port(), kf.get_measurement_input_port())
-        builder.Connect(kf.get_target_output_port(), selector.get_input_port(i))
+        get = kf.get_target_output_port if kind is ActiveTargetSelector else kf.get_polynomial_output_port
+        builder.Connect(get(), selector.get_input_port(i))
         cameras.append(camera)
         filters.append(kf)
     return CameraEstimators(selector.get_target_output_port(), cameras, filters, selector)

@@ -32,6 +32,12 @@ def test_disturbance_law():
     np.testing.assert_allclose(d.torque(0.125, np.array([0, 0, 1.0])),
                                [np.sin(2 * np.pi * 2 * 0.125), 0, -0.3 * np.tanh(100)])
     np.testing.assert_allclose(d.torque(0.6, np.zeros(3)), [np.sin(2 * np.pi * 2 * 0.6), 2, 0])
+    context = d.CreateDefaultContext()  # the C++ (symbolic) system computes the same law
+    for t, v in ((0.125, [0, 0, 1.0]), (0.5, [0, 0, -0.002]), (0.6, [0, 0, 0.001])):
+        context.SetTime(t)
+        d.get_input_port().FixValue(context, np.r_[np.zeros(3), v])
+        np.testing.assert_allclose(d.get_output_port().Eval(context), d.torque(t, np.array(v)),
+                                   rtol=1e-14, atol=1e-15)
     with pytest.raises(ValueError, match="one value per joint"):
         JointDisturbance(3, 3, amplitude=[1, 2])
 

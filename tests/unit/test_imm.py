@@ -103,14 +103,34 @@ def test_covariances_stay_spd_through_dropouts():
 
 def test_state_is_named_and_output_layout_is_the_kalman_one():
     est = AdaptiveTargetEstimator(config=MeasurementConfig(noise_std=0.002))
-    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities"}
+    assert set(est.groups) == {"meta", "estimates", "covariances", "probabilities", "polynomial"}
     context = est.CreateDefaultContext()
     sizes = [context.get_discrete_state(est.groups[n]).size()
-             for n in ("meta", "estimates", "covariances", "probabilities")]
+             for n in ("meta", "estimates", "covariances", "probabilities", "polynomial")]
     m = len(MODELS)
-    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m]
+    assert sizes == [4, m * imm.N, m * imm.N * imm.N, m, 28]
     assert est.get_target_output_port().size() == 9
     np.testing.assert_array_equal(est.get_target_output_port().Eval(context), np.zeros(9))
+
+
+def test_output_extrapolates_the_combined_estimate():
+    """The output is [p + vΔt + aΔt²/2, v + aΔt, a] of χ̂ = Σ μⱼ χⱼ, bit for bit, from the
+    ``polynomial`` stored at each update (and after priming)."""
+    config = MeasurementConfig(noise_std=0.002, latency=0.02)
+    prior = [(t, CURVE.evaluate(t)[0:3]) for t in (-0.2, -0.1667, -0.1333, -0.1)]
+    est = AdaptiveTargetEstimator(config=config, prior=prior)
+    context = est.CreateDefaultContext()
+    est.get_measurement_input_port().FixValue(context, [0.01, *CURVE.evaluate(0.01)[0:3], 1.0])
+    simulator = Simulator(est, context)
+    for t in (0.0, 0.05):
+        simulator.AdvanceTo(t)
+        meta, X, _, mu = est.state(context)
+        assert context.get_discrete_state(est.groups["polynomial"]).value()[0] == meta[1]
+        dt = t - meta[1]
+        combined = mu @ X
+        p, v, a = combined[0:3], combined[3:6], combined[6:9]
+        np.testing.assert_array_equal(est.get_target_output_port().Eval(context),
+                                      np.concatenate([p + dt * v + (0.5 * dt * dt) * a, v + dt * a, a]))
 
 
 @pytest.mark.parametrize("measurement, field, hint", [
