@@ -1,0 +1,48 @@
+"""run_outputs.simulate_beside: the simulation in a forked process while this one prepares
+the figures; its result, its exceptions and its death reach the caller."""
+
+import os
+import types
+
+import pytest
+
+from ptint_drake import run_outputs
+from ptint_drake.scenario import ScenarioError
+
+pytestmark = pytest.mark.skipif(not run_outputs.can_fork(), reason="this process cannot fork")
+
+
+def _fake(behaviour):
+    def simulate(scenario, progress=None, warn=None):
+        if behaviour == "raise":
+            raise ScenarioError("interceptions[0].tf: unreachable")
+        if behaviour == "die":
+            os._exit(3)
+        return types.SimpleNamespace(metrics={"pid": os.getpid(), "scenario": scenario},
+                                     series={"t": [0.0, 0.1]})
+    return simulate
+
+
+def test_the_simulation_runs_in_another_process_while_prepare_runs_here(monkeypatch):
+    monkeypatch.setattr(run_outputs, "simulate", _fake("ok"))
+    prepared = []
+    metrics, series = run_outputs.simulate_beside("s", lambda: prepared.append(os.getpid()))
+    assert prepared == [os.getpid()] and metrics["pid"] != os.getpid()
+    assert metrics["scenario"] == "s" and series == {"t": [0.0, 0.1]}
+
+
+def test_without_prepare_it_runs_here(monkeypatch):
+    monkeypatch.setattr(run_outputs, "simulate", _fake("ok"))
+    assert run_outputs.simulate_beside("s")[0]["pid"] == os.getpid()
+
+
+def test_its_exception_is_raised_here(monkeypatch):
+    monkeypatch.setattr(run_outputs, "simulate", _fake("raise"))
+    with pytest.raises(ScenarioError, match=r"interceptions\[0\]\.tf"):
+        run_outputs.simulate_beside("s", lambda: None)
+
+
+def test_its_death_is_an_error_here(monkeypatch):
+    monkeypatch.setattr(run_outputs, "simulate", _fake("die"))
+    with pytest.raises(RuntimeError, match="exit code 3"):
+        run_outputs.simulate_beside("s", lambda: None)
