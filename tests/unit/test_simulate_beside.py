@@ -1,6 +1,7 @@
 """run_outputs.simulate_beside: the simulation in a forked process while this one prepares
 the figures; its result, its exceptions and its death reach the caller."""
 
+import multiprocessing
 import os
 import types
 
@@ -9,14 +10,26 @@ import pytest
 from ptint_drake import run_outputs
 from ptint_drake.scenario import ScenarioError
 
-pytestmark = pytest.mark.skipif(not run_outputs.can_fork(), reason="this process cannot fork")
+pytestmark = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(),
+                                reason="no fork on this platform")
+
+
+@pytest.fixture(autouse=True)
+def _forkable(monkeypatch):
+    """Fork whatever an earlier test in this process left behind (a Meshcat, a thread makes
+    ``can_fork`` say no): the fake simulations below touch none of it."""
+    monkeypatch.setattr(run_outputs, "can_fork", lambda: True)
 
 
 def _fake(behaviour):
+    parent = os.getpid()
+
     def simulate(scenario, progress=None, warn=None):
         if behaviour == "raise":
             raise ScenarioError("interceptions[0].tf: unreachable")
         if behaviour == "die":
+            if os.getpid() == parent:  # never end the test process itself
+                raise AssertionError("the simulation ran in the test's own process")
             os._exit(3)
         return types.SimpleNamespace(metrics={"pid": os.getpid(), "scenario": scenario},
                                      series={"t": [0.0, 0.1]})
