@@ -46,14 +46,33 @@ def new_figure(figsize, **kwargs):
     return Figure(figsize=figsize, dpi=DPI, **kwargs)
 
 
-def preload() -> None:
+_PRELOADED: set = set()
+
+
+def preload(studies: bool = False) -> None:
     """Import what drawing a run's figures needs (matplotlib's figure, Agg and 3D axes,
-    Pillow, SciPy's spline) now: worker processes forked afterwards share it."""
-    import matplotlib.backends.backend_agg  # noqa: F401, PLC0415
+    Pillow, SciPy's spline) and draw the kinds of text the run figures show (mathtext, each
+    font size), so the font lookups and the mathtext parser are made once: worker processes
+    forked afterwards share all of it.  ``studies``: pyplot and ``scipy.signal`` too (≈ 0.8 s,
+    for the axes figure's filter: a single run leaves it to the worker drawing that figure,
+    where it overlaps the other figures).  Once per process."""
+    if studies and "studies" not in _PRELOADED:
+        _PRELOADED.add("studies")
+        __getattr__("plt")
+        import scipy.signal  # noqa: F401, PLC0415
+    if "figures" in _PRELOADED:
+        return
+    _PRELOADED.add("figures")
+    import matplotlib.backends.backend_agg  # noqa: PLC0415
     import matplotlib.figure  # noqa: F401, PLC0415
     import mpl_toolkits.mplot3d  # noqa: F401, PLC0415
     import PIL.Image  # noqa: F401, PLC0415
     import scipy.interpolate  # noqa: F401, PLC0415
+
+    fig = new_figure((2, 1))
+    for size in (7, 8, 9, 10, 12):
+        fig.text(0.0, 0.0, "|e($t_f$)| $\\mathdefault{10^{-3}}$ m/s² ξ̇ τ θ° −", fontsize=size)
+    matplotlib.backends.backend_agg.FigureCanvasAgg(fig).draw()
 
 
 def envelope(x: np.ndarray, y: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray]:

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import html
 import time
-from contextlib import ExitStack
 from pathlib import Path
 
-from ptint_drake.figures import tbg_family_figure
+from ptint_drake.figures import preload, tbg_family_figure
 from ptint_drake.metrics import segment_reasons
-from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
-from ptint_drake.run_outputs import draw_views, run_metrics, view_tasks
+from ptint_drake.outputs import staged_output
+from ptint_drake.run_outputs import frozen_heap, run_and_write
 from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
 
@@ -46,54 +45,66 @@ COMPARED = ("curve_b075_tf15", "assembly")
 
 
 def paper_task(kind: str, name: str, *args):
-    """One parallel job of ``ptint paper`` (runs in a worker): a paper scenario's run
-    (its metrics and series), a TBG family figure, a compare row, or the hold of a
-    paper scenario with the paper's own s_d formula after tf (``k_hold = k``)."""
+    """One parallel job of ``ptint paper`` (runs in a worker): a paper scenario's run with
+    its folder written as ``ptint run`` writes it (args: the paper's folder, svg; returns its
+    metrics.json), a TBG family figure, the camera figure, a compare row, a compare
+    result's files (args: the result, its folder), or the hold of a paper scenario with the
+    paper's own s_d formula after tf (``k_hold = k``)."""
     from ptint_drake.scenario import scenario_text  # noqa: PLC0415
-    from ptint_drake.studies.compare import compare_run  # noqa: PLC0415
+    from ptint_drake.studies import compare  # noqa: PLC0415
 
     if kind == "run":
-        result = simulate(load_scenario(name))
-        return result.metrics, result.series
+        out_dir, svg = args
+        return run_and_write(load_scenario(name), Path(out_dir) / name, svg=svg, workers=1)
     if kind == "tbg":
         settings, title = TBG_FIGURES[name]
         tbg_family_figure(settings, args[0], name, title)
         return None
+    if kind == "camera":
+        return _camera_figure(args[0])
+    if kind == "compare_files":
+        return compare.write_compare(*args)
     _, text = scenario_text(name)
     if kind == "compare":
-        return compare_run(text, name, *args)
+        return compare.compare_run(text, name, *args)
     scenario = load_scenario(name)
     scenario.controller.k_hold = scenario.controller.k
     return [seg["e_hold_max_norm"] for seg in simulate(scenario, check=False).metrics["segments"]]
 
 
-def _parallel_part(tbg_stage: Path, workers=None, progress_factory=None) -> tuple[dict, dict, dict]:
-    """The paper scenarios' runs, the TBG figures, the comparisons of ``COMPARED`` and the
-    paper-formula holds, all in parallel; returns (runs {name: (metrics, series)},
-    comparisons, holds)."""
+def _parallel_part(out_dir: Path, tbg_stage: Path, svg: bool, workers=None,
+                   progress_factory=None) -> tuple[dict, dict, dict]:
+    """Every simulation of the paper on worker processes, each writing what it shows as
+    soon as it is done: the paper scenarios' folders (simulation, figures, replay), the TBG
+    figures, the camera figure, the comparisons of ``COMPARED`` and the paper-formula holds,
+    the longest first; then the comparisons' files.  Returns (metrics.json of each paper
+    scenario, comparisons, holds)."""
     from ptint_drake.studies import compare  # noqa: PLC0415
     from ptint_drake.studies.runner import run_tasks  # noqa: PLC0415
 
     controllers, variants = compare.DEFAULT_CONTROLLERS, compare.DEFAULT_VARIANTS
     pairs = compare.pairs(controllers, variants)
     runs = sorted(PAPER_SCENARIOS, key=lambda n: n != "assembly")  # the longest first
-    tasks = [("run", name) for name in runs] + [("tbg", stem, tbg_stage) for stem in TBG_FIGURES]
+    tasks = [("run", name, out_dir, svg) for name in runs] + [("camera", CAMERA_SCENARIO, out_dir / "camera")]
+    tasks += [("tbg", stem, tbg_stage) for stem in TBG_FIGURES]
     first = len(tasks)
     tasks += [("compare", name, c, v) for name in COMPARED for c, v in pairs]
     tasks += [("hold", name) for name in PAPER_SCENARIOS]
 
     def report(done, total, index, result):
         if progress_factory is not None and index < len(runs):
-            duration = result[0]["duration"]
-            progress_factory(runs[index])(duration, duration)
+            progress_factory(runs[index])(result["duration"], result["duration"])
 
     t0 = time.perf_counter()
-    results = run_tasks(paper_task, tasks, workers=workers, progress=report)
+    with frozen_heap():  # every worker is forked from here
+        results = run_tasks(paper_task, tasks, workers=workers, progress=report)
     wall = time.perf_counter() - t0
     compared = results[first:]
     comparisons = {name: compare.comparison(load_scenario(name), name, controllers, variants,
                                             compared[k * len(pairs):(k + 1) * len(pairs)], wall)
                    for k, name in enumerate(COMPARED)}
+    run_tasks(paper_task, [("compare_files", name, result, out_dir / f"compare_{name}")
+                           for name, result in comparisons.items()], workers=workers)
     holds = dict(zip(PAPER_SCENARIOS, compared[len(COMPARED) * len(pairs):]))
     return dict(zip(runs, results)), comparisons, holds
 
@@ -152,22 +163,18 @@ def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = 
     """Run every paper scenario and the controller comparisons; write ``out_dir/index.html``
     (``svg``: the run figures as SVG too).
 
-    The simulations (paper scenarios, comparisons, holds) and the TBG figures run on
-    worker processes first; then every scenario's figures and replay are drawn on worker
-    processes in one batch (``run_outputs.draw_views``).  Each scenario's folder is staged
-    as ``ptint run`` stages it (``outputs.staged_output``)."""
-    from ptint_drake.studies.compare import write_compare  # noqa: PLC0415
-
+    Everything runs on worker processes forked after this one imported matplotlib
+    (``figures.preload``): each paper scenario's run writes its folder as ``ptint run``
+    does (staged, ``outputs.staged_output``) as soon as it is simulated, beside the other
+    simulations (``_parallel_part``)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
     (out_dir / "index.html").unlink(missing_ok=True)
+    preload(studies=True)  # once, before the workers fork: none imports matplotlib again
     with staged_output(out_dir / "tbg") as stage:
-        runs, comparisons, paper_holds = _parallel_part(stage, workers, progress_factory)
-    for name, result in comparisons.items():
-        write_compare(result, out_dir / f"compare_{name}")
-    _camera_figure(out_dir / "camera")
-    metrics = _write_runs(out_dir, runs, svg, workers)
+        metrics, comparisons, paper_holds = _parallel_part(out_dir, stage, svg, workers,
+                                                           progress_factory)
     rows, sections = [], []
     for name, (figs, claim) in PAPER_SCENARIOS.items():
         m = metrics[name]
@@ -184,24 +191,6 @@ def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = 
     tmp.write_text(page, encoding="utf-8")
     tmp.replace(out_dir / "index.html")
     return out_dir / "index.html"
-
-
-def _write_runs(out_dir: Path, runs: dict, svg: bool, workers) -> dict:
-    """Each paper scenario's folder, as ``ptint run`` writes it, from its run's (metrics,
-    series); all the figures and replays drawn in one batch.  Returns {name: metrics.json}."""
-    written = {}
-    with ExitStack() as stack:
-        tasks = []
-        for name, (sim_metrics, series) in runs.items():
-            scenario = load_scenario(name)
-            stage = stack.enter_context(staged_output(out_dir / name))
-            save_series(stage / SERIES, series)
-            tasks += view_tasks(scenario, series, sim_metrics, stage, svg=svg)
-            written[name] = (stage, run_metrics(scenario, sim_metrics))
-        draw_views(tasks, workers)
-        for stage, metrics in written.values():
-            write_json_atomic(stage / METRICS, metrics)
-    return {name: metrics for name, (_, metrics) in written.items()}
 
 
 def _page(rows, sections, compared: str, elapsed: float) -> str:

@@ -6,6 +6,7 @@ replay.html, metrics.json last) through ``outputs.staged_output``.
 
 from __future__ import annotations
 
+import gc
 import multiprocessing
 import os
 import re
@@ -13,6 +14,7 @@ import shutil
 import subprocess
 import sys
 import threading
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -54,15 +56,69 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
     """Simulate ``scenario`` and write its outputs into ``out_dir``; returns the metrics.
     ``warn(message)`` gets the warnings known before the simulation, before it starts.
     ``svg``: the figures as SVG too; ``workers``: processes drawing the figures and the
-    replay (default: one per CPU; see ``draw_views``)."""
-    result = simulate(scenario, progress=progress, warn=warn)
-    metrics = run_metrics(scenario, result.metrics, figures)
+    replay (default: one per CPU; see ``draw_views``).  With figures to draw and a second
+    CPU, the simulation runs in a forked process while this one prepares the figures
+    (``simulate_beside``)."""
+    prepare = None
+    if figures and (workers or os.cpu_count() or 1) > 1:
+        from ptint_drake.figures import preload as prepare  # noqa: PLC0415
+    metrics, series = simulate_beside(scenario, prepare, progress=progress, warn=warn)
+    run_json = run_metrics(scenario, metrics, figures)
     with staged_output(out_dir) as stage:
-        save_series(stage / SERIES, result.series)
-        draw_views(view_tasks(scenario, result.series, result.metrics, stage, figures=figures,
+        save_series(stage / SERIES, series)
+        draw_views(view_tasks(scenario, series, metrics, stage, figures=figures,
                               replay=replay, svg=svg), workers)
-        write_json_atomic(stage / METRICS, metrics)
-    return metrics
+        write_json_atomic(stage / METRICS, run_json)
+    return run_json
+
+
+def _simulate_child(conn, scenario: Scenario, progress, warn) -> None:
+    """The forked process of ``simulate_beside``: (True, (metrics, series)) or (False, the
+    exception) on ``conn``."""
+    import signal  # noqa: PLC0415
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    try:
+        result = simulate(scenario, progress=progress, warn=warn)
+        reply = (True, (result.metrics, result.series))
+    except BaseException as exc:  # noqa: BLE001  (re-raised in the parent)
+        reply = (False, exc)
+    try:
+        conn.send(reply)
+    except Exception as exc:  # noqa: BLE001  (an unpicklable exception)
+        conn.send((False, RuntimeError(f"simulation: {reply[1]!r} ({exc!r})"[:500])))
+
+
+def simulate_beside(scenario: Scenario, prepare=None, **kwargs) -> tuple[dict, dict]:
+    """(metrics, series) of ``simulate(scenario, **kwargs)``; when ``prepare`` is given and
+    this process may fork (``can_fork``), the simulation runs in a forked process while this
+    one calls ``prepare()`` (e.g. importing matplotlib: 1-2 s that then overlap the
+    simulation instead of following it).  Its exceptions are raised here; Ctrl-C stops it."""
+    if prepare is None or not can_fork():
+        result = simulate(scenario, **kwargs)
+        return result.metrics, result.series
+    ctx = multiprocessing.get_context("fork")
+    conn, child_conn = ctx.Pipe(duplex=False)
+    child = ctx.Process(target=_simulate_child, args=(child_conn, scenario, kwargs.get("progress"),
+                                                      kwargs.get("warn")), daemon=True)
+    with frozen_heap():  # until the child is done: neither process copies the other's pages
+        child.start()
+        child_conn.close()
+        try:
+            prepare()
+            ok, value = conn.recv()
+            child.join(5.0)
+        except EOFError:
+            child.join(1.0)
+            raise RuntimeError(f"the simulation's process died (exit code {child.exitcode})") from None
+        finally:
+            if child.is_alive():
+                child.terminate()
+                child.join()
+            conn.close()
+    if not ok:
+        raise value
+    return value
 
 
 def run_metrics(scenario: Scenario, metrics: dict, figures: bool = True) -> dict:
@@ -128,6 +184,19 @@ def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, fig
             for n in names]
 
 
+@contextmanager
+def frozen_heap():
+    """Fork inside this: the objects alive now stay out of the garbage collector's passes
+    (``gc.freeze``) until it ends.  Otherwise a forked child's first full collection writes
+    to the header of every object it inherited and so copies most pages of this process
+    (~10,000 page faults a figure worker, 0.1-0.3 s each on these machines)."""
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
+
+
 def can_fork() -> bool:
     """Whether a forked worker is safe: this process runs one Python thread and holds no
     Meshcat (its server threads are C++ threads: a fork would copy the ``Meshcat`` object
@@ -155,7 +224,8 @@ def draw_views(tasks: list[tuple], workers: int | None = None) -> None:
     if workers > 1 and can_fork():
         from ptint_drake.studies.runner import run_tasks  # noqa: PLC0415
 
-        run_tasks(view_task, tasks, workers=workers, max_tasks_per_child=None)
+        with frozen_heap():
+            run_tasks(view_task, tasks, workers=workers, max_tasks_per_child=None)
     else:
         for task in tasks:
             view_task(*task)

@@ -10,7 +10,7 @@ import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
-from ptint_drake.figures import envelope, tbg_family_figure, uniform_derivatives
+from ptint_drake.figures import tbg_family_figure, uniform_derivatives
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 BROWSER_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
@@ -150,22 +150,6 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
     assert len(rows) > 0.2 * img.shape[0]
     red = (r > 0.6) & (g < 0.25) & (b < 0.25)  # object 1 (red) around the tool
     assert red.sum() > 150
-
-
-def test_envelope_keeps_each_pixel_columns_extremes():
-    """Thinned to a min and a max per pixel column: every column keeps its extremes (so the
-    line covers the same pixels), the ends stay, and short series are left whole."""
-    rng = np.random.default_rng(4)
-    x = np.sort(rng.uniform(0, 3, 20_000))
-    y = np.sin(7 * x) + 0.3 * rng.normal(size=x.size)
-    xs, ys = envelope(x, y, 400)
-    assert len(xs) <= 2 * 400 + 2 and np.all(np.diff(xs) >= 0)
-    assert (xs[0], xs[-1]) == (x[0], x[-1])
-    col = np.minimum(((x - x[0]) / (x[-1] - x[0]) * 400).astype(int), 399)
-    col_s = np.minimum(((xs - x[0]) / (x[-1] - x[0]) * 400).astype(int), 399)
-    for c in range(400):
-        assert ys[col_s == c].max() == y[col == c].max() and ys[col_s == c].min() == y[col == c].min()
-    assert len(envelope(x[:1000], y[:1000], 400)[0]) == 1000  # at most 4 points a column: whole
 
 
 def test_views_in_workers_equal_views_drawn_here(tmp_path):
