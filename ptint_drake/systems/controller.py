@@ -43,16 +43,12 @@ def pinv_solve(J, b, damping: float):
 
     3 rows: a 3 × 3 solve (Cramer's rule, ``_solve3``) for a square J, the minimum-norm solution
     Jᵀ(JJᵀ)⁻¹ b for more joints.  6 rows (position and orientation, ``systems.task``): the
-    minimum-norm least-squares solution: J⁻¹ b for a square J, the least-squares fit for fewer
-    joints than rows (a 5-joint wrist) — both by Householder QR (``_qr_solve``) while J has full
-    column rank, else ``lstsq`` — and the minimum-norm one (``lstsq``) for more.  With
+    minimum-norm least-squares solution (``lstsq``): J⁻¹ b for a square J, the least-squares fit
+    for fewer joints than rows (a 5-joint wrist), the minimum-norm one for more.  With
     ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which stays
     bounded through singular configurations at the cost of a small bias near them."""
     n, nv = J.shape
     if damping <= 0.0 and n != 3:
-        x = np.empty(nv)
-        if n >= nv and _qr_solve(J, b, x):
-            return x
         return np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
     if damping <= 0.0 and nv == 3:
         x = np.empty(3)
@@ -67,51 +63,6 @@ def pinv_solve(J, b, damping: float):
     else:
         y[:] = np.linalg.solve(A, b.copy())
     return J.T @ y if nv > 8 else _transpose_times(J, y)
-
-
-@njit(cache=True)
-def _qr_solve(J, b, out) -> bool:
-    """``out`` ← the least-squares solution of J x = b for an m × k J with m ≥ k (J⁻¹ b when
-    square) by Householder QR and back substitution; False, ``out`` unspecified, when J is
-    numerically rank deficient (a diagonal entry of R below 1e-12 of the largest)."""
-    m, k = J.shape
-    A, y, v = J.copy(), b.copy(), np.empty(m)
-    for j in range(k):
-        norm = 0.0
-        for i in range(j, m):
-            norm += A[i, j] * A[i, j]
-        norm = np.sqrt(norm)
-        if norm == 0.0:
-            return False
-        alpha = -norm if A[j, j] >= 0.0 else norm  # the sign that avoids cancellation in v
-        vv = 0.0
-        for i in range(j, m):
-            v[i] = A[i, j] - alpha if i == j else A[i, j]
-            vv += v[i] * v[i]
-        for c in range(j, k):
-            f = 0.0
-            for i in range(j, m):
-                f += v[i] * A[i, c]
-            f *= 2.0 / vv
-            for i in range(j, m):
-                A[i, c] -= f * v[i]
-        f = 0.0
-        for i in range(j, m):
-            f += v[i] * y[i]
-        f *= 2.0 / vv
-        for i in range(j, m):
-            y[i] -= f * v[i]
-    top = 0.0
-    for j in range(k):
-        top = max(top, abs(A[j, j]))
-    for j in range(k - 1, -1, -1):
-        if abs(A[j, j]) <= 1e-12 * top:
-            return False
-        acc = y[j]
-        for c in range(j + 1, k):
-            acc -= A[j, c] * out[c]
-        out[j] = acc / A[j, j]
-    return True
 
 
 @njit(cache=True)

@@ -1,7 +1,6 @@
 """The compiled task error (systems/task.py, orientation.py) against the equations written here
 with numpy and Drake's quaternion (the earlier Python implementation), to 1e-12; the fused
-pose kernel on the chain against the same law on the plant's kinematics; the 6-row
-pseudo-inverse by QR against numpy's lstsq."""
+pose kernel on the chain against the same law on the plant's kinematics."""
 
 import math
 
@@ -12,7 +11,6 @@ from pydrake.math import RotationMatrix
 
 from ptint_drake import rvm1
 from ptint_drake.robot import parse_model
-from ptint_drake.systems.controller import pinv_solve
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.interceptor import InterceptorLaw
 from ptint_drake.systems.orientation import OrientedTarget, SpinningOrientation, rpy_matrix
@@ -119,15 +117,3 @@ def test_pose_kernel_on_the_chain_equals_the_law_on_the_plants_kinematics(task):
                              part["R"], part["omega"], part["target_rotation"])
         np.testing.assert_array_equal(part["e"], e)
         np.testing.assert_array_equal(part["edot"], edot)
-
-
-@pytest.mark.parametrize("nv", [6, 5])
-def test_six_row_pseudo_inverse_by_qr_equals_lstsq(nv):
-    rng = np.random.default_rng(nv)
-    for _ in range(200):
-        J, b = rng.normal(size=(6, nv)), rng.normal(size=6)
-        x = pinv_solve(J, b, 0.0)
-        ref = np.linalg.lstsq(J, b, rcond=None)[0]
-        assert np.abs(x - ref).max() <= 1e-13 * np.linalg.cond(J) * np.abs(ref).max()
-    J[:, -1] = J[:, 0]  # rank deficient: the minimum-norm solution (lstsq)
-    np.testing.assert_allclose(pinv_solve(J, b, 0.0), np.linalg.lstsq(J, b, rcond=None)[0], atol=1e-12)
