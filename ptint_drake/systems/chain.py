@@ -38,7 +38,7 @@ def _then(R, p, R2, p2, tmp):
 
 
 @njit(cache=True)
-def _axis_rotation(a, angle, out):
+def axis_rotation(a, angle, out):
     """``out`` ← the rotation by ``angle`` (rad) about the unit axis a (Rodrigues' formula)."""
     c, s = np.cos(angle), np.sin(angle)
     t = 1.0 - c
@@ -68,7 +68,7 @@ def chain_kinematics(q, kinds, q_index, v_index, fixed, axes, nv):
             axes_w[k, i] = R[i, 0] * a[0] + R[i, 1] * a[1] + R[i, 2] * a[2]
             origins[k, i] = p[i]
         if kinds[k] == REVOLUTE:
-            _axis_rotation(a, q[q_index[k]], M)
+            axis_rotation(a, q[q_index[k]], M)
             _then(R, p, M, zero, tmp)
         else:
             for i in range(3):

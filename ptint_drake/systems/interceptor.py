@@ -23,6 +23,7 @@ Model-free like the blocks: it reads the plant's state and kinematics only.
 
 from __future__ import annotations
 
+from functools import cached_property
 from typing import Optional, Sequence
 
 import numpy as np
@@ -31,16 +32,17 @@ from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain
 
 from ptint_drake.systems.controller import null_space_terms, null_space_torque
 from ptint_drake.systems.gains import ControllerGains
-from ptint_drake.systems.interceptor_row import law_row, pack_chain, pack_gains, position_row
+from ptint_drake.systems.interceptor_row import pack_chain, pack_gains, pose_row, position_row, task_row
 from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.orientation import active_rotation_values
+from ptint_drake.systems.orientation import ROTATION_WIDTH, active_rotation_values, compiled_rotations
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
 from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE, TARGET_ROTATION_SIZE, Slots
 from ptint_drake.systems.sliding_surface import SurfaceLaw
 from ptint_drake.systems.targets import active_target_values, compiled_targets
-from ptint_drake.systems.task import TASK_DIM, task_error, task_jacobian
+from ptint_drake.systems.task import TASK_DIM, TASKS
 
 _NO_TARGET = np.empty(0)
+_NO_ROTATIONS = np.zeros((1, ROTATION_WIDTH))
 
 
 def telemetry_layout(nv: int, task: str = "position") -> dict:
@@ -172,31 +174,32 @@ class InterceptorLaw(LeafSystem):
             row[self._tau] += null_space_torque(J, qv[:self._nq], qv[self._nq:], q_start, D, rate)
         return row
 
+    @cached_property
+    def _rotations(self):
+        """The targets' compiled orientations (``orientation.compiled_rotations``), or None: a
+        target port, or a sampled orientation (then evaluated in Python, ``_pose_row``)."""
+        return None if self._targets is None else compiled_rotations(self._targets)
+
     def _pose_row(self, t, qv, sigma, captured, target, rotation) -> np.ndarray:
-        """The row of any other task or plant (the pose task, a plant the chain cannot describe):
-        kinematics and task error in Python, the law (``law_row``) compiled."""
-        nq, n = self._nq, self._n
-        if len(target) == 0:
-            target = np.array(active_target_values(self._schedule, self._targets, t)[TARGET_PORT])
-        target = np.asarray(target, dtype=float)
-        if self._task == "position":
-            x, xdot, J = self._kinematics.compute(qv[:nq], qv[nq:])
-            e, edot = task_error("position", self._rot_scale, x, xdot, target[0:3], target[3:6])
-            extra = []
+        """The row of any other task or plant (the pose and top-down tasks, a plant the chain
+        cannot describe), compiled: ``pose_row`` on the chain, else the plant's kinematics and
+        ``task_row``.  Only a sampled orientation of the system's own targets is evaluated here."""
+        nq, n, rotations = self._nq, self._n, self._rotations
+        if rotation is None:
+            rotation = _NO_TARGET if rotations is not None or self._task == "position" else \
+                np.array(active_rotation_values(self._schedule, self._targets, t))
+        rotations = _NO_ROTATIONS if rotations is None else rotations
+        row = np.empty(self._size + 5 + n)
+        task, scale = TASKS.index(self._task), self._rot_scale
+        if self._chain is not None:
+            pose_row(float(t), qv, sigma, captured, target, rotation, task, scale, self._schedule.table,
+                     self._gains, *self._chain, self._compiled, rotations, row)
         else:
-            x, xdot, R, omega, J_v, J_w = self._kinematics.compute_pose(qv[:nq], qv[nq:])
-            J = task_jacobian(J_v, J_w, self._rot_scale)
-            if rotation is None:
-                rotation = active_rotation_values(self._schedule, self._targets, t)
-            e, edot = task_error(self._task, self._rot_scale, x.tolist(), xdot.tolist(), target[0:3].tolist(),
-                                 target[3:6].tolist(), R.ravel().tolist(), omega.tolist(), list(rotation))
-            extra = [R.ravel(), omega, np.asarray(rotation, dtype=float)]
-        tbg, surface = np.empty(10), np.empty(6 * n)
-        tau = law_row(float(t), np.asarray(e, dtype=float), np.asarray(edot, dtype=float),
-                      np.ascontiguousarray(J), np.ascontiguousarray(sigma, dtype=float),
-                      np.asarray(captured, dtype=float), self._schedule.table, self._gains, tbg, surface)
-        return np.concatenate([x, xdot, target[:9], tbg[:5], surface[:5 * n], sigma, tau, *extra,
-                               tbg[5:10], surface[5 * n:]])
+            x, _, R, _, J_v, J_w = self._kinematics.compute_pose(qv[:nq], qv[nq:])
+            f64 = np.ascontiguousarray
+            task_row(float(t), x, f64(R), f64(J_v), f64(J_w), f64(qv[nq:]), sigma, captured, target,
+                     rotation, task, scale, self._schedule.table, self._gains, self._compiled, rotations, row)
+        return row
 
 
 class PrescribedTimeInterceptor(Diagram):

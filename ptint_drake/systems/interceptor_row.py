@@ -4,8 +4,10 @@
 13), the surface (``sliding_surface.surface_law``, eqs. 16-17) and the torque
 (``controller.sliding_mode_torque``, eq. 18) — from a task error; ``position_row`` adds the
 position task end to end: the compiled kinematic chain (``chain.chain_kinematics``, eq. 5), the
-target (``targets.target_row``, or a given one) and e = x − x_r (eq. 11).  The blocks call the
-same kernels one by one, so there is one implementation of each equation.
+target (``targets.target_row``, or a given one) and e = x − x_r (eq. 11); ``pose_row`` the same
+for any task (``task_row``: with orientation, the target's rotation from
+``orientation.rotation_row`` or a given one, and the error ``task.task_error_of``).  The blocks
+call the same kernels one by one, so there is one implementation of each equation.
 
 The parameters travel as a few arrays (each argument costs the call ~0.15 µs):
 ``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
@@ -20,8 +22,10 @@ from numba import njit
 
 from ptint_drake.systems.chain import chain_kinematics
 from ptint_drake.systems.controller import sliding_mode_torque
+from ptint_drake.systems.orientation import rotation_row
 from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
 from ptint_drake.systems.targets import target_row
+from ptint_drake.systems.task import POSITION, task_error_of
 from ptint_drake.systems.tbg import tbg_row
 
 GAINS_HEAD = 8  # ϵ, δ, α_hold, k, k_hold, law, φ, λ; then Λ (n) and K (nv)
@@ -84,3 +88,64 @@ def position_row(t, qv, sigma, captured, target, segments, gains, joints, geomet
     out[0:3], out[3:6], out[6:15], out[15:20] = x, xdot, ref[:9], tbg[:5]
     out[20:35], out[35:38], out[38:38 + nv] = surface[:15], sigma, tau
     out[38 + nv:43 + nv], out[43 + nv:46 + nv] = tbg[5:10], surface[15:18]
+
+
+@njit(cache=True)
+def task_row(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
+             targets, rotations, out):
+    """``out`` ← the row of any task (``interceptor.telemetry_layout(nv, task)`` then
+    [index, t0, tf, β, phase] then σ̇) from the frame's position x, orientation R (3 × 3),
+    Jacobians J_v, J_ω (3 × nv) and the joint speeds v.  ``task``: its code (``task.TASKS``);
+    ``target``: [x_r, ẋ_r, ẍ_r] (≥ 9) or empty to evaluate ``targets`` (``targets.target_row``);
+    ``rotation``: [R_r, ω_r, ω̇_r] (15) or empty to evaluate ``rotations``
+    (``orientation.rotation_row``), both at t for the active segment."""
+    nv, n = len(v), 3 if task == POSITION else 6
+    xdot, omega, R9 = np.zeros(3), np.zeros(3), np.empty(9)
+    for i in range(3):
+        for k in range(nv):
+            xdot[i] += J_v[i, k] * v[k]
+            omega[i] += J_w[i, k] * v[k]
+        for j in range(3):
+            R9[3 * i + j] = R[i, j]
+    active = max(np.searchsorted(segments[0], t, side="right") - 1, 0)
+    ref, rot = np.empty(12), np.zeros(15)
+    if len(target) == 0:
+        target_row(targets[active], t, ref)
+    else:
+        ref[:9] = target[:9]
+    if task != POSITION:
+        if len(rotation) == 0:
+            rotation_row(rotations[active], t, rot)
+        else:
+            rot[:] = rotation[:15]
+    err, J = np.empty(2 * n), np.empty((n, nv))
+    task_error_of(task, rot_scale, x, xdot, ref[0:3], ref[3:6], R9, omega, rot, err)
+    for k in range(nv):
+        for i in range(3):
+            J[i, k] = J_v[i, k]
+            if n == 6:
+                J[3 + i, k] = rot_scale * J_w[i, k]
+    tbg, surface = np.empty(10), np.empty(6 * n)
+    tau = law_row(t, err[:n], err[n:], J, sigma, captured, segments, gains, tbg, surface)
+    m = 20 + 5 * n
+    out[0:3], out[3:6], out[6:15], out[15:20], out[20:m] = x, xdot, ref[:9], tbg[:5], surface[:5 * n]
+    out[m:m + n], out[m + n:m + n + nv] = sigma, tau
+    m += n + nv
+    if task != POSITION:
+        out[m:m + 9], out[m + 9:m + 12], out[m + 12:m + 27] = R9, omega, rot
+        m += 27
+    out[m:m + 5], out[m + 5:m + 5 + n] = tbg[5:10], surface[5 * n:]
+
+
+@njit(cache=True)
+def pose_row(t, qv, sigma, captured, target, rotation, task, rot_scale, segments, gains, joints, geometry,
+             targets, rotations, out):
+    """``task_row`` with the kinematics of the compiled chain (``chain.chain_kinematics``, joints and
+    geometry of ``pack_chain``) at the plant state ``qv`` = [q; v]: the whole row of the pose and
+    top-down tasks (or the position task) in one call."""
+    nv = len(gains) - GAINS_HEAD - (3 if task == POSITION else 6)
+    nq = len(qv) - nv
+    x, R, J_v, J_w = chain_kinematics(qv[:nq], joints[0], joints[1], joints[2], geometry[:, :4],
+                                      geometry[:-1, 4], nv)
+    task_row(t, x, R, J_v, J_w, qv[nq:], sigma, captured, target, rotation, task, rot_scale, segments,
+             gains, targets, rotations, out)

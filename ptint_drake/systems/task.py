@@ -8,27 +8,49 @@ the sliding surface drives to zero, and the Jacobian that maps joint speeds onto
   in the least-squares sense (rank 5 on a 5-joint wrist).
 
 c = ``rot_scale`` (m per rad) says how a radian of orientation error weighs against a metre.
+``task_error_of`` is the one implementation (compiled, numba): the fused interceptor's kernel
+calls it, and ``task_error`` (the blocks) wraps it.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-from ptint_drake.systems.orientation import rotation_error, tool_yaw, top_down_reference
+from ptint_drake.systems.orientation import rotation_error_of, tool_yaw, tool_yaw_of, top_down_of, \
+    top_down_reference
 
-TASKS = ("position", "pose", "top_down")
+TASKS = ("position", "pose", "top_down")  # their codes in compiled code: the index
+POSITION, POSE, TOP_DOWN = 0, 1, 2
 TASK_MIN_JOINTS = {"position": 3, "pose": 6, "top_down": 5}
 TASK_DIM = {"position": 3, "pose": 6, "top_down": 6}
+_NO_ROTATION = np.zeros(15)
 
 
-def position_error(x, xdot, x_r, xdot_r) -> tuple:
-    """(e, ė) = (x − x_r, ẋ − ẋ_r) of 3 plain floats each (paper eq. 11)."""
-    x0, x1, x2 = x
-    r0, r1, r2 = x_r
-    e = [x0 - r0, x1 - r1, x2 - r2]
-    x0, x1, x2 = xdot
-    r0, r1, r2 = xdot_r
-    return e, [x0 - r0, x1 - r1, x2 - r2]
+@njit(cache=True)
+def task_error_of(task: int, rot_scale: float, x, xdot, x_r, xdot_r, R, omega, rot_r, out) -> None:
+    """``out[:2n]`` ← [e; ė] of the task with code ``task`` (the index in ``TASKS``; n = 3 for
+    ``position``, 6 otherwise): see the module docstring.  R (row-major, 9), ω: the tool's
+    orientation and angular velocity; rot_r: the object's [R_r, ω_r, ω̇_r] (15); the three are
+    not read for ``position``."""
+    n = 3 if task == POSITION else 6
+    for i in range(3):
+        out[i], out[n + i] = x[i] - x_r[i], xdot[i] - xdot_r[i]
+    if task == POSITION:
+        return
+    rotation = np.empty(6)
+    if task == TOP_DOWN:
+        reference = np.empty(15)
+        top_down_of(rot_r, tool_yaw_of(R), reference)
+        rotation_error_of(R, omega, reference, rotation)
+    else:
+        rotation_error_of(R, omega, rot_r, rotation)
+    for i in range(3):
+        out[3 + i], out[9 + i] = rot_scale * rotation[i], rot_scale * rotation[3 + i]
+
+
+def _flat(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float).reshape(-1)
 
 
 def task_reference(task: str, rot_r, R) -> list:
@@ -39,15 +61,15 @@ def task_reference(task: str, rot_r, R) -> list:
 
 def task_error(task: str, rot_scale: float, x, xdot, x_r, xdot_r, R=None, omega=None,
                rot_r=None) -> tuple:
-    """(e, ė) of the task as lists of plain floats (3 for ``position``, 6 otherwise): see the
-    module docstring.  R (3 × 3 or row-major), ω: the tool's orientation and angular velocity;
-    rot_r: the object's [R_r, ω_r, ω̇_r]."""
-    e, edot = position_error(x, xdot, x_r, xdot_r)
-    if task == "position":
-        return e, edot
-    e_R, edot_R = rotation_error(R, omega, task_reference(task, rot_r, R))
-    c = rot_scale
-    return e + [c * a for a in e_R], edot + [c * a for a in edot_R]
+    """(e, ė) of the task as arrays (3 for ``position``, 6 otherwise; ``task_error_of``).
+    R (3 × 3 or row-major), ω: the tool's orientation and angular velocity; rot_r: the object's
+    [R_r, ω_r, ω̇_r]; none of them needed for ``position``."""
+    n = TASK_DIM[task]
+    out = np.empty(2 * n)
+    rotation = [_NO_ROTATION] * 3 if task == "position" else [_flat(R), _flat(omega), _flat(rot_r)]
+    task_error_of(TASKS.index(task), float(rot_scale), _flat(x), _flat(xdot), _flat(x_r), _flat(xdot_r),
+                  *rotation, out)
+    return out[:n], out[n:]
 
 
 def task_jacobian(J_v: np.ndarray, J_w: np.ndarray, rot_scale: float) -> np.ndarray:

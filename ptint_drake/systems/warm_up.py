@@ -5,7 +5,8 @@ numba compiles a kernel at its first call for the argument types of that call an
 ``cache=True``, stores the machine code beside the module (or in ``NUMBA_CACHE_DIR``, or the
 user's cache directory when the install is read-only).  Short runs of the bundled scenarios
 exercise the kernels with the very types a ``ptint run`` passes: the fused position task with a
-curve, a line and a thrown object, a target from a filter, the pose task and the five blocks.
+curve, a line and a thrown object, a target from a filter, the pose task (``pose_row``) and the
+five blocks; then the orientation equations as the blocks and the metrics call them.
 """
 
 from __future__ import annotations
@@ -47,7 +48,25 @@ def warm_up(duration: float = 0.05) -> float:
                 [duration], *inputs, context.get_discrete_state(0).value()[None])
     alpha_peak(1.5, 0.75)
     tbg_profile(0.5, 1.5, 0.75)
+    _orientation_kernels()
     return time.perf_counter() - t0
+
+
+def _orientation_kernels() -> None:
+    """Call the compiled orientation equations as the blocks and a run's metrics call them (the
+    fused pose kernel, ``interceptor_row.pose_row``, compiles in the ``curve_pose`` run)."""
+    import numpy as np  # noqa: PLC0415
+
+    from ptint_drake.systems.orientation import (SpinningOrientation, orientation_error_angle,  # noqa: PLC0415
+                                                 rotation_error, rotation_exp)
+    from ptint_drake.systems.signals import IDENTITY_ROTATION  # noqa: PLC0415
+    from ptint_drake.systems.task import task_error, task_reference  # noqa: PLC0415
+
+    R, w = rotation_exp([0.1, 0.2, 0.3]), [0.1, 0.0, 0.0]
+    rot_r = SpinningOrientation([0.0, 0.0, 30.0], [0.0, 0.0, 10.0]).values(0.5)
+    task_error("top_down", 0.1, *np.zeros((4, 3)), R, w, rot_r)
+    rotation_error(R, w, task_reference("top_down", IDENTITY_ROTATION, R))
+    orientation_error_angle("pose", R, rot_r)
 
 
 if __name__ == "__main__":

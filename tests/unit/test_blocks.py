@@ -173,14 +173,14 @@ def test_surface_law_matches_the_paper_equations():
     """``SurfaceLaw.values`` (what the fused system and the block call) against eqs. 11, 16, 17
     written with numpy arrays: e, ė, s = ė + αe, s_d = s(t0) e^(−kτ) (hold: e^(−k tf − k_hold(τ − tf))),
     s_x = s − s_d + Λσ, σ̇ = tanh((s − s_d)/φ)."""
-    from ptint_drake.systems.task import position_error
+    from ptint_drake.systems.task import task_error
 
     law = SurfaceLaw(Lambda=5.0, k=3.0, switching="tanh", phi=0.01, k_hold=50.0)
     rng = np.random.default_rng(11)
     for t, phase_tf in ((0.7, 1.5), (1.8, 1.5)):
         x, xdot, x_r, xdot_r, sigma, s0 = rng.normal(scale=0.1, size=(6, 3))
         alpha = 2.5
-        e_list, edot_list = position_error(x.tolist(), xdot.tolist(), x_r.tolist(), xdot_r.tolist())
+        e_list, edot_list = task_error("position", 0.1, *(a.tolist() for a in (x, xdot, x_r, xdot_r)))
         out = np.array(law.values(t, e_list, edot_list, alpha,
                                   [0.0, 0.0, phase_tf, 0.75, 1.0], [0.0, *s0], sigma.tolist()))
         e, edot = x - x_r, xdot - xdot_r
