@@ -19,8 +19,9 @@ axis and identical on the three axes, so the error state per axis is χ = [δθ,
                      [δθ; ω̂] ← K y (per axis), R̂ ← exp([δθ]×) R̂, δθ ← 0,
                      P ← (I − K H) P (I − K H)ᵀ + R_θ K Kᵀ   (Joseph form)
 
-The rotation math is Drake's (``RotationMatrix``, ``AngleAxis``; ``orientation.rotation_log``
-through its quaternion); R̂ is re-projected onto SO(3) at every update.  The timing — update
+The exponential is Drake's (``RotationMatrix``, ``AngleAxis``, ``orientation.rotation_from_vector``);
+the log is ``orientation.rotation_log``, the one compiled log the controller and the metrics use
+too; R̂ is re-projected onto SO(3) at every update.  The timing — update
 instants at the camera's rate offset by its latency, the latency compensated by
 predicting from the sample's stamp, predict-only during dropouts, priming with the pre-run
 samples — is ``kalman.TargetKalmanFilter``'s.  The first sample sets R̂ = Z, ω̂ = 0,
