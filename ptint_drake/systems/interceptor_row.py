@@ -7,10 +7,13 @@ position task end to end: the compiled kinematic chain (``chain.chain_kinematics
 target (``targets.target_row``, or a given one) and e = x − x_r (eq. 11).  The blocks call the
 same kernels one by one, so there is one implementation of each equation.
 
-The parameters travel as a few arrays (each argument costs the call ~0.15 µs):
-``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
+The parameters travel as a few arrays (each argument costs the call ~0.15 µs, a read-only one
+~0.7 µs): ``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
 (``pack_gains``), ``segments`` = ``Schedule.table``, ``joints`` = [kinds; q index; v index] and
 ``geometry`` = the chain's fixed transforms with each joint's axis (``pack_chain``).
+``position_output`` takes all of them as one array (``pack_position``) and the loop's values as
+one input vector [q; v; σ; index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so a simulation step pays for four
+arguments.
 """
 
 from __future__ import annotations
@@ -84,3 +87,48 @@ def position_row(t, qv, sigma, captured, target, segments, gains, joints, geomet
     out[0:3], out[3:6], out[6:15], out[15:20] = x, xdot, ref[:9], tbg[:5]
     out[20:35], out[35:38], out[38:38 + nv] = surface[:15], sigma, tau
     out[38 + nv:43 + nv], out[43 + nv:46 + nv] = tbg[5:10], surface[15:18]
+
+
+POSITION_HEAD = 8  # nq, nv, segments, joints, targets, target width, σ reset, target given
+
+
+def pack_position(nq: int, segments, gains, joints, geometry, targets, reset: bool,
+                  given_target: bool) -> np.ndarray:
+    """The static arrays of ``position_row`` as one float array for ``position_output``: a head
+    [nq, nv, segment count, joint count, target count, target row width, σ reset (0/1), target in
+    the input (0/1)], then ``segments``, ``gains``, ``joints``, ``geometry`` and ``targets``
+    (compiled rows), each flattened."""
+    nv = len(gains) - GAINS_HEAD - 3
+    head = [nq, nv, segments.shape[1], joints.shape[1], targets.shape[0], targets.shape[1],
+            float(reset), float(given_target)]
+    return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in (
+        segments, gains, joints, geometry, targets))])
+
+
+@njit(cache=True)
+def position_output(t, u, static, row, tau_sigma_dot):
+    """``position_row`` on a packed input: ``u`` = [q; v; σ (the Integrator's); captured
+    [index, s(t0), σ0]; the target [x_r, ẋ_r, ẍ_r] when the system has a target input],
+    ``static`` from ``pack_position``; ``row`` ← the row, ``tau_sigma_dot`` ← [τ; σ̇]
+    (σ − σ0 used with ``sigma_policy`` reset)."""
+    nq, nv, n_seg, n_joints = int(static[0]), int(static[1]), int(static[2]), int(static[3])
+    n_targets, width = int(static[4]), int(static[5])
+    o = POSITION_HEAD
+    segments = static[o:o + 4 * n_seg].reshape(4, n_seg)
+    o += 4 * n_seg
+    gains = static[o:o + GAINS_HEAD + 3 + nv]
+    o += GAINS_HEAD + 3 + nv
+    joints = static[o:o + 3 * n_joints].astype(np.int64).reshape(3, n_joints)
+    o += 3 * n_joints
+    geometry = static[o:o + 15 * (n_joints + 1)].reshape(n_joints + 1, 5, 3)
+    o += 15 * (n_joints + 1)
+    targets = static[o:o + n_targets * width].reshape(n_targets, width)
+    m = nq + nv
+    sigma = u[m:m + 3].copy()
+    captured = u[m + 3:m + 10]
+    if static[6] != 0.0:
+        sigma -= captured[4:7]
+    target = u[m + 10:m + 19] if static[7] != 0.0 else u[m + 10:m + 10]
+    position_row(t, u[:m], sigma, captured, target, segments, gains, joints, geometry, targets, row)
+    tau_sigma_dot[:nv] = row[38:38 + nv]
+    tau_sigma_dot[nv:] = row[43 + nv:46 + nv]
