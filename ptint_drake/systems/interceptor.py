@@ -143,10 +143,10 @@ class InterceptorLaw(LeafSystem):
 
     def _calc_position_output(self, context, output) -> None:
         """[τ; σ̇] of the compiled position path (no null-space term): the ``loop`` input as it
-        is into the kernel that ``row`` calls too, which writes [τ; σ̇] (and a reused row)."""
+        is into the kernel that ``row`` calls too, which writes [τ; σ̇] into the output's own
+        memory (and the row into a reused buffer)."""
         position_output(context.get_time(), self._loop_in.EvalBasicVector(context).value(), self._static,
-                        self._row, self._out)
-        output.SetFromVector(self._out)
+                        self._row, output.get_mutable_value())
 
     def _capture(self, context, state) -> None:
         """Store [index, s(t0), σ0] at a segment start (σ0: σ then, with ``sigma_policy`` reset)."""
