@@ -10,7 +10,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget
+from ptint_drake.systems.targets import LinearTarget, WaypointTarget
 
 from arms import OFFSET_ARM, REDUNDANT_ARM
 
@@ -148,3 +148,21 @@ def test_fused_law_reads_one_loop_input(own_targets):
     assert out.tolist() == np.r_[tau, sigma_dot].tolist()
     assert row[law.layout["sigma"]].tolist() == (sigma - captured[4:]).tolist()
     assert np.any(np.abs(tau) > 1e-3)
+
+
+def test_fused_waypoint_target_equals_blocks():
+    """A target without a compiled row (waypoints) is evaluated in Python on the fused path too:
+    the same torque as the blocks (the compiled output once read a zero target row here)."""
+    target = WaypointTarget([0.0, 0.5, 1.0, 1.5], [[0.35, -0.1, 0.5], [0.35, -0.05, 0.5],
+                                                   [0.35, 0.0, 0.52], [0.35, 0.05, 0.5]])
+    torques = []
+    for fused in (True, False):
+        diagram, plant, h = _closed_loop(OFFSET_ARM, fused, ControllerGains(),
+                                         Schedule([Segment(0.0, 1.0, 0.75)]), target)
+        ctx = diagram.CreateDefaultContext()
+        diagram.ExecuteInitializationEvents(ctx)
+        plant.SetPositions(plant.GetMyMutableContextFromRoot(ctx), [0.3, 0.5, 1.2])
+        ctx.SetTime(0.4)
+        out = (h.fused if fused else h.controller).GetOutputPort("tau")
+        torques.append(out.Eval(out.get_system().GetMyContextFromRoot(ctx)).tolist())
+    assert torques[0] == torques[1]
