@@ -7,12 +7,12 @@ position task end to end: the compiled kinematic chain (``chain.chain_kinematics
 target (``targets.target_row``, or a given one) and e = x − x_r (eq. 11).  The blocks call the
 same kernels one by one, so there is one implementation of each equation.
 
-The parameters travel as a few arrays (each argument costs the call ~0.15 µs, a read-only one
-~0.7 µs): ``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
+The parameters travel as a few arrays (each argument costs the call ~0.1-0.2 µs):
+``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
 (``pack_gains``), ``segments`` = ``Schedule.table``, ``joints`` = [kinds; q index; v index] and
 ``geometry`` = the chain's fixed transforms with each joint's axis (``pack_chain``).
 ``position_output`` takes all of them as one array (``pack_position``) and the loop's values as
-one input vector [q; v; σ; index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so a simulation step pays for four
+one input vector [q; v; σ; index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so an evaluation passes five
 arguments.
 """
 
@@ -53,13 +53,17 @@ def law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface):
     """τ (nv) of eq. 18 for the task error e, ė (n) and Jacobian J (n × nv), with σ and the
     captured [index, s(t0)]; fills ``tbg`` (10, ``signals.TBG``) and ``surface`` (6n,
     ``signals.surface_slots``) on the way."""
+    n = len(e)
     tbg_row(t, segments, gains[0], gains[1], gains[2], tbg)
-    return surface_torque(t, e, edot, J, sigma, captured, gains, tbg, surface)
+    surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
+                gains[3], gains[4], int(gains[5]), gains[6], surface)
+    return sliding_mode_torque(gains[GAINS_HEAD + n:], J, surface[:n], gains[7])
 
 
 @njit(cache=True)
 def surface_torque(t, e, edot, J, sigma, captured, gains, tbg, surface):
-    """``law_row`` after the TBG: τ from a given ``tbg`` row; fills ``surface``."""
+    """``law_row`` after the TBG (``position_row``'s, which may reuse a TBG row): τ from a given
+    ``tbg`` row; fills ``surface``."""
     n = len(e)
     surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
                 gains[3], gains[4], int(gains[5]), gains[6], surface)
