@@ -268,9 +268,7 @@ def kernel_cost(scenario, calls: int = 2000) -> "float | None":
     context = built.diagram.CreateDefaultContext()
     built.diagram.ExecuteInitializationEvents(context)
     ctx = law.GetMyContextFromRoot(context)
-    args = (0.5 * scenario.duration, law.get_input_port(0).Eval(ctx), law.GetInputPort("sigma").Eval(ctx),
-            ctx.get_discrete_state(0).value(),
-            law.GetInputPort("target").Eval(ctx) if law.HasInputPort("target") else None)
+    args = (0.5 * scenario.duration, *law.loop_values(ctx))
     best = float("inf")
     for _ in range(3):
         t0 = time.perf_counter()

@@ -5,11 +5,15 @@
 (``interceptor_row``: the TBG, the surface law, the torque and, for the position task, the
 kinematic chain and the target, in one call).  It is a small Diagram:
 
-    state ─> InterceptorLaw ─[τ; σ̇]─> Demultiplexer ─τ─> (Bᵀ) ─> u
-                  ↑ σ                               └σ̇─> Integrator (σ) ─┘
+    state ─> Multiplexer ─loop─> InterceptorLaw ─[τ; σ̇]─> Demultiplexer ─τ─> (Bᵀ) ─> u
+    (target)    ↑ σ, captured                                      └σ̇─> Integrator (σ) ─┐
+                └──────────────────────────────────────────────────────────────────────┘
 
 so each derivative evaluation enters Python once (the law's one output; Drake's Integrator
-holds σ and Drake's cache hands the same output to the plant and to the integrator).  Its
+holds σ and Drake's cache hands the same output to the plant and to the integrator) and reads
+one input: the Multiplexer gathers the plant state, σ, the law's own ``captured`` state (a state
+output: no feedthrough, no algebraic loop) and the ``target`` input into one vector, which the
+compiled position path (``interceptor_row.position_output``) takes as it is.  Its
 ``telemetry`` port carries every intermediate signal (layout in ``telemetry_layout``).  A run
 logs only C++ ports (the plant's state, ``sigma`` and ``captured``) and ``telemetry_at``
 recomputes the telemetry of each logged sample afterwards — the same kernel on the same state,
@@ -28,11 +32,12 @@ from typing import Optional, Sequence
 
 import numpy as np
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain
+from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain, Multiplexer
 
 from ptint_drake.systems.controller import null_space_terms, null_space_torque
 from ptint_drake.systems.gains import ControllerGains
-from ptint_drake.systems.interceptor_row import pack_chain, pack_gains, pose_row, position_row, task_row
+from ptint_drake.systems.interceptor_row import (pack_chain, pack_gains, pack_position, pose_row,
+                                                 position_output, task_row)
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.orientation import ROTATION_WIDTH, active_rotation_values, compiled_rotations
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
@@ -55,10 +60,18 @@ def telemetry_layout(nv: int, task: str = "position") -> dict:
                  ("sigma", n), ("tau", nv), *extra).slices()
 
 
+def loop_sizes(nq: int, nv: int, n: int, target_input: bool) -> list:
+    """The parts of ``InterceptorLaw``'s ``loop`` input: [q; v] (nq + nv), σ (n), captured
+    [index, s(t0), σ0] (1 + 2n) and, with a target input, [x_r, ẋ_r, ẍ_r] (``TARGET_PORT_SIZE``)."""
+    return [nq + nv, n, 1 + 2 * n] + ([TARGET_PORT_SIZE] if target_input else [])
+
+
 class InterceptorLaw(LeafSystem):
-    """Inputs ``state`` ([q; v]), ``sigma`` (σ, n), and ``target`` / ``target_rotation`` without
-    target objects; outputs ``tau_sigma_dot`` ([τ; σ̇], nv + n), ``telemetry`` and ``captured``
-    (its discrete state [index, s(t0), σ0], 1 + 2n).  See ``PrescribedTimeInterceptor``."""
+    """Inputs ``loop`` ([q; v; σ; captured; target], ``loop_sizes``: the plant state, the
+    Integrator's σ (n), the ``captured`` output fed back and, without target objects, the target
+    estimate) and, with an orientation task and no target objects, ``target_rotation``; outputs
+    ``tau_sigma_dot`` ([τ; σ̇], nv + n), ``telemetry`` and ``captured`` (its discrete state
+    [index, s(t0), σ0], 1 + 2n).  See ``PrescribedTimeInterceptor``."""
 
     def __init__(self, *, plant, frame, schedule: Schedule, gains: ControllerGains,
                  targets: Optional[Sequence] = None, posture: Optional[np.ndarray] = None):
@@ -85,10 +98,9 @@ class InterceptorLaw(LeafSystem):
         self._tau = self.layout["tau"]
         self._sigma_dot = slice(size + 5, size + 5 + n)
 
-        self._state_in = self.DeclareVectorInputPort("state", nq + nv)
-        self._sigma_in = self.DeclareVectorInputPort("sigma", n)
-        self._target_in = None if targets is not None else self.DeclareVectorInputPort(
-            "target", TARGET_PORT_SIZE)
+        self.loop_sizes = loop_sizes(nq, nv, n, targets is None)
+        self._loop_in = self.DeclareVectorInputPort("loop", sum(self.loop_sizes))
+        self._parts = np.cumsum(self.loop_sizes)[:-1]
         self._rotation_in = None if targets is not None or gains.task == "position" else \
             self.DeclareVectorInputPort("target_rotation", TARGET_ROTATION_SIZE)
         self._capture_index = self.DeclareDiscreteState(np.r_[-1.0, np.zeros(2 * n)])
@@ -97,10 +109,12 @@ class InterceptorLaw(LeafSystem):
         deps = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         self._out = np.empty(nv + n)
         self._row = np.empty(size + 5 + n)  # the fast path's row, reused by every evaluation
-        self._row_args = None if not self._fast or self._null_space is not None else (
-            self._schedule.table, self._gains, *self._chain, self._compiled)
-        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_output if self._row_args is None
-                                     else self._calc_position_output, prerequisites_of_calc=deps)
+        self._static = None if not self._fast else pack_position(
+            nq, schedule.table, self._gains, *self._chain, self._compiled, self._law.reset_sigma,
+            targets is None or self._python_targets)
+        compiled_output = self._fast and self._null_space is None and not self._python_targets
+        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_position_output if compiled_output
+                                     else self._calc_output, prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("telemetry", size,
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
                                      prerequisites_of_calc=deps)
@@ -113,13 +127,15 @@ class InterceptorLaw(LeafSystem):
     def telemetry_size(self) -> int:
         return self._size
 
+    def loop_values(self, context) -> tuple:
+        """([q; v], σ, captured, target or None): the ``loop`` input at ``context`` taken apart."""
+        qv, sigma, captured, *target = np.split(self._loop_in.Eval(context), self._parts)
+        return qv, sigma, captured, target[0] if target else None
+
     def _eval(self, context) -> np.ndarray:
         """The row (telemetry, active segment, σ̇) at ``context``."""
         rotation = None if self._rotation_in is None else self._rotation_in.Eval(context)
-        return self.row(context.get_time(), self._state_in.EvalBasicVector(context).value(),
-                        self._sigma_in.EvalBasicVector(context).value(),
-                        context.get_discrete_state(self._capture_index).value(),
-                        None if self._target_in is None else self._target_in.Eval(context), rotation)
+        return self.row(context.get_time(), *self.loop_values(context), rotation)
 
     def _calc_output(self, context, output) -> None:
         row = self._eval(context)
@@ -128,18 +144,11 @@ class InterceptorLaw(LeafSystem):
         output.SetFromVector(out)
 
     def _calc_position_output(self, context, output) -> None:
-        """[τ; σ̇] of the compiled position path (no null-space term): the inputs read once, the
-        kernel writes into a reused row — the same numbers as ``row``."""
-        captured = context.get_discrete_state(self._capture_index).value()
-        sigma = self._sigma_in.EvalBasicVector(context).value()
-        if self._law.reset_sigma:
-            sigma = sigma - captured[1 + self._n:]
-        target = _NO_TARGET if self._target_in is None else self._target_in.EvalBasicVector(context).value()
-        row, out = self._row, self._out
-        position_row(context.get_time(), self._state_in.EvalBasicVector(context).value(), sigma, captured,
-                     target, *self._row_args, row)
-        out[:self._nv], out[self._nv:] = row[self._tau], row[self._sigma_dot]
-        output.SetFromVector(out)
+        """[τ; σ̇] of the compiled position path (no null-space term): the ``loop`` input as it
+        is into the kernel that ``row`` calls too, which writes [τ; σ̇] into the output's own
+        memory (and the row into a reused buffer)."""
+        position_output(context.get_time(), self._loop_in.EvalBasicVector(context).value(), self._static,
+                        self._row, output.get_mutable_value())
 
     def _capture(self, context, state) -> None:
         """Store [index, s(t0), σ0] at a segment start (σ0: σ then, with ``sigma_policy`` reset)."""
@@ -147,7 +156,7 @@ class InterceptorLaw(LeafSystem):
         index = row[self._size]
         if index < 0:
             return
-        sigma = self._sigma_in.Eval(context) if self._law.reset_sigma else np.zeros(self._n)
+        sigma = self.loop_values(context)[1] if self._law.reset_sigma else np.zeros(self._n)
         state.get_mutable_discrete_state(self._capture_index).SetFromVector(
             np.concatenate([[index], row[self.layout["s"]], sigma]))
 
@@ -155,18 +164,19 @@ class InterceptorLaw(LeafSystem):
             target: Optional[np.ndarray], rotation: Optional[np.ndarray] = None) -> np.ndarray:
         """The row (telemetry, active segment [index, t0, tf, β, phase], σ̇) from the time, the
         plant state [q; v], the integrator's σ, [index, s(t0), σ0] and the ``target`` (and
-        ``target_rotation``) inputs' values (None: the system's own targets)."""
+        ``target_rotation``) inputs' values (None: the system's own targets).  The compiled
+        position path is the simulation's own kernel (``position_output``) on the same values."""
         n = self._n
-        if self._law.reset_sigma:
-            sigma = sigma - captured[1 + n:]
         if target is None:
             target = np.array(active_target_values(self._schedule, self._targets, t)[TARGET_PORT]) \
                 if self._python_targets else _NO_TARGET
         if self._fast:
             row = np.empty(self._size + 5 + n)
-            position_row(t, qv, sigma, captured, target, self._schedule.table, self._gains, *self._chain,
-                         self._compiled, row)
+            position_output(float(t), np.concatenate([qv, sigma, captured, target]), self._static, row,
+                            np.empty(self._nv + n))
         else:
+            if self._law.reset_sigma:
+                sigma = sigma - captured[1 + n:]
             row = self._pose_row(t, qv, sigma, captured, target, rotation)
         if self._null_space is not None:  # redundant arms, optional (off by default)
             D, rate, q_start = self._null_space
@@ -226,12 +236,17 @@ class PrescribedTimeInterceptor(Diagram):
         nv, n = plant.num_velocities(), law.num_tasks
         split = builder.AddNamedSystem("split", Demultiplexer([nv, n]))
         sigma = builder.AddNamedSystem("sigma", Integrator(n))
+        loop = builder.AddNamedSystem("loop", Multiplexer(law.loop_sizes))
         builder.Connect(law.GetOutputPort("tau_sigma_dot"), split.get_input_port())
         builder.Connect(split.get_output_port(1), sigma.get_input_port())
-        builder.Connect(sigma.get_output_port(), law.GetInputPort("sigma"))
-        for name in ("state", "target", "target_rotation"):
-            if law.HasInputPort(name):
-                builder.ExportInput(law.GetInputPort(name), name)
+        builder.ExportInput(loop.get_input_port(0), "state")
+        builder.Connect(sigma.get_output_port(), loop.get_input_port(1))
+        builder.Connect(law.GetOutputPort("captured"), loop.get_input_port(2))
+        builder.Connect(loop.get_output_port(), law.GetInputPort("loop"))
+        if targets is None:
+            builder.ExportInput(loop.get_input_port(3), "target")
+        if law.HasInputPort("target_rotation"):
+            builder.ExportInput(law.GetInputPort("target_rotation"), "target_rotation")
         BT = plant.MakeActuationMatrix().T
         tau = split.get_output_port(0)
         u = tau if BT.shape[0] == nv and np.array_equal(BT, np.eye(nv)) else None

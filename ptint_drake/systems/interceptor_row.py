@@ -9,10 +9,13 @@ for any task (``task_row``: with orientation, the target's rotation from
 ``orientation.rotation_row`` or a given one, and the error ``task.task_error_of``).  The blocks
 call the same kernels one by one, so there is one implementation of each equation.
 
-The parameters travel as a few arrays (each argument costs the call ~0.15 µs):
+The parameters travel as a few arrays (each argument costs the call ~0.1-0.2 µs):
 ``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
 (``pack_gains``), ``segments`` = ``Schedule.table``, ``joints`` = [kinds; q index; v index] and
 ``geometry`` = the chain's fixed transforms with each joint's axis (``pack_chain``).
+``position_output`` takes all of them as one array (``pack_position``) and the loop's values as
+one input vector [q; v; σ; index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so an evaluation passes five
+arguments.
 """
 
 from __future__ import annotations
@@ -62,11 +65,23 @@ def law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface):
 
 
 @njit(cache=True)
-def position_row(t, qv, sigma, captured, target, segments, gains, joints, geometry, targets, out):
+def surface_torque(t, e, edot, J, sigma, captured, gains, tbg, surface):
+    """``law_row`` after the TBG (``position_row``'s, which may reuse a TBG row): τ from a given
+    ``tbg`` row; fills ``surface``."""
+    n = len(e)
+    surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
+                gains[3], gains[4], int(gains[5]), gains[6], surface)
+    return sliding_mode_torque(gains[GAINS_HEAD + n:], J, surface[:n], gains[7])
+
+
+@njit(cache=True)
+def position_row(t, qv, sigma, captured, target, segments, gains, joints, geometry, targets, memo, out):
     """``out`` ← the fused interceptor's row for the position task (``interceptor.telemetry_layout``
     then [index, t0, tf, β, phase] then σ̇): x, ẋ, x_r, ẋ_r, ẍ_r, ξ…ξ⃛, α, s_x, e, ė, s, s_d,
     σ, τ.  ``target``: [x_r, ẋ_r, ẍ_r] (9), or empty to evaluate ``targets`` (one compiled row
-    per segment, ``targets.compiled_targets``) at t."""
+    per segment, ``targets.compiled_targets``) at t.  ``memo`` = [t, TBG row (10), target (12)]
+    of the last call: the TBG and the compiled target are functions of t alone, and one
+    evaluation in three (an RK3 step's first stage) comes at the previous one's time."""
     nv = len(gains) - GAINS_HEAD - 3
     nq = len(qv) - nv
     x, _, J, _ = chain_kinematics(qv[:nq], joints[0], joints[1], joints[2], geometry[:, :4],
@@ -76,15 +91,18 @@ def position_row(t, qv, sigma, captured, target, segments, gains, joints, geomet
     for i in range(3):
         for k in range(nv):
             xdot[i] += J[i, k] * v[k]
-    ref = np.empty(12)
-    if len(target) == 0:
-        i = max(np.searchsorted(segments[0], t, side="right") - 1, 0)
-        target_row(targets[i], t, ref)
-    else:
+    tbg, ref = memo[1:11], memo[11:23]
+    if memo[0] != t:  # (NaN at first)
+        tbg_row(t, segments, gains[0], gains[1], gains[2], tbg)
+        if len(target) == 0:
+            i = max(np.searchsorted(segments[0], t, side="right") - 1, 0)
+            target_row(targets[i], t, ref)
+        memo[0] = t
+    if len(target) != 0:
         ref[:9] = target[:9]
     e, edot = x - ref[0:3], xdot - ref[3:6]
-    tbg, surface = np.empty(10), np.empty(18)
-    tau = law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface)
+    surface = np.empty(18)
+    tau = surface_torque(t, e, edot, J, sigma, captured, gains, tbg, surface)
     out[0:3], out[3:6], out[6:15], out[15:20] = x, xdot, ref[:9], tbg[:5]
     out[20:35], out[35:38], out[38:38 + nv] = surface[:15], sigma, tau
     out[38 + nv:43 + nv], out[43 + nv:46 + nv] = tbg[5:10], surface[15:18]
@@ -149,3 +167,51 @@ def pose_row(t, qv, sigma, captured, target, rotation, task, rot_scale, segments
                                       geometry[:-1, 4], nv)
     task_row(t, x, R, J_v, J_w, qv[nq:], sigma, captured, target, rotation, task, rot_scale, segments,
              gains, targets, rotations, out)
+
+
+POSITION_HEAD = 8  # nq, nv, segments, joints, targets, target width, σ reset, target given
+MEMO = 23  # position_row's memo: [t, TBG row (10), target (12)]
+
+
+def pack_position(nq: int, segments, gains, joints, geometry, targets, reset: bool,
+                  given_target: bool) -> np.ndarray:
+    """The static arrays of ``position_row`` as one float array for ``position_output``: a head
+    [nq, nv, segment count, joint count, target count, target row width, σ reset (0/1), target in
+    the input (0/1)], then ``segments``, ``gains``, ``joints``, ``geometry`` and ``targets``
+    (compiled rows), each flattened, and ``position_row``'s memo (``MEMO`` slots, written by
+    every call)."""
+    nv = len(gains) - GAINS_HEAD - 3
+    head = [nq, nv, segments.shape[1], joints.shape[1], targets.shape[0], targets.shape[1],
+            float(reset), float(given_target)]
+    return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in (
+        segments, gains, joints, geometry, targets)), np.full(MEMO, np.nan)])
+
+
+@njit(cache=True)
+def position_output(t, u, static, row, tau_sigma_dot):
+    """``position_row`` on a packed input: ``u`` = [q; v; σ (the Integrator's); captured
+    [index, s(t0), σ0]; the target [x_r, ẋ_r, ẍ_r] when the system has a target input],
+    ``static`` from ``pack_position``; ``row`` ← the row, ``tau_sigma_dot`` ← [τ; σ̇]
+    (σ − σ0 used with ``sigma_policy`` reset)."""
+    nq, nv, n_seg, n_joints = int(static[0]), int(static[1]), int(static[2]), int(static[3])
+    n_targets, width = int(static[4]), int(static[5])
+    o = POSITION_HEAD
+    segments = static[o:o + 4 * n_seg].reshape(4, n_seg)
+    o += 4 * n_seg
+    gains = static[o:o + GAINS_HEAD + 3 + nv]
+    o += GAINS_HEAD + 3 + nv
+    joints = static[o:o + 3 * n_joints].astype(np.int64).reshape(3, n_joints)
+    o += 3 * n_joints
+    geometry = static[o:o + 15 * (n_joints + 1)].reshape(n_joints + 1, 5, 3)
+    o += 15 * (n_joints + 1)
+    targets = static[o:o + n_targets * width].reshape(n_targets, width)
+    m = nq + nv
+    sigma = u[m:m + 3].copy()
+    captured = u[m + 3:m + 10]
+    if static[6] != 0.0:
+        sigma -= captured[4:7]
+    target = u[m + 10:m + 19] if static[7] != 0.0 else u[m + 10:m + 10]
+    position_row(t, u[:m], sigma, captured, target, segments, gains, joints, geometry, targets,
+                 static[len(static) - MEMO:], row)
+    tau_sigma_dot[:nv] = row[38:38 + nv]
+    tau_sigma_dot[nv:] = row[43 + nv:46 + nv]

@@ -43,9 +43,8 @@ def warm_up(duration: float = 0.05) -> float:
         law = getattr(built.controller.system, "law", None)
         if law is not None and not law.HasInputPort("target"):
             context = law.GetMyContextFromRoot(simulator.get_context())
-            inputs = [law.GetInputPort(p).Eval(context)[None] for p in ("state", "sigma")]
-            built.controller.system.telemetry_at(
-                [duration], *inputs, context.get_discrete_state(0).value()[None])
+            qv, sigma, captured, _ = law.loop_values(context)
+            built.controller.system.telemetry_at([duration], qv[None], sigma[None], captured[None])
     alpha_peak(1.5, 0.75)
     tbg_profile(0.5, 1.5, 0.75)
     _orientation_kernels()

@@ -10,7 +10,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget
+from ptint_drake.systems.targets import LinearTarget, WaypointTarget
 
 from arms import OFFSET_ARM, REDUNDANT_ARM
 
@@ -105,3 +105,64 @@ def test_fused_and_blocks_compute_the_same_floats(urdf, q, gains):
         torques.append(row)
     assert torques[0] == torques[1]
     assert all(np.all(np.isfinite(r)) and np.any(np.abs(r) > 1e-3) for r in torques[0])
+
+
+@pytest.mark.parametrize("own_targets", [True, False])
+def test_fused_law_reads_one_loop_input(own_targets):
+    """The law has one input, ``loop`` = [q; v; σ; captured (fed back); target (without target
+    objects)]; its [τ; σ̇] (the compiled output path) equals the ``row`` the telemetry uses, on
+    the same values to the last bit, with σ reset (σ − σ0) at a segment start."""
+    schedule = Schedule([Segment(0.0, 1.0, 0.75)])
+    target = LinearTarget([0.35, -0.1, 0.5], [0.0, 0.1, 0.0])
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    Parser(plant).AddModelsFromString(OFFSET_ARM, "urdf")
+    plant.Finalize()
+    h = AddPrescribedTimeInterceptor(builder, plant, plant.GetFrameByName("hand"), schedule,
+                                     [target] if own_targets else None, ControllerGains(sigma_policy="reset"),
+                                     fused=True)
+    if not own_targets:
+        builder.ExportInput(h.target_input, "target")
+    diagram = builder.Build()
+    law = h.fused.law
+    assert [law.get_input_port(i).get_name() for i in range(law.num_input_ports())] == ["loop"]
+    assert law.get_input_port(0).size() == 6 + 3 + 7 + (0 if own_targets else 9)
+    ctx = diagram.CreateDefaultContext()
+    if not own_targets:
+        diagram.get_input_port(0).FixValue(ctx, target.evaluate(0.4)[:9])
+    diagram.ExecuteInitializationEvents(ctx)
+    rng = np.random.default_rng(7)
+    plant.SetPositionsAndVelocities(plant.GetMyMutableContextFromRoot(ctx),
+                                    np.r_[0.3, 0.5, 1.2, rng.normal(scale=0.3, size=3)])
+    sub = h.fused.GetMyMutableContextFromRoot(ctx)
+    sub.SetContinuousState(rng.normal(scale=0.01, size=3))
+    captured = np.r_[0.0, rng.normal(scale=0.01, size=6)]
+    sub.SetDiscreteState(captured)
+    ctx.SetTime(0.4)
+    lctx = law.GetMyContextFromRoot(ctx)
+    qv, sigma, seen, tg = law.loop_values(lctx)
+    assert seen.tolist() == captured.tolist() and (tg is None) == own_targets
+    out = law.GetOutputPort("tau_sigma_dot").Eval(lctx)
+    row = law.row(0.4, qv, sigma, seen, tg)
+    tau, sigma_dot = row[law.layout["tau"]], row[law.telemetry_size + 5:]
+    assert out.tolist() == np.r_[tau, sigma_dot].tolist()
+    assert row[law.layout["sigma"]].tolist() == (sigma - captured[4:]).tolist()
+    assert np.any(np.abs(tau) > 1e-3)
+
+
+def test_fused_waypoint_target_equals_blocks():
+    """A target without a compiled row (waypoints) is evaluated in Python on the fused path too:
+    the same torque as the blocks (the compiled output once read a zero target row here)."""
+    target = WaypointTarget([0.0, 0.5, 1.0, 1.5], [[0.35, -0.1, 0.5], [0.35, -0.05, 0.5],
+                                                   [0.35, 0.0, 0.52], [0.35, 0.05, 0.5]])
+    torques = []
+    for fused in (True, False):
+        diagram, plant, h = _closed_loop(OFFSET_ARM, fused, ControllerGains(),
+                                         Schedule([Segment(0.0, 1.0, 0.75)]), target)
+        ctx = diagram.CreateDefaultContext()
+        diagram.ExecuteInitializationEvents(ctx)
+        plant.SetPositions(plant.GetMyMutableContextFromRoot(ctx), [0.3, 0.5, 1.2])
+        ctx.SetTime(0.4)
+        out = (h.fused if fused else h.controller).GetOutputPort("tau")
+        torques.append(out.Eval(out.get_system().GetMyContextFromRoot(ctx)).tolist())
+    assert torques[0] == torques[1]
