@@ -41,10 +41,11 @@ def warm_up(duration: float = 0.05) -> float:
         simulator = prepared_simulator(built, scenario)
         simulator.AdvanceTo(duration)
         law = getattr(built.controller.system, "law", None)
-        if law is not None and not law.HasInputPort("target"):
+        system = built.controller.system
+        if law is not None and not system.has_target_input and not system.has_rotation_input:
             context = law.GetMyContextFromRoot(simulator.get_context())
             qv, sigma, captured, _ = law.loop_values(context)
-            built.controller.system.telemetry_at([duration], qv[None], sigma[None], captured[None])
+            system.telemetry_at([duration], qv[None], sigma[None], captured[None])
     alpha_peak(1.5, 0.75)
     tbg_profile(0.5, 1.5, 0.75)
     _orientation_kernels()
