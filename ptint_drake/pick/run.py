@@ -33,6 +33,7 @@ from ptint_drake.pick.targets import GripperSequence, PickTargets
 from ptint_drake.pick.tasks import PickPlan, pick_plan
 from ptint_drake.pick.world import MakePickStation, PickStation
 from ptint_drake.scenario import PlantConfig, Scenario, ScenarioError
+from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
@@ -134,6 +135,7 @@ def build_pick(scenario: Scenario) -> PickBuilt:
                 for name, port in handles.log_ports.items()}
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
+    install_stateless_derivatives(diagram)  # as simulation.build: Drake's nanobind bindings
     return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits)
 
 

@@ -22,6 +22,7 @@ from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenar
 from ptint_drake.scenario_yaml import drake_version
 from ptint_drake.simulation import Built, prepared_simulator, build, simulate
 from ptint_drake.station import MakeStation
+from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
 
 CONFIGS = {
     "default": "",
@@ -205,7 +206,9 @@ def _floor_diagram(scenario, kind: str):
         source = builder.AddSystem(_ZeroTorque(station.plant.num_multibody_states(), n_act))
         builder.Connect(system.GetOutputPort("state"), source.get_input_port())
     builder.Connect(source.get_output_port(), system.GetInputPort("actuation"))
-    return Built(builder.Build(), station, None, {}, scenario.schedule())
+    diagram = builder.Build()
+    install_stateless_derivatives(diagram)  # the same treatment as ``build`` gives the controller
+    return Built(diagram, station, None, {}, scenario.schedule())
 
 
 def floors(names=None, repeats: int = 3, progress=None) -> dict:
@@ -216,7 +219,9 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
     plant with a C++ constant actuation (Drake's own floor: plant dynamics and the framework),
     with a Python LeafSystem that reads the state and outputs zeros (what any Python controller
     costs before it computes anything), and with the scenario's own controller (no loggers, no
-    monitor).  µs per derivative evaluation = the fastest of ``repeats`` wall times / the
+    monitor); all three get ``simulation.build``'s treatment of Python leaves
+    (``stateless_derivatives``), so the do-nothing floor is what a Python controller costs in
+    the package's own diagrams.  µs per derivative evaluation = the fastest of ``repeats`` wall times / the
     evaluations (the uncontrolled arms take other steps; the cost of an evaluation hardly
     depends on them).  ``needed_for_3x_us``: what an evaluation may cost for the controlled
     run to take a third of its time at the same number of evaluations.  ``kernels_us``: what
