@@ -109,21 +109,14 @@ def _too_short(i: int, tf: float, need_acc: np.ndarray, need_g: np.ndarray,
             f"{hint}")
 
 
-def singularity_warnings(plant: MultibodyPlant, scenario: Scenario, series: dict) -> list:
-    """A warning when J's smallest singular value drops below ``limits.singular_value_warning``:
-    when it first did, and the time and configuration where it was smallest."""
+def singularity_warnings(scenario: Scenario, series: dict) -> list:
+    """A warning when J's smallest singular value (``series["sigma_min_J"]``, per logged step,
+    from ``simulation.collect_series``) drops below ``limits.singular_value_warning``: when it
+    first did, and the time and configuration where it was smallest."""
     threshold = scenario.limits.singular_value_warning
     if threshold <= 0 or len(series["t"]) == 0:
         return []
-    frame = plant.GetFrameByName(scenario.robot.end_effector)
-    context = plant.CreateDefaultContext()
-    Js = np.empty((len(series["t"]), 3, plant.num_velocities()))
-    origin, world = np.zeros(3), plant.world_frame()
-    for k, q in enumerate(series["q"]):
-        plant.SetPositions(context, q)
-        Js[k] = plant.CalcJacobianTranslationalVelocity(
-            context, JacobianWrtVariable.kV, frame, origin, world, world)
-    smallest = np.linalg.svd(Js, compute_uv=False)[:, -1]  # one batched call
+    smallest = series["sigma_min_J"]
     below = np.nonzero(smallest < threshold)[0]
     if len(below) == 0:
         return []

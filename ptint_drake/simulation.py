@@ -181,7 +181,7 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
         series |= orientation_series(scenario.controller.task, kinematics, series, built.station.true_targets,
                                      scenario.schedule(), scenario.duration)
     metrics = run_metrics(scenario, samples, series, built.station.effort_limits)
-    warnings += singularity_warnings(plant, scenario, series) + joint_limit_warnings(plant, series)
+    warnings += singularity_warnings(scenario, series) + joint_limit_warnings(plant, series)
     if watchdog.failure:
         metrics["failure"] = watchdog.failure
     metrics["status"], reasons = verdict(metrics, scenario.criteria)
@@ -219,7 +219,9 @@ def _sim_info(scenario: Scenario, integrator, t_end: float, total: float, wall: 
 
 def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:
     """The per-step logs as arrays: t, q, v, the controller's telemetry, the gripper point
-    from the plant state, the true objects and the error against the active true target."""
+    from the plant state with J's smallest singular value (``sigma_min_J``, m/rad, for
+    ``run_warnings.singularity_warnings``), the true objects and the error against the active
+    true target."""
     logs = {}
     for name, logger in built.loggers.items():
         log = logger.FindLog(context)
@@ -235,13 +237,17 @@ def collect_series(built: Built, context, kinematics: FrameKinematics) -> dict:
     xdot = np.empty((len(t), 3))
     redundant = plant.num_velocities() > 3
     self_motion = np.zeros(len(t))
+    jacobians = np.empty((len(t), 3, plant.num_velocities()))
     for k in range(len(t)):
         v = state[k, nq:]
         x[k], xdot[k], J = kinematics.compute(state[k, :nq], v)
+        jacobians[k] = J
         if redundant:  # |(I − J⁺J)(q − q_start)|: how far the arm wandered in its self-motion
             dq = state[k, :nq] - state[0, :nq]
             self_motion[k] = np.linalg.norm(dq - J.T @ np.linalg.solve(J @ J.T, J @ dq))
     series["x"], series["xdot"] = x, xdot
+    series["sigma_min_J"] = np.linalg.svd(jacobians, compute_uv=False)[:, -1] if len(t) \
+        else np.empty(0)  # J's smallest singular value (m/rad): how near a singularity
     if redundant:
         series["self_motion"] = self_motion
     targets = station.true_targets
