@@ -156,10 +156,10 @@ def simulate(scenario: Scenario, check: bool = True, progress=None,
     for message in warnings if warn is not None else ():
         warn(message)
     n_before = len(warnings)
-    t_start = time.perf_counter()  # the realtime factor counts simulation, telemetry, metrics
     plant = built.plant
-    simulator = prepared_simulator(built, scenario)
     kinematics = FrameKinematics(plant, plant.GetFrameByName(scenario.robot.end_effector))
+    t_start = time.perf_counter()  # the realtime factor counts simulation, telemetry, metrics
+    simulator = prepared_simulator(built, scenario)
     nq = plant.num_positions()
 
     def gripper(ctx):

@@ -31,7 +31,7 @@ from functools import cached_property
 from typing import Optional, Sequence
 
 import numpy as np
-from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain, Multiplexer
 
 from ptint_drake.systems.controller import null_space_terms, null_space_torque
@@ -41,7 +41,8 @@ from ptint_drake.systems.interceptor_row import (pack_chain, pack_gains, pack_po
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.orientation import ROTATION_WIDTH, active_rotation_values, compiled_rotations
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
-from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE, TARGET_ROTATION_SIZE, Slots
+from ptint_drake.systems.signals import (IDENTITY_ROTATION, TARGET_PORT, TARGET_PORT_SIZE,
+                                        TARGET_ROTATION_SIZE, Slots)
 from ptint_drake.systems.sliding_surface import SurfaceLaw
 from ptint_drake.systems.targets import active_target_values, compiled_targets
 from ptint_drake.systems.task import TASK_DIM, TASKS
@@ -118,6 +119,26 @@ class InterceptorLaw(LeafSystem):
         self.DeclareVectorOutputPort("telemetry", size,
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
                                      prerequisites_of_calc=deps)
+        self._loop_writeable = True
+        self._load_kernels()
+
+    def _load_kernels(self) -> None:
+        """Evaluate the law once, now, on zero inputs with the very argument types a simulation
+        passes (the ``loop`` input's array as the bindings hand it out: read-only on Drake 1.51):
+        numba then loads the machine code from its cache (50-150 ms) while the diagram is built,
+        not at a run's first derivative evaluation, and ``row`` passes the same types, so one
+        compiled version serves both.  Nothing of it is kept (the kernel's memo is a copy's)."""
+        context = self.CreateDefaultContext()
+        self._loop_in.FixValue(context, np.zeros(self._loop_in.size()))
+        if self._rotation_in is not None:
+            self._rotation_in.FixValue(context, np.array(IDENTITY_ROTATION))
+        u = self._loop_in.EvalBasicVector(context).value()
+        self._loop_writeable = bool(u.flags.writeable)
+        if self._fast:
+            out = BasicVector(self._nv + self._n)
+            position_output(0.0, u, self._static.copy(), np.empty_like(self._row), out.get_mutable_value())
+        if not self._fast or self._null_space is not None or self._python_targets:
+            self._eval(context)
 
     @property
     def num_tasks(self) -> int:
@@ -172,8 +193,9 @@ class InterceptorLaw(LeafSystem):
                 if self._python_targets else _NO_TARGET
         if self._fast:
             row = np.empty(self._size + 5 + n)
-            position_output(float(t), np.concatenate([qv, sigma, captured, target]), self._static, row,
-                            np.empty(self._nv + n))
+            u = np.concatenate([qv, sigma, captured, target])
+            u.flags.writeable = self._loop_writeable  # the simulation's argument types (one kernel)
+            position_output(float(t), u, self._static, row, np.empty(self._nv + n))
         else:
             if self._law.reset_sigma:
                 sigma = sigma - captured[1 + n:]

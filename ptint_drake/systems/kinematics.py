@@ -35,6 +35,8 @@ class FrameKinematics:
         self._world = plant.world_frame()
         self._plant_context = plant.CreateDefaultContext()
         self._kV = JacobianWrtVariable.kV
+        if self.chain is not None:  # numba loads the compiled chain now, not at a run's first step
+            self.chain.evaluate(np.zeros(plant.num_positions()))
 
     def compute(self, q, v) -> tuple:
         """(x, ẋ, J) at joint positions q and velocities v: arrays of 3, 3 and 3 × nv."""

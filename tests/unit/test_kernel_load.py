@@ -1,0 +1,33 @@
+"""The interceptor loads its compiled kernels when it is built: a run adds no compiled version.
+
+numba loads (or compiles) a kernel for each new combination of argument types at the call
+that first passes it, and a load costs 50-150 ms.  ``InterceptorLaw`` evaluates itself once
+when built with the argument types of a simulation, and ``row`` (the telemetry after a run)
+passes the same types, so neither the first derivative evaluation nor the telemetry loads
+anything: the realtime factor measures the run, and a controller's first step is not slow.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from ptint_drake.scenario import parse_with_overrides, scenario_text
+from ptint_drake.simulation import build, prepared_simulator
+from ptint_drake.systems.interceptor_row import pose_row, position_output
+
+
+@pytest.mark.parametrize("name, kernel", [("curve_b075_tf15", position_output), ("curve_pose", pose_row)])
+def test_a_run_and_its_telemetry_load_no_kernel(name, kernel):
+    _, text = scenario_text(name)
+    scenario = parse_with_overrides(text, [], name)
+    built = build(scenario)
+    loaded = list(kernel.signatures)
+    assert loaded, f"{kernel.__name__} is not loaded when the diagram is built"
+    simulator = prepared_simulator(built, scenario)
+    simulator.AdvanceTo(0.03)
+    system = built.controller.system
+    context = system.law.GetMyContextFromRoot(simulator.get_context())
+    qv, sigma, captured, _ = system.law.loop_values(context)
+    rows = system.telemetry_at([0.03], qv[None], sigma[None], captured[None])
+    assert rows.shape == (1, system.law.telemetry_size)
+    assert list(kernel.signatures) == loaded  # the run and the telemetry used the loaded version
