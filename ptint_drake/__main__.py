@@ -2,6 +2,6 @@
 
 import sys
 
-from ptint_drake.cli import main
+from ptint_drake.cli import console
 
-sys.exit(main())
+sys.exit(console())

@@ -68,3 +68,23 @@ def test_a_value_that_is_no_number_keeps_argparses_message(capsys):
         cli.main(["tune", "x", "--margin", "two"])
     assert stop.value.code == 2
     assert "argument --margin: invalid float value: 'two'" in capsys.readouterr().err
+
+
+def test_the_program_leaves_its_heap_out_of_the_exit_collections(monkeypatch, capsys):
+    """``console`` (the ``ptint`` program) returns ``main``'s exit code with every live object
+    frozen (the interpreter's exit then skips them); ``main`` alone, as tests and notebooks
+    call it, freezes nothing."""
+    import gc
+
+    monkeypatch.setattr("sys.argv", ["ptint", "list"])
+    gc.unfreeze()
+    try:
+        assert cli.main(["list"]) == 0 and gc.get_freeze_count() == 0
+        assert cli.console() == 0
+        assert gc.get_freeze_count() > 1000
+    finally:
+        gc.unfreeze()
+    assert "curve_b075_tf15" in capsys.readouterr().out
+    monkeypatch.setattr("sys.argv", ["ptint", "run", "no_such_scenario"])
+    assert cli.console() == 2  # an error keeps its exit code
+    gc.unfreeze()
