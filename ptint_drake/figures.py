@@ -53,13 +53,10 @@ def preload(studies: bool = False) -> None:
     """Import what drawing a run's figures needs (matplotlib's figure, Agg and 3D axes,
     Pillow, SciPy's spline) and draw the kinds of text the run figures show (mathtext, each
     font size), so the font lookups and the mathtext parser are made once: worker processes
-    forked afterwards share all of it.  ``studies``: pyplot and ``scipy.signal`` too (≈ 0.8 s,
-    for the axes figure's filter: a single run leaves it to the worker drawing that figure,
-    where it overlaps the other figures).  Once per process."""
+    forked afterwards share all of it.  ``studies``: pyplot too.  Once per process."""
     if studies and "studies" not in _PRELOADED:
         _PRELOADED.add("studies")
         __getattr__("plt")
-        import scipy.signal  # noqa: F401, PLC0415
     if "figures" in _PRELOADED:
         return
     _PRELOADED.add("figures")
