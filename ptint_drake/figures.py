@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.derivatives import uniform_derivatives
+from ptint_drake.figure_grid import place_grid
 from ptint_drake.systems.tbg import alpha_gain, tbg_profile
 
 AXES = ("X", "Y", "Z")
@@ -90,17 +91,17 @@ def envelope(x: np.ndarray, y: np.ndarray, columns: int) -> tuple[np.ndarray, np
     return x[keep], y[keep]
 
 
-def save(fig, out_dir: Path, stem: str, formats=FORMATS) -> list[Path]:
+def save(fig, out_dir: Path, stem: str, formats=FORMATS, laid_out: bool = False) -> list[Path]:
     """Write ``stem.png`` (and ``stem.svg`` when in ``formats``) in ``out_dir``; returns the paths.
 
-    A figure with a constrained layout is drawn once at ``DPI`` and its pixels written as
-    the PNG; the SVG (on request) reuses that layout.  Other figures are cropped to their
-    contents (``bbox_inches="tight"``).
+    A figure with a constrained layout, or ``laid_out`` already (``figure_grid.place_grid``),
+    is drawn once at ``DPI`` and its pixels written as the PNG; the SVG (on request) reuses
+    that layout.  Other figures are cropped to their contents (``bbox_inches="tight"``).
     """
     from matplotlib.layout_engine import ConstrainedLayoutEngine  # noqa: PLC0415
 
     paths = [Path(out_dir) / f"{stem}.{ext}" for ext in formats]
-    if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+    if laid_out or isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
         _save_laid_out(fig, paths)
     else:
         for path in paths:
@@ -246,7 +247,7 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
     x_u = np.column_stack([np.interp(t_u, t, series["x"][:, k]) for k in range(3)])
     xr_u = np.column_stack([np.interp(t_u, t, series["x_r"][:, k]) for k in range(3)])
     _, vr, ar, jr = uniform_derivatives(t, series["xdot_r"])
-    fig = new_figure((12, 10.5), layout="constrained")
+    fig = new_figure((12, 10.5))
     axes = fig.subplots(4, 3, sharex=True)
     rows = (("position", "m", x_u, xr_u), ("velocity", "m/s", v, vr),
             ("acceleration", "m/s²", a, ar), ("jerk", "m/s³", j, jr))
@@ -258,7 +259,7 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
             _mark_times(ax, tfs)
             ax.grid(alpha=0.3)
             if r == 0:
-                ax.set_title(AXES[k])
+                ax.set_title(AXES[k], y=1.0)  # where it goes (no offset text to avoid there)
             if k == 0:
                 ax.set_ylabel(f"{name} [{unit}]")
             if r >= 2:  # linear axes scaled to the curves; the robot's peak marked with its time
@@ -272,9 +273,9 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
     for k in range(3):
         axes[-1, k].set_xlabel("time [s]")
     handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=9)
-    fig.suptitle(f"{title}: robot vs target per axis")
-    save(fig, out_dir, "axes", formats)
+    legend = fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9)
+    place_grid(fig, axes, fig.suptitle(f"{title}: robot vs target per axis"), legend)
+    save(fig, out_dir, "axes", formats, laid_out=True)
 
 
 def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:

@@ -8,7 +8,8 @@ from ptint_drake.derivatives import savgol_derivative, uniform_derivatives
 
 
 @pytest.mark.parametrize("shape", [(400,), (300, 3)])
-@pytest.mark.parametrize(("window", "order", "deriv"), [(21, 3, 1), (21, 3, 2), (5, 3, 2), (11, 2, 1), (9, 4, 3)])
+@pytest.mark.parametrize(("window", "order", "deriv"),
+                         [(21, 3, 1), (21, 3, 2), (5, 3, 2), (11, 2, 1), (9, 4, 3)])
 def test_savgol_derivative_equals_scipy(shape, window, order, deriv):
     rng = np.random.default_rng(7)
     t = np.arange(shape[0]) * 1e-3
