@@ -26,7 +26,9 @@ def place_grid(fig, axes, suptitle=None, legend=None) -> None:
     row's titles, every panel's y tick labels and offset text (e.g. ``1e3``), the first
     column's y labels, the bottom row's x tick labels and labels, and ``legend`` (a figure
     legend at the lower centre) below them; ``PAD_PT`` between any two of them, ``GAP_PT``
-    between two rows.  Every axis label is then pinned beside its own tick labels."""
+    between two rows.  Every axis label is then pinned beside its own tick labels, and the
+    titles above the top row's offset texts if there are any (pin a title's place with
+    ``set_title(..., y=1.0)``: otherwise the draw measures the panel again to place it)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: PLC0415
 
     renderer = FigureCanvasAgg(fig).get_renderer()
@@ -34,26 +36,30 @@ def place_grid(fig, axes, suptitle=None, legend=None) -> None:
     width, height = fig.bbox.width, fig.bbox.height
     pad, row_gap = PAD_PT * fig.dpi / 72.0, GAP_PT * fig.dpi / 72.0
     fig.subplots_adjust(left=0.1, right=0.95, bottom=0.1, top=0.9)
-    top = pad  # vertical: fixed by the fonts
+    head = pad  # vertical: fixed by the fonts (and any y offset text)
     if suptitle is not None:  # at the top edge, ``PAD_PT`` below it
         suptitle.set_y(1.0 - pad / height)
-        top += suptitle.get_window_extent(renderer).height + pad
-    top += max(_beyond(ax, ax.title, renderer)[3] for ax in grid[0]) + pad
+        head += suptitle.get_window_extent(renderer).height + pad
+    titles = max(_beyond(ax, ax.title, renderer)[3] for ax in grid[0])
     below = {ax: _tick_reach(ax, ax.xaxis, renderer, 1) for ax in grid[-1]}
     bottom = pad + max(below[ax] + _label_depth(ax.xaxis, renderer) for ax in grid[-1])
     bottom += legend.get_window_extent(renderer).y1 + pad if legend is not None else 0.0
-    offset = 0.0
-    for _ in range(2):  # again only if a y offset text (e.g. "1e3") appears above a lower row
-        _adjust(fig, grid.shape, (None, width - pad), (bottom, height - top), (None, row_gap + offset))
+    offsets = np.zeros(2)  # room for a y offset text (e.g. "1e3") above the top row, the others
+    for _ in range(3):  # again only when an offset text appears where there was no room for it
+        top = head + titles + offsets[0] + pad  # the titles go above an offset text
+        _adjust(fig, grid.shape, (None, width - pad), (bottom, height - top), (None, row_gap + offsets[1]))
         left_of = {ax: _tick_reach(ax, ax.yaxis, renderer, 0) for ax in grid.flat}  # the y ticks
-        above = max((_offset_height(ax.yaxis, renderer) for ax in grid[1:].flat), default=0.0)
-        if above <= offset:
+        found = [max((_offset_height(ax.yaxis, renderer) for ax in rows.flat), default=0.0)
+                 for rows in (grid[:1], grid[1:])]
+        if np.all(found <= offsets):
             break
-        offset = above
+        offsets = np.maximum(offsets, found)
     left = pad + max(left_of[ax] + _label_depth(ax.yaxis, renderer) for ax in grid[:, 0])
     gap = pad + max((left_of[ax] + _label_depth(ax.yaxis, renderer) for ax in grid[:, 1:].flat), default=0.0)
     right = pad + max(_tick_reach(ax, ax.xaxis, renderer, 2) for ax in grid[-1])
-    _adjust(fig, grid.shape, (left, width - right), (bottom, height - top), (gap, row_gap + offset))
+    _adjust(fig, grid.shape, (left, width - right), (bottom, height - top), (gap, row_gap + offsets[1]))
+    for ax in grid[0]:
+        ax.title.set_y(1.0 + offsets[0] / ax.bbox.height)
     for ax in grid.flat:  # where the draw would put each label: ``labelpad`` beyond its tick labels
         ax.yaxis.set_label_coords(-(left_of[ax] + _labelpad(ax.yaxis)) / ax.bbox.width, 0.5)
         ax.xaxis.set_label_coords(0.5, -(below.get(ax, 0.0) + _labelpad(ax.xaxis)) / ax.bbox.height)
@@ -111,6 +117,10 @@ def _label_depth(axis, renderer) -> float:
 
 
 def _offset_height(axis, renderer) -> float:
-    """The height of the axis' offset text (e.g. "1e3"), 0 without one [pixels]."""
-    text = axis.offsetText
-    return text.get_window_extent(renderer).height if text.get_visible() and text.get_text() else 0.0
+    """How far a y axis' offset text (e.g. "1e3") reaches above its panel, 0 without one: the
+    draw puts it ``OFFSETTEXTPAD`` points above the frame [pixels]."""
+    text, offset = axis.offsetText, axis.get_major_formatter().get_offset()  # of the ticks computed
+    if not (text.get_visible() and offset):
+        return 0.0
+    text.set_text(offset)  # as the draw will
+    return axis.OFFSETTEXTPAD * renderer.dpi / 72.0 + text.get_window_extent(renderer).height
