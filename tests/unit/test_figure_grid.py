@@ -46,7 +46,8 @@ def test_nothing_leaves_the_figure_or_overlaps():
         for b in everything[i + 1:]:
             assert not a.overlaps(b), (a, b)
     for ax in axes[0]:  # the titles clear the offset texts
-        assert not ax.title.get_window_extent(renderer).overlaps(ax.yaxis.offsetText.get_window_extent(renderer))
+        offset = ax.yaxis.offsetText.get_window_extent(renderer)
+        assert not ax.title.get_window_extent(renderer).overlaps(offset)
     # the axis labels sit where the draw would put them: beside their own tick labels
     for ax in axes[:, 0]:
         ticks = max(t.get_window_extent(renderer).x0 for t in ax.get_yticklabels() if t.get_text())
