@@ -25,14 +25,16 @@ def place_grid(fig, axes, suptitle=None, legend=None) -> None:
     the panels overlaps or leaves the figure: ``suptitle`` (its ``Text``) on top, the top
     row's titles, every panel's y tick labels and offset text (e.g. ``1e3``), the first
     column's y labels, the bottom row's x tick labels and labels, and ``legend`` (a figure
-    legend at the lower centre) below them; ``PAD_PT`` between any two of them, ``GAP_PT``
+    legend at the lower centre) below them, the last column's legends where they reach out
+    to the right (``bbox_to_anchor=(1.01, 1.0)``); ``PAD_PT`` between any two of them, ``GAP_PT``
     between two rows.  Every axis label is then pinned beside its own tick labels, and the
     titles above the top row's offset texts if there are any (pin a title's place with
     ``set_title(..., y=1.0)``: otherwise the draw measures the panel again to place it)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: PLC0415
 
     renderer = FigureCanvasAgg(fig).get_renderer()
-    grid = np.asarray(axes, dtype=object).reshape(len(axes), -1)
+    grid = np.asarray(axes, dtype=object)
+    grid = grid.reshape(grid.shape[0] if grid.ndim else 1, -1)
     width, height = fig.bbox.width, fig.bbox.height
     pad, row_gap = PAD_PT * fig.dpi / 72.0, GAP_PT * fig.dpi / 72.0
     fig.subplots_adjust(left=0.1, right=0.95, bottom=0.1, top=0.9)
@@ -56,7 +58,8 @@ def place_grid(fig, axes, suptitle=None, legend=None) -> None:
         offsets = np.maximum(offsets, found)
     left = pad + max(left_of[ax] + _label_depth(ax.yaxis, renderer) for ax in grid[:, 0])
     gap = pad + max((left_of[ax] + _label_depth(ax.yaxis, renderer) for ax in grid[:, 1:].flat), default=0.0)
-    right = pad + max(_tick_reach(ax, ax.xaxis, renderer, 2) for ax in grid[-1])
+    legends = [_beyond(ax, ax.get_legend(), renderer)[2] for ax in grid[:, -1] if ax.get_legend()]
+    right = pad + max([_tick_reach(ax, ax.xaxis, renderer, 2) for ax in grid[-1]] + legends)
     _adjust(fig, grid.shape, (left, width - right), (bottom, height - top), (gap, row_gap + offsets[1]))
     for ax in grid[0]:
         ax.title.set_y(1.0 + offsets[0] / ax.bbox.height)

@@ -282,7 +282,7 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
 
 def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig = new_figure((10, 8.5), layout="constrained")
+    fig = new_figure((10, 8.5))
     axes = fig.subplots(3, 1, sharex=True)
     e_norm = np.linalg.norm(series["e_true"], axis=1)
     width = _columns(fig)
@@ -301,7 +301,8 @@ def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, 
         verdict = "intercepted" if status == "ok" else f"{status.upper()} ({', '.join(metrics['reasons'])})"
     else:
         verdict = "intercepted" if all(hit) else f"{len(hit) - sum(hit)} of {len(hit)} late"
-    axes[0].set_title(f"|e($t_f$)| = {values} mm (criterion ≤ {bound * 1e3:g} mm): {verdict}", fontsize=10)
+    axes[0].set_title(f"|e($t_f$)| = {values} mm (criterion ≤ {bound * 1e3:g} mm): {verdict}",
+                      fontsize=10, y=1.0)
     axes[0].set_ylabel("|e| [m]")
     for k, axis in enumerate(AXES):  # per axis, as the paper's Fig. 16
         axes[1].plot(*envelope(t, series["edot_true"][:, k], width), label=f"ė_{axis.lower()}")
@@ -317,13 +318,13 @@ def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, 
         _mark_times(ax, tfs)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    fig.suptitle(f"{title}: interception error, velocity error, torques")
-    save(fig, out_dir, "errors", formats)
+    place_grid(fig, axes, fig.suptitle(f"{title}: interception error, velocity error, torques"))
+    save(fig, out_dir, "errors", formats, laid_out=True)
 
 
 def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig = new_figure((8, 7), layout="constrained")
+    fig = new_figure((8, 7))
     axes = fig.subplots(series["q"].shape[1], 1, sharex=True)
     for k, ax in enumerate(np.atleast_1d(axes)):
         ax.plot(*envelope(t, np.degrees(series["q"][:, k]), _columns(fig)))
@@ -332,8 +333,8 @@ def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, 
         ax.grid(alpha=0.3)
     np.atleast_1d(axes)[0].legend(fontsize=8, loc="best")
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
-    fig.suptitle(f"{title}: joint trajectories (model angles θ)")
-    save(fig, out_dir, "joints", formats)
+    place_grid(fig, axes, fig.suptitle(f"{title}: joint trajectories (model angles θ)"))
+    save(fig, out_dir, "joints", formats, laid_out=True)
 
 
 def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
