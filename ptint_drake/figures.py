@@ -9,8 +9,8 @@ velocity resampled on a uniform 1 ms grid (the integrator's steps are not unifor
 What a figure costs is what it shows: matplotlib is imported when a figure is drawn
 (not with this module; ``pyplot`` only for the studies that ask for ``figures.plt``), a
 line is drawn with at most two points (its minimum and maximum) per pixel column
-(``envelope``), and a figure laid out by matplotlib's constrained layout is drawn once,
-at the PNG's resolution, its pixels written as the PNG (``save``).
+(``envelope``), the run's grids are laid out by measuring them once (``figure_grid``), and
+a laid-out figure is drawn once, at the PNG's resolution, its pixels the PNG (``save``).
 """
 
 from __future__ import annotations
