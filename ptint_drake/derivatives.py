@@ -2,23 +2,52 @@
 a Savitzky–Golay filter (the integrator's steps are not uniform, and its error, relative
 1e-4, would dominate a finite-difference jerk).
 
-The filter is SciPy's ``savgol_filter``, imported where it is used (``scipy.signal`` costs
-about 0.2–0.8 s to import, so a run that draws no acceleration figure does not pay it).
+The filter (``savgol_derivative``) is the Savitzky–Golay least-squares polynomial smoother
+(A. Savitzky and M. J. E. Golay, Anal. Chem. 36(8), 1964), with the edges treated as SciPy's
+``scipy.signal.savgol_filter`` does for ``mode="interp"``: equal to it to 1e-12
+(tests/unit/test_derivatives.py), without importing ``scipy.signal`` (≈ 0.7–1.3 s: it imports
+``scipy.stats``) in the process that draws the figure.
 """
 
 from __future__ import annotations
 
+from math import factorial
+
 import numpy as np
+from numpy.polynomial import polynomial as P
+
+
+def savgol_derivative(v: np.ndarray, window: int, order: int, deriv: int, delta: float) -> np.ndarray:
+    """The ``deriv``-th derivative of the samples ``v`` (spacing ``delta``, along axis 0) by a
+    Savitzky–Golay filter: a polynomial of degree ``order`` fitted by least squares to the
+    ``window`` (odd) samples around each one, differentiated at its centre.  The first and last
+    ``window // 2`` samples take the derivative of the polynomial fitted to the first (last)
+    ``window`` samples, at their own places (SciPy's ``mode="interp"``)."""
+    half = window // 2
+    # weights w with w · v[i - half : i + half + 1] = the fitted polynomial's derivative at i:
+    # the minimum-norm solution of A w = e, A[p, j] = (j - half)^p, e[p] = deriv! / δ^deriv at p = deriv
+    offsets = np.arange(-half, half + 1, dtype=float)
+    vandermonde = offsets[np.newaxis, :] ** np.arange(order + 1)[:, np.newaxis]
+    target = np.zeros(order + 1)
+    target[deriv] = factorial(deriv) / delta**deriv
+    weights = np.linalg.lstsq(vandermonde, target, rcond=None)[0]
+    n = len(v)
+    out = np.empty(v.shape, dtype=float)
+    out[half:n - half] = np.lib.stride_tricks.sliding_window_view(v, window, axis=0) @ weights
+    local = np.arange(window, dtype=float)  # the edge windows: first and last ``window`` samples
+    for rows, start in ((slice(0, half), 0), (slice(n - half, n), n - window)):
+        coef = P.polyder(P.polyfit(local, v[start:start + window], order), deriv)
+        out[rows] = P.polyval(local[rows.start - start:rows.stop - start], coef).T / delta**deriv
+    return out
 
 
 def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3, window_s: float = 0.021):
-    """(t_u, ẋ, ẍ, x⃛) on a uniform grid from per-step samples of ẋ.
+    """(t_u, ẋ, ẍ, x⃛) on a uniform grid from per-step samples of ẋ (axis 0: time).
 
     The samples are put on a uniform ``dt`` grid by a cubic spline, then
     differentiated with a Savitzky–Golay filter (cubic, ``window_s`` wide).
     """
     from scipy.interpolate import CubicSpline  # noqa: PLC0415  (only where a figure needs it)
-    from scipy.signal import savgol_filter  # noqa: PLC0415  (≈ 0.2–0.8 s to import: only here)
 
     keep = np.concatenate([[True], np.diff(t) > 1e-12])
     spline = CubicSpline(t[keep], xdot[keep], axis=0)
@@ -27,5 +56,4 @@ def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3, windo
     n = max(5, int(round(window_s / dt)) | 1)
     if len(t_u) <= n:
         return t_u, v, spline(t_u, 1), spline(t_u, 2)
-    return (t_u, v, savgol_filter(v, n, 3, deriv=1, delta=dt, axis=0),
-            savgol_filter(v, n, 3, deriv=2, delta=dt, axis=0))
+    return t_u, v, savgol_derivative(v, n, 3, 1, dt), savgol_derivative(v, n, 3, 2, dt)

@@ -9,8 +9,8 @@ velocity resampled on a uniform 1 ms grid (the integrator's steps are not unifor
 What a figure costs is what it shows: matplotlib is imported when a figure is drawn
 (not with this module; ``pyplot`` only for the studies that ask for ``figures.plt``), a
 line is drawn with at most two points (its minimum and maximum) per pixel column
-(``envelope``), and a figure laid out by matplotlib's constrained layout is drawn once,
-at the PNG's resolution, its pixels written as the PNG (``save``).
+(``envelope``), the run's grids are laid out by measuring them once (``figure_grid``), and
+a laid-out figure is drawn once, at the PNG's resolution, its pixels the PNG (``save``).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.derivatives import uniform_derivatives
+from ptint_drake.figure_grid import place_grid
 from ptint_drake.systems.tbg import alpha_gain, tbg_profile
 
 AXES = ("X", "Y", "Z")
@@ -53,13 +54,10 @@ def preload(studies: bool = False) -> None:
     """Import what drawing a run's figures needs (matplotlib's figure, Agg and 3D axes,
     Pillow, SciPy's spline) and draw the kinds of text the run figures show (mathtext, each
     font size), so the font lookups and the mathtext parser are made once: worker processes
-    forked afterwards share all of it.  ``studies``: pyplot and ``scipy.signal`` too (≈ 0.8 s,
-    for the axes figure's filter: a single run leaves it to the worker drawing that figure,
-    where it overlaps the other figures).  Once per process."""
+    forked afterwards share all of it.  ``studies``: pyplot too.  Once per process."""
     if studies and "studies" not in _PRELOADED:
         _PRELOADED.add("studies")
         __getattr__("plt")
-        import scipy.signal  # noqa: F401, PLC0415
     if "figures" in _PRELOADED:
         return
     _PRELOADED.add("figures")
@@ -93,17 +91,17 @@ def envelope(x: np.ndarray, y: np.ndarray, columns: int) -> tuple[np.ndarray, np
     return x[keep], y[keep]
 
 
-def save(fig, out_dir: Path, stem: str, formats=FORMATS) -> list[Path]:
+def save(fig, out_dir: Path, stem: str, formats=FORMATS, laid_out: bool = False) -> list[Path]:
     """Write ``stem.png`` (and ``stem.svg`` when in ``formats``) in ``out_dir``; returns the paths.
 
-    A figure with a constrained layout is drawn once at ``DPI`` and its pixels written as
-    the PNG; the SVG (on request) reuses that layout.  Other figures are cropped to their
-    contents (``bbox_inches="tight"``).
+    A figure with a constrained layout, or ``laid_out`` already (``figure_grid.place_grid``),
+    is drawn once at ``DPI`` and its pixels written as the PNG; the SVG (on request) reuses
+    that layout.  Other figures are cropped to their contents (``bbox_inches="tight"``).
     """
     from matplotlib.layout_engine import ConstrainedLayoutEngine  # noqa: PLC0415
 
     paths = [Path(out_dir) / f"{stem}.{ext}" for ext in formats]
-    if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+    if laid_out or isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
         _save_laid_out(fig, paths)
     else:
         for path in paths:
@@ -116,17 +114,19 @@ def save(fig, out_dir: Path, stem: str, formats=FORMATS) -> list[Path]:
 
 
 def _save_laid_out(fig, paths) -> None:
-    """One draw at ``DPI`` (layout included), its pixels as the PNG; then the layout frozen
-    for the vector formats."""
+    """One draw at ``DPI`` (layout included), its pixels as the PNG (RGB when every pixel is
+    opaque); then the layout frozen for the vector formats."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: PLC0415
     from PIL import Image  # noqa: PLC0415
 
     fig.set_dpi(DPI)
     canvas = FigureCanvasAgg(fig)
     canvas.draw()
+    rgba = np.asarray(canvas.buffer_rgba())
+    pixels = rgba[..., :3] if rgba[..., 3].min() == 255 else rgba  # opaque: RGB, the same image
     for path in paths:
-        if path.suffix == ".png":
-            Image.fromarray(np.asarray(canvas.buffer_rgba())).save(path, format="png", dpi=(DPI, DPI))
+        if path.suffix == ".png":  # zlib level 1: a third of the default's time, about its size
+            Image.fromarray(pixels).save(path, format="png", dpi=(DPI, DPI), compress_level=1)
     fig.set_layout_engine("none")
     for path in paths:
         if path.suffix != ".png":
@@ -249,7 +249,7 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
     x_u = np.column_stack([np.interp(t_u, t, series["x"][:, k]) for k in range(3)])
     xr_u = np.column_stack([np.interp(t_u, t, series["x_r"][:, k]) for k in range(3)])
     _, vr, ar, jr = uniform_derivatives(t, series["xdot_r"])
-    fig = new_figure((12, 10.5), layout="constrained")
+    fig = new_figure((12, 10.5))
     axes = fig.subplots(4, 3, sharex=True)
     rows = (("position", "m", x_u, xr_u), ("velocity", "m/s", v, vr),
             ("acceleration", "m/s²", a, ar), ("jerk", "m/s³", j, jr))
@@ -261,7 +261,7 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
             _mark_times(ax, tfs)
             ax.grid(alpha=0.3)
             if r == 0:
-                ax.set_title(AXES[k])
+                ax.set_title(AXES[k], y=1.0)  # where it goes (no offset text to avoid there)
             if k == 0:
                 ax.set_ylabel(f"{name} [{unit}]")
             if r >= 2:  # linear axes scaled to the curves; the robot's peak marked with its time
@@ -275,14 +275,14 @@ def _axes_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, fo
     for k in range(3):
         axes[-1, k].set_xlabel("time [s]")
     handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=9)
-    fig.suptitle(f"{title}: robot vs target per axis")
-    save(fig, out_dir, "axes", formats)
+    legend = fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9)
+    place_grid(fig, axes, fig.suptitle(f"{title}: robot vs target per axis"), legend)
+    save(fig, out_dir, "axes", formats, laid_out=True)
 
 
 def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig = new_figure((10, 8.5), layout="constrained")
+    fig = new_figure((10, 8.5))
     axes = fig.subplots(3, 1, sharex=True)
     e_norm = np.linalg.norm(series["e_true"], axis=1)
     width = _columns(fig)
@@ -301,7 +301,8 @@ def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, 
         verdict = "intercepted" if status == "ok" else f"{status.upper()} ({', '.join(metrics['reasons'])})"
     else:
         verdict = "intercepted" if all(hit) else f"{len(hit) - sum(hit)} of {len(hit)} late"
-    axes[0].set_title(f"|e($t_f$)| = {values} mm (criterion ≤ {bound * 1e3:g} mm): {verdict}", fontsize=10)
+    axes[0].set_title(f"|e($t_f$)| = {values} mm (criterion ≤ {bound * 1e3:g} mm): {verdict}",
+                      fontsize=10, y=1.0)
     axes[0].set_ylabel("|e| [m]")
     for k, axis in enumerate(AXES):  # per axis, as the paper's Fig. 16
         axes[1].plot(*envelope(t, series["edot_true"][:, k], width), label=f"ė_{axis.lower()}")
@@ -317,13 +318,13 @@ def _errors_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, 
         _mark_times(ax, tfs)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    fig.suptitle(f"{title}: interception error, velocity error, torques")
-    save(fig, out_dir, "errors", formats)
+    place_grid(fig, axes, fig.suptitle(f"{title}: interception error, velocity error, torques"))
+    save(fig, out_dir, "errors", formats, laid_out=True)
 
 
 def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
     t = series["t"]
-    fig = new_figure((8, 7), layout="constrained")
+    fig = new_figure((8, 7))
     axes = fig.subplots(series["q"].shape[1], 1, sharex=True)
     for k, ax in enumerate(np.atleast_1d(axes)):
         ax.plot(*envelope(t, np.degrees(series["q"][:, k]), _columns(fig)))
@@ -332,8 +333,8 @@ def _joints_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, 
         ax.grid(alpha=0.3)
     np.atleast_1d(axes)[0].legend(fontsize=8, loc="best")
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
-    fig.suptitle(f"{title}: joint trajectories (model angles θ)")
-    save(fig, out_dir, "joints", formats)
+    place_grid(fig, axes, fig.suptitle(f"{title}: joint trajectories (model angles θ)"))
+    save(fig, out_dir, "joints", formats, laid_out=True)
 
 
 def _paths_figure(series: dict, metrics: dict, tfs, out_dir: Path, title: str, formats) -> None:
