@@ -21,7 +21,8 @@ def test_a_tf_the_actuators_cannot_do_is_a_miss(tmp_path, ptint_here):
 
 
 def test_the_paper_run_is_ok_and_exits_0(tmp_path, ptint_here):
-    out = ptint_here("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay", "--no-figures")
+    out = ptint_here("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
+                     "--no-figures")
     assert out.returncode == 0, out.stderr
     assert out.stdout.rstrip().endswith("ok (every segment meets the criteria)")
     m = json.loads((tmp_path / "metrics.json").read_text())
