@@ -1,13 +1,13 @@
-"""ptint tune: gains for an arm the paper's gains do not fit, checked against a fine grid.
-
-The commands run in this process (``ptint_here``): tune's runs are in its worker processes
-either way, and test_cli.py keeps a real ``ptint run``."""
+"""ptint tune: gains for an arm the paper's gains do not fit, checked against a fine grid."""
 
 import json
+import subprocess
+import sys
 
 import numpy as np
 from conftest import TOO_SHORT_TF
 from heavy_arm import heavy_arm_scenario, heavy_arm_urdf
+from test_cli import ptint
 
 from ptint_drake.scenario import apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
@@ -25,14 +25,14 @@ def _heavy(tmp_path):
     return scenario
 
 
-def test_tune_finds_gains_for_a_heavy_six_joint_arm(tmp_path, ptint_here, monkeypatch):
+def test_tune_finds_gains_for_a_heavy_six_joint_arm(tmp_path):
     scenario = _heavy(tmp_path)
     text = scenario.read_text()
     # the paper's gains (K = 50) miss on this arm once its masses are 1.5 × the model's
     heavy = apply_variant(parse_scenario(text), "mass_x1.5")
     assert simulate(heavy, check=False).metrics["status"] == "missed"
 
-    out = ptint_here("tune", str(scenario), "--workers", "2", "--out", str(tmp_path / "tuned"), "--quiet")
+    out = ptint("tune", str(scenario), "--workers", "2", "--out", str(tmp_path / "tuned"), "--quiet")
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith("K = ") and "margin 2" in out.stdout
     result = json.loads((tmp_path / "tuned" / "tune.json").read_text())
@@ -66,16 +66,16 @@ def test_tune_finds_gains_for_a_heavy_six_joint_arm(tmp_path, ptint_here, monkey
     # tuned.yaml runs as it is from another folder
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
-    monkeypatch.chdir(elsewhere)
-    run = ptint_here("run", str(tmp_path / "tuned" / "tuned.yaml"), "--out", "o", "--quiet", "--no-replay",
-                     "--no-figures", "--set", "plant.mass_scale=1.5")
+    run = subprocess.run([sys.executable, "-m", "ptint_drake", "run", str(tmp_path / "tuned" / "tuned.yaml"),
+                          "--out", "o", "--quiet", "--no-replay", "--no-figures", "--set",
+                          "plant.mass_scale=1.5"], capture_output=True, text=True, cwd=elsewhere, timeout=600)
     assert run.returncode == 0, run.stdout + run.stderr
     assert json.loads((elsewhere / "o" / "metrics.json").read_text())["status"] == "ok"
 
 
-def test_tune_on_the_paper_robot_says_how_it_compares(tmp_path, ptint_here):
-    out = ptint_here("tune", "curve_b075_tf15", "--variants", "nominal,mass_x1.5", "--workers", "2",
-                     "--out", str(tmp_path), "--quiet")
+def test_tune_on_the_paper_robot_says_how_it_compares(tmp_path):
+    out = ptint("tune", "curve_b075_tf15", "--variants", "nominal,mass_x1.5", "--workers", "2",
+                "--out", str(tmp_path), "--quiet")
     assert out.returncode == 0, out.stderr
     assert "× the scenario's 50" in out.stdout
     result = json.loads((tmp_path / "tune.json").read_text())
@@ -84,11 +84,11 @@ def test_tune_on_the_paper_robot_says_how_it_compares(tmp_path, ptint_here):
     assert simulate(tuned, check=False).metrics["status"] == "ok"
 
 
-def test_no_gain_can_save_a_too_short_tf(tmp_path, ptint_here):
+def test_no_gain_can_save_a_too_short_tf(tmp_path):
     scenario = tmp_path / "short.yaml"
     scenario.write_text(TOO_SHORT_TF)
-    out = ptint_here("tune", str(scenario), "--variants", "nominal", "--workers", "2",
-                     "--out", str(tmp_path / "out"), "--quiet")
+    out = ptint("tune", str(scenario), "--variants", "nominal", "--workers", "2",
+                "--out", str(tmp_path / "out"), "--quiet")
     assert out.returncode == 1, out.stderr
     assert out.stdout.startswith("no K in [") and "late" in out.stdout
     assert not (tmp_path / "out" / "tuned.yaml").exists()
