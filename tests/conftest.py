@@ -113,9 +113,10 @@ interceptions:
 # The longest files first (pyproject.toml runs the files on two processes, a whole file to one,
 # in this order: a long file started last would keep one process busy while the other idles),
 # then the other end-to-end files, then tests/unit.  Measured with --durations; order only.
-LONGEST_FIRST = ("test_notebooks.py", "test_visuals.py", "test_pick_place.py", "test_pose.py",
-                 "test_tune.py", "test_controllers.py", "test_cli_hygiene.py", "test_runner.py",
-                 "test_robustness.py", "test_plugin.py", "test_sweep.py", "test_benchmark.py")
+LONGEST_FIRST = ("test_notebooks.py", "test_visuals.py", "test_pick_place.py", "test_runner.py",
+                 "test_plugin.py", "test_sweep.py", "test_tune.py", "test_filter_floor.py",
+                 "test_benchmark.py", "test_robustness.py", "test_pose.py", "test_controllers.py",
+                 "test_switching.py", "test_cli_hygiene.py")
 
 
 def _run_order(item) -> tuple:

@@ -3,8 +3,6 @@ per-evaluation cost floors (structure only: timings are for the benchmark's JSON
 
 import functools
 import json
-import subprocess
-import sys
 
 import pytest
 
@@ -46,9 +44,9 @@ def test_floors_structure():
     assert row["needed_for_3x_us"] == pytest.approx(row["controller"]["us_per_evaluation"] / 3, abs=0.011)
 
 
-def test_cli_floors_prints_json():
-    out = subprocess.run([sys.executable, "-m", "ptint_drake", "bench", "--floors", "--repeats", "1",
-                          "curve_b075_tf12"], capture_output=True, text=True, check=False, timeout=300)
+def test_cli_floors_prints_json(ptint_here):
+    """``ptint bench --floors`` in this process: its JSON is what it prints on stdout."""
+    out = ptint_here("bench", "--floors", "--repeats", "1", "curve_b075_tf12")
     assert out.returncode == 0, out.stderr
     result = json.loads(out.stdout)
     assert set(result["floors"]) == {"curve_b075_tf12"} and result["machine"]["drake"]

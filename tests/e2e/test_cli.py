@@ -20,8 +20,9 @@ def ptint(*args):
                           text=True, cwd=Path(__file__).parent, timeout=600)
 
 
-def test_list_names_every_paper_scenario():
-    out = ptint("list")
+def test_list_names_every_paper_scenario(ptint_here):
+    """In this process (test_cli_hygiene.py pipes the real command into head)."""
+    out = ptint_here("list")
     assert out.returncode == 0
     names = [line.split()[0] for line in out.stdout.splitlines()]
     assert set(PAPER) <= set(names)
@@ -59,8 +60,8 @@ def test_run_writes_spec_outputs(tmp_path):
     assert not list(tmp_path.glob(".ptint-stage-*"))
 
 
-def test_set_overrides_a_field(tmp_path):
-    out = ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
+def test_set_overrides_a_field(tmp_path, ptint_here):
+    out = ptint_here("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
                 "--no-figures", "--set", "interceptions=[{start: 0, tf: 1.0, beta: 0.5, target: "
                 "{linear: {start: [0.25, 0.05, 0.3], velocity: [0, 0.05, 0]}}}]", "--set", "duration=1.5")
     assert out.returncode == 0, out.stderr
@@ -119,18 +120,18 @@ def test_bad_input_fails_with_one_line(tmp_path, case, ptint_here):
     assert not (out_dir / "metrics.json").exists()
 
 
-def test_missing_scenario_name():
-    out = ptint("run", "no_such_scenario", "--quiet")
+def test_missing_scenario_name(ptint_here):
+    out = ptint_here("run", "no_such_scenario", "--quiet")
     assert out.returncode == 2 and "scenario" in out.stderr and "Traceback" not in out.stderr
 
 
-def test_failed_run_keeps_previous_complete_output(tmp_path):
+def test_failed_run_keeps_previous_complete_output(tmp_path, ptint_here):
     """A bad scenario into a folder with a complete run leaves that run intact."""
-    ok = ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
+    ok = ptint_here("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
                "--no-figures")
     assert ok.returncode == 0
     before = (tmp_path / "metrics.json").read_text()
     bad = tmp_path / "bad.yaml"
     bad.write_text(BAD["beta_high"][0])
-    assert ptint("run", str(bad), "--out", str(tmp_path), "--quiet").returncode == 2
+    assert ptint_here("run", str(bad), "--out", str(tmp_path), "--quiet").returncode == 2
     assert (tmp_path / "metrics.json").read_text() == before

@@ -20,10 +20,9 @@ from ptint_drake.scenario_yaml import override_text
 TESTS = Path(__file__).parent
 
 
-def ptint(*args, umask=None):
+def ptint(*args):
     return subprocess.run([sys.executable, "-m", "ptint_drake", *args], check=False, capture_output=True,
-                          text=True, cwd=TESTS, timeout=600,
-                          umask=-1 if umask is None else umask)
+                          text=True, cwd=TESTS, timeout=600)
 
 
 def _one_error_line(out):
@@ -135,8 +134,8 @@ def test_bad_set_path_on_the_command_line(tmp_path, pair, ptint_here):
     assert not (tmp_path / "o" / "metrics.json").exists()
 
 
-def test_set_on_a_list_item_changes_the_run(tmp_path):
-    out = ptint("run", "curve_b075_tf15", "--set", "interceptions[0].tf=1.2", "--no-replay",
+def test_set_on_a_list_item_changes_the_run(tmp_path, ptint_here):
+    out = ptint_here("run", "curve_b075_tf15", "--set", "interceptions[0].tf=1.2", "--no-replay",
                 "--no-figures", "--quiet", "--out", str(tmp_path))
     assert out.returncode == 0, out.stderr
     m = json.loads((tmp_path / "metrics.json").read_text())
@@ -163,8 +162,9 @@ def test_progress_prints_a_line_per_tenth_when_not_a_tty(monkeypatch):
     assert err.getvalue().splitlines()[-1] == "two-arg:  50 % (1.50/3.00 s simulated)"
 
 
-def test_progress_lines_appear_on_a_non_tty_stderr(tmp_path):
-    out = ptint("run", "curve_b075_tf15", "--set", "duration=12", "--no-replay", "--no-figures",
+def test_progress_lines_appear_on_a_non_tty_stderr(tmp_path, ptint_here):
+    """``ptint run`` in this process, its stderr captured (not a terminal)."""
+    out = ptint_here("run", "curve_b075_tf15", "--set", "duration=12", "--no-replay", "--no-figures",
                 "--out", str(tmp_path))
     assert out.returncode == 0, out.stderr
     lines = [line for line in out.stderr.splitlines() if re.search(r"\d+ % \(", line)]
@@ -201,14 +201,19 @@ def test_atomic_and_staged_files_follow_the_umask(tmp_path):
         assert mode == (0o755 if path.is_dir() else 0o644), (path, oct(mode))
 
 
-def test_run_and_robust_outputs_readable_under_umask_022(tmp_path):
+def test_run_and_robust_outputs_readable_under_umask_022(tmp_path, ptint_here):
+    """Both commands in this process under umask 022 (the package reads the umask when it
+    writes, and the figure workers it forks inherit it)."""
     run_dir, robust_dir = tmp_path / "run", tmp_path / "robust"
-    out = ptint("run", "curve_b075_tf15", "--no-replay", "--quiet", "--out", str(run_dir),
-                umask=0o022)
-    assert out.returncode == 0, out.stderr
-    out = ptint("robust", "curve_b075_tf15", "--samples", "1", "--workers", "1", "--quiet",
-                "--out", str(robust_dir), umask=0o022)
-    assert out.returncode == 0, out.stderr
+    old = os.umask(0o022)
+    try:
+        out = ptint_here("run", "curve_b075_tf15", "--no-replay", "--quiet", "--out", str(run_dir))
+        assert out.returncode == 0, out.stderr
+        out = ptint_here("robust", "curve_b075_tf15", "--samples", "1", "--workers", "1", "--quiet",
+                         "--out", str(robust_dir))
+        assert out.returncode == 0, out.stderr
+    finally:
+        os.umask(old)
     for root, must in ((run_dir, {"metrics.json", "series.npz", "axes.png", ".ptint-manifest.json"}),
                        (robust_dir, {"robust.json", "samples.json", "worst.yaml", "robust.png"})):
         modes = _modes(root)

@@ -5,15 +5,15 @@ import json
 
 import pytest
 from arms import OFFSET_ARM
-from test_cli import ptint
 
 SEGMENT_KEYS = {"e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_max_norm", "t_arrive",
                 # the orientation metrics (null for a position task: the paper's)
                 "e_rot0_deg", "e_rot_half_deg", "e_rot_tf_deg", "e_rot_hold_max_deg", "edot_rot_tf_deg_s"}
 
 
-def test_compare_writes_the_table_and_the_paper_controller_is_ok(tmp_path):
-    out = ptint("compare", "curve_b075_tf15", "--controllers", "ptsmc,pd,ct_quintic",
+def test_compare_writes_the_table_and_the_paper_controller_is_ok(tmp_path, ptint_here):
+    """``ptint compare`` in this process (test_plugin.py runs it as a real command)."""
+    out = ptint_here("compare", "curve_b075_tf15", "--controllers", "ptsmc,pd,ct_quintic",
                 "--variants", "nominal,mass_x1.5", "--workers", "2", "--out", str(tmp_path), "--quiet")
     assert out.returncode == 0, out.stderr  # misses are results: exit 0
     result = json.loads((tmp_path / "compare.json").read_text())
@@ -46,7 +46,7 @@ def test_compare_writes_the_table_and_the_paper_controller_is_ok(tmp_path):
     assert "6 runs" in out.stdout and "meet the criteria" in out.stdout
 
 
-def test_compare_on_an_arm_the_package_has_never_seen(tmp_path):
+def test_compare_on_an_arm_the_package_has_never_seen(tmp_path, ptint_here):
     urdf = tmp_path / "offset_arm.urdf"
     urdf.write_text(OFFSET_ARM)
     scenario = tmp_path / "reach.yaml"
@@ -56,8 +56,8 @@ interceptions:
   - {{start: 0.0, tf: 1.0, beta: 0.75,
      target: {{linear: {{start: [0.42, 0.10, 0.55], velocity: [0.0, 0.05, 0.0]}}}}}}
 """)
-    out = ptint("compare", str(scenario), "--variants", "nominal", "--workers", "2",
-                "--out", str(tmp_path / "out"), "--quiet")
+    out = ptint_here("compare", str(scenario), "--variants", "nominal", "--workers", "2",
+                     "--out", str(tmp_path / "out"), "--quiet")
     assert out.returncode == 0, out.stderr
     rows = json.loads((tmp_path / "out" / "compare.json").read_text())["rows"]
     assert [r["controller"] for r in rows] == ["ptsmc", "pd", "smc", "ct_quintic"]

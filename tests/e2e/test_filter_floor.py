@@ -2,9 +2,6 @@
 without an arm, measured against the true objects."""
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +10,6 @@ from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, 
 from ptint_drake.simulation import simulate
 from ptint_drake.studies import filter_floor as floor
 
-TESTS = Path(__file__).parent
 NAME, TEXT = scenario_text("curve_camera")
 LOADED = LoadedScenario.parse(TEXT, NAME)
 SEEDS = 6
@@ -96,11 +92,6 @@ def test_bad_arguments_name_the_field():
         floor.filter_floor(LOADED, [0.03], 1, measurement={"noise_std": -1.0}, workers=1)
 
 
-def ptint(*args):
-    return subprocess.run([sys.executable, "-m", "ptint_drake", *args], check=False, capture_output=True,
-                          text=True, cwd=TESTS, timeout=600)
-
-
 @pytest.mark.parametrize("args, message", [
     (["--process-noise", "0.03,-0.1"],
      "ptint: error: --process-noise: every value must be > 0 and finite, got -0.1"),
@@ -115,8 +106,8 @@ def test_cli_bad_value_is_one_line_exit_2(tmp_path, args, message, ptint_here):
     assert not (tmp_path / "o").exists()
 
 
-def test_cli_writes_json_and_markdown(tmp_path):
-    out = ptint("study", "camera", "--filter-floor", "--seeds", "2", "--process-noise", "0.03",
+def test_cli_writes_json_and_markdown(tmp_path, ptint_here):
+    out = ptint_here("study", "camera", "--filter-floor", "--seeds", "2", "--process-noise", "0.03",
                 "--set", "measurement.noise_std=0.001", "--workers", "1", "--out", str(tmp_path), "--quiet")
     assert out.returncode == 0, out.stderr
     assert len(out.stdout.splitlines()) == 1 and "best kalman_ca q = 0.03" in out.stdout

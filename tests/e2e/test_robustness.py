@@ -65,8 +65,9 @@ def test_payload_and_friction_reach_the_plant():
     assert loaded.metrics["torque_peak"][1] > base.metrics["torque_peak"][1] + 0.5
 
 
-def test_robust_study_and_exact_replay_of_worst_seed(tmp_path):
-    out = ptint("robust", "curve_b075_tf15", "--samples", "6", "--seed", "11", "--workers", "2",
+def test_robust_study_and_exact_replay_of_worst_seed(tmp_path, ptint_here):
+    """Both commands in this process (``ptint_here``)."""
+    out = ptint_here("robust", "curve_b075_tf15", "--samples", "6", "--seed", "11", "--workers", "2",
                 "--out", str(tmp_path), "--quiet")
     assert out.returncode == 0, out.stderr
     summary = json.loads((tmp_path / "robust.json").read_text())
@@ -78,7 +79,7 @@ def test_robust_study_and_exact_replay_of_worst_seed(tmp_path):
     worst = summary["worst"]
     assert 11 <= worst["seed"] < 17
     # the worst sample replays exactly from its file, and from its seed
-    replay = ptint("run", str(tmp_path / "worst.yaml"), "--out", str(tmp_path / "replay"), "--quiet",
+    replay = ptint_here("run", str(tmp_path / "worst.yaml"), "--out", str(tmp_path / "replay"), "--quiet",
                    "--no-replay", "--no-figures")
     assert replay.returncode == 0, replay.stderr
     metrics = json.loads((tmp_path / "replay" / "metrics.json").read_text())
@@ -88,10 +89,10 @@ def test_robust_study_and_exact_replay_of_worst_seed(tmp_path):
     assert RANGES["mass"][0] <= params["mass_scale"] <= RANGES["mass"][1]
 
 
-def test_too_short_tf_warns_and_saturates_but_stays_stable(tmp_path):
+def test_too_short_tf_warns_and_saturates_but_stays_stable(tmp_path, ptint_here):
     scenario = tmp_path / "short.yaml"
     scenario.write_text(TOO_SHORT_TF)
-    out = ptint("run", str(scenario), "--out", str(tmp_path / "out"), "--quiet", "--no-replay",
+    out = ptint_here("run", str(scenario), "--out", str(tmp_path / "out"), "--quiet", "--no-replay",
                 "--no-figures")
     assert out.returncode == 1, out.stderr  # a miss: exit 1
     assert "MISSED (late, hold)" in out.stdout and "ptint tune" in out.stdout
@@ -129,8 +130,8 @@ def test_target_through_a_singularity(damping):
         assert max(m["torque_command_peak"]) > 100.0
 
 
-def test_forced_divergence_is_reported_and_kept(tmp_path):
-    out = ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
+def test_forced_divergence_is_reported_and_kept(tmp_path, ptint_here):
+    out = ptint_here("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
                 "--set", "plant.disturbance={step: [0, 500, 0], step_time: 0.5}")
     assert out.returncode == 1
     assert "diverged at t = 0.5" in out.stderr and "joint speed" in out.stderr
@@ -168,10 +169,13 @@ def test_sigint_leaves_no_half_written_files(tmp_path):
         assert (run / "series.npz").is_file() and (run / "replay.html").is_file()
 
 
-def test_second_run_does_not_mix_with_the_first(tmp_path):
-    assert ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet").returncode == 0
-    assert (tmp_path / "replay.html").is_file()
-    assert ptint("run", "curve_b050_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
+def test_second_run_does_not_mix_with_the_first(tmp_path, ptint_here):
+    """The first run (0.6 s of it: its files are the point, not its length) writes a replay and
+    figures as a real command (a replay drawn in this process would leave a Meshcat here)."""
+    assert ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--set", "duration=0.6",
+                 "--set", "interceptions[0].tf=0.5").returncode == 0
+    assert (tmp_path / "replay.html").is_file() and (tmp_path / "axes.png").is_file()
+    assert ptint_here("run", "curve_b050_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
                  "--no-figures").returncode == 0
     assert not (tmp_path / "replay.html").exists() and not (tmp_path / "axes.png").exists()
     assert json.loads((tmp_path / "metrics.json").read_text())["scenario"] == "curve_b050_tf15"

@@ -2,10 +2,7 @@
 
 import csv
 import multiprocessing
-import subprocess
-import sys
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -58,11 +55,10 @@ def test_run_sweep_on_a_local_dask_cluster():
     assert rows[3]["e_tf"] == pytest.approx(direct["e_tf"], rel=1e-9)
 
 
-def test_cli_sweep_writes_csv_and_heatmaps(tmp_path):
-    done = subprocess.run([sys.executable, "-m", "ptint_drake", "sweep", "curve_b075_tf15",
-                           "--beta", "0.5,0.75", "--tf", "1.2,1.5", "--workers", "2",
-                           "--out", str(tmp_path), "--quiet"],
-                          capture_output=True, text=True, timeout=600, cwd=Path(__file__).parent)
+def test_cli_sweep_writes_csv_and_heatmaps(tmp_path, ptint_here):
+    """``ptint sweep`` in this process (test_runner.py runs it as a real command)."""
+    done = ptint_here("sweep", "curve_b075_tf15", "--beta", "0.5,0.75", "--tf", "1.2,1.5", "--workers", "2",
+                      "--out", str(tmp_path), "--quiet")
     assert done.returncode == 0, done.stderr
     with open(tmp_path / "sweep.csv") as f:
         rows = list(csv.DictReader(f))

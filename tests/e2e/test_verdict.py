@@ -1,12 +1,13 @@
-"""A run says plainly whether it intercepted: exit codes, MISSED lines, warnings, honest peaks."""
+"""A run says plainly whether it intercepted: exit codes, MISSED lines, warnings, honest peaks.
+
+``ptint run`` in this process (``ptint_here``): what it prints and its exit code are the
+command's; test_cli.py keeps a real subprocess run."""
 
 import json
 
-from test_cli import ptint
 
-
-def test_a_tf_the_actuators_cannot_do_is_a_miss(tmp_path):
-    out = ptint("run", "curve_b075_tf15", "--set", "interceptions[0].tf=0.03", "--out", str(tmp_path),
+def test_a_tf_the_actuators_cannot_do_is_a_miss(tmp_path, ptint_here):
+    out = ptint_here("run", "curve_b075_tf15", "--set", "interceptions[0].tf=0.03", "--out", str(tmp_path),
                 "--quiet", "--no-replay", "--no-figures")
     assert out.returncode == 1, out.stderr
     assert "curve_b075_tf15 segment 0:" in out.stdout and "MISSED (late" in out.stdout
@@ -19,8 +20,9 @@ def test_a_tf_the_actuators_cannot_do_is_a_miss(tmp_path):
     assert m["segments"][0]["tf"] == 0.03
 
 
-def test_the_paper_run_is_ok_and_exits_0(tmp_path):
-    out = ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay", "--no-figures")
+def test_the_paper_run_is_ok_and_exits_0(tmp_path, ptint_here):
+    out = ptint_here("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet", "--no-replay",
+                     "--no-figures")
     assert out.returncode == 0, out.stderr
     assert out.stdout.rstrip().endswith("ok (every segment meets the criteria)")
     m = json.loads((tmp_path / "metrics.json").read_text())
@@ -33,8 +35,8 @@ def test_the_paper_run_is_ok_and_exits_0(tmp_path):
     assert m["sim"]["realtime_factor"] <= m["sim"]["simulation_realtime_factor"]
 
 
-def test_assembly_warns_about_joint_speeds_beyond_the_model(tmp_path):
-    out = ptint("run", "assembly", "--out", str(tmp_path), "--quiet", "--no-replay", "--no-figures")
+def test_assembly_warns_about_joint_speeds_beyond_the_model(tmp_path, ptint_here):
+    out = ptint_here("run", "assembly", "--out", str(tmp_path), "--quiet", "--no-replay", "--no-figures")
     assert out.returncode == 0, out.stderr
     speed = [line for line in out.stderr.splitlines()
              if "speed" in line and "beyond the model's limit 3" in line]
