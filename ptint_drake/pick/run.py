@@ -282,18 +282,24 @@ def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=No
                 "warnings_before_run": len(warnings),
                 "controller": {"type": built.controller.name, "notes": built.controller.notes,
                                "model_based": built.controller.model_based}}
-    total = time.perf_counter() - t_start
-    t_end = context.get_time()
-    metrics["sim"] = {"controller": scenario.controller.type,
-                      "control_period": scenario.controller.control_period,
-                      "plant_time_step": built.station.config.time_step,
-                      "contact_approximation": built.station.config.contact_approximation,
-                      "contact_model": built.station.config.contact_model,
-                      "simulated_s": t_end, "wall_time_s": total, "simulation_wall_time_s": wall,
-                      "realtime_factor": t_end / total if total > 0 else float("inf"),
-                      "simulation_realtime_factor": t_end / wall if wall > 0 else float("inf"),
-                      "steps": int(simulator.get_integrator().get_num_steps_taken())}
+    metrics["sim"] = _pick_sim_info(scenario, built, simulator, time.perf_counter() - t_start, wall)
     return RunResult(scenario, metrics, series)
+
+
+def _pick_sim_info(scenario: Scenario, built: PickBuilt, simulator, total: float, wall: float) -> dict:
+    """The ``sim`` block of a pick run's metrics.json: ``realtime_factor`` end to end
+    (``total`` s: simulation, series, metrics), ``simulation_realtime_factor`` over ``wall``."""
+    t_end = simulator.get_context().get_time()
+    config = built.station.config
+    return {"controller": scenario.controller.type,
+            "control_period": scenario.controller.control_period,
+            "plant_time_step": config.time_step,
+            "contact_approximation": config.contact_approximation,
+            "contact_model": config.contact_model,
+            "simulated_s": t_end, "wall_time_s": total, "simulation_wall_time_s": wall,
+            "realtime_factor": t_end / total if total > 0 else float("inf"),
+            "simulation_realtime_factor": t_end / wall if wall > 0 else float("inf"),
+            "steps": int(simulator.get_integrator().get_num_steps_taken())}
 
 
 def pick_series(built: PickBuilt, logs: dict) -> dict:
