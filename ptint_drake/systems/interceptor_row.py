@@ -28,7 +28,7 @@ from ptint_drake.systems.controller import sliding_mode_torque
 from ptint_drake.systems.orientation import rotation_row
 from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
 from ptint_drake.systems.targets import target_row
-from ptint_drake.systems.task import POSITION, task_error_of
+from ptint_drake.systems.task import POSITION, task_error_of, task_jacobian_of
 from ptint_drake.systems.tbg import tbg_row
 
 GAINS_HEAD = 8  # ϵ, δ, α_hold, k, k_hold, law, φ, λ; then Λ (n) and K (nv)
@@ -138,11 +138,7 @@ def task_row(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_
             rot[:] = rotation[:15]
     err, J = np.empty(2 * n), np.empty((n, nv))
     task_error_of(task, rot_scale, x, xdot, ref[0:3], ref[3:6], R9, omega, rot, err)
-    for k in range(nv):
-        for i in range(3):
-            J[i, k] = J_v[i, k]
-            if n == 6:
-                J[3 + i, k] = rot_scale * J_w[i, k]
+    task_jacobian_of(J_v, J_w, rot_scale, J)
     tbg, surface = np.empty(10), np.empty(6 * n)
     tau = law_row(t, err[:n], err[n:], J, sigma, captured, segments, gains, tbg, surface)
     m = 20 + 5 * n

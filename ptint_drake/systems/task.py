@@ -72,6 +72,21 @@ def task_error(task: str, rot_scale: float, x, xdot, x_r, xdot_r, R=None, omega=
     return out[:n], out[n:]
 
 
+@njit(cache=True)
+def task_jacobian_of(J_v, J_w, rot_scale, J):
+    """J ← the Jacobian of the stacked task error: J_v (3 × nv) for a position task (J 3 × nv),
+    [J_v; c J_ω] for a task with orientation (J 6 × nv, c = ``rot_scale``)."""
+    n, nv = J.shape
+    for k in range(nv):
+        for i in range(3):
+            J[i, k] = J_v[i, k]
+            if n == 6:
+                J[3 + i, k] = rot_scale * J_w[i, k]
+
+
 def task_jacobian(J_v: np.ndarray, J_w: np.ndarray, rot_scale: float) -> np.ndarray:
-    """[J_v; c J_ω] (6 × nv): the Jacobian of the stacked task error."""
-    return np.vstack([J_v, rot_scale * J_w])
+    """[J_v; c J_ω] (6 × nv): the Jacobian of the stacked task error (``task_jacobian_of``)."""
+    J = np.empty((6, np.shape(J_v)[1]))
+    task_jacobian_of(np.ascontiguousarray(J_v, dtype=float), np.ascontiguousarray(J_w, dtype=float),
+                     float(rot_scale), J)
+    return J

@@ -60,13 +60,14 @@ def _orientation_kernels() -> None:
     from ptint_drake.systems.orientation import (SpinningOrientation, orientation_error_angle,  # noqa: PLC0415
                                                  rotation_error, rotation_exp)
     from ptint_drake.systems.signals import IDENTITY_ROTATION  # noqa: PLC0415
-    from ptint_drake.systems.task import task_error, task_reference  # noqa: PLC0415
+    from ptint_drake.systems.task import task_error, task_jacobian, task_reference  # noqa: PLC0415
 
     R, w = rotation_exp([0.1, 0.2, 0.3]), [0.1, 0.0, 0.0]
     rot_r = SpinningOrientation([0.0, 0.0, 30.0], [0.0, 0.0, 10.0]).values(0.5)
     task_error("top_down", 0.1, *np.zeros((4, 3)), R, w, rot_r)
     rotation_error(R, w, task_reference("top_down", IDENTITY_ROTATION, R))
     orientation_error_angle("pose", R, rot_r)
+    task_jacobian(np.zeros((3, 5)), np.zeros((3, 5)), 0.1)
 
 
 if __name__ == "__main__":
