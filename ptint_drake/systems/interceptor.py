@@ -31,7 +31,7 @@ from functools import cached_property
 from typing import Optional, Sequence
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain, Multiplexer
 
 from ptint_drake.systems.controller import null_space_terms, null_space_torque
@@ -119,26 +119,21 @@ class InterceptorLaw(LeafSystem):
         self.DeclareVectorOutputPort("telemetry", size,
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
                                      prerequisites_of_calc=deps)
-        self._loop_writeable = True
         self._load_kernels()
 
     def _load_kernels(self) -> None:
-        """Evaluate the law once, now, on zero inputs with the very argument types a simulation
-        passes (the ``loop`` input's array as the bindings hand it out: read-only on Drake 1.51):
-        numba then loads the machine code from its cache (50-150 ms) while the diagram is built,
-        not at a run's first derivative evaluation, and ``row`` passes the same types, so one
-        compiled version serves both.  Nothing of it is kept (the kernel's memo is a copy's)."""
+        """Evaluate the law once, now, on zero inputs (the outputs' own path: ``row`` passes
+        the kernels the argument types a simulation does, the ``loop`` input's array marked
+        read-only when the bindings hand it out so, as Drake 1.51's do): numba loads the machine
+        code from its cache (50-150 ms) while the diagram is built, not at a run's first
+        derivative evaluation, and one compiled version serves the simulation and ``row``
+        (tests/unit/test_kernel_load.py).  The TBG and target kept for t = 0 are those of t = 0."""
         context = self.CreateDefaultContext()
         self._loop_in.FixValue(context, np.zeros(self._loop_in.size()))
         if self._rotation_in is not None:
             self._rotation_in.FixValue(context, np.array(IDENTITY_ROTATION))
-        u = self._loop_in.EvalBasicVector(context).value()
-        self._loop_writeable = bool(u.flags.writeable)
-        if self._fast:
-            out = BasicVector(self._nv + self._n)
-            position_output(0.0, u, self._static.copy(), np.empty_like(self._row), out.get_mutable_value())
-        if not self._fast or self._null_space is not None or self._python_targets:
-            self._eval(context)
+        self._loop_writeable = bool(self._loop_in.EvalBasicVector(context).value().flags.writeable)
+        self._eval(context)
 
     @property
     def num_tasks(self) -> int:
