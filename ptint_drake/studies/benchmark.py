@@ -272,8 +272,9 @@ def kernel_cost(scenario, calls: int = 2000) -> "float | None":
         return None
     context = built.diagram.CreateDefaultContext()
     built.diagram.ExecuteInitializationEvents(context)
+    context.SetTime(0.5 * scenario.duration)
     ctx = law.GetMyContextFromRoot(context)
-    args = (0.5 * scenario.duration, *law.loop_values(ctx))
+    args = law.row_arguments(ctx)
     best = float("inf")
     for _ in range(3):
         t0 = time.perf_counter()

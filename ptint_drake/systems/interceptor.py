@@ -148,10 +148,15 @@ class InterceptorLaw(LeafSystem):
         qv, sigma, captured, *target = np.split(self._loop_in.Eval(context), self._parts)
         return qv, sigma, captured, target[0] if target else None
 
+    def row_arguments(self, context) -> tuple:
+        """``row``'s arguments at ``context``: (t, [q; v], σ, captured, target or None,
+        target_rotation or None)."""
+        rotation = None if self._rotation_in is None else self._rotation_in.Eval(context)
+        return (context.get_time(), *self.loop_values(context), rotation)
+
     def _eval(self, context) -> np.ndarray:
         """The row (telemetry, active segment, σ̇) at ``context``."""
-        rotation = None if self._rotation_in is None else self._rotation_in.Eval(context)
-        return self.row(context.get_time(), *self.loop_values(context), rotation)
+        return self.row(*self.row_arguments(context))
 
     def _calc_output(self, context, output) -> None:
         row = self._eval(context)

@@ -56,3 +56,14 @@ def test_cli_bad_repeats_is_one_line(ptint_here):
     out = ptint_here("bench", "--pair", "{}", "{}", "--repeats", "0")
     assert out.returncode == 2
     assert "Traceback" not in out.stderr and "--repeats: must be >= 1" in out.stderr
+
+
+@pytest.mark.parametrize("name", ["conveyor_yaw_camera", "conveyor_yaw", "conveyor_pair_camera"])
+def test_kernel_cost_takes_the_law_inputs_as_the_simulation_does(name):
+    """``kernels_us`` of ``bench --floors`` for a pose task fed by a camera (target and
+    target_rotation on ports) and the other paths; it failed on conveyor_yaw_camera when the
+    benchmark dropped the rotation input."""
+    from ptint_drake.scenario import parse_with_overrides, scenario_text
+
+    scenario = parse_with_overrides(scenario_text(name)[1], "{}", name)
+    assert benchmark.kernel_cost(scenario, calls=50) > 0
