@@ -6,7 +6,9 @@ numba compiles a kernel at its first call for the argument types of that call an
 user's cache directory when the install is read-only).  Short runs of the bundled scenarios
 exercise the kernels with the very types a ``ptint run`` passes: the fused position task with a
 curve, a line and a thrown object, a target from a filter, the pose task (``pose_row``) and the
-five blocks; then the orientation equations as the blocks and the metrics call them.
+five blocks, the IMM of ``estimator: auto`` (``imm.imm_cycle``, ``imm.initial_state``, in the
+camera runs); then the orientation equations as the blocks and the metrics call them, and the
+IMM's kernels once more directly (a cycle with a sample and one without).
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ def warm_up(duration: float = 0.05) -> float:
     alpha_peak(1.5, 0.75)
     tbg_profile(0.5, 1.5, 0.75)
     _orientation_kernels()
+    _imm_kernels()
     return time.perf_counter() - t0
 
 
@@ -68,6 +71,18 @@ def _orientation_kernels() -> None:
     rotation_error(R, w, task_reference("top_down", IDENTITY_ROTATION, R))
     orientation_error_angle("pose", R, rot_r)
     task_jacobian(np.zeros((3, 5)), np.zeros((3, 5)), 0.1)
+
+
+def _imm_kernels() -> None:
+    """Call the IMM's kernels with the argument types ``AdaptiveTargetEstimator.step`` passes."""
+    import numpy as np  # noqa: PLC0415
+
+    from ptint_drake.systems.imm import NO_SAMPLE, imm_cycle, initial_state  # noqa: PLC0415
+
+    z = np.array([0.3, 0.0, 0.2])
+    X, Ps, mu = initial_state(z, 4.0e-6)
+    for sample in (z, NO_SAMPLE):
+        X, Ps, mu = imm_cycle(X, Ps, mu, 1.0 / 30.0, sample, 4.0e-6)
 
 
 if __name__ == "__main__":
