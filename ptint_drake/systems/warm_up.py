@@ -6,7 +6,7 @@ numba compiles a kernel at its first call for the argument types of that call an
 user's cache directory when the install is read-only).  Short runs of the bundled scenarios
 exercise the kernels with the very types a ``ptint run`` passes: the fused position task with a
 curve, a line and a thrown object, a target from a filter, the pose task (``pose_row``) and the
-five blocks, the IMM of ``estimator: auto`` (``imm.imm_cycle``, ``imm.initial_state``, in the
+five blocks, the IMM of ``estimator: auto`` (``imm_kernels.imm_cycle``, ``initial_state``, in the
 camera runs); then the orientation equations as the blocks and the metrics call them, and the
 IMM's kernels once more directly (a cycle with a sample and one without).
 """
@@ -77,7 +77,7 @@ def _imm_kernels() -> None:
     """Call the IMM's kernels with the argument types ``AdaptiveTargetEstimator.step`` passes."""
     import numpy as np  # noqa: PLC0415
 
-    from ptint_drake.systems.imm import NO_SAMPLE, imm_cycle, initial_state  # noqa: PLC0415
+    from ptint_drake.systems.imm_kernels import NO_SAMPLE, imm_cycle, initial_state  # noqa: PLC0415
 
     z = np.array([0.3, 0.0, 0.2])
     X, Ps, mu = initial_state(z, 4.0e-6)

@@ -8,7 +8,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.scenario import ScenarioError, parse_scenario
-from ptint_drake.systems import imm
+from ptint_drake.systems import imm_kernels as imm
 from ptint_drake.systems.camera import MeasurementConfig, validate_measurement
 from ptint_drake.systems.imm import MODELS, AdaptiveTargetEstimator
 from ptint_drake.systems.kalman import AddCameraEstimators
