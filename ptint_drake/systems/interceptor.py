@@ -37,7 +37,7 @@ from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain, Mu
 from ptint_drake.systems.controller import null_space_terms, null_space_torque
 from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.interceptor_row import (pack_chain, pack_gains, pack_position, pose_row,
-                                                 position_output, task_row)
+                                                 position_output, position_rows, task_row)
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.orientation import ROTATION_WIDTH, active_rotation_values, compiled_rotations
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
@@ -113,8 +113,9 @@ class InterceptorLaw(LeafSystem):
         self._static = None if not self._fast else pack_position(
             nq, schedule.table, self._gains, *self._chain, self._compiled, self._law.reset_sigma,
             targets is None or self._python_targets)
-        compiled_output = self._fast and self._null_space is None and not self._python_targets
-        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_position_output if compiled_output
+        # the compiled position path end to end: the output's kernel, and ``rows`` in one call
+        self._batch = self._fast and self._null_space is None and not self._python_targets
+        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_position_output if self._batch
                                      else self._calc_output, prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("telemetry", size,
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
@@ -127,13 +128,16 @@ class InterceptorLaw(LeafSystem):
         read-only when the bindings hand it out so, as Drake 1.51's do): numba loads the machine
         code from its cache (50-150 ms) while the diagram is built, not at a run's first
         derivative evaluation, and one compiled version serves the simulation and ``row``
-        (tests/unit/test_kernel_load.py).  The TBG and target kept for t = 0 are those of t = 0."""
+        (tests/unit/test_kernel_load.py); ``rows``' batch kernel is loaded here too.  The TBG
+        and target kept for t = 0 are those of t = 0."""
         context = self.CreateDefaultContext()
         self._loop_in.FixValue(context, np.zeros(self._loop_in.size()))
         if self._rotation_in is not None:
             self._rotation_in.FixValue(context, np.array(IDENTITY_ROTATION))
         self._loop_writeable = bool(self._loop_in.EvalBasicVector(context).value().flags.writeable)
         self._eval(context)
+        if self._batch:  # the telemetry's kernel (``rows``)
+            self.rows(np.zeros(1), *(None if p is None else p[None] for p in self.loop_values(context)))
 
     @property
     def num_tasks(self) -> int:
@@ -205,6 +209,24 @@ class InterceptorLaw(LeafSystem):
             J = self._kinematics.compute(qv[:self._nq], qv[self._nq:])[2]
             row[self._tau] += null_space_torque(J, qv[:self._nq], qv[self._nq:], q_start, D, rate)
         return row
+
+    def rows(self, t: np.ndarray, qv: np.ndarray, sigma: np.ndarray, captured: np.ndarray,
+             target: Optional[np.ndarray] = None, rotation: Optional[np.ndarray] = None) -> np.ndarray:
+        """``row`` at each of k logged samples (arrays with k rows; ``target`` / ``rotation``
+        None without those inputs): the compiled position path in one call
+        (``position_rows``, the same kernel on the same values), else ``row`` per sample."""
+        k = len(t)
+        if self._batch:
+            parts = [qv, sigma, captured] + ([] if target is None else [target])
+            U = np.ascontiguousarray(np.hstack(parts), dtype=float)
+            out = np.empty((k, self._size + 5 + self._n))
+            position_rows(np.ascontiguousarray(t, dtype=float), U, self._static, out,
+                          np.empty(self._nv + self._n))
+            return out
+        targets = [None] * k if target is None else target
+        rotations = [None] * k if rotation is None else rotation
+        return np.array([self.row(*values) for values in zip(
+            np.asarray(t, dtype=float).tolist(), qv, sigma, captured, targets, rotations)])
 
     @cached_property
     def _rotations(self):
@@ -299,16 +321,12 @@ class PrescribedTimeInterceptor(Diagram):
                      rotation: Optional[np.ndarray] = None) -> np.ndarray:
         """Telemetry rows for logged samples (time, plant state, σ, [index, s(t0), σ0], and the
         ``target`` / ``target_rotation`` inputs' values when the system has those ports): the
-        law's ``row`` called directly on the logged values (no context, no cache entry)."""
+        law's ``rows`` on the logged values (no context, no cache entry)."""
         size = self.law.telemetry_size
-        k = len(t)
-        if k == 0:
+        if len(t) == 0:
             return np.empty((0, size))
-        targets = [None] * k if not self.has_target_input else np.asarray(target, dtype=float)
-        rotations = [None] * k if not self.has_rotation_input else np.asarray(rotation, dtype=float)
-        row = self.law.row
-        f64 = lambda a: np.ascontiguousarray(a, dtype=float)  # noqa: E731
-        rows = np.array([row(tk, qv, sg, cap, tg, rt) for tk, qv, sg, cap, tg, rt in zip(
-            np.asarray(t, dtype=float).tolist(), f64(plant_state), f64(sigma), f64(captured),
-            targets, rotations)])
+        f64 = lambda a: None if a is None else np.ascontiguousarray(a, dtype=float)  # noqa: E731
+        rows = self.law.rows(t, f64(plant_state), f64(sigma), f64(captured),
+                             f64(target) if self.has_target_input else None,
+                             f64(rotation) if self.has_rotation_input else None)
         return rows[:, :size]

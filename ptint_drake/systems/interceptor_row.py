@@ -211,3 +211,12 @@ def position_output(t, u, static, row, tau_sigma_dot):
                  static[len(static) - MEMO:], row)
     tau_sigma_dot[:nv] = row[38:38 + nv]
     tau_sigma_dot[nv:] = row[43 + nv:46 + nv]
+
+
+@njit(cache=True)
+def position_rows(t, U, static, rows, tau_sigma_dot):
+    """``position_output`` at each logged sample k: ``rows[k]`` ← the row at time t[k] from the
+    ``loop`` input's values U[k] then (the telemetry of a run in one call, not one per sample);
+    ``tau_sigma_dot`` is scratch."""
+    for k in range(len(t)):
+        position_output(t[k], U[k], static, rows[k], tau_sigma_dot)

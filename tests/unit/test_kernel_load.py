@@ -31,3 +31,24 @@ def test_a_run_and_its_telemetry_load_no_kernel(name, kernel):
     rows = system.telemetry_at([0.03], qv[None], sigma[None], captured[None])
     assert rows.shape == (1, system.law.telemetry_size)
     assert list(kernel.signatures) == loaded  # the run and the telemetry used the loaded version
+
+
+def test_the_telemetry_in_one_call_is_the_row_of_each_sample():
+    """``InterceptorLaw.rows`` (``position_rows``: the compiled position path over all logged
+    samples in one call) equals ``row`` sample by sample, bit for bit, on perturbed states."""
+    import numpy as np
+
+    _, text = scenario_text("curve_b075_tf15")
+    scenario = parse_with_overrides(text, [], "curve_b075_tf15")
+    law = build(scenario, log=False).controller.system.law
+    rng = np.random.default_rng(3)
+    k = 40
+    t = np.sort(rng.uniform(0.0, scenario.duration, k))
+    t[5] = t[4]  # a repeated time (the kernels' memo)
+    qv = np.radians([10.0, 40.0, 35.0, 0.0, 0.0, 0.0]) + rng.normal(0.0, 0.1, (k, 6))
+    sigma = rng.normal(0.0, 1e-3, (k, 3))
+    captured = np.tile(np.r_[0.0, rng.normal(0.0, 0.01, 6)], (k, 1))
+    batch = law.rows(t, qv, sigma, captured)
+    one_by_one = np.array([law.row(*values, None, None) for values in zip(t.tolist(), qv, sigma, captured)])
+    assert batch.shape == one_by_one.shape and np.isfinite(batch).all()
+    np.testing.assert_array_equal(batch, one_by_one)
