@@ -26,7 +26,7 @@ from numba import njit
 REVOLUTE, PRISMATIC = 0, 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _then(R, p, R2, p2, tmp):
     """(R, p) ← (R R2, p + R p2) in place: the transform (R, p) followed by (R2, p2)."""
     for i in range(3):
@@ -37,7 +37,7 @@ def _then(R, p, R2, p2, tmp):
             R[i, j] = tmp[j]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def axis_rotation(a, angle, out):
     """``out`` ← the rotation by ``angle`` (rad) about the unit axis a (Rodrigues' formula)."""
     c, s = np.cos(angle), np.sin(angle)
@@ -55,29 +55,45 @@ def chain_kinematics(q, kinds, q_index, v_index, fixed, axes, nv):
 
     ``fixed`` (n + 1, 4, 3): X_0 … X_n as [R; pᵀ]; ``axes`` (n, 3): each joint's unit axis in
     its frame F; ``kinds``: ``REVOLUTE`` or ``PRISMATIC``; ``q_index``, ``v_index``: each joint's
-    position and velocity in the plant's q and v."""
+    position and velocity in the plant's q and v (``chain_kinematics_into`` in new arrays)."""
     n = len(kinds)
-    R = fixed[0, :3].copy()
-    p = fixed[0, 3].copy()
-    work = np.empty((2 * n + 4, 3))  # axes and origins in the world, a rotation, a row
+    x, R, J_v, J_w = np.empty(3), np.empty((3, 3)), np.empty((3, nv)), np.empty((3, nv))
+    chain_kinematics_into(q, kinds, q_index, v_index, fixed, axes, x, R, J_v, J_w,
+                          np.empty((2 * n + 5, 3)))
+    return x, R, J_v, J_w
+
+
+@njit(cache=True, inline="always")
+def chain_kinematics_into(q, kinds, q_index, v_index, fixed, axes, x, R, J_v, J_w, work) -> None:
+    """x (3), R (3 × 3), J_v, J_ω (3 × nv) ← ``chain_kinematics`` without allocating: ``work``
+    is a scratch block of ≥ 2n + 5 rows of 3 (n joints).  ``kinds``, ``q_index`` and ``v_index``
+    may be integer arrays or whole numbers held as floats (a packed float array)."""
+    n = len(kinds)
+    p = x
+    for i in range(3):
+        p[i] = fixed[0, 3, i]
+        for j in range(3):
+            R[i, j] = fixed[0, i, j]
+    # axes and origins in the world, a rotation, a row, a zero translation
     axes_w, origins, M, tmp = work[:n], work[n:2 * n], work[2 * n:2 * n + 3], work[2 * n + 3]
-    zero = np.zeros(3)
+    zero = work[2 * n + 4]
+    zero[:] = 0.0
     for k in range(n):
         a = axes[k]
         for i in range(3):
             axes_w[k, i] = R[i, 0] * a[0] + R[i, 1] * a[1] + R[i, 2] * a[2]
             origins[k, i] = p[i]
         if kinds[k] == REVOLUTE:
-            axis_rotation(a, q[q_index[k]], M)
+            axis_rotation(a, q[int(q_index[k])], M)
             _then(R, p, M, zero, tmp)
         else:
             for i in range(3):
-                p[i] += q[q_index[k]] * axes_w[k, i]
+                p[i] += q[int(q_index[k])] * axes_w[k, i]
         _then(R, p, fixed[k + 1, :3], fixed[k + 1, 3], tmp)
-    J_v = np.zeros((3, nv))
-    J_w = np.zeros((3, nv))
+    J_v[:] = 0.0
+    J_w[:] = 0.0
     for k in range(n):
-        a, col = axes_w[k], v_index[k]
+        a, col = axes_w[k], int(v_index[k])
         if kinds[k] == REVOLUTE:
             r0, r1, r2 = p[0] - origins[k, 0], p[1] - origins[k, 1], p[2] - origins[k, 2]
             J_v[0, col] += a[1] * r2 - a[2] * r1
@@ -88,7 +104,6 @@ def chain_kinematics(q, kinds, q_index, v_index, fixed, axes, nv):
         else:
             for i in range(3):
                 J_v[i, col] += a[i]
-    return p, R, J_v, J_w
 
 
 def _pose(X) -> np.ndarray:

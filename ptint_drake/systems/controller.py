@@ -16,7 +16,7 @@ from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.task import TASK_DIM
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _solve3(A, b, out) -> None:
     """``out`` ← A⁻¹ b for a 3 × 3 A by Cramer's rule; the least-squares solution when A is
     numerically singular."""
@@ -25,7 +25,10 @@ def _solve3(A, b, out) -> None:
     g, h, i = A[2, 0], A[2, 1], A[2, 2]
     co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * co0 + b_ * co1 + c * co2
-    scale = np.abs(A).max()
+    scale = 0.0  # max |A_ij| (NaN in A makes det NaN: the solve below)
+    for r in range(3):
+        for c_ in range(3):
+            scale = max(scale, abs(A[r, c_]))
     if scale == 0.0:
         scale = 1.0
     if abs(det) <= 1e-12 * scale**3:
@@ -46,55 +49,84 @@ def pinv_solve(J, b, damping: float):
     minimum-norm least-squares solution (``lstsq``): J⁻¹ b for a square J, the least-squares fit
     for fewer joints than rows (a 5-joint wrist), the minimum-norm one for more.  With
     ``damping`` λ > 0 (m/rad), J⁺ is the damped pseudoinverse Jᵀ(JJᵀ + λ²I)⁻¹, which stays
-    bounded through singular configurations at the cost of a small bias near them."""
+    bounded through singular configurations at the cost of a small bias near them.
+    (``pinv_solve_into`` in a new array.)"""
+    n, nv = J.shape
+    out = np.empty(nv)
+    pinv_solve_into(J, b, damping, out, np.empty(n * n + n))
+    return out
+
+
+@njit(cache=True, inline="always")
+def pinv_solve_into(J, b, damping: float, out, work) -> None:
+    """``out`` (nv) ← ``pinv_solve(J, b, damping)``; ``work``: a scratch vector of ≥ n² + n
+    (J Jᵀ and its solve then take no new memory for up to 8 joints, nor does a square 3 × 3 J;
+    the 6-row undamped ``lstsq`` does)."""
     n, nv = J.shape
     if damping <= 0.0 and n != 3:
-        return np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
+        out[:] = np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
+        return
     if damping <= 0.0 and nv == 3:
-        x = np.empty(3)
-        _solve3(J, b, x)
-        return x
-    A = J @ J.T if nv > 8 else _gram(J)
+        _solve3(J, b, out)
+        return
+    if nv > 8:
+        A = J @ J.T
+    else:
+        A = work[:n * n].reshape(n, n)
+        _gram(J, A)
     for i in range(n):
         A[i, i] += damping * damping
-    y = np.empty(n)
+    y = work[n * n:n * n + n]
     if n == 3:
         _solve3(A, b, y)
     else:
         y[:] = np.linalg.solve(A, b.copy())
-    return J.T @ y if nv > 8 else _transpose_times(J, y)
+    if nv > 8:
+        out[:] = J.T @ y
+    else:
+        _transpose_times(J, y, out)
 
 
-@njit(cache=True)
-def _gram(J):
-    """J Jᵀ by loops (BLAS costs more than it saves on a few rows)."""
+@njit(cache=True, inline="always")
+def _gram(J, A) -> None:
+    """A ← J Jᵀ by loops (BLAS costs more than it saves on a few rows)."""
     n, nv = J.shape
-    A = np.zeros((n, n))
     for i in range(n):
         for j in range(n):
             acc = 0.0
             for k in range(nv):
                 acc += J[i, k] * J[j, k]
             A[i, j] = acc
-    return A
 
 
-@njit(cache=True)
-def _transpose_times(J, y):
-    """Jᵀ y by loops."""
+@njit(cache=True, inline="always")
+def _transpose_times(J, y, x) -> None:
+    """x ← Jᵀ y by loops."""
     n, nv = J.shape
-    x = np.zeros(nv)
     for k in range(nv):
+        x[k] = 0.0
         for i in range(n):
             x[k] += J[i, k] * y[i]
-    return x
 
 
 @njit(cache=True)
 def sliding_mode_torque(K, J, s_x, damping: float):
     """τ = −K J⁺ s_x (paper eq. 18): K the nv gains (N·m·s/rad), J (n × nv) and s_x (n; n = 3,
-    or 6 with orientation) as ``pinv_solve`` takes them."""
-    return -K * pinv_solve(J, s_x, damping)
+    or 6 with orientation) as ``pinv_solve`` takes them (``sliding_mode_torque_into`` in a new
+    array)."""
+    n, nv = J.shape
+    tau = np.empty(nv)
+    sliding_mode_torque_into(K, J, s_x, damping, tau, np.empty(n * n + n))
+    return tau
+
+
+@njit(cache=True, inline="always")
+def sliding_mode_torque_into(K, J, s_x, damping: float, tau, work) -> None:
+    """``tau`` (nv) ← τ = −K J⁺ s_x (eq. 18) without new memory for up to 8 joints
+    (``pinv_solve_into``; ``work`` ≥ n² + n)."""
+    pinv_solve_into(J, s_x, damping, tau, work)
+    for k in range(len(tau)):
+        tau[k] = -K[k] * tau[k]
 
 
 def pinv_apply(J, b, damping: float = 0.0) -> np.ndarray:

@@ -15,16 +15,22 @@ The parameters travel as a few arrays (each argument costs the call ~0.1-0.2 µs
 ``geometry`` = the chain's fixed transforms with each joint's axis (``pack_chain``).
 ``position_output`` takes all of them as one array (``pack_position``) and the loop's values as
 one input vector [q; v; σ; index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so an evaluation passes five
-arguments.
+arguments; the same array holds the memo of the last call and a scratch block for every
+intermediate (``chain.chain_kinematics_into``, ``controller.sliding_mode_torque_into``), so the
+simulation's evaluation allocates no memory; its views are borrowed (``borrow``: no atomic
+reference counts), and the equation kernels are inlined into it (numba ``inline="always"``: a
+call between compiled functions passes each array as 7-11 words).  Every kernel keeps its
+order of operations, so the bits are those of the blocks (tests/unit/test_kernel_identity.py).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import carray, njit, types
+from numba.extending import intrinsic
 
-from ptint_drake.systems.chain import chain_kinematics
-from ptint_drake.systems.controller import sliding_mode_torque
+from ptint_drake.systems.chain import chain_kinematics, chain_kinematics_into
+from ptint_drake.systems.controller import sliding_mode_torque, sliding_mode_torque_into
 from ptint_drake.systems.orientation import rotation_row
 from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
 from ptint_drake.systems.targets import target_row
@@ -64,33 +70,50 @@ def law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface):
     return sliding_mode_torque(gains[GAINS_HEAD + n:], J, surface[:n], gains[7])
 
 
-@njit(cache=True)
-def surface_torque(t, e, edot, J, sigma, captured, gains, tbg, surface):
-    """``law_row`` after the TBG (``position_row``'s, which may reuse a TBG row): τ from a given
-    ``tbg`` row; fills ``surface``."""
-    n = len(e)
-    surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
-                gains[3], gains[4], int(gains[5]), gains[6], surface)
-    return sliding_mode_torque(gains[GAINS_HEAD + n:], J, surface[:n], gains[7])
+@intrinsic
+def _address(typingctx, a, start):
+    """The address of a[start] (a 1-D array) as a typed pointer."""
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        return builder.gep(data, [args[1]])
+    return types.CPointer(a.dtype)(a, types.intp), codegen
 
 
-@njit(cache=True)
-def position_row(t, qv, sigma, captured, target, segments, gains, joints, geometry, targets, memo, out):
+@njit(cache=True, inline="always")
+def borrow(a, start, shape):
+    """a[start:start + size] (a 1-D array) as a C-ordered array of ``shape`` that does not count
+    references: its views cost no atomic reference counting (about a third of an evaluation
+    otherwise) and no reshape.  Valid while ``a`` is; only for views that do not outlive the call."""
+    size = 1
+    for d in shape:
+        size *= d
+    if start < 0 or start + size > len(a):
+        raise IndexError("borrow: outside the array")
+    return carray(_address(a, start), shape)
+
+
+@njit(cache=True, inline="always")
+def position_row(t, qv, sigma, captured, target, segments, gains, joints, geometry, targets, memo, work,
+                 out):
     """``out`` ← the fused interceptor's row for the position task (``interceptor.telemetry_layout``
     then [index, t0, tf, β, phase] then σ̇): x, ẋ, x_r, ẋ_r, ẍ_r, ξ…ξ⃛, α, s_x, e, ė, s, s_d,
     σ, τ.  ``target``: [x_r, ẋ_r, ẍ_r] (9), or empty to evaluate ``targets`` (one compiled row
     per segment, ``targets.compiled_targets``) at t.  ``memo`` = [t, TBG row (10), target (12)]
     of the last call: the TBG and the compiled target are functions of t alone, and one
-    evaluation in three (an RK3 step's first stage) comes at the previous one's time."""
-    nv = len(gains) - GAINS_HEAD - 3
+    evaluation in three (an RK3 step's first stage) comes at the previous one's time.  ``work``:
+    scratch (``work_size``) for every intermediate, so that a call allocates nothing."""
+    nv, n_joints = len(gains) - GAINS_HEAD - 3, joints.shape[1]
     nq = len(qv) - nv
-    x, _, J, _ = chain_kinematics(qv[:nq], joints[0], joints[1], joints[2], geometry[:, :4],
-                                  geometry[:-1, 4], nv)
+    x, R, xdot, e, edot = work[0:3], borrow(work, 3, (3, 3)), work[12:15], work[15:18], work[18:21]
+    surface, solve = work[21:39], work[39:51]  # 6n; n² + n
+    J_v, J_w = borrow(work, 51, (3, nv)), borrow(work, 51 + 3 * nv, (3, nv))
+    chain_kinematics_into(qv[:nq], joints[0], joints[1], joints[2], geometry[:, :4], geometry[:-1, 4],
+                          x, R, J_v, J_w, borrow(work, 51 + 6 * nv, (2 * n_joints + 5, 3)))
     v = qv[nq:]
-    xdot = np.zeros(3)
     for i in range(3):
+        xdot[i] = 0.0
         for k in range(nv):
-            xdot[i] += J[i, k] * v[k]
+            xdot[i] += J_v[i, k] * v[k]
     tbg, ref = memo[1:11], memo[11:23]
     if memo[0] != t:  # (NaN at first)
         tbg_row(t, segments, gains[0], gains[1], gains[2], tbg)
@@ -100,12 +123,21 @@ def position_row(t, qv, sigma, captured, target, segments, gains, joints, geomet
         memo[0] = t
     if len(target) != 0:
         ref[:9] = target[:9]
-    e, edot = x - ref[0:3], xdot - ref[3:6]
-    surface = np.empty(18)
-    tau = surface_torque(t, e, edot, J, sigma, captured, gains, tbg, surface)
+    for i in range(3):
+        e[i], edot[i] = x[i] - ref[i], xdot[i] - ref[3 + i]
+    surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + 3],
+                gains[3], gains[4], int(gains[5]), gains[6], surface)
+    tau = out[38:38 + nv]
+    sliding_mode_torque_into(gains[GAINS_HEAD + 3:], J_v, surface[:3], gains[7], tau, solve)
     out[0:3], out[3:6], out[6:15], out[15:20] = x, xdot, ref[:9], tbg[:5]
-    out[20:35], out[35:38], out[38:38 + nv] = surface[:15], sigma, tau
+    out[20:35], out[35:38] = surface[:15], sigma
     out[38 + nv:43 + nv], out[43 + nv:46 + nv] = tbg[5:10], surface[15:18]
+
+
+def work_size(nv: int, n_joints: int) -> int:
+    """Floats of ``position_row``'s scratch: x, R, ẋ, e, ė, the surface row, the solve's, J_v,
+    J_ω, the chain's (``chain.chain_kinematics_into``) and σ (``position_output``)."""
+    return 51 + 6 * nv + 6 * n_joints + 15 + 3
 
 
 @njit(cache=True)
@@ -173,14 +205,15 @@ def pack_position(nq: int, segments, gains, joints, geometry, targets, reset: bo
                   given_target: bool) -> np.ndarray:
     """The static arrays of ``position_row`` as one float array for ``position_output``: a head
     [nq, nv, segment count, joint count, target count, target row width, σ reset (0/1), target in
-    the input (0/1)], then ``segments``, ``gains``, ``joints``, ``geometry`` and ``targets``
-    (compiled rows), each flattened, and ``position_row``'s memo (``MEMO`` slots, written by
-    every call)."""
+    the input (0/1)], then ``segments``, ``gains``, ``joints`` (whole numbers as floats),
+    ``geometry`` and ``targets`` (compiled rows), each flattened, then ``position_row``'s memo
+    (``MEMO`` slots) and its scratch (``work_size``), both written by every call."""
     nv = len(gains) - GAINS_HEAD - 3
     head = [nq, nv, segments.shape[1], joints.shape[1], targets.shape[0], targets.shape[1],
             float(reset), float(given_target)]
     return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in (
-        segments, gains, joints, geometry, targets)), np.full(MEMO, np.nan)])
+        segments, gains, joints, geometry, targets)), np.full(MEMO, np.nan),
+        np.zeros(work_size(nv, joints.shape[1]))])
 
 
 @njit(cache=True)
@@ -188,27 +221,30 @@ def position_output(t, u, static, row, tau_sigma_dot):
     """``position_row`` on a packed input: ``u`` = [q; v; σ (the Integrator's); captured
     [index, s(t0), σ0]; the target [x_r, ẋ_r, ẍ_r] when the system has a target input],
     ``static`` from ``pack_position``; ``row`` ← the row, ``tau_sigma_dot`` ← [τ; σ̇]
-    (σ − σ0 used with ``sigma_policy`` reset)."""
+    (σ − σ0 used with ``sigma_policy`` reset).  Allocates nothing, and its views are borrowed
+    (``borrow``)."""
     nq, nv, n_seg, n_joints = int(static[0]), int(static[1]), int(static[2]), int(static[3])
     n_targets, width = int(static[4]), int(static[5])
     o = POSITION_HEAD
-    segments = static[o:o + 4 * n_seg].reshape(4, n_seg)
+    segments = borrow(static, o, (4, n_seg))
     o += 4 * n_seg
-    gains = static[o:o + GAINS_HEAD + 3 + nv]
+    gains = borrow(static, o, (GAINS_HEAD + 3 + nv,))
     o += GAINS_HEAD + 3 + nv
-    joints = static[o:o + 3 * n_joints].astype(np.int64).reshape(3, n_joints)
+    joints = borrow(static, o, (3, n_joints))
     o += 3 * n_joints
-    geometry = static[o:o + 15 * (n_joints + 1)].reshape(n_joints + 1, 5, 3)
+    geometry = borrow(static, o, (n_joints + 1, 5, 3))
     o += 15 * (n_joints + 1)
-    targets = static[o:o + n_targets * width].reshape(n_targets, width)
+    targets = borrow(static, o, (n_targets, width))
+    o += n_targets * width
+    memo, work = borrow(static, o, (MEMO,)), borrow(static, o + MEMO, (len(static) - o - MEMO,))
     m = nq + nv
-    sigma = u[m:m + 3].copy()
-    captured = u[m + 3:m + 10]
-    if static[6] != 0.0:
-        sigma -= captured[4:7]
-    target = u[m + 10:m + 19] if static[7] != 0.0 else u[m + 10:m + 10]
-    position_row(t, u[:m], sigma, captured, target, segments, gains, joints, geometry, targets,
-                 static[len(static) - MEMO:], row)
+    sigma = work[len(work) - 3:]
+    captured = borrow(u, m + 3, (7,))
+    for i in range(3):
+        sigma[i] = u[m + i] - captured[4 + i] if static[6] != 0.0 else u[m + i]
+    target = borrow(u, m + 10, (9 if static[7] != 0.0 else 0,))
+    position_row(t, borrow(u, 0, (m,)), sigma, captured, target, segments, gains, joints, geometry,
+                 targets, memo, work, borrow(row, 0, (len(row),)))
     tau_sigma_dot[:nv] = row[38:38 + nv]
     tau_sigma_dot[nv:] = row[43 + nv:46 + nv]
 

@@ -45,7 +45,7 @@ SWITCHING_LAWS = ("sign", "tanh", "sat")  # their codes in compiled code: the in
 SIGMA_POLICIES = ("keep", "reset")
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def switch(law: int, phi: float, w: np.ndarray, out: np.ndarray) -> None:
     """``out`` ← switch(w) of eq. 17 elementwise: ``law`` 0 the paper's sign, 1 tanh(w/φ),
     2 sat(w/φ) = clip(w/φ, −1, 1) (codes: the index in ``SWITCHING_LAWS``; NaN stays NaN)."""
@@ -74,7 +74,7 @@ def switching_law(law: str, phi: float):
     return apply
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def surface_law(t: float, e, edot, alpha: float, segment, captured, sigma, Lambda, k: float,
                 k_hold: float, law: int, phi: float, out) -> None:
     """``out`` ← [s_x, e, ė, s, s_d, σ̇] (``signals.surface_slots(n)``) of paper eqs. 16, 17 for

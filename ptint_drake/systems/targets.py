@@ -36,7 +36,7 @@ SINUSOID, LINEAR, BALLISTIC = 1.0, 2.0, 3.0
 COMPILED_WIDTH = 38
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def target_row(c, t: float, out) -> None:
     """``out[:12]`` ← [x_r, ẋ_r, ẍ_r, x⃛_r] at time t of the target whose row is c (the
     ``compiled`` row of a ``SinusoidTarget``, ``LinearTarget`` or ``BallisticTarget``)."""

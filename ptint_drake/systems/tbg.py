@@ -58,7 +58,7 @@ def gamma_gain(tf: float, beta: float) -> float:
     return float(beta_function(1.0 - beta, 1.0 - beta)) / tf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tbg_derivatives(tau: float, tf: float, beta: float, gamma: float) -> tuple:
     """(ξ, ξ̇, ξ̈, ξ⃛) at one time τ = t − t0 since the segment start (paper eqs. 6-10);
     ``gamma`` = ``gamma_gain(tf, beta)``, computed once per segment.
@@ -107,7 +107,7 @@ def tbg_profile(tau, tf: float, beta: float) -> tuple:
     return tuple(rows[k].reshape(tau_arr.shape) for k in range(4))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def alpha_gain(xi, xi_dot, epsilon=1e-6, delta=1e-6):
     """α = −(1 + ϵ) ξ̇ / (ξ + δ)  (paper eq. 13), ≥ 0 during the segment (floats or arrays)."""
     return -(1.0 + epsilon) * xi_dot / (xi + delta)
@@ -120,7 +120,7 @@ def alpha_peak(tf: float, beta: float, epsilon: float = 1e-6, delta: float = 1e-
     return float(np.max(alpha_gain(xi, xi_d, epsilon, delta)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tbg_row(t: float, segments: np.ndarray, epsilon: float, delta: float, alpha_hold: float,
             out: np.ndarray) -> None:
     """``out`` ← [ξ, ξ̇, ξ̈, ξ⃛, α, index, t0, tf, β, phase] (``signals.TBG``) of the segment

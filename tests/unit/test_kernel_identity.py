@@ -1,0 +1,65 @@
+"""The fused position kernel (``position_output``: scratch and memo in its packed array, borrowed
+views, everything inlined) gives the very bits of the blocks' kernels called one by one: the
+chain, the TBG, the target, the surface and the torque.  A wrong offset in the packed array or
+its scratch, or a memo that leaks one evaluation into the next, shows here."""
+
+import numpy as np
+import pytest
+from pydrake.systems.framework import BasicVector
+
+from ptint_drake import rvm1
+from ptint_drake.robot import parse_model
+from ptint_drake.systems.chain import KinematicChain
+from ptint_drake.systems.controller import smc_torque
+from ptint_drake.systems.interceptor_row import GAINS_HEAD, borrow, pack_chain, pack_position, \
+    position_output
+from ptint_drake.systems.sliding_surface import SurfaceLaw
+from ptint_drake.systems.targets import SinusoidTarget
+from ptint_drake.systems.tbg import gamma_gain, tbg_row
+
+EPS, DELTA, K_GAIN = 1e-6, 1e-6, 50.0
+
+
+def _blocks_row(chain, table, target, law, t, q, v, sigma, captured):
+    """The row as the blocks compute it, kernel by kernel."""
+    x, _, J_v, _ = chain.evaluate(q)
+    xdot = np.zeros(3)
+    for i in range(3):
+        for k in range(len(v)):
+            xdot[i] += J_v[i, k] * v[k]
+    tbg = np.empty(10)
+    tbg_row(float(t), table, EPS, DELTA, 0.0, tbg)
+    ref = target.evaluate(t)
+    surface = law.values(t, x - ref[:3], xdot - ref[3:6], tbg[4], tbg[5:10], captured[:4], sigma)
+    tau = smc_torque(np.full(3, K_GAIN), J_v, surface[:3])
+    return np.concatenate([x, xdot, ref[:9], tbg[:5], surface[:15], sigma, tau, tbg[5:10], surface[15:]])
+
+
+@pytest.mark.parametrize("reset", [False, True])
+def test_position_output_gives_the_blocks_bits(reset):
+    plant = parse_model("rvm1")
+    plant.Finalize()
+    chain = KinematicChain.of(plant, plant.GetFrameByName(rvm1.END_EFFECTOR))
+    table = np.array([[0.0, 1.2], [1.0, 1.5], [0.75, 0.6], [gamma_gain(1.0, 0.75), gamma_gain(1.5, 0.6)]])
+    target = SinusoidTarget([0.24, 0.0, 0.3], [0.1, 0.1, 0.1], 1.5, [0.0, np.pi / 2, 0.0])
+    law = SurfaceLaw(Lambda=5.0, k=3.0, switching="tanh", phi=0.01, k_hold=50.0)
+    gains = np.r_[EPS, DELTA, 0.0, law.k, law.k_hold, law.code, law.phi, 0.0, law.Lambda, np.full(3, K_GAIN)]
+    assert len(gains) == GAINS_HEAD + 6
+    static = pack_position(3, table, gains, *pack_chain(chain), np.array([target.compiled, target.compiled]),
+                           reset, False)
+    rng = np.random.default_rng(7)
+    row, out = np.empty(49), np.empty(6)
+    for t in (0.0, 0.4, 0.4, 1.1, 1.3, 2.9):  # start, converging, memo hit, hold, next segment
+        q, v, sigma = rng.uniform(-1, 1, 3), rng.uniform(-1, 1, 3), rng.uniform(-0.1, 0.1, 3)
+        captured = np.r_[0.0 if t < 1.2 else 1.0, rng.uniform(-0.1, 0.1, 3), rng.uniform(-0.1, 0.1, 3)]
+        u = BasicVector(np.r_[q, v, sigma, captured]).value()  # the simulation's array (flags)
+        position_output(t, u, static, row, out)
+        expected = _blocks_row(chain, table, target, law, t, q, v,
+                               sigma - captured[4:] if reset else sigma, captured)
+        np.testing.assert_array_equal(row, expected)
+        np.testing.assert_array_equal(out, np.r_[expected[38:41], expected[46:49]])
+
+
+def test_a_borrowed_view_stays_inside_its_array():
+    with pytest.raises(IndexError):
+        borrow(np.zeros(5), 3, (3,))
