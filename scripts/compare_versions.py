@@ -22,8 +22,8 @@ back to back, so a change in the machine's load hits both), and reports the medi
 - ``paper``: wall time of ``ptint paper``;
 - ``realtime/NAME``: ``sim.realtime_factor`` of metrics.json (SPEC 5.3, in-process end to end)
   of ``ptint run NAME --no-replay --no-figures`` for every bundled scenario without a camera
-  (a continuous plant fed the true target); ``metrics_equal`` says whether every other
-  metric of the two versions agrees within max(1 %, 1 µm) (timing fields left out);
+  (a continuous plant fed the true target) that both versions have; ``metrics_equal`` says
+  whether every other metric of the two versions agrees within max(1 %, 1 µm) (timing fields left out);
 - ``robust``: ``samples_per_s`` of ``ptint robust curve_b075_tf15 --samples 200 --workers 2``.
 """
 
@@ -172,13 +172,13 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     new_tree = Path(args.new).resolve()
     ref = args.old or default_old_ref(new_tree)
-    cases = []
-    for case in args.cases.split(","):
-        cases += ([f"realtime/{n}" for n in continuous_scenarios(new_tree)] if case == "realtime"
-                  else [case])
     with tempfile.TemporaryDirectory(prefix="ptint-compare-") as tmp:
         tmp = Path(tmp)
         old_tree = export_tree(new_tree, ref, (tmp / "old_src").resolve())
+        both = sorted(set(continuous_scenarios(new_tree)) & set(continuous_scenarios(old_tree)))
+        cases = []
+        for case in args.cases.split(","):
+            cases += [f"realtime/{n}" for n in both] if case == "realtime" else [case]
         for label in ("old", "new"):
             (tmp / label).mkdir(exist_ok=True)
         old = Version("old", old_tree, args.python, tmp / "old")
