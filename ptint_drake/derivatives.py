@@ -15,6 +15,7 @@ from math import factorial
 
 import numpy as np
 from numpy.polynomial import polynomial as P
+from pydrake.trajectories import PiecewisePolynomial
 
 
 def savgol_derivative(v: np.ndarray, window: int, order: int, deriv: int, delta: float) -> np.ndarray:
@@ -44,16 +45,19 @@ def savgol_derivative(v: np.ndarray, window: int, order: int, deriv: int, delta:
 def uniform_derivatives(t: np.ndarray, xdot: np.ndarray, dt: float = 1e-3, window_s: float = 0.021):
     """(t_u, ẋ, ẍ, x⃛) on a uniform grid from per-step samples of ẋ (axis 0: time).
 
-    The samples are put on a uniform ``dt`` grid by a cubic spline, then
-    differentiated with a Savitzky–Golay filter (cubic, ``window_s`` wide).
+    The samples are put on a uniform ``dt`` grid by a cubic spline with not-a-knot ends
+    (Drake's ``PiecewisePolynomial.CubicWithContinuousSecondDerivatives``: SciPy's default
+    ``CubicSpline`` to rounding, tests/unit/test_derivatives.py, without importing
+    ``scipy.interpolate``, ≈ 0.2 s, where a run's figures are drawn), then differentiated with
+    a Savitzky–Golay filter (cubic, ``window_s`` wide).  Two distinct times give a line.
     """
-    from scipy.interpolate import CubicSpline  # noqa: PLC0415  (only where a figure needs it)
-
     keep = np.concatenate([[True], np.diff(t) > 1e-12])
-    spline = CubicSpline(t[keep], xdot[keep], axis=0)
+    breaks, samples = np.asarray(t, dtype=float)[keep], np.asarray(xdot, dtype=float)[keep]
+    spline = PiecewisePolynomial.FirstOrderHold(breaks, samples.T) if len(breaks) < 3 else \
+        PiecewisePolynomial.CubicWithContinuousSecondDerivatives(breaks, samples.T, False)
     t_u = np.arange(t[0], t[-1], dt)
-    v = spline(t_u)
+    v = spline.vector_values(t_u).T
     n = max(5, int(round(window_s / dt)) | 1)
     if len(t_u) <= n:
-        return t_u, v, spline(t_u, 1), spline(t_u, 2)
+        return t_u, v, *(spline.derivative(k).vector_values(t_u).T for k in (1, 2))
     return t_u, v, savgol_derivative(v, n, 3, 1, dt), savgol_derivative(v, n, 3, 2, dt)

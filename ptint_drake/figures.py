@@ -52,7 +52,7 @@ _PRELOADED: set = set()
 
 def preload(studies: bool = False) -> None:
     """Import what drawing a run's figures needs (matplotlib's figure, Agg and 3D axes,
-    Pillow, SciPy's spline) and draw the kinds of text the run figures show (mathtext, each
+    Pillow) and draw the kinds of text the run figures show (mathtext, each
     font size), so the font lookups and the mathtext parser are made once: worker processes
     forked afterwards share all of it.  ``studies``: pyplot too.  Once per process."""
     if studies and "studies" not in _PRELOADED:
@@ -65,7 +65,6 @@ def preload(studies: bool = False) -> None:
     import matplotlib.figure  # noqa: F401, PLC0415
     import mpl_toolkits.mplot3d  # noqa: F401, PLC0415
     import PIL.Image  # noqa: F401, PLC0415
-    import scipy.interpolate  # noqa: F401, PLC0415
 
     fig = new_figure((2, 1))
     for size in (7, 8, 9, 10, 12):

@@ -29,3 +29,20 @@ def test_uniform_derivatives_of_a_cubic_are_exact():
     t_u, v, a, j = uniform_derivatives(t, xdot)
     np.testing.assert_allclose(a, np.column_stack([3 * t_u**2 - 1, 4 * t_u, -3 * t_u**2]), atol=1e-9)
     np.testing.assert_allclose(j, np.column_stack([6 * t_u, 4 + 0 * t_u, -6 * t_u]), atol=1e-6)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 60, 1400])
+def test_uniform_grid_spline_is_scipys_not_a_knot_cubic(n):
+    """The resampling spline is SciPy's default ``CubicSpline`` (not-a-knot ends) to rounding,
+    with repeated times dropped; two distinct times give the line through them."""
+    from scipy.interpolate import CubicSpline
+
+    rng = np.random.default_rng(n)
+    t = np.sort(rng.uniform(0.0, 0.3, n))
+    t[0] = 0.0
+    t = np.insert(t, 1, t[1])  # a repeated time (an event: two log rows)
+    xdot = np.column_stack([np.sin(9 * t), np.cos(4 * t), t**3])
+    t_u, v, _, _ = uniform_derivatives(t, xdot)
+    keep = np.r_[True, np.diff(t) > 1e-12]
+    ref = CubicSpline(t[keep], xdot[keep], axis=0)(t_u)
+    np.testing.assert_allclose(v, ref, rtol=0, atol=1e-13)
