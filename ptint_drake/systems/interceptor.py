@@ -101,7 +101,8 @@ class InterceptorLaw(LeafSystem):
 
         self.loop_sizes = loop_sizes(nq, nv, n, targets is None)
         self._loop_in = self.DeclareVectorInputPort("loop", sum(self.loop_sizes))
-        self._parts = np.cumsum(self.loop_sizes)[:-1]
+        ends = np.cumsum(self.loop_sizes).tolist()
+        self._parts = [slice(a, b) for a, b in zip([0] + ends[:-1], ends)]  # views: np.split costs ~8 µs
         self._rotation_in = None if targets is not None or gains.task == "position" else \
             self.DeclareVectorInputPort("target_rotation", TARGET_ROTATION_SIZE)
         self._capture_index = self.DeclareDiscreteState(np.r_[-1.0, np.zeros(2 * n)])
@@ -149,8 +150,8 @@ class InterceptorLaw(LeafSystem):
 
     def loop_values(self, context) -> tuple:
         """([q; v], σ, captured, target or None): the ``loop`` input at ``context`` taken apart."""
-        qv, sigma, captured, *target = np.split(self._loop_in.Eval(context), self._parts)
-        return qv, sigma, captured, target[0] if target else None
+        u, parts = self._loop_in.Eval(context), self._parts
+        return u[parts[0]], u[parts[1]], u[parts[2]], u[parts[3]] if len(parts) > 3 else None
 
     def row_arguments(self, context) -> tuple:
         """``row``'s arguments at ``context``: (t, [q; v], σ, captured, target or None,
