@@ -25,15 +25,18 @@ _RUNS = (
     ("throw_camera", []),
     ("curve_pose", []),
     ("curve_b075_tf15", ["controller.type=smc"]),
+    ("curve_b075_tf15", ["controller.type=ct_quintic"]),  # pinv_solve (``ptint paper``'s comparisons)
 )
 
 
 def warm_up(duration: float = 0.05) -> float:
     """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
     telemetry of the last state, as a run's outputs do); the wall time in s."""
+    import numpy as np  # noqa: PLC0415
+
     from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
     from ptint_drake.simulation import build, prepared_simulator  # noqa: PLC0415
-    from ptint_drake.systems.tbg import alpha_peak, tbg_profile  # noqa: PLC0415
+    from ptint_drake.systems.tbg import alpha_gain, alpha_peak, tbg_profile  # noqa: PLC0415
 
     t0 = time.perf_counter()
     for name, overrides in _RUNS:
@@ -50,6 +53,8 @@ def warm_up(duration: float = 0.05) -> float:
             system.telemetry_at([duration], qv[None], sigma[None], captured[None])
     alpha_peak(1.5, 0.75)
     tbg_profile(0.5, 1.5, 0.75)
+    xi, xi_dot, _, _ = tbg_profile(np.linspace(0.0, 1.5, 5), 1.5, 0.75)
+    alpha_gain(xi, xi_dot)  # arrays, as ``figures.tbg_family_figure`` (``ptint paper``) calls it
     _orientation_kernels()
     _imm_kernels()
     return time.perf_counter() - t0
