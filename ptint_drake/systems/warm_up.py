@@ -16,6 +16,8 @@ from __future__ import annotations
 import sys
 import time
 
+import numpy as np
+
 # scenario, ``--set`` overrides: each reaches kernels (or argument types) the others do not
 _RUNS = (
     ("curve_b075_tf15", []),
@@ -32,8 +34,6 @@ _RUNS = (
 def warm_up(duration: float = 0.05) -> float:
     """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
     telemetry of the last state, as a run's outputs do); the wall time in s."""
-    import numpy as np  # noqa: PLC0415
-
     from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
     from ptint_drake.simulation import build, prepared_simulator  # noqa: PLC0415
     from ptint_drake.systems.tbg import alpha_gain, alpha_peak, tbg_profile  # noqa: PLC0415
@@ -63,8 +63,6 @@ def warm_up(duration: float = 0.05) -> float:
 def _orientation_kernels() -> None:
     """Call the compiled orientation equations as the blocks and a run's metrics call them (the
     fused pose kernel, ``interceptor_row.pose_row``, compiles in the ``curve_pose`` run)."""
-    import numpy as np  # noqa: PLC0415
-
     from ptint_drake.systems.orientation import (SpinningOrientation, orientation_error_angle,  # noqa: PLC0415
                                                  rotation_error, rotation_exp)
     from ptint_drake.systems.signals import IDENTITY_ROTATION  # noqa: PLC0415
@@ -80,8 +78,6 @@ def _orientation_kernels() -> None:
 
 def _imm_kernels() -> None:
     """Call the IMM's kernels with the argument types ``AdaptiveTargetEstimator.step`` passes."""
-    import numpy as np  # noqa: PLC0415
-
     from ptint_drake.systems.imm_kernels import NO_SAMPLE, imm_cycle, initial_state  # noqa: PLC0415
 
     z = np.array([0.3, 0.0, 0.2])
