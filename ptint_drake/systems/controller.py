@@ -41,6 +41,100 @@ def _solve3(A, b, out) -> None:
 
 
 @njit(cache=True)
+def pinv_work_size(n: int, nv: int) -> int:
+    """Floats of ``pinv_solve_into``'s scratch for an n × nv Jacobian."""
+    return max(n * n + n, n * nv + max(n, nv) + 2 * min(n, nv))
+
+
+@njit(cache=True, inline="always")
+def _householder(A, rdiag, betas) -> bool:
+    """Householder QR of the m × p (m ≥ p) ``A`` in place: column k below the diagonal and on it
+    holds the k-th reflector v (H_k = I − β_k v vᵀ, β_k = 1 / (s (s + |a_kk|)) in ``betas``),
+    above the diagonal R, and ``rdiag`` R's diagonal.  False when a column has nothing left to reflect or
+    min |r_ii| ≤ 1e-10 max |r_ii| (numerically rank-deficient: the caller falls back to the SVD)."""
+    m, p = A.shape
+    for k in range(p):
+        s = 0.0
+        for i in range(k, m):
+            s += A[i, k] * A[i, k]
+        s = np.sqrt(s)
+        if s == 0.0 or s != s:
+            return False
+        a = A[k, k]
+        alpha = -s if a > 0.0 else s
+        A[k, k] = a - alpha
+        beta = 1.0 / (s * (s + abs(a)))
+        betas[k] = beta
+        for j in range(k + 1, p):
+            f = 0.0
+            for i in range(k, m):
+                f += A[i, k] * A[i, j]
+            f *= beta
+            for i in range(k, m):
+                A[i, j] -= f * A[i, k]
+        rdiag[k] = alpha
+    big, small = 0.0, np.inf
+    for k in range(p):
+        big, small = max(big, abs(rdiag[k])), min(small, abs(rdiag[k]))
+    return small > 1e-10 * big
+
+
+@njit(cache=True, inline="always")
+def _reflect(A, betas, k, y) -> None:
+    """y[k:] ← H_k y[k:] (``_householder``'s k-th reflector)."""
+    m = A.shape[0]
+    f = 0.0
+    for i in range(k, m):
+        f += A[i, k] * y[i]
+    f *= betas[k]
+    for i in range(k, m):
+        y[i] -= f * A[i, k]
+
+
+@njit(cache=True, inline="always")
+def _householder_solve(J, b, out, work) -> bool:
+    """``out`` ← the least-squares solution of J x = b (n ≥ nv: J = QR, x = R⁻¹ Qᵀ b) or its
+    minimum-norm solution (n < nv: Jᵀ = QR, x = Q R⁻ᵀ b), by Householder QR in ``work``
+    (``pinv_work_size``) — for a full-rank J what numpy's ``lstsq`` (an SVD)
+    returns, to rounding, for a fraction of its cost and no new memory.  False (``out`` not
+    written) for a numerically rank-deficient J (``_householder``)."""
+    n, nv = J.shape
+    m, p = max(n, nv), min(n, nv)
+    A = work[:m * p].reshape(m, p)
+    y = work[m * p:m * p + m]
+    rdiag, betas = work[m * p + m:m * p + m + p], work[m * p + m + p:m * p + m + 2 * p]
+    tall = n >= nv
+    for i in range(m):
+        for j in range(p):
+            A[i, j] = J[i, j] if tall else J[j, i]
+    if not _householder(A, rdiag, betas):
+        return False
+    if tall:
+        for i in range(n):
+            y[i] = b[i]
+        for k in range(p):
+            _reflect(A, betas, k, y)
+        for i in range(p - 1, -1, -1):
+            acc = y[i]
+            for j in range(i + 1, p):
+                acc -= A[i, j] * out[j]
+            out[i] = acc / rdiag[i]
+    else:
+        for i in range(p):  # Rᵀ z = b
+            acc = b[i]
+            for j in range(i):
+                acc -= A[j, i] * y[j]
+            y[i] = acc / rdiag[i]
+        for i in range(p, m):
+            y[i] = 0.0
+        for k in range(p - 1, -1, -1):
+            _reflect(A, betas, k, y)
+        for i in range(m):
+            out[i] = y[i]
+    return True
+
+
+@njit(cache=True)
 def pinv_solve(J, b, damping: float):
     """J⁺ b for an n × nv Jacobian J and an n-vector b (the pseudo-inverse of eq. 18).
 
@@ -53,18 +147,20 @@ def pinv_solve(J, b, damping: float):
     (``pinv_solve_into`` in a new array.)"""
     n, nv = J.shape
     out = np.empty(nv)
-    pinv_solve_into(J, b, damping, out, np.empty(n * n + n))
+    pinv_solve_into(J, b, damping, out, np.empty(pinv_work_size(n, nv)))
     return out
 
 
 @njit(cache=True, inline="always")
 def pinv_solve_into(J, b, damping: float, out, work) -> None:
-    """``out`` (nv) ← ``pinv_solve(J, b, damping)``; ``work``: a scratch vector of ≥ n² + n
-    (J Jᵀ and its solve then take no new memory for up to 8 joints, nor does a square 3 × 3 J;
-    the 6-row undamped ``lstsq`` does)."""
+    """``out`` (nv) ← ``pinv_solve(J, b, damping)``; ``work``: a scratch vector of
+    ``pinv_work_size(n, nv)`` (J Jᵀ and its solve then take no new memory for up to 8 joints,
+    nor does a square 3 × 3 J, nor the 6-row undamped solve of a full-rank J:
+    ``_householder_solve``; a rank-deficient one goes to numpy's ``lstsq``)."""
     n, nv = J.shape
     if damping <= 0.0 and n != 3:
-        out[:] = np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
+        if pinv_work_size(n, nv) > len(work) or not _householder_solve(J, b, out, work):
+            out[:] = np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
         return
     if damping <= 0.0 and nv == 3:
         _solve3(J, b, out)
@@ -116,7 +212,7 @@ def sliding_mode_torque(K, J, s_x, damping: float):
     array)."""
     n, nv = J.shape
     tau = np.empty(nv)
-    sliding_mode_torque_into(K, J, s_x, damping, tau, np.empty(n * n + n))
+    sliding_mode_torque_into(K, J, s_x, damping, tau, np.empty(pinv_work_size(n, nv)))
     return tau
 
 

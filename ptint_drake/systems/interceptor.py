@@ -36,8 +36,9 @@ from pydrake.systems.primitives import Demultiplexer, Integrator, MatrixGain, Mu
 
 from ptint_drake.systems.controller import null_space_terms, null_space_torque
 from ptint_drake.systems.gains import ControllerGains
-from ptint_drake.systems.interceptor_row import (pack_chain, pack_gains, pack_position, pose_row,
-                                                 position_output, position_rows, task_row)
+from ptint_drake.systems.interceptor_row import (pack_chain, pack_gains, pack_pose, pack_position,
+                                                 pose_output, pose_row, pose_rows, position_output,
+                                                 position_rows, task_row)
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.orientation import ROTATION_WIDTH, active_rotation_values, compiled_rotations
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
@@ -61,16 +62,18 @@ def telemetry_layout(nv: int, task: str = "position") -> dict:
                  ("sigma", n), ("tau", nv), *extra).slices()
 
 
-def loop_sizes(nq: int, nv: int, n: int, target_input: bool) -> list:
+def loop_sizes(nq: int, nv: int, n: int, target_input: bool, rotation_input: bool = False) -> list:
     """The parts of ``InterceptorLaw``'s ``loop`` input: [q; v] (nq + nv), σ (n), captured
-    [index, s(t0), σ0] (1 + 2n) and, with a target input, [x_r, ẋ_r, ẍ_r] (``TARGET_PORT_SIZE``)."""
-    return [nq + nv, n, 1 + 2 * n] + ([TARGET_PORT_SIZE] if target_input else [])
+    [index, s(t0), σ0] (1 + 2n), with a target input [x_r, ẋ_r, ẍ_r] (``TARGET_PORT_SIZE``) and
+    with a rotation input too [R_r, ω_r, ω̇_r] (``TARGET_ROTATION_SIZE``)."""
+    return [nq + nv, n, 1 + 2 * n] + ([TARGET_PORT_SIZE] if target_input else []) + \
+        ([TARGET_ROTATION_SIZE] if rotation_input else [])
 
 
 class InterceptorLaw(LeafSystem):
-    """Inputs ``loop`` ([q; v; σ; captured; target], ``loop_sizes``: the plant state, the
-    Integrator's σ (n), the ``captured`` output fed back and, without target objects, the target
-    estimate) and, with an orientation task and no target objects, ``target_rotation``; outputs
+    """Input ``loop`` ([q; v; σ; captured; target; target_rotation], ``loop_sizes``: the plant
+    state, the Integrator's σ (n), the ``captured`` output fed back and, without target objects,
+    the target estimate and, with an orientation task, the target's rotation); outputs
     ``tau_sigma_dot`` ([τ; σ̇], nv + n), ``telemetry`` and ``captured`` (its discrete state
     [index, s(t0), σ0], 1 + 2n).  See ``PrescribedTimeInterceptor``."""
 
@@ -94,29 +97,40 @@ class InterceptorLaw(LeafSystem):
         chain = self._kinematics.chain
         self._fast = gains.task == "position" and chain is not None
         self._chain = pack_chain(chain) if chain is not None else None
+        # the pose and top-down tasks on the chain: packed too, unless an orientation is sampled
+        self._fast_pose = gains.task != "position" and chain is not None and not self._python_targets \
+            and (targets is None or self._rotations is not None)
         self.layout = telemetry_layout(nv, gains.task)
         self._size = size = max(part.stop for part in self.layout.values())
         self._tau = self.layout["tau"]
         self._sigma_dot = slice(size + 5, size + 5 + n)
 
-        self.loop_sizes = loop_sizes(nq, nv, n, targets is None)
+        self._rotation_input = targets is None and gains.task != "position"
+        self.loop_sizes = loop_sizes(nq, nv, n, targets is None, self._rotation_input)
         self._loop_in = self.DeclareVectorInputPort("loop", sum(self.loop_sizes))
         ends = np.cumsum(self.loop_sizes).tolist()
         self._parts = [slice(a, b) for a, b in zip([0] + ends[:-1], ends)]  # views: np.split costs ~8 µs
-        self._rotation_in = None if targets is not None or gains.task == "position" else \
-            self.DeclareVectorInputPort("target_rotation", TARGET_ROTATION_SIZE)
         self._capture_index = self.DeclareDiscreteState(np.r_[-1.0, np.zeros(2 * n)])
         DeclareSegmentStartEvents(self, schedule, self._capture)
         self.DeclareStateOutputPort("captured", self._capture_index)
         deps = {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()}
         self._out = np.empty(nv + n)
         self._row = np.empty(size + 5 + n)  # the fast path's row, reused by every evaluation
-        self._static = None if not self._fast else pack_position(
-            nq, schedule.table, self._gains, *self._chain, self._compiled, self._law.reset_sigma,
-            targets is None or self._python_targets)
-        # the compiled position path end to end: the output's kernel, and ``rows`` in one call
-        self._batch = self._fast and self._null_space is None and not self._python_targets
-        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_position_output if self._batch
+        self._static, self._kernel, self._rows_kernel = None, None, None
+        if self._fast:
+            self._static = pack_position(
+                nq, schedule.table, self._gains, *self._chain, self._compiled, self._law.reset_sigma,
+                targets is None or self._python_targets)
+            self._kernel, self._rows_kernel = position_output, position_rows
+        elif self._fast_pose:
+            self._static = pack_pose(
+                nq, TASKS.index(gains.task), self._rot_scale, schedule.table, self._gains, *self._chain,
+                self._compiled, _NO_ROTATIONS if self._rotations is None else self._rotations,
+                self._law.reset_sigma, targets is None, self._rotation_input)
+            self._kernel, self._rows_kernel = pose_output, pose_rows
+        # the compiled path end to end: the output's kernel, and ``rows`` in one call
+        self._batch = self._kernel is not None and self._null_space is None and not self._python_targets
+        self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_packed_output if self._batch
                                      else self._calc_output, prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("telemetry", size,
                                      lambda c, o: o.SetFromVector(self._eval(c)[:size]),
@@ -132,13 +146,14 @@ class InterceptorLaw(LeafSystem):
         (tests/unit/test_kernel_load.py); ``rows``' batch kernel is loaded here too.  The TBG
         and target kept for t = 0 are those of t = 0."""
         context = self.CreateDefaultContext()
-        self._loop_in.FixValue(context, np.zeros(self._loop_in.size()))
-        if self._rotation_in is not None:
-            self._rotation_in.FixValue(context, np.array(IDENTITY_ROTATION))
+        loop = np.zeros(self._loop_in.size())
+        if self._rotation_input:
+            loop[self._parts[4]] = IDENTITY_ROTATION
+        self._loop_in.FixValue(context, loop)
         self._loop_writeable = bool(self._loop_in.EvalBasicVector(context).value().flags.writeable)
         self._eval(context)
         if self._batch:  # the telemetry's kernel (``rows``)
-            self.rows(np.zeros(1), *(None if p is None else p[None] for p in self.loop_values(context)))
+            self.rows(np.zeros(1), *(None if p is None else p[None] for p in self.row_arguments(context)[1:]))
 
     @property
     def num_tasks(self) -> int:
@@ -149,15 +164,17 @@ class InterceptorLaw(LeafSystem):
         return self._size
 
     def loop_values(self, context) -> tuple:
-        """([q; v], σ, captured, target or None): the ``loop`` input at ``context`` taken apart."""
+        """([q; v], σ, captured, target or None): the ``loop`` input at ``context`` taken apart
+        (``row_arguments`` adds the target's rotation)."""
         u, parts = self._loop_in.Eval(context), self._parts
         return u[parts[0]], u[parts[1]], u[parts[2]], u[parts[3]] if len(parts) > 3 else None
 
     def row_arguments(self, context) -> tuple:
         """``row``'s arguments at ``context``: (t, [q; v], σ, captured, target or None,
         target_rotation or None)."""
-        rotation = None if self._rotation_in is None else self._rotation_in.Eval(context)
-        return (context.get_time(), *self.loop_values(context), rotation)
+        u, parts = self._loop_in.Eval(context), self._parts
+        return (context.get_time(), u[parts[0]], u[parts[1]], u[parts[2]],
+                u[parts[3]] if len(parts) > 3 else None, u[parts[4]] if len(parts) > 4 else None)
 
     def _eval(self, context) -> np.ndarray:
         """The row (telemetry, active segment, σ̇) at ``context``."""
@@ -169,12 +186,13 @@ class InterceptorLaw(LeafSystem):
         out[:self._nv], out[self._nv:] = row[self._tau], row[self._sigma_dot]
         output.SetFromVector(out)
 
-    def _calc_position_output(self, context, output) -> None:
-        """[τ; σ̇] of the compiled position path (no null-space term): the ``loop`` input as it
-        is into the kernel that ``row`` calls too, which writes [τ; σ̇] into the output's own
-        memory (and the row into a reused buffer)."""
-        position_output(context.get_time(), self._loop_in.EvalBasicVector(context).value(), self._static,
-                        self._row, output.get_mutable_value())
+    def _calc_packed_output(self, context, output) -> None:
+        """[τ; σ̇] of the compiled path (``position_output``, or ``pose_output`` for a task with
+        orientation; no null-space term): the ``loop`` input as it is into the kernel that
+        ``row`` calls too, which writes [τ; σ̇] into the output's own memory (and the row into a
+        reused buffer)."""
+        self._kernel(context.get_time(), self._loop_in.EvalBasicVector(context).value(), self._static,
+                     self._row, output.get_mutable_value())
 
     def _capture(self, context, state) -> None:
         """Store [index, s(t0), σ0] at a segment start (σ0: σ then, with ``sigma_policy`` reset)."""
@@ -196,11 +214,12 @@ class InterceptorLaw(LeafSystem):
         if target is None:
             target = np.array(active_target_values(self._schedule, self._targets, t)[TARGET_PORT]) \
                 if self._python_targets else _NO_TARGET
-        if self._fast:
+        if self._kernel is not None:
             row = np.empty(self._size + 5 + n)
-            u = np.concatenate([qv, sigma, captured, target])
+            parts = [qv, sigma, captured, target] + ([] if rotation is None else [rotation])
+            u = np.concatenate(parts)
             u.flags.writeable = self._loop_writeable  # the simulation's argument types (one kernel)
-            position_output(float(t), u, self._static, row, np.empty(self._nv + n))
+            self._kernel(float(t), u, self._static, row, np.empty(self._nv + n))
         else:
             if self._law.reset_sigma:
                 sigma = sigma - captured[1 + n:]
@@ -214,15 +233,15 @@ class InterceptorLaw(LeafSystem):
     def rows(self, t: np.ndarray, qv: np.ndarray, sigma: np.ndarray, captured: np.ndarray,
              target: Optional[np.ndarray] = None, rotation: Optional[np.ndarray] = None) -> np.ndarray:
         """``row`` at each of k logged samples (arrays with k rows; ``target`` / ``rotation``
-        None without those inputs): the compiled position path in one call
-        (``position_rows``, the same kernel on the same values), else ``row`` per sample."""
+        None without those inputs): the compiled path in one call (``position_rows`` or
+        ``pose_rows``, the same kernel on the same values), else ``row`` per sample."""
         k = len(t)
         if self._batch:
-            parts = [qv, sigma, captured] + ([] if target is None else [target])
+            parts = [qv, sigma, captured] + [p for p in (target, rotation) if p is not None]
             U = np.ascontiguousarray(np.hstack(parts), dtype=float)
             out = np.empty((k, self._size + 5 + self._n))
-            position_rows(np.ascontiguousarray(t, dtype=float), U, self._static, out,
-                          np.empty(self._nv + self._n))
+            self._rows_kernel(np.ascontiguousarray(t, dtype=float), U, self._static, out,
+                              np.empty(self._nv + self._n))
             return out
         targets = [None] * k if target is None else target
         rotations = [None] * k if rotation is None else rotation
@@ -290,8 +309,8 @@ class PrescribedTimeInterceptor(Diagram):
         builder.Connect(loop.get_output_port(), law.GetInputPort("loop"))
         if targets is None:
             builder.ExportInput(loop.get_input_port(3), "target")
-        if law.HasInputPort("target_rotation"):
-            builder.ExportInput(law.GetInputPort("target_rotation"), "target_rotation")
+        if len(law.loop_sizes) > 4:
+            builder.ExportInput(loop.get_input_port(4), "target_rotation")
         BT = plant.MakeActuationMatrix().T
         tau = split.get_output_port(0)
         u = tau if BT.shape[0] == nv and np.array_equal(BT, np.eye(nv)) else None

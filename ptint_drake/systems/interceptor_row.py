@@ -30,8 +30,8 @@ from numba import carray, njit, types
 from numba.extending import intrinsic
 
 from ptint_drake.systems.chain import chain_kinematics, chain_kinematics_into
-from ptint_drake.systems.controller import sliding_mode_torque, sliding_mode_torque_into
-from ptint_drake.systems.orientation import rotation_row
+from ptint_drake.systems.controller import pinv_work_size, sliding_mode_torque, sliding_mode_torque_into
+from ptint_drake.systems.orientation import ROTATION_WIDTH, rotation_row
 from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
 from ptint_drake.systems.targets import target_row
 from ptint_drake.systems.task import POSITION, task_error_of, task_jacobian_of
@@ -140,47 +140,77 @@ def work_size(nv: int, n_joints: int) -> int:
     return 51 + 6 * nv + 6 * n_joints + 15 + 3
 
 
+TASK_MEMO = 38  # task_row_into's memo: [t, TBG row (10), target (12), rotation (15)]
+
+
 @njit(cache=True)
-def task_row(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
-             targets, rotations, out):
+def task_work_size(n: int, nv: int) -> int:
+    """Floats of ``task_row_into``'s scratch for a task of dimension n on nv joints: ẋ, ω, R, [e; ė],
+    J, the surface row and the solve's (``controller.pinv_work_size``)."""
+    return 15 + 2 * n + n * nv + 6 * n + pinv_work_size(n, nv)
+
+
+@njit(cache=True, inline="always")
+def task_row_into(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
+                  targets, rotations, memo, work, out):
     """``out`` ← the row of any task (``interceptor.telemetry_layout(nv, task)`` then
     [index, t0, tf, β, phase] then σ̇) from the frame's position x, orientation R (3 × 3),
     Jacobians J_v, J_ω (3 × nv) and the joint speeds v.  ``task``: its code (``task.TASKS``);
     ``target``: [x_r, ẋ_r, ẍ_r] (≥ 9) or empty to evaluate ``targets`` (``targets.target_row``);
     ``rotation``: [R_r, ω_r, ω̇_r] (15) or empty to evaluate ``rotations``
-    (``orientation.rotation_row``), both at t for the active segment."""
+    (``orientation.rotation_row``), both at t for the active segment.  ``memo`` (``TASK_MEMO``):
+    the TBG, target and rotation of the last call's t, functions of t alone (NaN at first);
+    ``work``: scratch (``task_work_size``)."""
     nv, n = len(v), 3 if task == POSITION else 6
-    xdot, omega, R9 = np.zeros(3), np.zeros(3), np.empty(9)
+    xdot, omega, R9, err = work[0:3], work[3:6], work[6:15], work[15:15 + 2 * n]
+    o = 15 + 2 * n
+    J = borrow(work, o, (n, nv))
+    o += n * nv
+    surface = work[o:o + 6 * n]
+    solve = work[o + 6 * n:]
     for i in range(3):
+        xdot[i], omega[i] = 0.0, 0.0
         for k in range(nv):
             xdot[i] += J_v[i, k] * v[k]
             omega[i] += J_w[i, k] * v[k]
         for j in range(3):
             R9[3 * i + j] = R[i, j]
-    active = max(np.searchsorted(segments[0], t, side="right") - 1, 0)
-    ref, rot = np.empty(12), np.zeros(15)
-    if len(target) == 0:
-        target_row(targets[active], t, ref)
-    else:
-        ref[:9] = target[:9]
-    if task != POSITION:
-        if len(rotation) == 0:
+    tbg, ref, rot = memo[1:11], memo[11:23], memo[23:38]
+    if memo[0] != t:  # (NaN at first)
+        tbg_row(t, segments, gains[0], gains[1], gains[2], tbg)
+        active = max(np.searchsorted(segments[0], t, side="right") - 1, 0)
+        if len(target) == 0:
+            target_row(targets[active], t, ref)
+        if task != POSITION and len(rotation) == 0:
             rotation_row(rotations[active], t, rot)
-        else:
-            rot[:] = rotation[:15]
-    err, J = np.empty(2 * n), np.empty((n, nv))
+        memo[0] = t
+    if len(target) != 0:
+        ref[:9] = target[:9]
+    if task != POSITION and len(rotation) != 0:
+        rot[:] = rotation[:15]
     task_error_of(task, rot_scale, x, xdot, ref[0:3], ref[3:6], R9, omega, rot, err)
     task_jacobian_of(J_v, J_w, rot_scale, J)
-    tbg, surface = np.empty(10), np.empty(6 * n)
-    tau = law_row(t, err[:n], err[n:], J, sigma, captured, segments, gains, tbg, surface)
+    surface_law(t, err[:n], err[n:], tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
+                gains[3], gains[4], int(gains[5]), gains[6], surface)
     m = 20 + 5 * n
+    sliding_mode_torque_into(gains[GAINS_HEAD + n:], J, surface[:n], gains[7], out[m + n:m + n + nv], solve)
     out[0:3], out[3:6], out[6:15], out[15:20], out[20:m] = x, xdot, ref[:9], tbg[:5], surface[:5 * n]
-    out[m:m + n], out[m + n:m + n + nv] = sigma, tau
+    out[m:m + n] = sigma
     m += n + nv
     if task != POSITION:
         out[m:m + 9], out[m + 9:m + 12], out[m + 12:m + 27] = R9, omega, rot
         m += 27
     out[m:m + 5], out[m + 5:m + 5 + n] = tbg[5:10], surface[5 * n:]
+
+
+@njit(cache=True)
+def task_row(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
+             targets, rotations, out):
+    """``task_row_into`` with its own memo and scratch (the row of a plant the compiled chain
+    cannot describe, from Drake's kinematics)."""
+    n = 3 if task == POSITION else 6
+    task_row_into(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
+                  targets, rotations, np.full(TASK_MEMO, np.nan), np.empty(task_work_size(n, len(v))), out)
 
 
 @njit(cache=True)
@@ -256,3 +286,84 @@ def position_rows(t, U, static, rows, tau_sigma_dot):
     ``tau_sigma_dot`` is scratch."""
     for k in range(len(t)):
         position_output(t[k], U[k], static, rows[k], tau_sigma_dot)
+
+
+POSE_HEAD = 12  # POSITION_HEAD's, then the task code, c (rot_scale), rotation count, rotation given
+
+
+def pose_work_size(n: int, nv: int, n_joints: int) -> int:
+    """Floats of ``pose_output``'s scratch: x, R, J_v, J_ω, the chain's, σ and ``task_row_into``'s."""
+    return 12 + 6 * nv + 3 * (2 * n_joints + 5) + n + task_work_size(n, nv)
+
+
+def pack_pose(nq: int, task: int, rot_scale: float, segments, gains, joints, geometry, targets, rotations,
+              reset: bool, given_target: bool, given_rotation: bool) -> np.ndarray:
+    """``pack_position`` for any task (``task.TASKS`` code ``task``, c = ``rot_scale``): the head
+    [nq, nv, segment count, joint count, target count, target row width, σ reset, target in the
+    input, task, c, rotation count, rotation in the input], then ``segments``, ``gains``,
+    ``joints``, ``geometry``, ``targets`` and ``rotations`` (compiled orientations,
+    ``ROTATION_WIDTH`` each) flattened, then the memo (``TASK_MEMO``) and the scratch
+    (``pose_work_size``)."""
+    n = 3 if task == POSITION else 6
+    nv = len(gains) - GAINS_HEAD - n
+    rotations = np.asarray(rotations, dtype=float).reshape(-1, ROTATION_WIDTH)
+    head = [nq, nv, segments.shape[1], joints.shape[1], targets.shape[0], targets.shape[1], float(reset),
+            float(given_target), task, rot_scale, rotations.shape[0], float(given_rotation)]
+    return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in (
+        segments, gains, joints, geometry, targets, rotations)), np.full(TASK_MEMO, np.nan),
+        np.zeros(pose_work_size(n, nv, joints.shape[1]))])
+
+
+@njit(cache=True)
+def pose_output(t, u, static, row, tau_sigma_dot):
+    """``position_output`` for any task on the compiled chain (the pose and top-down tasks):
+    ``u`` = [q; v; σ (n); captured [index, s(t0), σ0] (1 + 2n); the target [x_r, ẋ_r, ẍ_r] (9)
+    when the system has a target input; [R_r, ω_r, ω̇_r] (15) when it has a rotation input],
+    ``static`` from ``pack_pose``; ``row`` ← the row (``task_row_into``), ``tau_sigma_dot`` ←
+    [τ; σ̇].  Its views are borrowed and its scratch is in ``static``."""
+    nq, nv, n_seg, n_joints = int(static[0]), int(static[1]), int(static[2]), int(static[3])
+    n_targets, width, task, n_rot = int(static[4]), int(static[5]), int(static[8]), int(static[10])
+    n = 3 if task == POSITION else 6
+    o = POSE_HEAD
+    segments = borrow(static, o, (4, n_seg))
+    o += 4 * n_seg
+    gains = borrow(static, o, (GAINS_HEAD + n + nv,))
+    o += GAINS_HEAD + n + nv
+    joints = borrow(static, o, (3, n_joints))
+    o += 3 * n_joints
+    geometry = borrow(static, o, (n_joints + 1, 5, 3))
+    o += 15 * (n_joints + 1)
+    targets = borrow(static, o, (n_targets, width))
+    o += n_targets * width
+    rotations = borrow(static, o, (n_rot, ROTATION_WIDTH))
+    o += n_rot * ROTATION_WIDTH
+    memo = borrow(static, o, (TASK_MEMO,))
+    work = borrow(static, o + TASK_MEMO, (len(static) - o - TASK_MEMO,))
+    x, R = work[0:3], borrow(work, 3, (3, 3))
+    J_v, J_w = borrow(work, 12, (3, nv)), borrow(work, 12 + 3 * nv, (3, nv))
+    c = 12 + 6 * nv
+    chain = borrow(work, c, (2 * n_joints + 5, 3))
+    c += 3 * (2 * n_joints + 5)
+    sigma = work[c:c + n]
+    m = nq + nv
+    captured = borrow(u, m + n, (1 + 2 * n,))
+    for i in range(n):
+        sigma[i] = u[m + i] - captured[1 + n + i] if static[6] != 0.0 else u[m + i]
+    p = m + 3 * n + 1
+    given_target = 9 if static[7] != 0.0 else 0
+    target = borrow(u, p, (given_target,))
+    rotation = borrow(u, p + given_target, (15 if static[11] != 0.0 else 0,))
+    chain_kinematics_into(borrow(u, 0, (nq,)), joints[0], joints[1], joints[2], geometry[:, :4],
+                          geometry[:-1, 4], x, R, J_v, J_w, chain)
+    task_row_into(t, x, R, J_v, J_w, borrow(u, nq, (nv,)), sigma, captured, target, rotation, task, static[9],
+                  segments, gains, targets, rotations, memo, work[c + n:], borrow(row, 0, (len(row),)))
+    m = 20 + 6 * n
+    tau_sigma_dot[:nv] = row[m:m + nv]
+    tau_sigma_dot[nv:] = row[len(row) - n:]
+
+
+@njit(cache=True)
+def pose_rows(t, U, static, rows, tau_sigma_dot):
+    """``pose_output`` at each logged sample k (``position_rows`` for any task)."""
+    for k in range(len(t)):
+        pose_output(t[k], U[k], static, rows[k], tau_sigma_dot)

@@ -156,6 +156,28 @@ def test_six_row_pinv_is_numpys_least_squares(nv, damping):
     np.testing.assert_allclose(pinv_apply(J, b, damping), expected, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("nv", [5, 6, 8])
+def test_six_row_pinv_of_a_rank_deficient_jacobian_is_the_svds(nv):
+    """A 6-row J with two equal columns (a wrist singularity) or a zero row: the Householder
+    solve says rank-deficient and the SVD's minimum-norm least-squares solution is returned
+    (not a huge or NaN one); a nearly singular J (condition ~1e8) still matches numpy."""
+    from ptint_drake.systems.controller import pinv_apply
+
+    rng = np.random.default_rng(10 + nv)
+    b = rng.normal(size=6)
+    equal = rng.normal(size=(6, nv))
+    equal[:, -1] = equal[:, -2]
+    zero_row = rng.normal(size=(6, nv))
+    zero_row[2] = 0.0
+    for J in (equal, zero_row):
+        x = pinv_apply(J, b)
+        np.testing.assert_allclose(x, np.linalg.lstsq(J, b, rcond=None)[0], atol=1e-10)
+        assert np.all(np.isfinite(x)) and np.linalg.norm(x) < 1e3
+    U, _, Vt = np.linalg.svd(rng.normal(size=(6, nv)), full_matrices=False)
+    J = U @ np.diag(np.logspace(0, -8, min(6, nv))) @ Vt
+    np.testing.assert_allclose(pinv_apply(J, b), np.linalg.lstsq(J, b, rcond=None)[0], rtol=1e-6)
+
+
 @pytest.mark.parametrize("law", ["sign", "tanh", "sat"])
 def test_switching_law_is_numpys(law):
     """The compiled law equals numpy's array form (sign, clip exactly; tanh to the last bits)."""

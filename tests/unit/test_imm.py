@@ -139,10 +139,11 @@ def test_compiled_cycle_matches_the_numpy_reference():
     """Along 400 cycles (random Δ, 15 % without a sample, a turning belt that becomes a throw):
     from each state, the compiled mixing, the prediction of every model (by its code) and the
     correction equal ``_ReferenceIMM``'s to 1e-12 (relative to each array's largest entry), and
-    a whole cycle to 1e-8; left to run on their own the two stay within 1e-6.  The looser
+    a whole cycle to 1e-7; left to run on their own the two stay within 1e-6.  The looser
     bounds are the filter's, not the port's: ``_ReferenceIMM`` itself moves a cycle's P by
     ~4e-9 when χ moves by one ulp (Ω's forward-difference Jacobian, h = 1e-5, and the Joseph
-    form's cancellation), and its own run by ~5e-8."""
+    form's cancellation), and its own run by ~5e-8; on an AVX-512 processor (numpy's BLAS
+    takes other kernels there) one cycle differed by 1.3e-8."""
     rng = np.random.default_rng(7)
     R = 4e-6
 
@@ -172,7 +173,7 @@ def test_compiled_cycle_matches_the_numpy_reference():
         one_step = _ReferenceIMM.imm_cycle(*ours, dt, z if sample else None, R)
         ours = imm.imm_cycle(*ours, dt, z if sample else imm.NO_SAMPLE, R)
         theirs = _ReferenceIMM.imm_cycle(*theirs, dt, z if sample else None, R)
-        close(ours, one_step, 1e-8)
+        close(ours, one_step, 1e-7)
         close(ours, theirs, 1e-6)
     assert ours[2].sum() == pytest.approx(1.0, abs=1e-12)
 

@@ -63,3 +63,49 @@ def test_position_output_gives_the_blocks_bits(reset):
 def test_a_borrowed_view_stays_inside_its_array():
     with pytest.raises(IndexError):
         borrow(np.zeros(5), 3, (3,))
+
+
+@pytest.mark.parametrize("task, inputs", [("pose", False), ("top_down", False), ("pose", True)])
+def test_pose_output_gives_the_allocating_kernels_bits(task, inputs):
+    """The packed pose kernel (``pose_output``, the pose and top-down tasks' simulation path:
+    scratch and memo in its packed array) gives the bits of ``pose_row`` (the chain and
+    ``task_row`` in new arrays) at a sequence of times with repeats (the memo), with the
+    system's own compiled target and orientation or with both as inputs (a filter's), with
+    σ reset; ``rows`` (all samples in one call) gives the same bits again."""
+    from ptint_drake.systems.gains import ControllerGains
+    from ptint_drake.systems.interceptor import InterceptorLaw
+    from ptint_drake.systems.interceptor_row import pose_row
+    from ptint_drake.systems.orientation import OrientedTarget, SpinningOrientation
+    from ptint_drake.systems.schedule import Schedule, Segment
+    from ptint_drake.systems.task import TASKS
+
+    plant = parse_model("rvm1_6dof" if task == "pose" else "rvm1_5dof")
+    plant.Finalize()
+    target = OrientedTarget(SinusoidTarget([0.24, 0, 0.3], [0.1, 0.1, 0.1], 1.5, [0, 1.57, 0]),
+                            SpinningOrientation([150.0, 50.0, 180.0], [0.0, -20.0, 30.0]))
+    schedule = Schedule([Segment(0.0, 1.2, 0.75), Segment(1.5, 1.0, 0.5)])
+    gains = ControllerGains(task=task, sigma_policy="reset")
+    law = InterceptorLaw(plant=plant, frame=plant.GetFrameByName(rvm1.END_EFFECTOR), schedule=schedule,
+                         gains=gains, targets=None if inputs else [target, target])
+    assert law._batch and law._kernel.__name__ == "pose_output"
+    nv = plant.num_velocities()
+    rng = np.random.default_rng(11 + nv)
+    times = [0.0, 0.3, 0.3, 0.9, 1.4, 1.7, 1.7, 2.9]
+    rows, args = [], []
+    for t in times:
+        qv, sigma = rng.normal(scale=0.5, size=2 * nv), rng.normal(scale=0.01, size=6)
+        captured = np.r_[float(schedule.active(t)), rng.normal(scale=0.1, size=12)]
+        ref, rot = (np.array(target.evaluate(t))[:9], np.array(target.rotation_values(t))) if inputs \
+            else (None, None)
+        rows.append(law.row(t, qv, sigma, captured, ref, rot))
+        args.append((t, qv, sigma, captured, ref, rot))
+        expected = np.empty_like(rows[-1])
+        targets = law._compiled if not inputs else np.zeros((1, 38))
+        rotations = law._rotations if not inputs else np.zeros((1, 12))
+        pose_row(float(t), qv, sigma - captured[7:], captured, np.empty(0) if ref is None else ref,
+                 np.empty(0) if rot is None else rot, TASKS.index(task), 0.1, schedule.table, law._gains,
+                 *law._chain, targets, rotations, expected)
+        np.testing.assert_array_equal(rows[-1], expected)
+    stacked = [np.array(column) for column in zip(*args)]
+    batch = law.rows(stacked[0], *stacked[1:4], *(stacked[4:] if inputs else (None, None)))
+    np.testing.assert_array_equal(batch, np.array(rows))

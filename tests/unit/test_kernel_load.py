@@ -13,10 +13,10 @@ import pytest
 
 from ptint_drake.scenario import parse_with_overrides, scenario_text
 from ptint_drake.simulation import build, prepared_simulator
-from ptint_drake.systems.interceptor_row import pose_row, position_output
+from ptint_drake.systems.interceptor_row import pose_output, position_output
 
 
-@pytest.mark.parametrize("name, kernel", [("curve_b075_tf15", position_output), ("curve_pose", pose_row)])
+@pytest.mark.parametrize("name, kernel", [("curve_b075_tf15", position_output), ("curve_pose", pose_output)])
 def test_a_run_and_its_telemetry_load_no_kernel(name, kernel):
     _, text = scenario_text(name)
     scenario = parse_with_overrides(text, [], name)

@@ -87,9 +87,9 @@ def test_spinning_orientation_is_exp_of_omega_t_times_R0():
 
 @pytest.mark.parametrize("task", ["pose", "top_down"])
 def test_pose_kernel_on_the_chain_equals_the_law_on_the_plants_kinematics(task):
-    """``pose_row`` (compiled chain, compiled target and orientation) and ``task_row`` on Drake's
-    kinematics with Python-evaluated targets give the same row (1e-12); its e, ė are
-    ``task_error`` of the row's own x, ẋ, R, ω and targets."""
+    """The simulation's kernel (``pose_output``: compiled chain, compiled target and orientation),
+    ``pose_row`` with Python-evaluated targets and ``task_row`` on Drake's kinematics give the
+    same row (1e-12); its e, ė are ``task_error`` of the row's own x, ẋ, R, ω and targets."""
     model = "rvm1_6dof" if task == "pose" else "rvm1_5dof"
     plant = parse_model(model)
     plant.Finalize()
@@ -106,10 +106,11 @@ def test_pose_kernel_on_the_chain_equals_the_law_on_the_plants_kinematics(task):
         captured = np.r_[0.0, rng.normal(scale=0.1, size=6), np.zeros(6)]
         fast = law.row(t, qv, sigma, captured, None)
         rot = np.array(target.rotation_values(t))
+        law._kernel, kernel = None, law._kernel  # the unpacked paths
         slow = law.row(t, qv, sigma, captured, target.evaluate(t), rot)
         law._chain, chain = None, law._chain
         plant_row = law.row(t, qv, sigma, captured, target.evaluate(t), rot)
-        law._chain = chain
+        law._chain, law._kernel = chain, kernel
         np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-12)
         np.testing.assert_allclose(fast, plant_row, rtol=0, atol=1e-12)
         part = {name: fast[s] for name, s in layout.items()}
