@@ -68,7 +68,7 @@ class AdaptiveTargetEstimator(LeafSystem):
     Input port ``measurement`` (5): [stamp, x, y, z, valid] from a ``Camera``.
     Output ports ``target`` (9): [p, v, a] of the combined estimate predicted to t (zeros
     before the first sample); ``probabilities`` (4): μ of ``MODELS``; ``polynomial`` (28): the
-    state of that name (``target_prediction.PolynomialTargetSelector`` evaluates it in C++).
+    state of that name (``target_prediction.PolynomialTargetSelector`` evaluates it, compiled).
     Discrete state groups (``groups`` maps the names to indices): ``meta`` = [initialised,
     t_est, last stamp consumed, t of the last update], ``estimates`` = χⱼ (4×10 row-major),
     ``covariances`` = Pⱼ (4×10×10), ``probabilities`` = μ (4), ``polynomial`` = [t_est, c₀, c₁,

@@ -84,7 +84,8 @@ position std from the DARE):
 
 ``ActiveTargetSelector`` passes on the estimate of the segment active at t; ``AddCameraEstimators``
 wires a camera and an estimator per object (``auto``: the IMM of ``imm``, whose polynomials
-``target_prediction.PolynomialTargetSelector`` selects in C++; ``kalman_cv`` / ``kalman_ca``: this filter).
+``target_prediction.PolynomialTargetSelector`` selects and evaluates, compiled; ``kalman_cv`` /
+``kalman_ca``: this filter).
 """
 
 from __future__ import annotations

@@ -26,6 +26,7 @@ _RUNS = (
     ("conveyor_pair_camera", []),
     ("throw_camera", []),
     ("curve_pose", []),
+    ("conveyor_yaw_camera", []),  # the top-down task from a filter, the orientation filter's output
     ("curve_b075_tf15", ["controller.type=smc"]),
     ("curve_b075_tf15", ["controller.type=ct_quintic"]),  # pinv_solve (``ptint paper``'s comparisons)
 )

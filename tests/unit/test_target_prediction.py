@@ -1,4 +1,4 @@
-"""target_prediction: the IMMs' polynomials selected and evaluated in C++."""
+"""target_prediction: the IMMs' polynomials selected and evaluated (compiled)."""
 
 import numpy as np
 import pytest
