@@ -21,6 +21,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenario_text
 from ptint_drake.scenario_yaml import drake_version
 from ptint_drake.simulation import Built, prepared_simulator, build, simulate
+from ptint_drake.controllers.slot import TargetView, measures_orientation, uses_analytic_targets
 from ptint_drake.station import MakeStation
 from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
 
@@ -177,23 +178,34 @@ def paired(names=None, a: str = "{}", b: str = BEFORE, repeats: int = 5, progres
 
 class _ZeroTorque(LeafSystem):
     """A Python controller that does nothing: reads the plant state, outputs zero actuation
-    (what any Python LeafSystem in the loop costs per derivative evaluation)."""
+    (what any Python LeafSystem in the loop costs per derivative evaluation).  With ``extra``
+    (sizes) it has inputs ``target_0`` … too and reads them as well (the camera floor: what a
+    controller fed by the camera path costs before it computes anything)."""
 
-    def __init__(self, n_state: int, n_actuation: int):
+    def __init__(self, n_state: int, n_actuation: int, extra=()):
         super().__init__()
         self._state_in = self.DeclareVectorInputPort("state", n_state)
+        self._extra = [self.DeclareVectorInputPort(f"target_{i}", size) for i, size in enumerate(extra)]
         self._zero = np.zeros(n_actuation)
-        self.DeclareVectorOutputPort("u", n_actuation, self._calc)
+        self.DeclareVectorOutputPort("u", n_actuation, self._calc_with_targets if extra else self._calc)
 
     def _calc(self, context, output):
         self._state_in.Eval(context)
         output.SetFromVector(self._zero)
 
+    def _calc_with_targets(self, context, output):
+        self._state_in.Eval(context)
+        for port in self._extra:
+            port.Eval(context)
+        output.SetFromVector(self._zero)
+
 
 def _floor_diagram(scenario, kind: str):
     """The scenario's station with ``kind`` in the controller's place: ``cpp`` (a Drake
-    ConstantVectorSource), ``python`` (``_ZeroTorque``) or ``controller`` (the scenario's own
-    controller, no loggers, no monitor)."""
+    ConstantVectorSource), ``python`` (``_ZeroTorque``), ``python_camera`` (``_ZeroTorque``
+    reading the camera path's target, and target rotation when the cameras measure one: the
+    cameras, estimators and selectors the controller gets, ``controllers.slot.TargetView``) or
+    ``controller`` (the scenario's own controller, no loggers, no monitor)."""
     if kind == "controller":
         return build(scenario, log=False)
     builder = DiagramBuilder()
@@ -203,8 +215,15 @@ def _floor_diagram(scenario, kind: str):
     if kind == "cpp":
         source = builder.AddSystem(ConstantVectorSource(np.zeros(n_act)))
     else:
-        source = builder.AddSystem(_ZeroTorque(station.plant.num_multibody_states(), n_act))
-        builder.Connect(system.GetOutputPort("state"), source.get_input_port())
+        ports = []
+        if kind == "python_camera":
+            view = TargetView(builder, system, scenario)
+            ports = [view.port()] + ([view.rotation_port()] if measures_orientation(scenario) else [])
+        source = builder.AddSystem(_ZeroTorque(station.plant.num_multibody_states(), n_act,
+                                               [p.size() for p in ports]))
+        builder.Connect(system.GetOutputPort("state"), source.get_input_port(0))
+        for i, port in enumerate(ports):
+            builder.Connect(port, source.get_input_port(1 + i))
     builder.Connect(source.get_output_port(), system.GetInputPort("actuation"))
     diagram = builder.Build()
     install_stateless_derivatives(diagram)  # the same treatment as ``build`` gives the controller
@@ -226,8 +245,12 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
     depends on them).  ``needed_for_3x_us``: what an evaluation may cost for the controlled
     run to take a third of its time at the same number of evaluations.  ``kernels_us``: what
     one call of the fused interceptor's row (its compiled kernels and the Python around them,
-    ``kernel_cost``) costs on its own.  A pick scenario (its own world, ``pick.world``) is
-    skipped with a note.
+    ``kernel_cost``) costs on its own.  ``controller_over_python``: controller / do-nothing.
+    A scenario with a camera in the loop adds ``python_camera``: the do-nothing controller fed
+    by the same cameras, estimators and selectors (their discrete updates, their outputs read
+    at every evaluation), and ``controller_over_python_camera``: what the controller adds to
+    what any controller fed by the camera pays.  A pick scenario (its own world,
+    ``pick.world``) is skipped with a note.
     """
     names = list(names or bundled_scenarios())
     out = {}
@@ -240,7 +263,8 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
             out[name] = {"skipped": "a pick scenario: its world (pick.world) has no floor diagrams"}
             continue
         row = {}
-        for kind in ("controller", "python", "cpp"):
+        camera = not uses_analytic_targets(scenario)
+        for kind in ("controller", "python", "cpp") + (("python_camera",) if camera else ()):
             built = _floor_diagram(scenario, kind)
             best, evals, steps = float("inf"), 0, 0
             for _ in range(repeats):
@@ -258,6 +282,11 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
         row["controller_work_us"] = round(
             row["controller"]["us_per_evaluation"] - row["python"]["us_per_evaluation"], 2)
         row["needed_for_3x_us"] = round(row["controller"]["us_per_evaluation"] / 3.0, 2)
+        row["controller_over_python"] = round(
+            row["controller"]["us_per_evaluation"] / row["python"]["us_per_evaluation"], 3)
+        if camera:
+            row["controller_over_python_camera"] = round(
+                row["controller"]["us_per_evaluation"] / row["python_camera"]["us_per_evaluation"], 3)
         row["kernels_us"] = kernel_cost(scenario)
         out[name] = row
     return out

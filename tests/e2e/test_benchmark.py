@@ -42,6 +42,18 @@ def test_floors_structure():
     assert row["python_crossing_us"] == pytest.approx(
         row["python"]["us_per_evaluation"] - row["cpp"]["us_per_evaluation"], abs=0.011)
     assert row["needed_for_3x_us"] == pytest.approx(row["controller"]["us_per_evaluation"] / 3, abs=0.011)
+    assert "python_camera" not in row and row["controller_over_python"] == pytest.approx(
+        row["controller"]["us_per_evaluation"] / row["python"]["us_per_evaluation"], abs=0.002)
+
+
+def test_floors_of_a_camera_scenario_add_the_camera_fed_do_nothing():
+    """With a camera in the loop, a fourth diagram: the do-nothing controller reading the camera
+    path's target (cameras, estimators, selector) at every evaluation."""
+    row = benchmark.floors(["throw_camera"], repeats=1)["throw_camera"]
+    camera = row["python_camera"]
+    assert camera["evaluations"] > 100 and camera["us_per_evaluation"] > row["cpp"]["us_per_evaluation"]
+    assert row["controller_over_python_camera"] == pytest.approx(
+        row["controller"]["us_per_evaluation"] / camera["us_per_evaluation"], abs=0.002)
 
 
 def test_cli_floors_prints_json(ptint_here):
