@@ -1,26 +1,27 @@
 """One evaluation of the fused interceptor as compiled code (numba): the whole row at once.
 
-``law_row`` chains the equation kernels — the TBG and α (``tbg.tbg_row``, paper eqs. 6-10,
-13), the surface (``sliding_surface.surface_law``, eqs. 16-17) and the torque
-(``controller.sliding_mode_torque``, eq. 18) — from a task error; ``position_row`` adds the
-position task end to end: the compiled kinematic chain (``chain.chain_kinematics``, eq. 5), the
-target (``targets.target_row``, or a given one) and e = x − x_r (eq. 11); ``pose_row`` the same
-for any task (``task_row``: with orientation, the target's rotation from
-``orientation.rotation_row`` or a given one, and the error ``task.task_error_of``).  The blocks
-call the same kernels one by one, so there is one implementation of each equation.
+``position_row`` chains the equation kernels for the position task end to end: the compiled
+kinematic chain (``chain.chain_kinematics_into``, eq. 5), the target (``targets.target_row``, or a
+given one), e = x − x_r (eq. 11), the TBG and α (``tbg.tbg_row``, paper eqs. 6-10, 13), the
+surface (``sliding_surface.surface_law``, eqs. 16-17) and the torque
+(``controller.sliding_mode_torque_into``, eq. 18); ``task_row_into`` the same for any task from
+the frame's kinematics (with orientation, the target's rotation from ``orientation.rotation_row``
+or a given one, and the error ``task.task_error_of``), ``pose_output`` with the chain.  The
+blocks call the same kernels one by one, so there is one implementation of each equation.
 
-The parameters travel as a few arrays (each argument costs the call ~0.1-0.2 µs):
-``gains`` = [ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)]
-(``pack_gains``), ``segments`` = ``Schedule.table``, ``joints`` = [kinds; q index; v index] and
-``geometry`` = the chain's fixed transforms with each joint's axis (``pack_chain``).
-``position_output`` takes all of them as one array (``pack_position``) and the loop's values as
-one input vector [q; v; σ; index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so an evaluation passes five
-arguments; the same array holds the memo of the last call and a scratch block for every
-intermediate (``chain.chain_kinematics_into``, ``controller.sliding_mode_torque_into``), so the
-simulation's evaluation allocates no memory; its views are borrowed (``borrow``: no atomic
-reference counts), and the equation kernels are inlined into it (numba ``inline="always"``: a
-call between compiled functions passes each array as 7-11 words).  Every kernel keeps its
-order of operations, so the bits are those of the blocks (tests/unit/test_kernel_identity.py).
+The parameters travel as a few arrays (each argument costs the call ~0.1-0.2 µs): ``gains`` =
+[ϵ, δ, α_hold, k, k_hold, law, φ, λ (pinv damping), Λ (n), K (nv)] (``pack_gains``),
+``segments`` = ``Schedule.table``, ``joints`` = [kinds; q index; v index] and ``geometry`` = the
+chain's fixed transforms with each joint's axis (``pack_chain``). ``position_output`` takes all
+of them as one array (``pack_position``) and the loop's values as one input vector [q; v; σ;
+index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so an evaluation passes five arguments (``pose_output``
+likewise, ``pack_pose``, with [R_r, ω_r, ω̇_r] last); the same array holds the memo of the last
+call and a scratch block for every intermediate (``chain.chain_kinematics_into``,
+``controller.sliding_mode_torque_into``), so the simulation's evaluation allocates no memory;
+its views are borrowed (``borrow``: no atomic reference counts), and the equation kernels are
+inlined into it (numba ``inline="always"``: a call between compiled functions passes each array
+as 7-11 words). Every kernel keeps its order of operations, so the bits are those of the blocks
+(tests/unit/test_kernel_identity.py).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from numba import carray, njit, types
 from numba.extending import intrinsic
 
 from ptint_drake.systems.chain import chain_kinematics, chain_kinematics_into
-from ptint_drake.systems.controller import pinv_work_size, sliding_mode_torque, sliding_mode_torque_into
+from ptint_drake.systems.controller import pinv_work_size, sliding_mode_torque_into
 from ptint_drake.systems.orientation import ROTATION_WIDTH, rotation_row
 from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
 from ptint_drake.systems.targets import target_row
@@ -56,18 +57,6 @@ def pack_chain(chain) -> tuple:
     geometry[:, :4] = chain.fixed
     geometry[:-1, 4] = chain.axes
     return joints, geometry
-
-
-@njit(cache=True)
-def law_row(t, e, edot, J, sigma, captured, segments, gains, tbg, surface):
-    """τ (nv) of eq. 18 for the task error e, ė (n) and Jacobian J (n × nv), with σ and the
-    captured [index, s(t0)]; fills ``tbg`` (10, ``signals.TBG``) and ``surface`` (6n,
-    ``signals.surface_slots``) on the way."""
-    n = len(e)
-    tbg_row(t, segments, gains[0], gains[1], gains[2], tbg)
-    surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
-                gains[3], gains[4], int(gains[5]), gains[6], surface)
-    return sliding_mode_torque(gains[GAINS_HEAD + n:], J, surface[:n], gains[7])
 
 
 @intrinsic
