@@ -348,7 +348,8 @@ def _parser():
     parser.add_argument("--floors", action="store_true",
                         help="instead: µs per derivative evaluation of the plant with a C++ constant "
                              "actuation, with a do-nothing Python controller, and with the scenario's "
-                             "controller")
+                             "controller (with a camera also the do-nothing controller fed by the "
+                             "camera's estimates)")
     return parser
 
 
