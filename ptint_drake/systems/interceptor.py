@@ -6,14 +6,15 @@
 kinematic chain and the target, in one call).  It is a small Diagram:
 
     state ─> Multiplexer ─loop─> InterceptorLaw ─[τ; σ̇]─> Demultiplexer ─τ─> (Bᵀ) ─> u
-    (target)    ↑ σ, captured                                      └σ̇─> Integrator (σ) ─┐
+    (targets)   ↑ σ, captured                                      └σ̇─> Integrator (σ) ─┐
                 └──────────────────────────────────────────────────────────────────────┘
 
 so each derivative evaluation enters Python once (the law's one output; Drake's Integrator
 holds σ and Drake's cache hands the same output to the plant and to the integrator) and reads
 one input: the Multiplexer gathers the plant state, σ, the law's own ``captured`` state (a state
-output: no feedthrough, no algebraic loop) and the ``target`` input into one vector, which the
-compiled position path (``interceptor_row.position_output``) takes as it is.  Its
+output: no feedthrough, no algebraic loop) and the ``target`` and ``target_rotation`` inputs into
+one vector, which the compiled paths (``interceptor_row.position_output``, and ``pose_output`` for
+the pose and top-down tasks) take as it is.  Its
 ``telemetry`` port carries every intermediate signal (layout in ``telemetry_layout``).  A run
 logs only C++ ports (the plant's state, ``sigma`` and ``captured``) and ``telemetry_at``
 recomputes the telemetry of each logged sample afterwards — the same kernel on the same state,
