@@ -164,18 +164,22 @@ class InterceptorLaw(LeafSystem):
     def telemetry_size(self) -> int:
         return self._size
 
+    def _loop_parts(self, context) -> tuple:
+        """([q; v], σ, captured, target or None, target_rotation or None): the ``loop`` input at
+        ``context`` taken apart."""
+        u, parts = self._loop_in.Eval(context), self._parts
+        return (u[parts[0]], u[parts[1]], u[parts[2]], u[parts[3]] if len(parts) > 3 else None,
+                u[parts[4]] if len(parts) > 4 else None)
+
     def loop_values(self, context) -> tuple:
         """([q; v], σ, captured, target or None): the ``loop`` input at ``context`` taken apart
         (``row_arguments`` adds the target's rotation)."""
-        u, parts = self._loop_in.Eval(context), self._parts
-        return u[parts[0]], u[parts[1]], u[parts[2]], u[parts[3]] if len(parts) > 3 else None
+        return self._loop_parts(context)[:4]
 
     def row_arguments(self, context) -> tuple:
         """``row``'s arguments at ``context``: (t, [q; v], σ, captured, target or None,
         target_rotation or None)."""
-        u, parts = self._loop_in.Eval(context), self._parts
-        return (context.get_time(), u[parts[0]], u[parts[1]], u[parts[2]],
-                u[parts[3]] if len(parts) > 3 else None, u[parts[4]] if len(parts) > 4 else None)
+        return (context.get_time(), *self._loop_parts(context))
 
     def _eval(self, context) -> np.ndarray:
         """The row (telemetry, active segment, σ̇) at ``context``."""

@@ -230,9 +230,31 @@ def pack_position(nq: int, segments, gains, joints, geometry, targets, reset: bo
     nv = len(gains) - GAINS_HEAD - 3
     head = [nq, nv, segments.shape[1], joints.shape[1], targets.shape[0], targets.shape[1],
             float(reset), float(given_target)]
-    return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in (
-        segments, gains, joints, geometry, targets)), np.full(MEMO, np.nan),
-        np.zeros(work_size(nv, joints.shape[1]))])
+    return _packed(head, (segments, gains, joints, geometry, targets), MEMO, work_size(nv, joints.shape[1]))
+
+
+def _packed(head, arrays, memo: int, work: int) -> np.ndarray:
+    """[head; each of ``arrays`` flattened; a memo of ``memo`` NaNs; ``work`` zeros] as floats."""
+    return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in arrays),
+                           np.full(memo, np.nan), np.zeros(work)])
+
+
+@njit(cache=True, inline="always")
+def _static_parts(static, o, n, nv):
+    """(segments, gains, joints, geometry, targets, the offset after them): the borrowed views of a
+    packed array (``pack_position``, ``pack_pose``) whose head ends at ``o``, for a task of
+    dimension n on nv joints (head slots 2-5: segment, joint and target counts, target width)."""
+    n_seg, n_joints, n_targets, width = int(static[2]), int(static[3]), int(static[4]), int(static[5])
+    segments = borrow(static, o, (4, n_seg))
+    o += 4 * n_seg
+    gains = borrow(static, o, (GAINS_HEAD + n + nv,))
+    o += GAINS_HEAD + n + nv
+    joints = borrow(static, o, (3, n_joints))
+    o += 3 * n_joints
+    geometry = borrow(static, o, (n_joints + 1, 5, 3))
+    o += 15 * (n_joints + 1)
+    targets = borrow(static, o, (n_targets, width))
+    return segments, gains, joints, geometry, targets, o + n_targets * width
 
 
 @njit(cache=True)
@@ -242,19 +264,8 @@ def position_output(t, u, static, row, tau_sigma_dot):
     ``static`` from ``pack_position``; ``row`` ← the row, ``tau_sigma_dot`` ← [τ; σ̇]
     (σ − σ0 used with ``sigma_policy`` reset).  Allocates nothing, and its views are borrowed
     (``borrow``)."""
-    nq, nv, n_seg, n_joints = int(static[0]), int(static[1]), int(static[2]), int(static[3])
-    n_targets, width = int(static[4]), int(static[5])
-    o = POSITION_HEAD
-    segments = borrow(static, o, (4, n_seg))
-    o += 4 * n_seg
-    gains = borrow(static, o, (GAINS_HEAD + 3 + nv,))
-    o += GAINS_HEAD + 3 + nv
-    joints = borrow(static, o, (3, n_joints))
-    o += 3 * n_joints
-    geometry = borrow(static, o, (n_joints + 1, 5, 3))
-    o += 15 * (n_joints + 1)
-    targets = borrow(static, o, (n_targets, width))
-    o += n_targets * width
+    nq, nv = int(static[0]), int(static[1])
+    segments, gains, joints, geometry, targets, o = _static_parts(static, POSITION_HEAD, 3, nv)
     memo, work = borrow(static, o, (MEMO,)), borrow(static, o + MEMO, (len(static) - o - MEMO,))
     m = nq + nv
     sigma = work[len(work) - 3:]
@@ -298,9 +309,8 @@ def pack_pose(nq: int, task: int, rot_scale: float, segments, gains, joints, geo
     rotations = np.asarray(rotations, dtype=float).reshape(-1, ROTATION_WIDTH)
     head = [nq, nv, segments.shape[1], joints.shape[1], targets.shape[0], targets.shape[1], float(reset),
             float(given_target), task, rot_scale, rotations.shape[0], float(given_rotation)]
-    return np.concatenate([np.asarray(head, dtype=float), *(np.ravel(a).astype(float) for a in (
-        segments, gains, joints, geometry, targets, rotations)), np.full(TASK_MEMO, np.nan),
-        np.zeros(pose_work_size(n, nv, joints.shape[1]))])
+    return _packed(head, (segments, gains, joints, geometry, targets, rotations), TASK_MEMO,
+                   pose_work_size(n, nv, joints.shape[1]))
 
 
 @njit(cache=True)
@@ -310,20 +320,10 @@ def pose_output(t, u, static, row, tau_sigma_dot):
     when the system has a target input; [R_r, ω_r, ω̇_r] (15) when it has a rotation input],
     ``static`` from ``pack_pose``; ``row`` ← the row (``task_row_into``), ``tau_sigma_dot`` ←
     [τ; σ̇].  Its views are borrowed and its scratch is in ``static``."""
-    nq, nv, n_seg, n_joints = int(static[0]), int(static[1]), int(static[2]), int(static[3])
-    n_targets, width, task, n_rot = int(static[4]), int(static[5]), int(static[8]), int(static[10])
+    nq, nv, n_joints = int(static[0]), int(static[1]), int(static[3])
+    task, n_rot = int(static[8]), int(static[10])
     n = 3 if task == POSITION else 6
-    o = POSE_HEAD
-    segments = borrow(static, o, (4, n_seg))
-    o += 4 * n_seg
-    gains = borrow(static, o, (GAINS_HEAD + n + nv,))
-    o += GAINS_HEAD + n + nv
-    joints = borrow(static, o, (3, n_joints))
-    o += 3 * n_joints
-    geometry = borrow(static, o, (n_joints + 1, 5, 3))
-    o += 15 * (n_joints + 1)
-    targets = borrow(static, o, (n_targets, width))
-    o += n_targets * width
+    segments, gains, joints, geometry, targets, o = _static_parts(static, POSE_HEAD, n, nv)
     rotations = borrow(static, o, (n_rot, ROTATION_WIDTH))
     o += n_rot * ROTATION_WIDTH
     memo = borrow(static, o, (TASK_MEMO,))

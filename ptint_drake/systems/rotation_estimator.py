@@ -51,7 +51,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
 
 from ptint_drake.systems.camera import TIME_TOL, MeasurementConfig, rotation_noise, validate_measurement
 from ptint_drake.systems.kalman import ActiveTargetSelector, process_covariance, transition
-from ptint_drake.systems.orientation import rotation_exp, rotation_exp_of, rotation_log
+from ptint_drake.systems.orientation import ROTATION_WIDTH, rotation_exp, rotation_log, rotation_row
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET_ROTATION_SIZE
 
@@ -70,22 +70,15 @@ def _turned(R: np.ndarray, phi: np.ndarray) -> np.ndarray:
 @njit(cache=True)
 def predicted_rotation(t: float, meta, R, w, out) -> None:
     """``out`` (15) ← [exp([ω̂ Δt]×) R̂ (row-major), ω̂, 0], Δt = t − t_est, from the filter's
-    ``meta`` [initialised, t_est, …], R̂ (row-major, 9) and ω̂; an unturned, fixed frame before
-    the first sample."""
+    ``meta`` [initialised, t_est, …], R̂ (row-major, 9) and ω̂ (``orientation.rotation_row`` of
+    [R̂, ω̂] at Δt); an unturned, fixed frame before the first sample."""
     if meta[0] < 0.5:
         out[:] = 0.0
         out[0] = out[4] = out[8] = 1.0
         return
-    dt = t - meta[1]
-    phi = np.empty(3)
-    for i in range(3):
-        phi[i] = w[i] * dt
-    E = np.empty((3, 3))
-    rotation_exp_of(phi, E)
-    for i in range(3):
-        for j in range(3):
-            out[3 * i + j] = E[i, 0] * R[j] + E[i, 1] * R[3 + j] + E[i, 2] * R[6 + j]
-        out[9 + i], out[12 + i] = w[i], 0.0
+    c = np.empty(ROTATION_WIDTH)  # the filter's state as a compiled spinning orientation
+    c[0:9], c[9:12] = R, w
+    rotation_row(c, t - meta[1], out)
 
 
 class RotationEstimator(LeafSystem):
