@@ -29,7 +29,9 @@ Local workers (the default) are this module's own small pool, not a
   this pool has no thread, so it forks safely;
 - Ctrl-C: the workers ignore SIGINT (the terminal sends it to the whole process
   group); the parent gets ``KeyboardInterrupt``, terminates every worker (SIGTERM,
-  then SIGKILL after 1 s), waits for them and re-raises — well under a second;
+  then SIGKILL after 1.5 s), waits for them and re-raises — well under a second.  In a
+  worker SIGTERM raises ``Terminated``, so the task in flight unwinds first: e.g. its
+  ``outputs.staged_output`` folder is removed, not left half-written;
 - a worker that dies (e.g. killed by the OOM killer) raises ``WorkerDied``.
 
 With ``dask=ADDRESS`` a ``distributed.Client`` is opened on that scheduler (and
@@ -183,11 +185,32 @@ def _run_dask(address, fn, tasks, window, progress, stats) -> list:
 
 # --------------------------------------------------------------------------- local pool
 
+class Terminated(BaseException):
+    """Raised in a local worker by SIGTERM (the parent stopping it after Ctrl-C or an error,
+    or the parent's death): the task's ``finally`` blocks and context managers run, e.g.
+    ``outputs.staged_output`` removes its half-written folder, and the worker exits."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated(f"stopped by signal {signum}")
+
+
 def _worker_main(conn, fn):
-    """A local worker: tasks ``(index, args)`` in, ``(index, ok, value, rss_mb)`` out."""
+    """A local worker: tasks ``(index, args)`` in, ``(index, ok, value, rss_mb)`` out.
+
+    SIGINT is ignored (the parent handles Ctrl-C); SIGTERM raises ``Terminated`` so the
+    task in flight unwinds (its cleanup runs) before the worker exits."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGTERM, _raise_terminated)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     _die_with_parent()
+    try:
+        _serve(conn, fn)
+    except Terminated:
+        pass
+
+
+def _serve(conn, fn) -> None:
     while True:
         try:
             message = conn.recv()
@@ -198,6 +221,8 @@ def _worker_main(conn, fn):
         index, args = message
         try:
             reply = (index, True, fn(*args))
+        except Terminated:
+            raise
         except BaseException as exc:  # noqa: BLE001  (sent to the parent, re-raised there)
             exc.add_note("in a worker process:\n" + "".join(traceback.format_exc()).rstrip())
             reply = (index, False, exc)

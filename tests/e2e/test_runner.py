@@ -36,6 +36,28 @@ def _die(i):
     return i
 
 
+def _stage_and_wait(out_dir):
+    """Stage a file in ``out_dir`` and wait there until stopped."""
+    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+
+    with staged_output(out_dir) as stage:
+        (stage / "half.txt").write_text("half")
+        time.sleep(60)
+    return "finished"
+
+
+def _fail_once_staged(out_dir):
+    """Raise as soon as the other task's staged folder exists."""
+    deadline = time.time() + 20
+    while not list(Path(out_dir).glob(".ptint-stage-*")) and time.time() < deadline:
+        time.sleep(0.01)
+    raise ValueError("the other task is staged")
+
+
+def _stage_or_fail(kind, out_dir):
+    return _stage_and_wait(out_dir) if kind == "stage" else _fail_once_staged(out_dir)
+
+
 def _comparable(row):
     return {k: v for k, v in row.items() if k != "realtime_factor"}  # wall-clock dependent
 
@@ -99,6 +121,17 @@ def test_a_task_error_is_raised_in_the_caller_and_no_worker_is_left():
         run_tasks(_boom, [(i,) for i in range(6)], workers=2)
     with pytest.raises(WorkerDied, match="exit code 3"):
         run_tasks(_die, [(i,) for i in range(4)], workers=2)
+    assert not _new_children(before)
+
+
+def test_a_stopped_worker_removes_its_half_written_folder(tmp_path):
+    # the parent stops the other worker (SIGTERM) on the error: its staged folder unwinds
+    before = set(_children(os.getpid()))
+    start = time.time()
+    with pytest.raises(ValueError, match="the other task is staged"):
+        run_tasks(_stage_or_fail, [("stage", str(tmp_path)), ("fail", str(tmp_path))], workers=2)
+    assert time.time() - start < 10
+    assert list(tmp_path.iterdir()) == []  # no .ptint-stage-*, no half.txt
     assert not _new_children(before)
 
 
