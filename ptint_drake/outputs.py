@@ -5,6 +5,10 @@ and moved in with ``os.replace`` only when complete; ``metrics.json`` is moved
 last, and the previous run's ``metrics.json`` is removed first, so a folder
 whose ``metrics.json`` exists always holds one complete run.  An interrupted
 run leaves the folder as it was, minus the old ``metrics.json``.
+
+Ctrl-C (SIGINT) and SIGTERM are held while the staged files move in and while the
+temporary folder is removed (``signals_deferred``): an interruption then takes effect
+right after, so it neither leaves a move half-done nor the temporary folder behind.
 """
 
 from __future__ import annotations
@@ -12,7 +16,9 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import tempfile
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -59,6 +65,37 @@ def write_json_atomic(path: Path, data) -> None:
 
 
 MANIFEST = ".ptint-manifest.json"
+_HELD = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextmanager
+def signals_deferred():
+    """Hold SIGINT and SIGTERM until the block ends: their Python handlers are swapped for one
+    that only notes the signal, and the first one noted is handed to its own handler after
+    the block (e.g. ``KeyboardInterrupt`` raised right after it).  A signal the process
+    ignores stays ignored.  Only the main thread can set handlers: elsewhere a no-op.
+    (Masking with ``pthread_sigmask`` would not do: the kernel hands a process's signal to
+    any thread that does not mask it, e.g. one of OpenBLAS's.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    noted: list[int] = []
+    previous = {}
+    for signum in _HELD:
+        handler = signal.getsignal(signum)
+        if handler not in (signal.SIG_IGN, None):
+            previous[signum] = signal.signal(signum, lambda n, _frame: noted.append(n))
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        if noted:
+            handler = previous[noted[0]]
+            if callable(handler):
+                handler(noted[0], None)
+            else:  # SIG_DFL: the signal's default action (SIGTERM ends the process)
+                signal.raise_signal(noted[0])
 
 
 @contextmanager
@@ -74,32 +111,43 @@ def staged_output(out_dir: Path, additive: bool = False):
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".ptint-stage-", dir=out_dir))
+    stage = None
     try:
+        with signals_deferred():
+            stage = Path(tempfile.mkdtemp(prefix=".ptint-stage-", dir=out_dir))
         _as_if_created(stage, 0o777)
         yield stage
-        (out_dir / METRICS).unlink(missing_ok=True)
-        names = sorted((p.name for p in stage.iterdir()), key=lambda n: n == METRICS)
-        for name in names:
-            target = out_dir / name
-            if target.is_dir():
-                shutil.rmtree(target)
-            os.replace(stage / name, target)
-        if additive:
-            return
-        try:
-            previous = set(json.loads((out_dir / MANIFEST).read_text()))
-        except (OSError, ValueError):
-            previous = set()
-        for name in previous - set(names):
-            stale = out_dir / name
-            if stale.is_dir():
-                shutil.rmtree(stale, ignore_errors=True)
-            elif "/" not in name and stale.exists():
-                stale.unlink()
-        write_json_atomic(out_dir / MANIFEST, names)
+        with signals_deferred():
+            _move_in(stage, out_dir, additive)
     finally:
-        shutil.rmtree(stage, ignore_errors=True)
+        if stage is not None:
+            with signals_deferred():
+                shutil.rmtree(stage, ignore_errors=True)
+
+
+def _move_in(stage: Path, out_dir: Path, additive: bool) -> None:
+    """``staged_output``'s commit: the staged files replace those in ``out_dir``,
+    ``metrics.json`` last; then the previous run's other files go (unless ``additive``)."""
+    (out_dir / METRICS).unlink(missing_ok=True)
+    names = sorted((p.name for p in stage.iterdir()), key=lambda n: n == METRICS)
+    for name in names:
+        target = out_dir / name
+        if target.is_dir():
+            shutil.rmtree(target)
+        os.replace(stage / name, target)
+    if additive:
+        return
+    try:
+        previous = set(json.loads((out_dir / MANIFEST).read_text()))
+    except (OSError, ValueError):
+        previous = set()
+    for name in previous - set(names):
+        stale = out_dir / name
+        if stale.is_dir():
+            shutil.rmtree(stale, ignore_errors=True)
+        elif "/" not in name and stale.exists():
+            stale.unlink()
+    write_json_atomic(out_dir / MANIFEST, names)
 
 
 def save_series(path: Path, series: dict) -> None:
