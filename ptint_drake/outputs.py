@@ -48,20 +48,26 @@ def _as_if_created(path, mode: int) -> None:
     os.chmod(path, mode & ~current_umask())
 
 
-def write_json_atomic(path: Path, data) -> None:
-    """Write ``data`` as JSON to ``path`` through a temporary file and ``os.replace``; the
-    file gets the usual mode for the user's umask (0644 under umask 022)."""
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file beside it and
+    ``os.replace``: ``path`` is either the old file or the whole new one, and an interruption
+    leaves no temporary file.  The file gets the usual mode for the user's umask (0644 under
+    umask 022)."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
         _as_if_created(tmp, 0o666)
-        with os.fdopen(fd, "w") as f:
-            json.dump(data, f, indent=2)
-            f.write("\n")
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_json_atomic(path: Path, data) -> None:
+    """Write ``data`` as JSON (indented, a final newline) to ``path`` (``write_text_atomic``)."""
+    write_text_atomic(path, json.dumps(data, indent=2) + "\n")
 
 
 MANIFEST = ".ptint-manifest.json"

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ptint_drake.figures import preload, tbg_family_figure
 from ptint_drake.metrics import segment_reasons
-from ptint_drake.outputs import staged_output
+from ptint_drake.outputs import staged_output, write_text_atomic
 from ptint_drake.run_outputs import frozen_heap, run_and_write
 from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
@@ -187,9 +187,7 @@ def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = 
                         f"{m['sim']['steps']} steps</p>{imgs}")
     compared = "".join(_compare_section(name, result) for name, result in comparisons.items())
     page = _page(rows, sections, compared, time.perf_counter() - t_start)
-    tmp = out_dir / ".index.html.tmp"
-    tmp.write_text(page, encoding="utf-8")
-    tmp.replace(out_dir / "index.html")
+    write_text_atomic(out_dir / "index.html", page)
     return out_dir / "index.html"
 
 

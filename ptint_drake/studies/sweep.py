@@ -16,7 +16,7 @@ point is ``ok`` when every part is placed.
 from __future__ import annotations
 
 import csv
-import os
+import io
 import time
 from concurrent.futures import Executor
 from pathlib import Path
@@ -25,6 +25,7 @@ import numpy as np
 
 # Imported here, not in the worker function: forked workers then inherit them ready.
 from ptint_drake.figures import plt, save, uniform_derivatives
+from ptint_drake.outputs import write_text_atomic
 from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, validate
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
@@ -104,14 +105,13 @@ def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, wor
 
 
 def write_csv(rows, path: Path) -> None:
-    """sweep.csv (``COLUMNS``) written to a temporary file and moved to ``path``."""
-    tmp = Path(path).with_suffix(".csv.tmp")
-    with open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: row.get(k, "") for k in COLUMNS})
-    os.replace(tmp, path)
+    """sweep.csv (``COLUMNS``) written at once (``outputs.write_text_atomic``)."""
+    text = io.StringIO()
+    writer = csv.DictWriter(text, fieldnames=COLUMNS)
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: row.get(k, "") for k in COLUMNS})
+    write_text_atomic(Path(path), text.getvalue())
 
 
 def _frame(ax, label: str, betas, tfs) -> None:
