@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import statistics
 import subprocess
 import sys
@@ -170,6 +171,10 @@ def main(argv=None) -> int:
                         help="comma list of run, paper, realtime, robust, realtime/NAME")
     parser.add_argument("--python", default=sys.executable, help="the Python (with Drake) to run")
     args = parser.parse_args(argv)
+    if "/" in args.python:  # a path: absolute (each version runs in its own folder); a venv's
+        args.python = str(Path(args.python).absolute())  # symlink is kept, not resolved
+    if shutil.which(args.python) is None:
+        raise SystemExit(f"compare_versions: --python {args.python}: no such executable")
     new_tree = Path(args.new).resolve()
     ref = args.old or default_old_ref(new_tree)
     with tempfile.TemporaryDirectory(prefix="ptint-compare-") as tmp:
