@@ -257,6 +257,14 @@ def _static_parts(static, o, n, nv):
     return segments, gains, joints, geometry, targets, o + n_targets * width
 
 
+@njit(cache=True, inline="always")
+def _loop_sigma(u, m, n, captured, reset, sigma) -> None:
+    """``sigma`` (n) ← the Integrator's σ at u[m:m + n], minus σ0 (``captured``[1 + n:]) when
+    ``reset`` (``sigma_policy`` reset)."""
+    for i in range(n):
+        sigma[i] = u[m + i] - captured[1 + n + i] if reset else u[m + i]
+
+
 @njit(cache=True)
 def position_output(t, u, static, row, tau_sigma_dot):
     """``position_row`` on a packed input: ``u`` = [q; v; σ (the Integrator's); captured
@@ -270,8 +278,7 @@ def position_output(t, u, static, row, tau_sigma_dot):
     m = nq + nv
     sigma = work[len(work) - 3:]
     captured = borrow(u, m + 3, (7,))
-    for i in range(3):
-        sigma[i] = u[m + i] - captured[4 + i] if static[6] != 0.0 else u[m + i]
+    _loop_sigma(u, m, 3, captured, static[6] != 0.0, sigma)
     target = borrow(u, m + 10, (9 if static[7] != 0.0 else 0,))
     position_row(t, borrow(u, 0, (m,)), sigma, captured, target, segments, gains, joints, geometry,
                  targets, memo, work, borrow(row, 0, (len(row),)))
@@ -336,8 +343,7 @@ def pose_output(t, u, static, row, tau_sigma_dot):
     sigma = work[c:c + n]
     m = nq + nv
     captured = borrow(u, m + n, (1 + 2 * n,))
-    for i in range(n):
-        sigma[i] = u[m + i] - captured[1 + n + i] if static[6] != 0.0 else u[m + i]
+    _loop_sigma(u, m, n, captured, static[6] != 0.0, sigma)
     p = m + 3 * n + 1
     given_target = 9 if static[7] != 0.0 else 0
     target = borrow(u, p, (given_target,))

@@ -18,8 +18,6 @@ output to rounding.
 
 from __future__ import annotations
 
-from bisect import bisect_right
-
 from numba import njit
 from pydrake.systems.framework import LeafSystem
 
@@ -47,7 +45,7 @@ class PolynomialTargetSelector(LeafSystem):
         if count != len(schedule):
             raise ValueError(f"count: one target per segment is needed, got {count} "
                              f"for {len(schedule)} segments")
-        self._starts = [float(s) for s in schedule.starts]
+        self._schedule = schedule
         self._inputs = [self.DeclareVectorInputPort(f"target_{i}", POLYNOMIAL_SIZE) for i in range(count)]
         self._target_out = self.DeclareVectorOutputPort(
             "target", TARGET_PORT_SIZE, self._calc,
@@ -58,5 +56,5 @@ class PolynomialTargetSelector(LeafSystem):
 
     def _calc(self, context, output) -> None:
         t = context.get_time()
-        i = max(bisect_right(self._starts, t) - 1, 0)
+        i = max(self._schedule.active(t), 0)
         polynomial_target(t, self._inputs[i].EvalBasicVector(context).value(), output.get_mutable_value())
