@@ -19,7 +19,7 @@ from pydrake.multibody.tree import (JointIndex, PrismaticJoint, RevoluteJoint, S
 
 from ptint_drake.mass_scaling import scaled_copy
 from ptint_drake.rvm1 import bundled_models, model_path
-from ptint_drake.scenario import Scenario, ScenarioError
+from ptint_drake.scenario import RobotConfig, Scenario, ScenarioError
 from ptint_drake.systems.task import TASK_MIN_JOINTS
 
 
@@ -79,9 +79,11 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
         raise ScenarioError(f"controller.task: {task!r} needs an arm with at least {needed} joints, "
                             f"{scenario.robot.model!r} has {plant.num_velocities()}")
     if len(scenario.robot.initial_q_deg) != plant.num_positions():
+        default = scenario.robot.initial_q_deg == RobotConfig().initial_q_deg
         raise ScenarioError(
             f"robot.initial_q_deg: the model has {plant.num_positions()} joints, "
-            f"got {len(scenario.robot.initial_q_deg)} angles")
+            f"got {len(scenario.robot.initial_q_deg)} angles"
+            + (" (the default, the 3-joint rvm1's: give one angle per joint)" if default else ""))
     return plant
 
 

@@ -60,3 +60,14 @@ def test_an_unreachable_pose_names_the_orientation():
     with pytest.raises(ScenarioError, match=r"^interceptions\[0\]\.target\.orientation: the arm cannot "
                                             r"reach the orientation rpy \[0\.0, -90\.0, 0\.0\] deg"):
         check_reachable(make_plant(scenario), scenario)
+
+
+@pytest.mark.parametrize("angles, hint", [("", True), (", initial_q_deg: [22.5, 45.0, 30.0, 0.0]", False)])
+def test_a_joint_count_mismatch_names_the_field_and_says_when_it_is_the_default(angles, hint):
+    text = FAR_OUT.replace(", initial_q_deg: [22.5, 45.0, 30.0, 0.0, 0.0]", angles)
+    scenario = parse_scenario(text, "mismatch")
+    with pytest.raises(ScenarioError) as error:
+        make_plant(scenario)
+    message = str(error.value)
+    assert message.startswith("robot.initial_q_deg: the model has 5 joints, got ")
+    assert ("the default, the 3-joint rvm1's" in message) == hint and "\n" not in message
