@@ -8,7 +8,9 @@ run leaves the folder as it was, minus the old ``metrics.json``.
 
 Ctrl-C (SIGINT) and SIGTERM are held while the staged files move in and while the
 temporary folder is removed (``signals_deferred``): an interruption then takes effect
-right after, so it neither leaves a move half-done nor the temporary folder behind.
+right after, so it neither leaves a move half-done nor the temporary folder behind.  A
+process that ends without unwinding (a worker stopped by SIGTERM) first removes the folders
+it is staging (``remove_live_stages``).
 """
 
 from __future__ import annotations
@@ -72,6 +74,18 @@ def write_json_atomic(path: Path, data) -> None:
 
 MANIFEST = ".ptint-manifest.json"
 _HELD = (signal.SIGINT, signal.SIGTERM)
+_LIVE_STAGES: dict = {}  # stage folder → pid of the process that staged it (forks inherit this)
+
+
+def remove_live_stages() -> None:
+    """Delete the folders this process is staging (``staged_output``): for a process about to
+    end without unwinding, e.g. a worker stopped by SIGTERM (``studies.runner``).  Those a
+    forked child inherited from its parent stay: they are the parent's."""
+    pid = os.getpid()
+    for stage, owner in list(_LIVE_STAGES.items()):
+        if owner == pid:
+            shutil.rmtree(stage, ignore_errors=True)
+            del _LIVE_STAGES[stage]
 
 
 @contextmanager
@@ -121,6 +135,7 @@ def staged_output(out_dir: Path, additive: bool = False):
     try:
         with signals_deferred():
             stage = Path(tempfile.mkdtemp(prefix=".ptint-stage-", dir=out_dir))
+            _LIVE_STAGES[stage] = os.getpid()
         _as_if_created(stage, 0o777)
         yield stage
         with signals_deferred():
@@ -129,6 +144,7 @@ def staged_output(out_dir: Path, additive: bool = False):
         if stage is not None:
             with signals_deferred():
                 shutil.rmtree(stage, ignore_errors=True)
+                _LIVE_STAGES.pop(stage, None)
 
 
 def _move_in(stage: Path, out_dir: Path, additive: bool) -> None:

@@ -29,9 +29,11 @@ Local workers (the default) are this module's own small pool, not a
   this pool has no thread, so it forks safely;
 - Ctrl-C: the workers ignore SIGINT (the terminal sends it to the whole process
   group); the parent gets ``KeyboardInterrupt``, terminates every worker (SIGTERM,
-  then SIGKILL after 1.5 s), waits for them and re-raises — well under a second.  In a
-  worker SIGTERM raises ``Terminated``, so the task in flight unwinds first: e.g. its
-  ``outputs.staged_output`` folder is removed, not left half-written;
+  then SIGKILL after 1.5 s), waits for them and re-raises — well under a second.  A
+  worker's SIGTERM handler removes the folders its task was staging
+  (``outputs.remove_live_stages``) and exits at once: nothing is left half-written, and no
+  exception is raised into whatever the task was running (a ctypes callback, e.g. numba's
+  cache, would print it and carry on);
 - a worker that dies (e.g. killed by the OOM killer) raises ``WorkerDied``.
 
 With ``dask=ADDRESS`` a ``distributed.Client`` is opened on that scheduler (and
@@ -61,6 +63,7 @@ import traceback
 from multiprocessing.connection import wait as wait_any
 
 from ptint_drake.controllers import plugin
+from ptint_drake.outputs import remove_live_stages
 
 MAX_TASKS_PER_CHILD = 50
 DASK_CONNECT_TIMEOUT_S = 5.0
@@ -185,32 +188,21 @@ def _run_dask(address, fn, tasks, window, progress, stats) -> list:
 
 # --------------------------------------------------------------------------- local pool
 
-class Terminated(BaseException):
-    """Raised in a local worker by SIGTERM (the parent stopping it after Ctrl-C or an error,
-    or the parent's death): the task's ``finally`` blocks and context managers run, e.g.
-    ``outputs.staged_output`` removes its half-written folder, and the worker exits."""
-
-
-def _raise_terminated(signum, frame):
-    raise Terminated(f"stopped by signal {signum}")
+def _stop_worker(signum, frame):
+    """A local worker's SIGTERM (the parent stopping it after Ctrl-C or an error, or the
+    parent's death): remove what its task was staging, then exit without unwinding."""
+    remove_live_stages()
+    os._exit(128 + signum)
 
 
 def _worker_main(conn, fn):
     """A local worker: tasks ``(index, args)`` in, ``(index, ok, value, rss_mb)`` out.
 
-    SIGINT is ignored (the parent handles Ctrl-C); SIGTERM raises ``Terminated`` so the
-    task in flight unwinds (its cleanup runs) before the worker exits."""
+    SIGINT is ignored (the parent handles Ctrl-C); SIGTERM is ``_stop_worker``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
-    signal.signal(signal.SIGTERM, _raise_terminated)
+    signal.signal(signal.SIGTERM, _stop_worker)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     _die_with_parent()
-    try:
-        _serve(conn, fn)
-    except Terminated:
-        pass
-
-
-def _serve(conn, fn) -> None:
     while True:
         try:
             message = conn.recv()
@@ -221,8 +213,6 @@ def _serve(conn, fn) -> None:
         index, args = message
         try:
             reply = (index, True, fn(*args))
-        except Terminated:
-            raise
         except BaseException as exc:  # noqa: BLE001  (sent to the parent, re-raised there)
             exc.add_note("in a worker process:\n" + "".join(traceback.format_exc()).rstrip())
             reply = (index, False, exc)

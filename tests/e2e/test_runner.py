@@ -46,6 +46,27 @@ def _stage_and_wait(out_dir):
     return "finished"
 
 
+def _stage_and_wait_in_c(out_dir):
+    """Stage a file, then wait inside C code that calls back into Python (libc's qsort with a
+    slow comparison, as numba's cache is called back from LLVM): an exception raised in a
+    callback is printed and swallowed there."""
+    import ctypes  # noqa: PLC0415
+
+    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+
+    compare = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int))
+
+    def slow(a, b):
+        time.sleep(0.01)
+        return a[0] - b[0]
+
+    values = (ctypes.c_int * 5000)(*range(5000, 0, -1))
+    with staged_output(out_dir) as stage:
+        (stage / "half.txt").write_text("half")
+        ctypes.CDLL(None).qsort(values, len(values), ctypes.sizeof(ctypes.c_int), compare(slow))
+    return "finished"
+
+
 def _fail_once_staged(out_dir):
     """Raise as soon as the other task's staged folder exists."""
     deadline = time.time() + 20
@@ -55,7 +76,9 @@ def _fail_once_staged(out_dir):
 
 
 def _stage_or_fail(kind, out_dir):
-    return _stage_and_wait(out_dir) if kind == "stage" else _fail_once_staged(out_dir)
+    if kind == "fail":
+        return _fail_once_staged(out_dir)
+    return _stage_and_wait(out_dir) if kind == "stage" else _stage_and_wait_in_c(out_dir)
 
 
 def _comparable(row):
@@ -132,6 +155,19 @@ def test_a_stopped_worker_removes_its_half_written_folder(tmp_path):
         run_tasks(_stage_or_fail, [("stage", str(tmp_path)), ("fail", str(tmp_path))], workers=2)
     assert time.time() - start < 10
     assert list(tmp_path.iterdir()) == []  # no .ptint-stage-*, no half.txt
+    assert not _new_children(before)
+
+
+def test_a_worker_stopped_inside_a_c_callback_removes_its_folder_quietly(tmp_path, capfd):
+    """Stopped while C code calls back into Python: nothing printed (no 'Exception ignored'
+    traceback), no staged folder left, well before the parent's SIGKILL."""
+    before = set(_children(os.getpid()))
+    start = time.time()
+    with pytest.raises(ValueError, match="the other task is staged"):
+        run_tasks(_stage_or_fail, [("stage_in_c", str(tmp_path)), ("fail", str(tmp_path))], workers=2)
+    assert time.time() - start < 10
+    assert list(tmp_path.iterdir()) == []
+    assert "Traceback" not in capfd.readouterr().err
     assert not _new_children(before)
 
 
