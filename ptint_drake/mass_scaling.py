@@ -22,7 +22,7 @@ from pydrake.multibody.tree import (BodyIndex, FixedOffsetFrame, FrameIndex, Joi
                                     ModelInstanceIndex, PrismaticJoint, RevoluteJoint,
                                     SpatialInertia, WeldJoint)
 
-from ptint_drake.validation import ScenarioError
+from ptint_drake.config.errors import ScenarioError
 
 _JOINTS = (RevoluteJoint, PrismaticJoint, WeldJoint)
 
@@ -93,3 +93,20 @@ def _copy_joint(joint, plant: MultibodyPlant, frames: dict) -> None:
     copy.set_velocity_limits(joint.velocity_lower_limits(), joint.velocity_upper_limits())
     copy.set_acceleration_limits(joint.acceleration_lower_limits(), joint.acceleration_upper_limits())
     copy.set_default_positions(joint.default_positions())
+
+
+def scale_in_context(plant: MultibodyPlant, context, instance, scale: float) -> None:
+    """The ``mass_xF`` variant of model ``instance`` set in ``context`` of a finalized plant:
+    every body's mass and inertia (``scaled_inertia``) and every actuator's rotor inertia ×
+    ``scale`` — for a world whose plant holds more than the arm (the pick station), where the
+    controller is not told either."""
+    if scale == 1.0:
+        return
+    for index in plant.GetBodyIndices(instance):
+        body = plant.get_body(index)
+        M = body.CalcSpatialInertiaInBodyFrame(context)
+        if M.get_mass() > 0.0:
+            body.SetSpatialInertiaInBodyFrame(context, scaled_inertia(M, scale))
+    for index in plant.GetJointActuatorIndices(instance):
+        actuator = plant.get_joint_actuator(index)
+        actuator.SetRotorInertia(context, actuator.rotor_inertia(context) * scale)

@@ -32,25 +32,10 @@ from typing import Optional
 
 import numpy as np
 
+from ptint_drake.config.criteria import Criteria
+
 ARRIVAL_TOLERANCE = 1.0e-3  # m: t_arrive is the first time |e| is within this
 STARTUP_FRACTION = 0.05  # peaks "after start-up" skip the first 5 % of each segment's tf
-
-
-@dataclass
-class Criteria:
-    """Pass criteria of a scenario (defaults: the paper's property as this project states it)."""
-
-    e_tf: float = 1.0e-3  # m: |e(start + tf)| at most this ("late" otherwise)
-    hold: float = 3.0e-3  # m: |e| while holding at most this ("hold" otherwise)
-    half_fraction: float = 0.25  # |e(tf/2)| at least this × |e0| ("early" otherwise)
-    min_e0: float = 1.0e-2  # m: the early check applies only when |e0| is at least this
-    # tasks with orientation (controller.task pose | top_down), issue 19:
-    e_rot_tf_deg: float = 2.0  # deg: the angle at start + tf at most this ("orientation" otherwise)
-    rot_hold_deg: float = 5.0  # deg: the angle while holding at most this ("orientation" otherwise)
-    min_e_rot0_deg: float = 5.0  # deg: the early check of the angle applies only from this
-    # pick and place (issue 20): a part is placed when it rests within both of its slot
-    place_mm: float = 3.0  # mm: the part's centre from its place pose at the end
-    place_deg: float = 3.0  # deg: the part's orientation from its slot's at the end
 
 
 def validate_criteria(c: Criteria) -> None:
@@ -133,14 +118,14 @@ def verdict(metrics: dict, criteria: Criteria, margin: float = 1.0) -> tuple[str
     it; one ``Reason`` carrying its message)."""
     if metrics.get("failure"):
         return "failed", [Reason(None, "failed", metrics["failure"]["message"])]
-    if "picks" in metrics:  # a pick and place: its picks decide (pick.metrics)
-        from ptint_drake.pick.metrics import pick_reasons  # noqa: PLC0415
-
-        reasons = [Reason(None, code, f"pick {k}: {code}") for k, code in pick_reasons(metrics["picks"])]
-        return ("missed" if reasons else "ok"), reasons
-    reasons = [Reason(i, code) for i, seg in enumerate(metrics["segments"])
-               for code in segment_reasons(seg, criteria, margin)]
+    reasons = segments_reasons(metrics, criteria, margin)
     return ("missed" if reasons else "ok"), reasons
+
+
+def segments_reasons(metrics: dict, criteria: Criteria, margin: float = 1.0) -> list[Reason]:
+    """A ``Reason`` per failed criterion of each of ``metrics["segments"]``."""
+    return [Reason(i, code) for i, seg in enumerate(metrics["segments"])
+            for code in segment_reasons(seg, criteria, margin)]
 
 
 def _peak(values: np.ndarray, t: np.ndarray, mask: Optional[np.ndarray] = None) -> dict:
@@ -218,14 +203,13 @@ def rotation_metrics(schedule, duration: float, t: np.ndarray, angle: Optional[n
     return rows
 
 
-def run_metrics(scenario, samples: dict, series: dict, limits: np.ndarray) -> dict:
+def run_metrics(scenario, schedule, samples: dict, series: dict, limits: np.ndarray) -> dict:
     """The metrics of a run (docs/results.md): segments, torque and joint-speed peaks with
     their times, the peaks after start-up, and the fraction of time the actuators saturate.
 
     ``series`` holds ``t``, ``x`` (gripper point from the plant state), ``objects`` (true
     positions), ``v`` (joint speeds), ``tau`` (commanded) and ``tau_applied`` (saturated).
     """
-    schedule = scenario.schedule()
     t = series["t"]
     segments = segment_metrics(schedule, scenario.duration, samples, t, series["x"], series["objects"])
     rotations = rotation_metrics(schedule, scenario.duration, t, series.get("rot_angle_deg"),

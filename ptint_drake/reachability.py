@@ -19,7 +19,8 @@ from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.solvers import Solve
 
-from ptint_drake.scenario import Scenario, ScenarioError
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.orientation import target_rotation_values
 
 POSITION_TOLERANCE = 1e-3  # m, per axis
@@ -86,17 +87,16 @@ def _reach_orientation(plant, frame, scenario: Scenario, i: int, t: float, x, ro
         f"(controller.task {task}, within {np.degrees(ORIENTATION_TOLERANCE):g} deg)")
 
 
-def check_reachable(plant: MultibodyPlant, scenario: Scenario, samples_per_hold: int = 4) -> None:
+def check_reachable(plant: MultibodyPlant, scenario: Scenario, schedule, targets: list,
+                    samples_per_hold: int = 4) -> None:
     """Every target must be reachable at its interception time and during its hold: its
     position, and for a task with orientation the orientation the task asks for.
 
-    Solved from the initial pose and then from the previous solution.  Raises
+    ``schedule`` and ``targets``: the interception world's segments and objects.  Solved from the initial pose and then from the previous solution.  Raises
     ScenarioError naming the interception (``.target``: the position; ``.target.orientation``
     or ``.target.waypoints.rpy_deg``: the orientation).
     """
     frame = plant.GetFrameByName(scenario.robot.end_effector)
-    schedule = scenario.schedule()
-    targets = scenario.targets()
     guess = np.radians(scenario.robot.initial_q_deg)
     for i, seg in enumerate(schedule.segments):
         t_end = schedule.hold_end(i, scenario.duration)

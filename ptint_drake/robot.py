@@ -8,6 +8,7 @@ after a run live in ``reachability`` and ``run_warnings``.
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +20,8 @@ from pydrake.multibody.tree import (JointIndex, PrismaticJoint, RevoluteJoint, S
 
 from ptint_drake.mass_scaling import scaled_copy
 from ptint_drake.rvm1 import bundled_models, model_path
-from ptint_drake.scenario import RobotConfig, Scenario, ScenarioError
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.schema import PlantConfig, RobotConfig, Scenario
 from ptint_drake.systems.task import TASK_MIN_JOINTS
 
 
@@ -85,6 +87,15 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
             f"got {len(scenario.robot.initial_q_deg)} angles"
             + (" (the default, the 3-joint rvm1's: give one angle per joint)" if default else ""))
     return plant
+
+
+def nominal_plant(scenario: Scenario) -> MultibodyPlant:
+    """The arm's model file as written — continuous, without the scenario's deviations (masses,
+    damping, payload) or its world (gripper, parts): the one "nominal arm" of the package, what
+    the controllers' kinematics and a model-based controller are allowed to know."""
+    nominal = copy.copy(scenario)
+    nominal.plant, nominal.multibody = PlantConfig(), None
+    return make_plant(nominal)
 
 
 def _apply_config(config: MultibodyPlantConfig, plant: MultibodyPlant) -> None:

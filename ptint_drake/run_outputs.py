@@ -17,38 +17,11 @@ import threading
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
 
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
-from ptint_drake.robot import resolve_model
-from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass, dump_yaml
+from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
 from ptint_drake.simulation import build, simulate
-
-
-def conveyor_belts(scenario: Scenario):
-    """Belts to draw for linear targets: the stretch each object travels, ±0.1 m."""
-    belts = []
-    for ic in scenario.interceptions:
-        lin = ic.target.linear
-        if lin is None:
-            continue
-        a = np.asarray(lin.start)
-        b = a + np.asarray(lin.velocity) * scenario.duration
-        d = (b - a) / (np.linalg.norm(b - a) or 1.0)
-        belts.append((a - 0.1 * d, b + 0.1 * d))
-    return belts
-
-
-def object_rotations(scenario: Scenario, series: dict):
-    """(task, rotations) for the replay's frame triads: each object's true orientation R_r
-    (row-major, N × objects × 9) at the logged times ``series["t"]``; None for a position task."""
-    from ptint_drake.systems.orientation import target_rotation_values  # noqa: PLC0415
-
-    if scenario.controller.task == "position":
-        return None
-    t, targets = series["t"], scenario.targets()
-    rotations = np.array([[target_rotation_values(tg, tk)[0:9] for tg in targets] for tk in t.tolist()])
-    return scenario.controller.task, rotations.reshape(len(t), len(targets), 9)
+from ptint_drake.worlds.registry import world_named, world_of
 
 
 def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figures: bool = True,
@@ -123,65 +96,26 @@ def simulate_beside(scenario: Scenario, prepare=None, **kwargs) -> tuple[dict, d
 
 def run_metrics(scenario: Scenario, metrics: dict, figures: bool = True) -> dict:
     """metrics.json of a run: the simulation's metrics, the scenario as run, the figures' files."""
-    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
-
     metrics = dict(metrics)
     metrics["scenario_config"] = dump_dataclass(scenario)
-    if figures and scenario.pick is not None:
-        metrics["figures"] = ["picks.png"]
-    elif figures:
-        metrics["figures"] = [f"{s}.png" for s in run_figure_stems(scenario.controller.task)]
+    if figures:
+        metrics["figures"] = world_of(scenario).figure_files(scenario)
     return metrics
 
 
-# the longest first: with two workers, the axes figure on one and the rest on the other;
-# "angle" only for a task with orientation (figures.run_figure_stems)
-VIEW_ORDER = ("axes", "errors", "paths3d", "joints", "angle", "replay")
-
-
-def view_task(name: str, series: dict, metrics: dict, stage: Path, title: str, replay_args: tuple):
-    """One figure (``name`` in ``figures.RUN_FIGURES``, ``replay_args`` = (formats,)) or the
-    replay (``name == "replay"``, ``replay_args`` = (model file, belts, end effector,
-    ``object_rotations``)),
-    written in ``stage``; module-level, so that a worker process can run it."""
-    if name in ("picks", "pick_replay"):  # a pick and place (replay_args = (its YAML text,))
-        from ptint_drake.pick.views import pick_figure, write_pick_replay  # noqa: PLC0415
-        from ptint_drake.scenario import parse_scenario  # noqa: PLC0415
-
-        if name == "picks":
-            pick_figure(series, metrics, stage / "picks.png")
-        else:
-            write_pick_replay(parse_scenario(replay_args[0], title), series, stage / "replay.html")
-        return name
-    if name == "replay":
-        from ptint_drake.replay import write_replay  # noqa: PLC0415
-
-        model_file, belts, end_effector, orientation = replay_args
-        write_replay(series, metrics, model_file, stage / "replay.html", conveyors=belts,
-                     end_effector=end_effector, orientation=orientation)
-        return name
-    from ptint_drake.figures import run_figure  # noqa: PLC0415
-
-    return run_figure(name, series, metrics, stage, title, *replay_args)
+def view_task(world: str, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple):
+    """One figure or the replay of a run of world ``world`` (``World.draw_view``), written in
+    ``stage``; module-level, so that a worker process can run it."""
+    return world_named(world).draw_view(name, series, metrics, stage, title, args)
 
 
 def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, figures: bool = True,
                replay: bool = True, svg: bool = False) -> list[tuple]:
     """``view_task`` arguments for a run's figures (PNG, and SVG when ``svg``) and its
-    ``replay.html``, written in ``stage``."""
-    if scenario.pick is not None:
-        names = [n for n, on in (("pick_replay", replay), ("picks", figures)) if on]
-        text = dump_yaml(scenario)  # picklable, for a worker process
-        return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
-    formats = ("png", "svg") if svg else ("png",)
-    replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
-                   scenario.robot.end_effector, object_rotations(scenario, series) if replay else None)
-    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415
-
-    stems = run_figure_stems(scenario.controller.task)
-    names = [n for n in VIEW_ORDER if (n == "replay" and replay) or (n in stems and figures)]
-    return [(n, series, metrics, stage, scenario.name, replay_args if n == "replay" else (formats,))
-            for n in names]
+    ``replay.html``, written in ``stage`` (the world's ``view_tasks``)."""
+    world = world_of(scenario)
+    return [(world.name, *task) for task in world.view_tasks(scenario, series, metrics, stage, figures,
+                                                             replay, svg)]
 
 
 @contextmanager
@@ -216,7 +150,7 @@ def draw_views(tasks: list[tuple], workers: int | None = None) -> None:
     here one after the other.  With workers, the replay's Meshcat lives in a worker, so this
     process stays fit to fork.
     """
-    if any(task[0] != "replay" for task in tasks):
+    if any(not task[1].endswith("replay") for task in tasks):
         from ptint_drake.figures import preload  # noqa: PLC0415
 
         preload()  # once here, not in every worker
@@ -236,9 +170,7 @@ def write_views(scenario: Scenario, series: dict, metrics: dict, stage: Path, fi
     """The run's figures and replay in ``stage`` (``view_tasks``, ``draw_views``); returns
     the figure stems."""
     draw_views(view_tasks(scenario, series, metrics, stage, figures, replay, svg), workers)
-    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415
-
-    return run_figure_stems(scenario.controller.task) if figures else []
+    return [Path(f).stem for f in world_of(scenario).figure_files(scenario)] if figures else []
 
 
 def normalize_graphviz_ids(text: str) -> str:

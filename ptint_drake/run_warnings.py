@@ -14,10 +14,10 @@ from pydrake.multibody.tree import JacobianWrtVariable
 
 from ptint_drake.reachability import inverse_kinematics
 from ptint_drake.robot import effort_limits
-from ptint_drake.scenario import Scenario
+from ptint_drake.config.schema import Scenario
 
 
-def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int = 200) -> list[str]:
+def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list, samples: int = 200) -> list[str]:
     """Warnings for segments whose tf looks too short for the actuators' effort limits.
 
     A planning estimate (it uses the model, the controller does not): on the ideal
@@ -26,7 +26,7 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int =
     cannot follow it anyway and the β = 1/2 profile's bound is used.  The joint
     torque estimate is |M(q) J⁻¹ a| + |g(q)| at the segment's start and
     interception configurations.  The acceleration part scales as 1/tf², which
-    gives the suggested tf.  e0 is taken from the start pose for the first
+    gives the suggested tf (``targets``: the interception world's objects).  e0 is taken from the start pose for the first
     segment and from the previous target for later ones.
     """
     from ptint_drake.systems.tbg import tbg_profile  # noqa: PLC0415
@@ -37,7 +37,6 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, samples: int =
     q_prev = np.radians(scenario.robot.initial_q_deg)
     plant.SetPositions(context, q_prev)
     x_prev = frame.CalcPoseInWorld(context).translation()
-    targets = scenario.targets()
     warnings = []
     for i, ic in enumerate(scenario.interceptions):
         e0 = x_prev - targets[i].evaluate(ic.start)[0:3]
@@ -111,7 +110,7 @@ def _too_short(i: int, tf: float, need_acc: np.ndarray, need_g: np.ndarray,
 
 def singularity_warnings(scenario: Scenario, series: dict) -> list:
     """A warning when J's smallest singular value (``series["sigma_min_J"]``, per logged step,
-    from ``simulation.collect_series``) drops below ``limits.singular_value_warning``: when it
+    from ``worlds.interception.series``) drops below ``limits.singular_value_warning``: when it
     first did, and the time and configuration where it was smallest."""
     threshold = scenario.limits.singular_value_warning
     if threshold <= 0 or len(series["t"]) == 0:

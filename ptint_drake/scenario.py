@@ -1,8 +1,8 @@
-"""Scenario files (docs/scenarios.md): the typed schema and loading.
+"""Scenario files (docs/scenarios.md): loading, overrides and validation over the schema.
 
 A scenario is one YAML mapping loaded with Drake's ``yaml_load_typed`` into
-``Scenario``; unknown keys are rejected; the checks live in ``validation``, the
-YAML writing and error messages in ``scenario_yaml``.  ``simulator`` is Drake's own
+``Scenario`` (the schema, ``config.schema``, re-exported here); unknown keys are rejected; the
+checks live in ``validation``, the YAML writing and error messages in ``config.yaml_io``.  ``simulator`` is Drake's own
 ``SimulatorConfig``.  ``load_scenario`` accepts a bundled name (see
 ``bundled_scenarios``) or a file path, and raises ``ScenarioError`` with a
 one-line message that names the offending field.
@@ -37,204 +37,28 @@ open, with their defaults:
 
 import copy
 import math
-from dataclasses import dataclass, field, make_dataclass
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Dict, List, Optional, Union
 
 from pydrake.common.yaml import yaml_load_typed
-from pydrake.multibody.plant import MultibodyPlantConfig
-from pydrake.systems.analysis import SimulatorConfig
 
-from ptint_drake.controllers import REGISTRY, plugin
-from ptint_drake.metrics import Criteria
-from ptint_drake.pick.tasks import PickConfig, pick_plan
-from ptint_drake.scenario_yaml import dump_dataclass, dump_yaml, yaml_error
-from ptint_drake.systems.camera import MeasurementConfig
-from ptint_drake.systems.gains import ControllerGains
-from ptint_drake.systems.orientation import OrientedTarget, SlerpOrientation, SpinningOrientation
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import BallisticTarget, LinearTarget, SinusoidTarget, WaypointTarget
-from ptint_drake.validation import TARGET_KINDS, ScenarioError, validate
+from ptint_drake.config.controller import ControllerConfig, ParamValue
+from ptint_drake.config.criteria import Criteria
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.schema import (BallisticConfig, DisturbanceConfig, InterceptionConfig, LimitsConfig,
+                                       LinearConfig, OrientationConfig, PlantConfig, RobotConfig, Scenario,
+                                       SinusoidConfig, TargetConfig, WaypointsConfig, default_simulator)
+from ptint_drake.config.yaml_io import dump_dataclass, dump_yaml, yaml_error
+from ptint_drake.controllers import plugin
+from ptint_drake.validation import TARGET_KINDS, validate
 
-__all__ = ["TARGET_KINDS", "ScenarioError", "Scenario", "dump_dataclass", "dump_yaml",
-           "load_scenario", "parse_scenario", "parse_with_overrides", "apply_variant", "check_variants",
-           "validate"]
-
-
-@dataclass
-class RobotConfig:
-    model: str = "rvm1"  # a bundled model name or a path to a URDF/SDFormat file
-    end_effector: str = "tool"  # frame whose origin is the interception point
-    initial_q_deg: List[float] = field(default_factory=lambda: [22.5, 45.0, 30.0])
-
-
-ParamValue = Union[List[float], float, int, str]  # a plugin's setting (the order is Drake YAML's)
-
-
-def _controller_config() -> type:
-    """``ControllerConfig``: the paper's gains flat (``ControllerGains``, shared by ``smc``), which
-    controller runs (``type``), a plugin's ``params``, and one block per registered controller
-    with settings of its own (``controller.pd``, ``controller.smc``, …: from the registry)."""
-    own = [(e.name, e.config, field(default_factory=e.config)) for e in REGISTRY.values() if e.config]
-    cls = make_dataclass("ControllerConfig", [
-        # a plain field rather than a tagged YAML variant, so that ``--set controller.type=pd``
-        # works and an untagged mapping stays the paper's controller
-        ("type", str, field(default="ptsmc")),  # a name of controllers.REGISTRY, or "module:Class"
-        ("implementation", str, field(default="fused")),  # ptsmc: "fused" one LeafSystem, or "blocks"
-        ("params", Dict[str, ParamValue], field(default_factory=dict)),  # a plugin's settings
-        ("control_period", float, field(default=0.0)),  # s: > 0 sampled, torque held between samples
-        *own], bases=(ControllerGains,), namespace={"__module__": __name__})
-    cls.__doc__ = _controller_config.__doc__
-    return cls
-
-
-ControllerConfig = _controller_config()
-
-
-@dataclass
-class SinusoidConfig:
-    center: List[float] = field(default_factory=list)
-    amplitude: List[float] = field(default_factory=list)
-    omega: float = 0.0
-    phase: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-@dataclass
-class LinearConfig:
-    start: List[float] = field(default_factory=list)
-    velocity: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-@dataclass
-class WaypointsConfig:
-    """A recorded path: positions (m) at increasing times (s), interpolated C² (cubic spline)."""
-
-    time: List[float] = field(default_factory=list)
-    # not List[List[float]]: yaml_load_typed cannot build a typing.List inside a list
-    position: list[list[float]] = field(default_factory=list)
-    # optional: the object's roll-pitch-yaw (degrees) at each time, slerped between samples
-    rpy_deg: list[list[float]] = field(default_factory=list)
-
-
-@dataclass
-class OrientationConfig:
-    """The object frame's orientation: Drake RollPitchYaw (R = Rz·Ry·Rx, degrees) at t = 0 and a
-    constant world-frame angular velocity (deg/s)."""
-
-    rpy_deg: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    rate_deg_s: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-@dataclass
-class BallisticConfig:
-    """A thrown object: free flight from ``release`` (s) at ``start`` (m) with ``velocity`` (m/s)."""
-
-    start: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    velocity: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    gravity: List[float] = field(default_factory=lambda: [0.0, 0.0, -9.81])  # m/s²
-    release: float = 0.0
-
-
-@dataclass
-class TargetConfig:
-    sinusoid: Optional[SinusoidConfig] = None
-    linear: Optional[LinearConfig] = None
-    waypoints: Optional[WaypointsConfig] = None
-    orientation: Optional[OrientationConfig] = None
-    ballistic: Optional[BallisticConfig] = None
-
-
-@dataclass
-class InterceptionConfig:
-    start: float = 0.0
-    tf: float = 1.5
-    beta: float = 0.75
-    target: TargetConfig = field(default_factory=TargetConfig)
-
-
-@dataclass
-class DisturbanceConfig:
-    """External joint torque d(t) = amplitude ⊙ sin(2π f t + phase) + step ⊙ [t ≥ step_time]."""
-
-    amplitude: List[float] = field(default_factory=list)  # N·m per joint (empty: none)
-    frequency_hz: float = 1.0
-    phase: List[float] = field(default_factory=list)  # rad per joint (empty: zeros)
-    step: List[float] = field(default_factory=list)  # N·m per joint (empty: none)
-    step_time: float = 0.0  # s
-
-
-@dataclass
-class PlantConfig:
-    """How the simulated robot differs from its model file (the controller never knows)."""
-
-    mass_scale: float = 1.0  # every link's mass and inertia and every rotor inertia × this
-    damping_scale: float = 1.0  # every joint's viscous damping × this
-    payload_kg: float = 0.0  # point-like mass (sphere r 3 cm) welded at the end effector
-    coulomb: List[float] = field(default_factory=list)  # N·m per joint: −F tanh(v / coulomb_speed)
-    coulomb_speed: float = 0.01  # rad/s, smoothing of the Coulomb law
-    disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
-
-
-@dataclass
-class LimitsConfig:
-    saturate: bool = True  # clamp torques to the model's effort limits (Drake Saturation)
-    max_error: float = 0.5  # m: |e| beyond this stops the run as diverged
-    max_joint_speed: float = 50.0  # rad/s (or m/s): beyond this stops the run as diverged
-    singular_value_warning: float = 0.02  # m/rad: warn when J's smallest singular value drops below
-
-
-def _default_simulator() -> SimulatorConfig:
-    return SimulatorConfig(integration_scheme="runge_kutta3", accuracy=1.0e-4,
-                           max_step_size=0.1, use_error_control=True)
-
-
-@dataclass
-class Scenario:
-    duration: float = 3.0
-    robot: RobotConfig = field(default_factory=RobotConfig)
-    controller: ControllerConfig = field(default_factory=ControllerConfig)
-    interceptions: List[InterceptionConfig] = field(default_factory=list)
-    plant: PlantConfig = field(default_factory=PlantConfig)
-    multibody: Optional[MultibodyPlantConfig] = None  # None: the continuous plant (robot.make_plant)
-    measurement: Optional[MeasurementConfig] = None  # None: no camera, the analytic target
-    limits: LimitsConfig = field(default_factory=LimitsConfig)
-    simulator: SimulatorConfig = field(default_factory=_default_simulator)
-    criteria: Criteria = field(default_factory=Criteria)
-    # a pick and place (``pick.tasks``): the world and the tasks, whose segments replace
-    # ``interceptions`` (None: an interception scenario)
-    pick: Optional[PickConfig] = None
-    name: str = ""
-
-    def schedule(self) -> Schedule:
-        """The interceptor's segments: ``interceptions``, or the pick tasks' (``pick_plan``)."""
-        if self.pick is not None:
-            return pick_plan(self.pick).schedule
-        return Schedule([Segment(i.start, i.tf, i.beta) for i in self.interceptions])
-
-    def targets(self) -> list:
-        return [make_target(i.target) for i in self.interceptions]
-
-
-def make_target(config: TargetConfig):
-    """The target object of a ``target`` block: its position kind, with its orientation
-    (``orientation.OrientedTarget``) when it has one (``orientation`` or waypoints' ``rpy_deg``)."""
-    if config.sinusoid is not None:
-        s = config.sinusoid
-        target = SinusoidTarget(s.center, s.amplitude, s.omega, s.phase)
-    elif config.waypoints is not None:
-        target = WaypointTarget(config.waypoints.time, config.waypoints.position)
-    elif config.ballistic is not None:
-        b = config.ballistic
-        target = BallisticTarget(b.start, b.velocity, b.gravity, b.release)
-    else:
-        target = LinearTarget(config.linear.start, config.linear.velocity)
-    if config.orientation is not None:
-        o = config.orientation
-        return OrientedTarget(target, SpinningOrientation(o.rpy_deg, o.rate_deg_s))
-    if config.waypoints is not None and config.waypoints.rpy_deg:
-        return OrientedTarget(target, SlerpOrientation(config.waypoints.time, config.waypoints.rpy_deg))
-    return target
+__all__ = ["TARGET_KINDS", "BallisticConfig", "ControllerConfig", "Criteria", "DisturbanceConfig",
+           "InterceptionConfig", "LimitsConfig", "LinearConfig", "LoadedScenario", "OrientationConfig",
+           "ParamValue", "PlantConfig", "RobotConfig", "Scenario", "ScenarioError", "SinusoidConfig",
+           "TargetConfig", "WaypointsConfig", "apply_variant", "bundled_scenarios", "check_variants",
+           "default_simulator", "dump_dataclass", "dump_yaml", "load_scenario", "parse_scenario",
+           "parse_with_overrides", "scenario_text", "validate"]
 
 
 def bundled_scenarios() -> "list[str]":
@@ -337,7 +161,7 @@ class LoadedScenario:
         """YAML ``text`` with ``overrides`` applied (``scenario_yaml.override_text``), validated.
         A bad override is one line naming its key (``--set KEY: ...``) or, when the file
         itself is valid, the field it made invalid (``--set: FIELD: ...``)."""
-        from ptint_drake.scenario_yaml import override_text  # noqa: PLC0415
+        from ptint_drake.config.yaml_io import override_text  # noqa: PLC0415
 
         changed = override_text(text, overrides)
         if changed is text:

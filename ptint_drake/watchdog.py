@@ -19,12 +19,15 @@ class Watchdog:
     Every 10th step (a Python call per step is all the other steps cost) the
     plant state must be finite and every joint speed within ``limits.max_joint_speed``;
     every 50th step |e| (against the true target, one extra evaluation of the
-    interceptor) within ``limits.max_error``.  A violation
+    interceptor) within ``limits.max_error`` of its value at the active segment's start
+    (``segment_started``, called at each segment's start: the runner stops there exactly) — it
+    judges growth, not size, so a segment that starts far away (a thrown object 1.4 m off) is
+    judged on where it goes.  A violation
     ends the simulation (ReachedTermination) with a message saying when and which
     quantity.  An integrator failure is caught by ``simulate`` the same way.
     """
 
-    def __init__(self, *, scenario, diagram, plant, position_of, true_target, progress=None):
+    def __init__(self, *, scenario, diagram, plant, position_of, true_target, progress=None, schedule=None):
         """``position_of(context)``: the gripper point from the plant state in the root
         context; ``true_target(t)``: the true active object's position."""
         self.failure = None
@@ -38,6 +41,11 @@ class Watchdog:
         self._progress = progress
         self._last = 0.0
         self._count = 0
+        self._reference = 0.0  # |e| at the active segment's start (m)
+
+    def segment_started(self, error: float) -> None:
+        """|e| at the start of the segment that begins now: the reference of the error check."""
+        self._reference = float(error)
 
     def __call__(self, context):
         self._count += 1
@@ -55,9 +63,10 @@ class Watchdog:
         if self._count % 50:
             return _SUCCEEDED
         err = float(np.linalg.norm(self._position_of(context) - self._true_target(t)))
-        if not np.isfinite(err) or err > limits.max_error:
-            return self._fail(t, f"interception error |e| = {err:.3g} m exceeds "
-                                 f"limits.max_error = {limits.max_error:g} m")
+        if not np.isfinite(err) or err > self._reference + limits.max_error:
+            return self._fail(t, f"interception error |e| = {err:.3g} m exceeds its value at the segment's "
+                                 f"start ({self._reference:.3g} m) by more than limits.max_error = "
+                                 f"{limits.max_error:g} m")
         return self._report(t)
 
     def _report(self, t):

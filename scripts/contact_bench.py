@@ -2,7 +2,7 @@
 
 For Drake's default approximation and each of sap, tamsi, lagged, similar that the installed Drake
 has (tamsi is gone from Drake 1.58; the PD-controlled finger and belt actuators need a SAP-family
-solver, so tamsi reports its error): the hold experiment of ``ptint_drake.pick.holding`` — the
+solver, so tamsi reports its error): the hold experiment of ``ptint_drake.worlds.pick.holding`` — the
 5-joint RV-M1 held still by a joint PD, a belt running at 0.1 m/s with a 30 mm box riding it, a
 second box held by the closed gripper (30 N per finger) — over ``--duration`` s, with point
 contact (and, with ``--hydroelastic``, Drake's hydroelastic_with_fallback as extra rows).
@@ -18,9 +18,9 @@ from importlib.metadata import version
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
-from ptint_drake.pick.config import (BeltConfig, GripperConfig, PartConfig, PickWorldConfig,
+from ptint_drake.worlds.pick.config import (BeltConfig, GripperConfig, PartConfig, PickWorldConfig,
                                      contact_approximations)
-from ptint_drake.pick.holding import measure_hold
+from ptint_drake.worlds.pick.holding import measure_hold
 
 CANDIDATES = ("sap", "tamsi", "lagged", "similar")
 

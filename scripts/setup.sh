@@ -86,7 +86,7 @@ venv_abs=$(cd "$VENV" && pwd)
 (cd / && "$venv_abs/bin/python" -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
 # compile the controller's numba kernels once (into numba's cache), so the first `ptint run`
 # does not pay for it (about 30-70 s of CPU on a cold cache; a few seconds when already warm)
-(cd / && "$venv_abs/bin/python" -m ptint_drake.systems.warm_up)
+(cd / && "$venv_abs/bin/python" -m ptint_drake.warm_up)
 info=$("$venv_abs/bin/python" -c 'import sys, importlib.metadata as m
 print("Python %s, Drake %s" % (sys.version.split()[0], m.version("drake")))')
 echo "setup: ready ($VENV/bin/ptint): $info (from $PY)" >&2

@@ -94,7 +94,7 @@ print(f"{pick['t_grasp']:11.3f} | {pick['t_grasp_prescribed']:14.3f} | "
 import tempfile
 from pathlib import Path
 from IPython.display import Image
-from ptint_drake.pick.views import pick_figure
+from ptint_drake.worlds.pick.views import pick_figure
 
 path = pick_figure(result.series, result.metrics, Path(tempfile.mkdtemp()) / "picks.png")
 Image(filename=str(path), width=900)""",

@@ -13,6 +13,7 @@ line below.  A user's own controller needs no edit at all: ``type: "module:Class
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Callable, Optional
 
@@ -21,12 +22,10 @@ from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.controllers import ct_quintic, pd, plugin, ptsmc, smc
 from ptint_drake.controllers.hold import AddActuationHold, held_telemetry
-from ptint_drake.controllers.slot import (ControllerHandles, ControllerSlot, TargetView, controller_targets,
-                                          target_view, uses_analytic_targets)
+from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, uses_analytic_targets
 
 __all__ = ["REGISTRY", "CONTROLLERS", "ControllerType", "ControllerHandles", "ControllerSlot",
-           "TargetView", "AddController", "AddControllerTo", "check_controller", "controller_targets",
-           "target_view",
+           "TargetView", "AddControllerTo", "check_controller", "controller_type",
            "uses_analytic_targets", "describe", "known_type"]
 
 
@@ -67,6 +66,17 @@ def known_type(type_: str) -> bool:
     return type_ in REGISTRY or plugin.is_plugin(type_)
 
 
+def controller_type(type_: str) -> ControllerType:
+    """The registry's entry of ``type_``, or for a plugin's ``module:Class`` an entry whose
+    ``add`` adapts the plugin's constructor (``plugin.AddPlugin``): every controller is built by
+    the same ``add(slot, settings, target)`` path."""
+    entry = REGISTRY.get(type_)
+    if entry is not None:
+        return entry
+    return ControllerType(type_, f"a user's controller ({plugin.FORM})",
+                          functools.partial(plugin.AddPlugin, type_=type_), settings=plugin.plugin_params)
+
+
 def describe() -> str:
     """One line per registered controller, and the plugin form (for help texts)."""
     lines = [f"{e.name}: {e.summary}" for e in REGISTRY.values()]
@@ -79,31 +89,20 @@ def check_controller(scenario) -> None:
         plugin.check(scenario.controller.type, scenario)
 
 
-def AddController(builder: DiagramBuilder, station_system, station, scenario) -> ControllerHandles:
-    """Add ``scenario.controller.type`` to ``builder`` and wire it to the station's ports, through
-    the drive's zero-order hold when ``controller.control_period`` > 0 (``hold``)."""
-    plant = station.plant
-    return AddControllerTo(builder, plant=plant, frame=plant.GetFrameByName(scenario.robot.end_effector),
-                           schedule=scenario.schedule(), state=station_system.GetOutputPort("state"),
-                           actuation=station_system.GetInputPort("actuation"), scenario=scenario,
-                           target=TargetView(builder, station_system, scenario))
-
-
 def AddControllerTo(builder: DiagramBuilder, *, plant, frame, schedule, state, actuation, scenario,
-                    target: TargetView) -> ControllerHandles:
+                    target: TargetView, targets: list = ()) -> ControllerHandles:
     """Add ``scenario.controller.type`` between the ports ``state`` (the arm's [q; v]) and
-    ``actuation`` (its torques, through the drive's hold when sampled), aiming at ``target``;
-    ``plant`` and ``frame``: the arm's kinematics and end effector (``AddController`` for the
-    interception station, ``pick.run`` for the pick-and-place one)."""
+    ``actuation`` (its torques, through the drive's hold when ``controller.control_period`` > 0,
+    ``hold``), aiming at ``target``; ``plant`` and ``frame``: the arm's kinematics and end
+    effector; ``targets``: the world's analytic objects ([] where none).  Each world wires its
+    station to these ports (``worlds``)."""
     block = scenario.controller
     held = AddActuationHold(builder, actuation, block.control_period) if block.control_period > 0 else None
     slot = ControllerSlot(builder=builder, plant=plant, frame=frame, schedule=schedule, state=state,
                           actuation=held.get_input_port() if held is not None else actuation,
-                          initial_q=np.radians(scenario.robot.initial_q_deg), scenario=scenario)
-    entry = REGISTRY.get(block.type)
-    if entry is None:
-        handles = plugin.AddPlugin(slot, plugin.plugin_params(block), target, block.type)
-    else:
-        handles = entry.add(slot, entry.settings_of(block), target)
-        handles.model_based = entry.model_based
+                          initial_q=np.radians(scenario.robot.initial_q_deg), scenario=scenario,
+                          targets=list(targets))
+    entry = controller_type(block.type)
+    handles = entry.add(slot, entry.settings_of(block), target)
+    handles.model_based = entry.model_based
     return handles if held is None else held_telemetry(handles, held, plant.MakeActuationMatrix())

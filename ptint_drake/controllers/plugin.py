@@ -34,7 +34,9 @@ import sys
 from pathlib import Path
 from typing import Sequence
 
+from ptint_drake.config.errors import ScenarioError
 from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, target_columns
+from ptint_drake.robot import nominal_plant
 from ptint_drake.systems.active_segment import SIZE as SEGMENT_SIZE
 from ptint_drake.systems.active_segment import ActiveSegment
 from ptint_drake.systems.signals import TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
@@ -70,8 +72,6 @@ def use_search_folders(folders: Sequence[str]) -> None:
 
 
 def _error(message: str):
-    from ptint_drake.validation import ScenarioError  # noqa: PLC0415  (validation imports this package)
-
     return ScenarioError(" ".join(message.split()))
 
 
@@ -151,14 +151,13 @@ def _has_port(system, kind: str, name: str) -> bool:
 def check(type_: str, scenario) -> None:
     """Import and construct the plugin of ``scenario`` once (before any run): ScenarioError if
     it cannot be used."""
-    from ptint_drake.robot import make_plant  # noqa: PLC0415
-
-    plant = make_plant(scenario)
+    plant = nominal_plant(scenario)
     make_plugin(type_, plant, scenario.robot.end_effector, plain_params(plugin_params(scenario.controller)))
 
 
-def AddPlugin(slot: ControllerSlot, params: dict, target: TargetView, type_: str) -> ControllerHandles:
-    """Add the user's controller ``type_`` to the slot (ports in the module docstring)."""
+def AddPlugin(slot: ControllerSlot, params: dict, target: TargetView, *, type_: str) -> ControllerHandles:
+    """Add the user's controller ``type_`` to the slot (ports in the module docstring); the
+    registry's adapter (``controllers.controller_type``) binds ``type_``."""
     builder = slot.builder
     system = make_plugin(type_, slot.nominal_plant(), slot.frame.name(), plain_params(params))
     if not system.get_name():

@@ -79,7 +79,7 @@ def orientation_notes(slot: ControllerSlot, config) -> list:
     kin = FrameKinematics(slot.plant, slot.frame)
     R = kin.compute_pose(slot.initial_q, np.zeros(slot.plant.num_velocities()))[2]
     notes = []
-    for i, (seg, tg) in enumerate(zip(slot.schedule.segments, slot.scenario.targets())):
+    for i, (seg, tg) in enumerate(zip(slot.schedule.segments, slot.targets)):
         angle = np.degrees(rotation_angle(R, np.reshape(target_rotation_values(tg, seg.start)[0:9], (3, 3))))
         if angle > NEAR_HALF_TURN_DEG:
             notes.append(f"ptsmc: warning: segment {i} starts {angle:.0f}° from the object's "

@@ -31,6 +31,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Frame
 from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
 
+from ptint_drake.robot import nominal_plant
 from ptint_drake.systems.kalman import AddCameraEstimators, CameraEstimators
 from ptint_drake.systems.orientation import has_orientation
 from ptint_drake.systems.rotation_estimator import AddRotationEstimators
@@ -38,8 +39,8 @@ from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.targets import TargetSource
 
-if TYPE_CHECKING:  # the scenario module imports this package (its schema comes from the registry)
-    from ptint_drake.scenario import Scenario
+if TYPE_CHECKING:
+    from ptint_drake.config.schema import Scenario
 
 
 @dataclass
@@ -68,18 +69,12 @@ class ControllerSlot:
     actuation: InputPort  # one torque per actuator, in actuator order (the hold's input when sampled)
     initial_q: np.ndarray  # the start posture (rad / m)
     scenario: "Scenario"
+    targets: list = field(default_factory=list)  # the world's analytic objects ([] where none)
 
     def nominal_plant(self) -> MultibodyPlant:
-        """A finalized plant of the model file as written, without the scenario's deviations
-        (masses, payload): what a model-based controller is allowed to know."""
-        import copy  # noqa: PLC0415
-
-        from ptint_drake.robot import make_plant  # noqa: PLC0415  (robot imports scenario)
-        from ptint_drake.scenario import PlantConfig  # noqa: PLC0415
-
-        nominal = copy.deepcopy(self.scenario)
-        nominal.plant = PlantConfig()
-        return make_plant(nominal)
+        """The arm's model file as written (``robot.nominal_plant``): what a model-based
+        controller is allowed to know."""
+        return nominal_plant(self.scenario)
 
     def connect(self, system, target: "TargetView") -> OutputPort:
         """Wire a controller with ports ``state``, ``target`` in and ``u`` out (and
@@ -99,36 +94,43 @@ class TargetView:
     ``rotation_port()`` ([R_r, ω_r, ω̇_r], ``signals.TARGET_ROTATION``: the analytic
     orientation, or with a camera what ``rotation_estimator`` makes of the camera's
     orientation samples when a target has an orientation).  With a camera both ports come
-    from one set of cameras (``camera_estimators``)."""
+    from one set of cameras (``camera_estimators``).  ``schedule`` and ``targets``: the world's
+    segments and the objects' true motions (which only the cameras see in camera mode)."""
 
-    def __init__(self, builder: DiagramBuilder, station_system, scenario: "Scenario"):
+    def __init__(self, builder: DiagramBuilder, station_system, scenario: "Scenario", schedule: Schedule,
+                 targets: list):
         self._builder, self._station, self._scenario = builder, station_system, scenario
-        self.analytic = controller_targets(scenario) if uses_analytic_targets(scenario) else None
+        self._schedule, self._targets = schedule, targets
+        self.analytic = targets if uses_analytic_targets(scenario) else None
         self._port: Optional[OutputPort] = None
         self._rotation_port: Optional[OutputPort] = None
         self._cameras: Optional[CameraEstimators] = None
 
     def port(self) -> OutputPort:
         if self._port is None:
-            self._port = (target_view(self._builder, self._station, self._scenario, self.analytic)
-                          if self.analytic is not None else self.camera_estimators().target_port)
+            if self.analytic is not None:
+                source = self._builder.AddNamedSystem("target_view", TargetSource(self._schedule, self.analytic))
+                self._port = source.GetOutputPort("target")
+            else:
+                self._port = self.camera_estimators().target_port
         return self._port
 
     def camera_estimators(self) -> CameraEstimators:
         """The cameras and position estimators (built on first use; camera mode only)."""
         if self._cameras is None:
-            self._cameras = camera_estimators(self._builder, self._station, self._scenario)
+            self._cameras = camera_estimators(self._builder, self._station, self._scenario, self._schedule,
+                                              self._targets)
         return self._cameras
 
     def rotation_port(self) -> OutputPort:
         if self._rotation_port is None:
-            if self.analytic is None and measures_orientation(self._scenario):
+            if self.analytic is None and measures_orientation(self._scenario, self._targets):
                 self._rotation_port = AddRotationEstimators(
                     self._builder, cameras=self.camera_estimators().cameras,
-                    schedule=self._scenario.schedule(), config=self._scenario.measurement).rotation_port
+                    schedule=self._schedule, config=self._scenario.measurement).rotation_port
             else:  # the analytic orientation (with a camera: no target has one, a fixed frame)
                 source = self._builder.AddNamedSystem("target_rotation_view", TargetSource(
-                    self._scenario.schedule(), self.analytic or self._scenario.targets()))
+                    self._schedule, self.analytic or self._targets))
                 self._rotation_port = source.GetOutputPort("target_rotation")
         return self._rotation_port
 
@@ -138,36 +140,22 @@ def uses_analytic_targets(scenario: "Scenario") -> bool:
     return scenario.measurement is None or scenario.measurement.estimator == "none"
 
 
-def measures_orientation(scenario: "Scenario") -> bool:
-    """True when a camera is in the loop and a target carries an orientation: the cameras then
-    measure the objects' orientations too (``measurement.rot_noise_deg``)."""
-    return not uses_analytic_targets(scenario) and any(has_orientation(t) for t in scenario.targets())
+def measures_orientation(scenario: "Scenario", targets: list) -> bool:
+    """True when a camera is in the loop and one of ``targets`` carries an orientation: the
+    cameras then measure the objects' orientations too (``measurement.rot_noise_deg``)."""
+    return not uses_analytic_targets(scenario) and any(has_orientation(t) for t in targets)
 
 
-def controller_targets(scenario: "Scenario") -> list:
-    """The analytic view: the true targets."""
-    return scenario.targets()
-
-
-def camera_estimators(builder: DiagramBuilder, station_system, scenario: "Scenario") -> CameraEstimators:
+def camera_estimators(builder: DiagramBuilder, station_system, scenario: "Scenario", schedule: Schedule,
+                      targets: list) -> CameraEstimators:
     """One camera + position estimator per object fed by the station's true object positions
-    (and orientations when ``measures_orientation``), in view before t = 0."""
-    rotations = station_system.GetOutputPort("object_rotations") if measures_orientation(scenario) else None
+    (and orientations when ``measures_orientation``), in view before t = 0 (``targets``: the
+    objects' motions before t = 0)."""
+    rotations = (station_system.GetOutputPort("object_rotations") if measures_orientation(scenario, targets)
+                 else None)
     return AddCameraEstimators(builder, objects_port=station_system.GetOutputPort("objects"),
-                               schedule=scenario.schedule(), config=scenario.measurement,
-                               histories=scenario.targets(), rotations_port=rotations)
-
-
-def target_view(builder: DiagramBuilder, station_system, scenario: "Scenario",
-                analytic: Optional[list] = None) -> OutputPort:
-    """The port that carries [x_r, ẋ_r, ẍ_r] of the active segment as the controller sees it:
-    the analytic targets (no camera), or one camera + estimator per object fed by the
-    station's true object positions (``auto``, ``kalman_cv``, ``kalman_ca``)."""
-    if uses_analytic_targets(scenario):
-        source = builder.AddNamedSystem("target_view", TargetSource(
-            scenario.schedule(), analytic if analytic is not None else controller_targets(scenario)))
-        return source.GetOutputPort("target")
-    return camera_estimators(builder, station_system, scenario).target_port
+                               schedule=schedule, config=scenario.measurement,
+                               histories=targets, rotations_port=rotations)
 
 
 def target_columns(target_log: np.ndarray) -> dict:

@@ -5,25 +5,14 @@ under ``controller.smc``: a constant λ = ``lambda_factor`` / tf per segment (no
 """
 
 # no postponed annotations here: Drake's yaml_load_typed / yaml_dump_typed read SmcOptions' types
-from dataclasses import dataclass
 
+from ptint_drake.config.controller import SmcOptions
 from ptint_drake.controllers.ptsmc import gains_of
 from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, telemetry_handles
 from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
 
 NAME = "smc"
 SUMMARY = "first-order sliding mode with a constant slope λ = lambda_factor/tf (no TBG), model-free"
-
-
-@dataclass
-class SmcOptions:
-    """``controller.smc``: what the first-order SMC adds to the paper's gains."""
-
-    lambda_factor: float = 4.0  # smc: constant λ = lambda_factor / tf (1/s); 4 settles in about tf
-
-    def validate(self) -> None:
-        if not self.lambda_factor > 0.0:
-            raise ValueError(f"smc.lambda_factor: must be > 0, got {self.lambda_factor}")
 
 
 CONFIG = SmcOptions

@@ -14,16 +14,13 @@ import json
 import platform
 import time
 
-import numpy as np
-from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import ConstantVectorSource
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
+from ptint_drake.config.yaml_io import drake_version
+from ptint_drake.controllers.slot import uses_analytic_targets
 from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenario_text
-from ptint_drake.scenario_yaml import drake_version
-from ptint_drake.simulation import Built, prepared_simulator, build, simulate
-from ptint_drake.controllers.slot import TargetView, measures_orientation, uses_analytic_targets
-from ptint_drake.station import MakeStation
-from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
+from ptint_drake.simulation import build, simulate
+from ptint_drake.worlds.registry import world_of
 
 CONFIGS = {
     "default": "",
@@ -176,60 +173,6 @@ def paired(names=None, a: str = "{}", b: str = BEFORE, repeats: int = 5, progres
     return out
 
 
-class _ZeroTorque(LeafSystem):
-    """A Python controller that does nothing: reads the plant state, outputs zero actuation
-    (what any Python LeafSystem in the loop costs per derivative evaluation).  With ``extra``
-    (sizes) it has inputs ``target_0`` … too and reads them as well (the camera floor: what a
-    controller fed by the camera path costs before it computes anything)."""
-
-    def __init__(self, n_state: int, n_actuation: int, extra=()):
-        super().__init__()
-        self._state_in = self.DeclareVectorInputPort("state", n_state)
-        self._extra = [self.DeclareVectorInputPort(f"target_{i}", size) for i, size in enumerate(extra)]
-        self._zero = np.zeros(n_actuation)
-        self.DeclareVectorOutputPort("u", n_actuation, self._calc_with_targets if extra else self._calc)
-
-    def _calc(self, context, output):
-        self._state_in.Eval(context)
-        output.SetFromVector(self._zero)
-
-    def _calc_with_targets(self, context, output):
-        self._state_in.Eval(context)
-        for port in self._extra:
-            port.Eval(context)
-        output.SetFromVector(self._zero)
-
-
-def _floor_diagram(scenario, kind: str):
-    """The scenario's station with ``kind`` in the controller's place: ``cpp`` (a Drake
-    ConstantVectorSource), ``python`` (``_ZeroTorque``), ``python_camera`` (``_ZeroTorque``
-    reading the camera path's target, and target rotation when the cameras measure one: the
-    cameras, estimators and selectors the controller gets, ``controllers.slot.TargetView``) or
-    ``controller`` (the scenario's own controller, no loggers, no monitor)."""
-    if kind == "controller":
-        return build(scenario, log=False)
-    builder = DiagramBuilder()
-    station = MakeStation(scenario)
-    system = builder.AddSystem(station.diagram)
-    n_act = station.plant.num_actuators()
-    if kind == "cpp":
-        source = builder.AddSystem(ConstantVectorSource(np.zeros(n_act)))
-    else:
-        ports = []
-        if kind == "python_camera":
-            view = TargetView(builder, system, scenario)
-            ports = [view.port()] + ([view.rotation_port()] if measures_orientation(scenario) else [])
-        source = builder.AddSystem(_ZeroTorque(station.plant.num_multibody_states(), n_act,
-                                               [p.size() for p in ports]))
-        builder.Connect(system.GetOutputPort("state"), source.get_input_port(0))
-        for i, port in enumerate(ports):
-            builder.Connect(port, source.get_input_port(1 + i))
-    builder.Connect(source.get_output_port(), system.GetInputPort("actuation"))
-    diagram = builder.Build()
-    install_stateless_derivatives(diagram)  # the same treatment as ``build`` gives the controller
-    return Built(diagram, station, None, {}, scenario.schedule())
-
-
 def floors(names=None, repeats: int = 3, progress=None) -> dict:
     """What one derivative evaluation of the closed loop costs, taken apart, per scenario.
 
@@ -249,8 +192,8 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
     A scenario with a camera in the loop adds ``python_camera``: the do-nothing controller fed
     by the same cameras, estimators and selectors (their discrete updates, their outputs read
     at every evaluation), and ``controller_over_python_camera``: what the controller adds to
-    what any controller fed by the camera pays.  A pick scenario (its own world,
-    ``pick.world``) is skipped with a note.
+    what any controller fed by the camera pays.  A world without floor diagrams
+    (``World.floor_diagram``: the pick world) is skipped with a note.
     """
     names = list(names or bundled_scenarios())
     out = {}
@@ -259,16 +202,18 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
             progress(f"{name} floors")
         _, text = scenario_text(name)
         scenario = parse_with_overrides(text, "{}", name)
-        if scenario.pick is not None:
-            out[name] = {"skipped": "a pick scenario: its world (pick.world) has no floor diagrams"}
+        world = world_of(scenario)
+        if world.floor_diagram(scenario, "cpp") is None:
+            out[name] = {"skipped": f"a {world.name} scenario: its world has no floor diagrams"}
             continue
         row = {}
         camera = not uses_analytic_targets(scenario)
         for kind in ("controller", "python", "cpp") + (("python_camera",) if camera else ()):
-            built = _floor_diagram(scenario, kind)
+            built = world.floor_diagram(scenario, kind)
             best, evals, steps = float("inf"), 0, 0
             for _ in range(repeats):
-                simulator = prepared_simulator(built, scenario)
+                simulator = Simulator(built.diagram)
+                ApplySimulatorConfig(scenario.simulator, simulator)
                 simulator.Initialize()
                 t0 = time.perf_counter()
                 simulator.AdvanceTo(scenario.duration)

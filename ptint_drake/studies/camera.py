@@ -35,6 +35,7 @@ from ptint_drake.figures import plt, save
 from ptint_drake.metrics import segment_reasons
 from ptint_drake.outputs import staged_output, write_json_atomic
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.worlds.registry import schedule_of
 from ptint_drake.scenario import Scenario, ScenarioError, parse_scenario, scenario_text, validate
 from ptint_drake.simulation import simulate
 from ptint_drake.systems.camera import MeasurementConfig
@@ -165,10 +166,10 @@ def estimate_figure(text: str, name: str, out_dir: Path, window: float = 0.3) ->
     result = simulate(scenario, check=False)
     s = result.series
     t = s["t"]
-    segments = scenario.schedule().segments
+    segments = schedule_of(scenario).segments
     fig, axes = plt.subplots(2, len(segments), figsize=(5.5 * len(segments), 6.5), squeeze=False)
     for i, seg in enumerate(segments):
-        hold_end = scenario.schedule().hold_end(i, scenario.duration)
+        hold_end = schedule_of(scenario).hold_end(i, scenario.duration)
         mask = (t >= seg.end - window) & (t <= min(seg.end + window, hold_end)) & \
             ~((t >= hold_end) & (i + 1 < len(segments)))  # not the next object's first sample
         truth = s["objects"][mask, 3 * i:3 * i + 3]

@@ -32,6 +32,7 @@ from ptint_drake.outputs import staged_output, write_json_atomic
 from ptint_drake.scenario import LoadedScenario, Scenario, ScenarioError
 from ptint_drake.studies.camera import DEFAULT_SEEDS, with_measurement
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.worlds.registry import schedule_of, world_of
 
 # scenario, process noises q (m²/s⁵ for kalman_ca) and output read rate (Hz)
 FLOOR_SCENARIO = "curve_camera"
@@ -50,7 +51,7 @@ def check_floor_scenario(scenario: Scenario) -> None:
 def floor_times(scenario: Scenario, sample_hz: float) -> np.ndarray:
     """0, 1/sample_hz, … ≤ duration, plus every segment's start + tf and hold end."""
     duration = scenario.duration
-    schedule = scenario.schedule()
+    schedule = schedule_of(scenario)
     grid = np.arange(0.0, duration + 0.5 / sample_hz, 1.0 / sample_hz)
     grid = grid[grid <= duration]
     ends = [t for i, seg in enumerate(schedule.segments)
@@ -79,7 +80,7 @@ def floor_case(text: str, name: str, measurement: dict, seed: int,
     except (ScenarioError, RuntimeError, ValueError) as exc:
         row["error"] = " ".join(str(exc).split())[:200]
         return row
-    schedule = scenario.schedule()
+    schedule = schedule_of(scenario)
     segments = []
     for i, seg in enumerate(schedule.segments):
         hold = (times >= seg.end) & (times <= schedule.hold_end(i, scenario.duration))
@@ -106,10 +107,10 @@ def _read_filters(scenario: Scenario, times: np.ndarray) -> dict:
     from ptint_drake.systems.targets import TargetSource  # noqa: PLC0415
 
     builder = DiagramBuilder()
-    truth = builder.AddNamedSystem("objects", TargetSource(scenario.schedule(), scenario.targets()))
+    truth = builder.AddNamedSystem("objects", TargetSource(schedule_of(scenario), world_of(scenario).objects(scenario)))
     estimators = AddCameraEstimators(builder, objects_port=truth.get_objects_output_port(),
-                                     schedule=scenario.schedule(), config=scenario.measurement,
-                                     histories=scenario.targets())  # in view before t = 0
+                                     schedule=schedule_of(scenario), config=scenario.measurement,
+                                     histories=world_of(scenario).objects(scenario))  # in view before t = 0
     diagram = builder.Build()
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -196,8 +197,8 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
             "measurement": {k: v for k, v in copy.deepcopy(vars(m)).items()
                             if k not in ("seed", "process_noise", "estimator")},
             "segments": [{"start": s.start, "tf": s.tf,
-                          "hold_end": base.schedule().hold_end(i, base.duration)}
-                         for i, s in enumerate(base.schedule().segments)],
+                          "hold_end": schedule_of(base).hold_end(i, base.duration)}
+                         for i, s in enumerate(schedule_of(base).segments)],
             "duration": base.duration,
             "table": table, "best": best, "runs": rows}
 

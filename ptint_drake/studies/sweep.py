@@ -71,7 +71,8 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
 
 def _pick_point(row: dict, scenario, beta: float, tf: float) -> dict:
     """A pick scenario's grid point (module docstring)."""
-    from ptint_drake.pick.tasks import PHASES, pick_plan  # noqa: PLC0415
+    from ptint_drake.config.pick import PHASES  # noqa: PLC0415
+    from ptint_drake.worlds.registry import schedule_of  # noqa: PLC0415
 
     for task in scenario.pick.tasks:
         for phase in PHASES:
@@ -79,7 +80,7 @@ def _pick_point(row: dict, scenario, beta: float, tf: float) -> dict:
         task.approach.tf = tf
     try:
         validate(scenario)
-        scenario.duration = max(scenario.duration, pick_plan(scenario.pick).end + 0.5)
+        scenario.duration = max(scenario.duration, schedule_of(scenario).segments[-1].end + 0.5)
         result = simulate(scenario)
     except (ScenarioError, RuntimeError) as exc:
         return row | {"error": " ".join(str(exc).split())[:200], "ok": False}

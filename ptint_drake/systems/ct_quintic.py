@@ -36,7 +36,6 @@ The quintic's coefficients live in the context's discrete state, not in Python a
 """
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
@@ -46,6 +45,7 @@ from pydrake.systems.controllers import InverseDynamicsController
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import Multiplexer
 
+from ptint_drake.config.controller import CtQuinticConfig
 from ptint_drake.systems.baseline_common import (
     layout_size,
     make_layout,
@@ -58,26 +58,6 @@ from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
 from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
 
 Predictor = Callable[[int, float, np.ndarray], np.ndarray]
-
-
-@dataclass
-class CtQuinticConfig:
-    """Plan and tracking parameters (units in the module docstring)."""
-
-    omega: float = 20.0  # rad/s: kp = ω² (1/s²), kd = 2ω (1/s) of the joint-space tracking
-    ki: float = 0.0  # 1/s³, integral gain of the InverseDynamicsController
-    k_x: float = 20.0  # 1/s, task-space position gain of the differential IK after tf
-    ik_tolerance: float = 1.0e-6  # m, |f(q_f) − x_f|∞ allowed by the IK
-    on_ik_failure: str = "nearest"  # nearest (closest reachable point) | raise (ValueError)
-    pinv_damping: float = 0.01  # m/rad: J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ in v_f and the differential IK; 0 = exact
-
-    def validate(self) -> None:
-        if not (self.omega > 0.0 and self.ik_tolerance > 0.0
-                and min(self.k_x, self.ki, self.pinv_damping) >= 0.0):
-            raise ValueError("ct_quintic: omega and ik_tolerance must be > 0, k_x, ki and "
-                             "pinv_damping ≥ 0")
-        if self.on_ik_failure not in ("nearest", "raise"):
-            raise ValueError(f"ct_quintic.on_ik_failure: use nearest or raise, got {self.on_ik_failure!r}")
 
 
 def quintic_coefficients(q0, v0, a0, qf, vf, af, T: float) -> np.ndarray:

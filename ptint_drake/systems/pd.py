@@ -25,7 +25,6 @@ Model-free: it evaluates the frame's position and Jacobian only (``FrameKinemati
 never the mass matrix, Coriolis, gravity or inverse dynamics.
 """
 
-from dataclasses import dataclass
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
@@ -37,42 +36,10 @@ from ptint_drake.systems.baseline_common import (
     segment_index,
 )
 from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.config.controller import PDConfig
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
 from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
-
-INTEGRAL_POLICIES = ("keep", "reset")
-
-
-@dataclass
-class PDConfig:
-    """Parameters of the PID gain rule (see the module docstring)."""
-
-    settling_factor: float = 8.4  # c: ω = c / tf (rad/s); 8.4 → 1 % of a step left at tf
-    mass: float = 10.0  # m (kg), design task-space mass of the pole placement
-    Kp: float | None = None  # N/m, overrides 3 m ω² when set
-    Kd: float | None = None  # N·s/m, overrides 3 m ω when set
-    Ki: float | None = None  # N/(m·s), overrides m ω³ when set (0 = PD)
-    integral_policy: str = "keep"  # keep | reset ∫e at a new segment
-
-    def gains_for(self, tf: float) -> dict:
-        """{"Kp", "Kd", "Ki", "omega"} used on a segment of duration tf (s)."""
-        if not tf > 0.0:
-            raise ValueError(f"pd: tf must be > 0, got {tf}")
-        omega = self.settling_factor / tf
-        m = self.mass
-        rule = {"Kp": 3.0 * m * omega**2, "Kd": 3.0 * m * omega, "Ki": m * omega**3}
-        gains = {k: float(rule[k] if getattr(self, k) is None else getattr(self, k)) for k in rule}
-        gains["omega"] = omega
-        return gains
-
-    def validate(self) -> None:
-        if self.integral_policy not in INTEGRAL_POLICIES:
-            raise ValueError(f"pd.integral_policy: use one of {INTEGRAL_POLICIES}, "
-                             f"got {self.integral_policy!r}")
-        if not (self.settling_factor > 0.0 and self.mass > 0.0):
-            raise ValueError("pd.settling_factor and pd.mass must be > 0")
-
 
 def pd_layout(nv: int) -> dict:
     """name -> slice of the PD controller's ``telemetry``."""

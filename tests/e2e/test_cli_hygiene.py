@@ -15,7 +15,7 @@ import pytest
 from ptint_drake import cli, cli_runs
 from ptint_drake.outputs import staged_output, write_json_atomic
 from ptint_drake.scenario import LoadedScenario, ScenarioError, scenario_text
-from ptint_drake.scenario_yaml import override_text
+from ptint_drake.config.yaml_io import override_text
 
 TESTS = Path(__file__).parent
 

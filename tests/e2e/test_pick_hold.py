@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from ptint_drake.pick.config import BeltConfig, GripperConfig, PartConfig, PickWorldConfig
-from ptint_drake.pick.holding import measure_hold
+from ptint_drake.worlds.pick.config import BeltConfig, GripperConfig, PartConfig, PickWorldConfig
+from ptint_drake.worlds.pick.holding import measure_hold
 
 
 @pytest.fixture(scope="module")

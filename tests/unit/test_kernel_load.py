@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 
 from ptint_drake.scenario import parse_with_overrides, scenario_text
-from ptint_drake.simulation import build, prepared_simulator
+from ptint_drake.simulation import build, make_simulator
 from ptint_drake.systems.interceptor_row import pose_output, position_output
 
 
@@ -23,7 +23,7 @@ def test_a_run_and_its_telemetry_load_no_kernel(name, kernel):
     built = build(scenario)
     loaded = list(kernel.signatures)
     assert loaded, f"{kernel.__name__} is not loaded when the diagram is built"
-    simulator = prepared_simulator(built, scenario)
+    simulator = make_simulator(built)
     simulator.AdvanceTo(0.03)
     system = built.controller.system
     context = system.law.GetMyContextFromRoot(simulator.get_context())

@@ -15,7 +15,7 @@ def test_a_position_run_keeps_its_four_figures(tmp_path):
     scenario = load_scenario("curve_b075_tf15")
     assert run_metrics(scenario, {"segments": []})["figures"] == POSITION_FIGURES
     tasks = view_tasks(scenario, {"t": np.zeros(3)}, {}, tmp_path)
-    assert [task[0] for task in tasks] == ["axes", "errors", "paths3d", "joints", "replay"]
+    assert [task[1] for task in tasks] == ["axes", "errors", "paths3d", "joints", "replay"]
     assert tasks[-1][-1][3] is None  # the replay draws no triads
 
 
@@ -23,7 +23,7 @@ def test_an_orientation_run_adds_the_angle_figure(tmp_path):
     for name in ("conveyor_yaw", "curve_pose"):
         scenario = load_scenario(name)
         assert run_metrics(scenario, {"segments": []})["figures"] == POSITION_FIGURES + ["angle.png"]
-        names = [task[0] for task in view_tasks(scenario, {}, {}, tmp_path, replay=False)]
+        names = [task[1] for task in view_tasks(scenario, {}, {}, tmp_path, replay=False)]
         assert names == ["axes", "errors", "paths3d", "joints", "angle"]
 
 
@@ -31,7 +31,7 @@ def test_the_replay_gets_each_objects_true_orientation(tmp_path):
     scenario = load_scenario("conveyor_yaw")
     t = np.array([0.0, 1.0, 2.5])
     replay = view_tasks(scenario, {"t": t}, {}, tmp_path, figures=False)
-    assert [task[0] for task in replay] == ["replay"]
+    assert [task[1] for task in replay] == ["replay"]
     task, rotations = replay[0][-1][3]
     assert task == "top_down" and rotations.shape == (3, 3, 9)
     c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))

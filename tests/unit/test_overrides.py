@@ -5,7 +5,7 @@ import pytest
 
 from ptint_drake.scenario import (LoadedScenario, ScenarioError, dump_yaml, parse_scenario,
                                   parse_with_overrides, scenario_text)
-from ptint_drake.scenario_yaml import override_text, split_path
+from ptint_drake.config.yaml_io import override_text, split_path
 
 NAME, TEXT = scenario_text("assembly")
 

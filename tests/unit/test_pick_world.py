@@ -12,8 +12,8 @@ import pytest
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import Simulator
 
-from ptint_drake.pick.config import BeltConfig, PartConfig, PickWorldConfig, SlotConfig, TrayConfig
-from ptint_drake.pick.world import MakePickStation
+from ptint_drake.worlds.pick.config import BeltConfig, PartConfig, PickWorldConfig, SlotConfig, TrayConfig
+from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.systems.gripper import GripperDriver
 from ptint_drake.validation import ScenarioError
 

@@ -5,6 +5,7 @@ nothing written; the bundled orientation scenarios pass it."""
 import pytest
 
 from ptint_drake import cli
+from ptint_drake.worlds.registry import schedule_of, world_of
 from ptint_drake.reachability import check_reachable
 from ptint_drake.robot import make_plant
 from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario
@@ -36,7 +37,7 @@ interceptions:
 @pytest.mark.parametrize("name", ["conveyor_yaw", "curve_pose"])
 def test_the_bundled_orientation_scenarios_are_reachable(name):
     scenario = load_scenario(name)
-    check_reachable(make_plant(scenario), scenario)
+    check_reachable(make_plant(scenario), scenario, schedule_of(scenario), world_of(scenario).objects(scenario))
 
 
 def test_an_unreachable_top_down_grasp_is_one_line_exit_2(tmp_path, capsys):
@@ -51,7 +52,7 @@ def test_an_unreachable_top_down_grasp_is_one_line_exit_2(tmp_path, capsys):
     assert "t = 0.500 s" in err and not out.exists()
     # the position alone is reachable: the same point with task position passes the check
     scenario = parse_scenario(FAR_OUT.replace("task: top_down", "task: position"))
-    check_reachable(make_plant(scenario), scenario)
+    check_reachable(make_plant(scenario), scenario, schedule_of(scenario), world_of(scenario).objects(scenario))
 
 
 def test_an_unreachable_pose_names_the_orientation():
@@ -59,7 +60,7 @@ def test_an_unreachable_pose_names_the_orientation():
     assert scenario.controller.task == "pose" and scenario.robot.model == "rvm1_6dof"
     with pytest.raises(ScenarioError, match=r"^interceptions\[0\]\.target\.orientation: the arm cannot "
                                             r"reach the orientation rpy \[0\.0, -90\.0, 0\.0\] deg"):
-        check_reachable(make_plant(scenario), scenario)
+        check_reachable(make_plant(scenario), scenario, schedule_of(scenario), world_of(scenario).objects(scenario))
 
 
 @pytest.mark.parametrize("angles, hint", [("", True), (", initial_q_deg: [22.5, 45.0, 30.0, 0.0]", False)])

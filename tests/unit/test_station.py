@@ -8,11 +8,12 @@ import pytest
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ptint_drake.controllers import AddController
+from ptint_drake.worlds.interception.world import AddController
 from ptint_drake.robot import make_plant
 from ptint_drake.scenario import ScenarioError, load_scenario
 from ptint_drake.simulation import simulate
-from ptint_drake.station import MakeStation
+from ptint_drake.worlds.registry import schedule_of
+from ptint_drake.worlds.interception.station import MakeStation
 
 
 def _scenario(mass_scale: float = 1.0, payload_kg: float = 0.0):
@@ -43,7 +44,7 @@ def test_a_users_diagram_with_only_the_station_and_the_controller_is_the_run():
     station_context = station_system.GetMyContextFromRoot(context)
     q0 = station_system.GetOutputPort("state").Eval(station_context)[:station.plant.num_positions()]
     np.testing.assert_array_equal(q0, np.radians(scenario.robot.initial_q_deg))
-    seg = scenario.schedule().segments[0]
+    seg = schedule_of(scenario).segments[0]
     for t in (seg.start + 0.5 * seg.tf, seg.end):  # the stops simulate() makes
         simulator.AdvanceTo(t)
     plant = station.plant

@@ -1,5 +1,5 @@
 """Compile (or load from numba's cache) every compiled kernel once: ``python -m
-ptint_drake.systems.warm_up`` (``scripts/setup.sh`` runs it after installing).
+ptint_drake.warm_up`` (``scripts/setup.sh`` runs it after installing).
 
 numba compiles a kernel at its first call for the argument types of that call and, with
 ``cache=True``, stores the machine code beside the module (or in ``NUMBA_CACHE_DIR``, or the
@@ -36,7 +36,7 @@ def warm_up(duration: float = 0.05) -> float:
     """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
     telemetry of the last state, as a run's outputs do); the wall time in s."""
     from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
-    from ptint_drake.simulation import build, prepared_simulator  # noqa: PLC0415
+    from ptint_drake.simulation import build, make_simulator  # noqa: PLC0415
     from ptint_drake.systems.tbg import alpha_gain, alpha_peak, tbg_profile  # noqa: PLC0415
 
     t0 = time.perf_counter()
@@ -44,7 +44,7 @@ def warm_up(duration: float = 0.05) -> float:
         _, text = scenario_text(name)
         scenario = parse_with_overrides(text, overrides, name)
         built = build(scenario, log=False)
-        simulator = prepared_simulator(built, scenario)
+        simulator = make_simulator(built)
         simulator.AdvanceTo(duration)
         law = getattr(built.controller.system, "law", None)
         system = built.controller.system

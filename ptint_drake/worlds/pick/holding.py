@@ -19,8 +19,8 @@ from pydrake.systems.controllers import PidController
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from ptint_drake.pick.config import PickWorldConfig
-from ptint_drake.pick.world import MakePickStation, PickStation
+from ptint_drake.worlds.pick.config import PickWorldConfig
+from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 
 ARM_KP, ARM_KD = 100.0, 5.0  # N·m/rad, N·m·s/rad: the holding PD (explicit: kd·dt/I stays ≪ 2)
 

@@ -18,7 +18,7 @@ from pydrake.common.yaml import yaml_dump_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
-from ptint_drake.validation import ScenarioError
+from ptint_drake.config.errors import ScenarioError
 
 # SimulatorConfig fields that only some supported Drake versions have, each with the value that
 # means the same as leaving it out (Drake 1.52 removed publish_every_time_step; false was the default).

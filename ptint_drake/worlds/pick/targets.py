@@ -35,7 +35,7 @@ import numpy as np
 from pydrake.math import RotationMatrix
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from ptint_drake.pick.tasks import PickPlan
+from ptint_drake.worlds.pick.tasks import PickPlan
 from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
 
 

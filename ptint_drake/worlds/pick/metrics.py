@@ -31,7 +31,7 @@ import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
 
-from ptint_drake.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
+from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_reference
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time

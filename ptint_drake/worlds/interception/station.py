@@ -38,10 +38,12 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import Saturation
 
 from ptint_drake.robot import actuator_effort_limits, effort_limits, make_plant
-from ptint_drake.scenario import Scenario, ScenarioError
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.disturbance import JointDisturbance
 from ptint_drake.systems.orientation import ObjectRotations
 from ptint_drake.systems.targets import TargetSource
+from ptint_drake.worlds.interception.objects import interception_schedule, interception_targets
 
 
 @dataclass
@@ -77,8 +79,8 @@ def MakeStation(scenario: Scenario) -> Station:
             raise ScenarioError(str(exc)) from None
         builder.Connect(plant.get_state_output_port(), disturbance.get_input_port())
         builder.Connect(disturbance.get_output_port(), plant.get_applied_generalized_force_input_port())
-    targets = scenario.targets()
-    truth = builder.AddNamedSystem("objects", TargetSource(scenario.schedule(), targets))
+    targets = interception_targets(scenario)
+    truth = builder.AddNamedSystem("objects", TargetSource(interception_schedule(scenario), targets))
     builder.ExportOutput(plant.get_state_output_port(), "state")
     builder.ExportOutput(truth.GetOutputPort("target"), "target")
     builder.ExportOutput(truth.GetOutputPort("objects"), "objects")

@@ -26,55 +26,14 @@ one ``PlanSegment`` per segment (what ``pick.targets.PickTargets`` aims at) and 
 commands (``pick.targets.GripperSequence``).
 """
 
-from dataclasses import dataclass, field
-from typing import List
+from dataclasses import dataclass
 
 import numpy as np
 
-from ptint_drake.pick.config import (BeltConfig, GripperConfig, PartConfig, TrayConfig, grasp_width)
+from ptint_drake.worlds.pick.config import (grasp_width)
 from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.validation import ScenarioError
-
-PHASES = ("approach", "descend", "lift", "carry", "place", "retreat")
-
-
-@dataclass
-class MoveConfig:
-    """One prescribed-time segment of a task: its duration tf (s) and TBG shape β."""
-
-    tf: float = 1.0  # s
-    beta: float = 0.75  # 1, in (0, 1)
-
-
-@dataclass
-class PickTaskConfig:
-    """One part picked off its belt and placed in one tray slot (see the module docstring)."""
-
-    part: str = ""  # the part's name (pick.parts[*].name)
-    slot: int = 0  # index into pick.tray.slots
-    start: float = 0.0  # s, the approach's start (0: right after the previous task)
-    approach: MoveConfig = field(default_factory=lambda: MoveConfig(1.2))
-    descend: MoveConfig = field(default_factory=lambda: MoveConfig(0.5))
-    lift: MoveConfig = field(default_factory=lambda: MoveConfig(0.4))
-    carry: MoveConfig = field(default_factory=lambda: MoveConfig(1.2))
-    place: MoveConfig = field(default_factory=lambda: MoveConfig(0.5))
-    retreat: MoveConfig = field(default_factory=lambda: MoveConfig(0.4))
-    clearance: float = 0.04  # m, of the pre-grasp pose above the part and of the retreat
-    lift_height: float = 0.05  # m, of the lift and the carry
-    dwell: float = 0.15  # s, the grip building up after the close, and the fingers opening
-    margin: float = 0.012  # m, the open fingers' clearance around the part (opening − width)
-
-
-@dataclass
-class PickConfig:
-    """The scenario's ``pick`` block: the physical world and the tasks."""
-
-    gripper: GripperConfig = field(default_factory=GripperConfig)
-    belts: List[BeltConfig] = field(default_factory=list)
-    parts: List[PartConfig] = field(default_factory=list)
-    tray: TrayConfig = field(default_factory=TrayConfig)
-    tasks: List[PickTaskConfig] = field(default_factory=list)
-
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.pick import PHASES, MoveConfig, PickConfig, PickTaskConfig  # noqa: F401
 
 @dataclass(frozen=True)
 class PlanSegment:

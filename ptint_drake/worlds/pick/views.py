@@ -24,8 +24,8 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
-    from ptint_drake.pick.metrics import rotation_of  # noqa: PLC0415
-    from ptint_drake.pick.probe import PART_WIDTH  # noqa: PLC0415
+    from ptint_drake.worlds.pick.metrics import rotation_of  # noqa: PLC0415
+    from ptint_drake.worlds.pick.probe import PART_WIDTH  # noqa: PLC0415
 
     t, probe = series["t"], series["probe"]
     picks = metrics["picks"]
@@ -67,8 +67,8 @@ def replay_world(scenario):
     from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig  # noqa: PLC0415
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
-    from ptint_drake.pick.run import world_config  # noqa: PLC0415
-    from ptint_drake.pick.world import _add_world  # noqa: PLC0415
+    from ptint_drake.worlds.pick.run import world_config  # noqa: PLC0415
+    from ptint_drake.worlds.pick.station import _add_world  # noqa: PLC0415
     from ptint_drake.replay import shared_meshcat  # noqa: PLC0415
 
     config = world_config(scenario)

@@ -35,7 +35,7 @@ from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelInstanceIndex,
                                     PdControllerGains, PrismaticJoint, SpatialInertia)
 
-from ptint_drake.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
+from ptint_drake.worlds.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
 from ptint_drake.rvm1 import model_path
 from ptint_drake.validation import ScenarioError
 

@@ -1,39 +1,37 @@
-"""Build and run a pick-and-place scenario: the pick station, the controller, the plan.
+"""Build a pick-and-place scenario's diagram: the pick station, the controller, the plan.
 
-``build_pick`` wires ``pick.world.MakePickStation`` (discrete plant with contact), the scenario's
+``build_pick`` wires ``station.MakePickStation`` (discrete plant with contact), the scenario's
 controller in its slot (``controllers.AddControllerTo``: the arm's [q; v] in, its torques out
 through the drive's zero-order hold and the effort limits; the arm's kinematics from a plant of
 the arm's model file alone — the controller knows nothing of the gripper, the parts or the
 payload), ``PickTargets`` (what each segment aims at, from the parts' simulated poses),
 ``GripperSequence`` (open, close at the prescribed time, open) and ``PickProbe`` (poses and
-contacts, logged every ``PROBE_PERIOD``).  ``simulate_pick`` runs it, stopping at every segment's
-start and end, and returns a ``RunResult`` whose metrics carry the segments and ``picks``
-(``pick.metrics``).
+contacts, logged every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it through the one runner
+(``worlds.runner``), stopping at every segment's start and end; its metrics carry the segments and
+``picks`` (``metrics``).
 """
 
 from __future__ import annotations
 
-import copy
-import dataclasses
-import time
-
-import numpy as np
 from dataclasses import dataclass
 
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+import numpy as np
+from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, Saturation
 
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.schema import Scenario, default_simulator
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
-from ptint_drake.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
-from ptint_drake.metrics import drive_metrics
-from ptint_drake.pick.metrics import pick_metrics, segment_rows
-from ptint_drake.pick.probe import PickProbe
-from ptint_drake.pick.targets import GripperSequence, PickTargets
-from ptint_drake.pick.tasks import PickPlan, pick_plan
-from ptint_drake.pick.world import MakePickStation, PickStation
-from ptint_drake.scenario import PlantConfig, Scenario, ScenarioError
+from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.robot import actuator_effort_limits, nominal_plant
+from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
+from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
+from ptint_drake.worlds.pick.probe import PickProbe
+from ptint_drake.worlds.pick.station import MakePickStation, PickStation
+from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
+from ptint_drake.worlds.pick.tasks import PickPlan, pick_plan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
@@ -53,7 +51,7 @@ def world_config(scenario: Scenario) -> PickWorldConfig:
     return config
 
 
-class _PortTargets(TargetView):
+class PortTargets(TargetView):
     """The target as ports already in the diagram (``PickTargets``'s outputs)."""
 
     def __init__(self, target, rotation):  # noqa: D107  (no call of TargetView.__init__: no analytic view)
@@ -73,15 +71,6 @@ class PickBuilt:
     loggers: dict
     arm: object  # the arm's model alone (continuous, nominal): the controller's kinematics
     limits: np.ndarray  # the arm's effort limits (N·m)
-
-
-def _kinematic_plant(scenario: Scenario):
-    """The arm's model file alone, continuous and nominal: what the controller's kinematics use."""
-    from ptint_drake.robot import make_plant  # noqa: PLC0415  (robot imports scenario)
-
-    arm = copy.deepcopy(scenario)
-    arm.multibody, arm.plant, arm.pick = None, PlantConfig(), None
-    return make_plant(arm)
 
 
 def place_positions(station: PickStation, plan: PickPlan) -> list:
@@ -110,13 +99,11 @@ def build_pick(scenario: Scenario) -> PickBuilt:
     for k in range(n):
         builder.Connect(st.GetOutputPort(f"part_{k}_pose"), targets.GetInputPort(f"part_{k}_pose"))
         builder.Connect(st.GetOutputPort(f"part_{k}_rotation"), targets.GetInputPort(f"part_{k}_rotation"))
-    arm = _kinematic_plant(scenario)
-    from ptint_drake.robot import actuator_effort_limits  # noqa: PLC0415
-
+    arm = nominal_plant(scenario)
     limits = actuator_effort_limits(arm)
     saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
     builder.Connect(saturation.get_output_port(), st.GetInputPort("actuation"))
-    view = _PortTargets(targets.GetOutputPort("target"), targets.GetOutputPort("target_rotation"))
+    view = PortTargets(targets.GetOutputPort("target"), targets.GetOutputPort("target_rotation"))
     handles = AddControllerTo(builder, plant=arm, frame=arm.GetFrameByName(scenario.robot.end_effector),
                               schedule=plan.schedule, state=st.GetOutputPort("state"),
                               actuation=saturation.get_input_port(), scenario=scenario, target=view)
@@ -152,33 +139,13 @@ def _probe(station: PickStation) -> PickProbe:
                      (tool.body().index(), tool.GetFixedPoseInBodyFrame()))
 
 
-def apply_arm_variant(station: PickStation, plant_context, variant: PlantConfig) -> None:
-    """``plant.mass_scale`` on the arm's links and rotors in ``plant_context`` (the controller is
-    not told).  The other plant deviations have no meaning here (the part is the payload)."""
-    f = variant.mass_scale
-    if f == 1.0:
-        return
-    plant = station.plant
-    for index in plant.GetBodyIndices(station.arm):
-        body = plant.get_body(index)
-        M = body.CalcSpatialInertiaInBodyFrame(plant_context)
-        if M.get_mass() > 0.0:
-            body.SetSpatialInertiaInBodyFrame(plant_context, type(M)(M.get_mass() * f, M.get_com(),
-                                                                     M.get_unit_inertia()))
-    for index in plant.GetJointActuatorIndices(station.arm):
-        actuator = plant.get_joint_actuator(index)
-        actuator.SetRotorInertia(plant_context, actuator.rotor_inertia(plant_context) * f)
-
-
 def pick_simulator(scenario: Scenario) -> SimulatorConfig:
     """The scenario's ``simulator``, except that the default (error-controlled RK3) becomes one
     explicit Euler step per control period: on the discrete plant, between two samples, the plant's
     state and the held torque are constant, so the controller's own state (σ) sees constant inputs
     and one step per sample integrates it as a digital drive would.  Measured on
     conveyor_pick_place: the same picks (place error 0.156 mm both) at 2.2× less CPU time."""
-    from ptint_drake.scenario import _default_simulator  # noqa: PLC0415
-
-    if repr(scenario.simulator) != repr(_default_simulator()):  # (config structs have no ==)
+    if repr(scenario.simulator) != repr(default_simulator()):  # (config structs have no ==)
         return scenario.simulator
     period = scenario.controller.control_period
     return SimulatorConfig(integration_scheme="explicit_euler", use_error_control=False, max_step_size=period,
@@ -198,9 +165,7 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
     """Before a run: every task's grasp (the part's nominal place on its belt at the prescribed grasp
     time), its lift point and its slot (and the carry above it) must be reachable from above
     (Drake's InverseKinematics, the model's joint limits); a ScenarioError naming the field."""
-    from ptint_drake.reachability import inverse_kinematics  # noqa: PLC0415
-
-    arm = _kinematic_plant(scenario)
+    arm = built.arm
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     plan, config = built.plan, built.station.config
     belts = {b.name: b for b in config.belts}
@@ -223,93 +188,12 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
             guess = solution
 
 
-def _stops(scenario: Scenario, plan: PickPlan) -> list:
-    stops = {scenario.duration, *plan.close_times}
-    for seg in plan.schedule.segments:
-        stops.update({seg.start, seg.end})
-    return sorted(t for t in stops if 0.0 <= t <= scenario.duration)
-
-
-def simulate_pick(scenario: Scenario, check: bool = True, progress=None, warn=None):
-    """Run a pick scenario; a ``simulation.RunResult`` with the metrics (``picks``, verdict)."""
-    from ptint_drake.simulation import RunResult  # noqa: PLC0415  (simulation dispatches here)
-
-    check_pick_plant(scenario)
-    built = build_pick(scenario)
-    warnings = []
-    if check:
-        check_pick_reachable(scenario, built)
-        from ptint_drake.run_warnings import sampled_control_warnings  # noqa: PLC0415
-
-        warnings = sampled_control_warnings(scenario)
-    for message in warnings if warn is not None else ():
-        warn(message)
-    t_start = time.perf_counter()
-    simulator = Simulator(built.diagram)
-    ApplySimulatorConfig(pick_simulator(scenario), simulator)
-    context = simulator.get_mutable_context()
-    plant_context = built.station.plant.GetMyMutableContextFromRoot(context)
-    apply_arm_variant(built.station, plant_context, scenario.plant)
-    built.station.start_running(plant_context)
-    simulator.Initialize()
-    aims, failure, wall = {}, None, 0.0
-    for t_stop in _stops(scenario, built.plan):
-        t0 = time.perf_counter()
-        try:
-            simulator.AdvanceTo(t_stop)
-        except RuntimeError as exc:
-            failure = {"time": context.get_time(), "message": " ".join(str(exc).split())[:300]}
-        wall += time.perf_counter() - t0
-        if failure:
-            break
-        aims[t_stop] = segment_aims(built, context)
-        if progress is not None:
-            progress(context.get_time(), scenario.duration, 0)
-    logs = {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
-            for name, logger in built.loggers.items()}
-    series = pick_series(built, logs)
-    metrics = pick_metrics(scenario, built, logs, segment_rows(built, aims))
-    metrics |= drive_metrics(built.plan.schedule, series["t"], series["tau"], series["tau_applied"],
-                             series["v"], built.limits)
-    if failure:
-        metrics["failure"] = failure
-    from ptint_drake.metrics import verdict  # noqa: PLC0415
-
-    metrics["status"], reasons = verdict(metrics, scenario.criteria)
-    metrics["reasons"] = [str(r) for r in reasons]
-    metrics["reason_codes"] = [r.as_dict() for r in reasons]
-    metrics |= {"criteria": dataclasses.asdict(scenario.criteria), "warnings": warnings,
-                "warnings_before_run": len(warnings),
-                "controller": {"type": built.controller.name, "notes": built.controller.notes,
-                               "model_based": built.controller.model_based}}
-    metrics["sim"] = _pick_sim_info(scenario, built, simulator, time.perf_counter() - t_start, wall)
-    return RunResult(scenario, metrics, series)
-
-
-def _pick_sim_info(scenario: Scenario, built: PickBuilt, simulator, total: float, wall: float) -> dict:
-    """The ``sim`` block of a pick run's metrics.json: ``realtime_factor`` end to end
-    (``total`` s: simulation, series, metrics), ``simulation_realtime_factor`` over ``wall``."""
-    t_end = simulator.get_context().get_time()
-    config = built.station.config
-    return {"controller": scenario.controller.type,
-            "control_period": scenario.controller.control_period,
-            "plant_time_step": config.time_step,
-            "contact_approximation": config.contact_approximation,
-            "contact_model": config.contact_model,
-            "simulated_s": t_end, "wall_time_s": total, "simulation_wall_time_s": wall,
-            "realtime_factor": t_end / total if total > 0 else float("inf"),
-            "simulation_realtime_factor": t_end / wall if wall > 0 else float("inf"),
-            "steps": int(simulator.get_integrator().get_num_steps_taken())}
-
-
 def pick_series(built: PickBuilt, logs: dict) -> dict:
     """The run's time series (every ``PROBE_PERIOD``): the probe, the fingers, the arm's q, v, the
     tool point x, ẋ (forward kinematics of the logged arm state), the target the controller aimed
     at and the error against it (``e_true``: the target *is* the part's simulated pose), the
     controller's telemetry (``tau`` commanded, ``tau_applied`` after the effort limits), and the
     whole plant's state every ``REPLAY_PERIOD`` (``replay_t``, ``plant_state``) for the replay."""
-    from ptint_drake.systems.kinematics import FrameKinematics  # noqa: PLC0415
-
     t, state = logs["state"]
     nq = built.arm.num_positions()
     kinematics = FrameKinematics(built.arm, built.arm.GetFrameByName(built.station.config.end_effector))

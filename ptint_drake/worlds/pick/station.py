@@ -48,9 +48,9 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from ptint_drake.pick.config import PickWorldConfig, check_pick_world, grasp_width
-from ptint_drake.pick.part_pose import PartPoses
-from ptint_drake.pick.scene import AddBelt, AddGripper, AddPart, AddTray, gripper_stroke
+from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
+from ptint_drake.worlds.pick.part_pose import PartPoses
+from ptint_drake.worlds.pick.scene import AddBelt, AddGripper, AddPart, AddTray, gripper_stroke
 from ptint_drake.robot import resolve_model
 from ptint_drake.systems.gripper import GripperDriver
 from ptint_drake.validation import ScenarioError
