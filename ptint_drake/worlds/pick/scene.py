@@ -37,7 +37,7 @@ from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelI
 
 from ptint_drake.worlds.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
 from ptint_drake.rvm1 import model_path
-from ptint_drake.validation import ScenarioError
+from ptint_drake.config.errors import ScenarioError
 
 BELT_KD = 1e5  # N·s/m: the belt's velocity servo (implicit, so any stiffness is stable)
 BELT_FORCE = 1e4  # N: the belt drive's force limit

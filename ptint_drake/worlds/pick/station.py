@@ -53,7 +53,7 @@ from ptint_drake.worlds.pick.part_pose import PartPoses
 from ptint_drake.worlds.pick.scene import AddBelt, AddGripper, AddPart, AddTray, gripper_stroke
 from ptint_drake.robot import resolve_model
 from ptint_drake.systems.gripper import GripperDriver
-from ptint_drake.validation import ScenarioError
+from ptint_drake.config.errors import ScenarioError
 
 
 @dataclass
