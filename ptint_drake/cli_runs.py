@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from ptint_drake.cli_options import out_folder, scenario_and_out
+from ptint_drake.worlds.registry import world_of
 from ptint_drake.scenario import LoadedScenario, bundled_scenarios, scenario_text
 
 
@@ -81,8 +82,9 @@ def cmd_run(args: argparse.Namespace) -> int:
                             progress=None if args.quiet else progress(scenario.name), warn=warn)
     for note in metrics["controller"]["notes"]:
         print(note)
-    if "picks" in metrics:
-        return _pick_lines(scenario, metrics, out)
+    own = world_of(scenario).report(scenario, metrics, out)  # a world's own lines, if it has them
+    if own is not None:
+        return own
     for i, seg in enumerate(metrics["segments"]):
         print(_segment_line(scenario.name, i, seg, scenario.criteria))
     sim = metrics["sim"]
@@ -100,32 +102,6 @@ def cmd_run(args: argparse.Namespace) -> int:
               f"this arm or tf: try `ptint tune {args.scenario}`")
         return 1
     print(f"{scenario.name}: ok (every segment meets the criteria)")
-    return 0
-
-
-def _pick_lines(scenario, metrics: dict, out) -> int:
-    """A pick scenario's output: one line per segment and per pick, the verdict (exit 1 unless ok)."""
-    for i, seg in enumerate(metrics["segments"]):
-        print(f"{scenario.name} segment {i} (task {seg['task']} {seg['phase']}): e0 = {_mm(seg['e0_norm'])}, "
-              f"e(tf) = {_mm(seg['e_tf_norm'])}, {seg['e_rot_tf_deg'] or 0.0:.2f}°")
-    for k, p in enumerate(metrics["picks"]):
-        grasp = "never" if p["t_grasp"] is None else \
-            f"{p['t_grasp']:.3f} s (prescribed {p['t_grasp_prescribed']:.3f} s)"
-        print(f"{scenario.name} pick {k} ({p['part']} → slot {p['slot']}): grasped at {grasp}, "
-              f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
-              f"{p['place_error_deg']:.2f}°"
-              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, grip {p['peak_grip_force_N']:.1f} N"
-              + (", COLLISION before the close" if p["collision"] else ""))
-    sim = metrics["sim"]
-    print(f"realtime factor {sim['realtime_factor']:.2f} end to end ({sim['contact_approximation']}, "
-          f"{sim['contact_model']} contact, {1e3 * sim['plant_time_step']:g} ms plant); wrote {out}/")
-    if metrics["status"] == "failed":
-        print(f"ptint: error: run failed: {metrics['failure']['message']}", file=sys.stderr)
-        return 1
-    if metrics["status"] == "missed":
-        print(f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])})")
-        return 1
-    print(f"{scenario.name}: ok (every part placed)")
     return 0
 
 

@@ -92,7 +92,8 @@ def check_reachable(plant: MultibodyPlant, scenario: Scenario, schedule, targets
     """Every target must be reachable at its interception time and during its hold: its
     position, and for a task with orientation the orientation the task asks for.
 
-    ``schedule`` and ``targets``: the interception world's segments and objects.  Solved from the initial pose and then from the previous solution.  Raises
+    ``schedule`` and ``targets``: the interception world's segments and objects.  Solved from
+    the initial pose and then from the previous solution.  Raises
     ScenarioError naming the interception (``.target``: the position; ``.target.orientation``
     or ``.target.waypoints.rpy_deg``: the orientation).
     """

@@ -17,7 +17,8 @@ from ptint_drake.robot import effort_limits
 from ptint_drake.config.schema import Scenario
 
 
-def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list, samples: int = 200) -> list[str]:
+def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list,
+                       samples: int = 200) -> list[str]:
     """Warnings for segments whose tf looks too short for the actuators' effort limits.
 
     A planning estimate (it uses the model, the controller does not): on the ideal
@@ -26,7 +27,8 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list,
     cannot follow it anyway and the β = 1/2 profile's bound is used.  The joint
     torque estimate is |M(q) J⁻¹ a| + |g(q)| at the segment's start and
     interception configurations.  The acceleration part scales as 1/tf², which
-    gives the suggested tf (``targets``: the interception world's objects).  e0 is taken from the start pose for the first
+    gives the suggested tf (``targets``: the interception world's objects).  e0 is taken from
+    the start pose for the first
     segment and from the previous target for later ones.
     """
     from ptint_drake.systems.tbg import tbg_profile  # noqa: PLC0415

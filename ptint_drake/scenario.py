@@ -2,7 +2,8 @@
 
 A scenario is one YAML mapping loaded with Drake's ``yaml_load_typed`` into
 ``Scenario`` (the schema, ``config.schema``, re-exported here); unknown keys are rejected; the
-checks live in ``validation``, the YAML writing and error messages in ``config.yaml_io``.  ``simulator`` is Drake's own
+checks live in ``validation``, the YAML writing and error messages in ``config.yaml_io``.
+``simulator`` is Drake's own
 ``SimulatorConfig``.  ``load_scenario`` accepts a bundled name (see
 ``bundled_scenarios``) or a file path, and raises ``ScenarioError`` with a
 one-line message that names the offending field.

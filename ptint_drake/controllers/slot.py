@@ -109,7 +109,8 @@ class TargetView:
     def port(self) -> OutputPort:
         if self._port is None:
             if self.analytic is not None:
-                source = self._builder.AddNamedSystem("target_view", TargetSource(self._schedule, self.analytic))
+                source = self._builder.AddNamedSystem("target_view",
+                                                      TargetSource(self._schedule, self.analytic))
                 self._port = source.GetOutputPort("target")
             else:
                 self._port = self.camera_estimators().target_port

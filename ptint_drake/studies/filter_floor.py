@@ -107,7 +107,8 @@ def _read_filters(scenario: Scenario, times: np.ndarray) -> dict:
     from ptint_drake.systems.targets import TargetSource  # noqa: PLC0415
 
     builder = DiagramBuilder()
-    truth = builder.AddNamedSystem("objects", TargetSource(schedule_of(scenario), world_of(scenario).objects(scenario)))
+    truth = builder.AddNamedSystem("objects", TargetSource(schedule_of(scenario),
+                                                         world_of(scenario).objects(scenario)))
     estimators = AddCameraEstimators(builder, objects_port=truth.get_objects_output_port(),
                                      schedule=schedule_of(scenario), config=scenario.measurement,
                                      histories=world_of(scenario).objects(scenario))  # in view before t = 0

@@ -40,6 +40,7 @@ from ptint_drake.figures import plt, save
 from ptint_drake.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.worlds.registry import world_of
 from ptint_drake.systems.camera import MeasurementConfig
 
 RANGES = {
@@ -61,8 +62,9 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     scenario = parse_scenario(text, name)
     rng = np.random.default_rng(seed)
     u = lambda key, size=None: rng.uniform(*ranges[key], size)  # noqa: E731
-    if scenario.pick is not None:
-        return _pick_sample(scenario, name, seed, u)
+    own = world_of(scenario).robust_sample(scenario, name, seed, u)
+    if own is not None:
+        return own
     nv = len(scenario.robot.initial_q_deg)
     p = scenario.plant
     p.mass_scale = float(u("mass"))
@@ -88,20 +90,6 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     return scenario, params
 
 
-def _pick_sample(scenario, name: str, seed: int, u):
-    """A pick scenario's sample: link masses, every part's mass and friction, every belt's speed."""
-    scenario.plant.mass_scale = float(u("mass"))
-    pick = scenario.pick
-    for part in pick.parts:
-        part.mass, part.friction = float(u("part_mass")), float(u("part_friction"))
-    for belt in pick.belts:
-        belt.speed *= float(u("belt_speed"))
-    scenario.name = f"{name}_seed{seed}"
-    return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
-                      "part_friction": [p.friction for p in pick.parts],
-                      "belt_speed": [b.speed for b in pick.belts]}
-
-
 def _camera(scenario, ranges: dict):
     """The sample's camera (``estimator: auto``; the scenario's own if it has one), or None
     when the noise and latency ranges are both [0, 0]."""
@@ -122,14 +110,9 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
         return {"seed": seed, "params": params, "ok": False, "error": " ".join(str(exc).split())[:300]}
     m = result.metrics
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
-    if "picks" in m:
-        return {"seed": seed, "params": params, "ok": m["status"] == "ok", "status": m["status"],
-                "e_tf": e_tf,
-                "e_tf_max": max((v for v in e_tf if v is not None), default=None),
-                "picks": [{k: p[k] for k in ("part", "grasped", "placed", "place_error_mm", "place_error_deg",
-                                             "slip_mm", "t_grasp", "collision")} for p in m["picks"]],
-                "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
-                "warnings": m["warnings"]}
+    own = world_of(scenario).robust_row(seed, params, m)
+    if own is not None:
+        return own
     return {
         "seed": seed, "params": params,
         "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
@@ -195,24 +178,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                           "last": stats["worker_rss_mb_by_task"][-1]},
         "rows": rows,
         "worst_yaml": dump_yaml(worst_scenario),
-    } | _pick_summary(rows)
-
-
-def _pick_summary(rows: list) -> dict:
-    """``pick_success_rate`` (placed parts over all parts; a sample that could not run places none)
-    and ``failures_by_reason`` ({reason code: count}) of a pick study; {} otherwise."""
-    if not any("picks" in r for r in rows):
-        return {}
-    per_sample = [len(r["picks"]) for r in rows if "picks" in r]
-    parts = max(per_sample) if per_sample else 0
-    placed = sum(p["placed"] for r in rows for p in r.get("picks", []))
-    reasons = {}
-    for r in rows:
-        for reason in r.get("reasons", []) or ([f"error: {r['error']}"] if r.get("error") else []):
-            code = reason.split(": ", 1)[-1] if reason.startswith("pick ") else reason
-            reasons[code] = reasons.get(code, 0) + 1
-    return {"pick_success_rate": placed / (parts * len(rows)) if parts else 0.0,
-            "failures_by_reason": reasons}
+    } | world_of(loaded.scenario).robust_summary(rows)
 
 
 def histogram(result: dict, out_dir: Path) -> None:

@@ -29,6 +29,7 @@ from ptint_drake.outputs import write_text_atomic
 from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, validate
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.worlds.registry import world_of
 
 COLUMNS = ("beta", "tf", "e0", "e_tf", "e_half", "hold", "peak_torque", "peak_torque_after_startup",
            "peak_jerk", "realtime_factor", "steps", "ok", "error")
@@ -39,8 +40,9 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
     row = {"beta": beta, "tf": tf, "error": ""}
     try:
         scenario = parse_scenario(text, name)
-        if scenario.pick is not None:
-            return _pick_point(row, scenario, beta, tf)
+        own = world_of(scenario).sweep_point(row, scenario, beta, tf, simulate, validate)
+        if own is not None:
+            return own
         for ic in scenario.interceptions:
             ic.beta, ic.tf = beta, tf
         last = scenario.interceptions[-1]
@@ -67,30 +69,6 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
         "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
     })
     return row
-
-
-def _pick_point(row: dict, scenario, beta: float, tf: float) -> dict:
-    """A pick scenario's grid point (module docstring)."""
-    from ptint_drake.config.pick import PHASES  # noqa: PLC0415
-    from ptint_drake.worlds.registry import schedule_of  # noqa: PLC0415
-
-    for task in scenario.pick.tasks:
-        for phase in PHASES:
-            getattr(task, phase).beta = beta
-        task.approach.tf = tf
-    try:
-        validate(scenario)
-        scenario.duration = max(scenario.duration, schedule_of(scenario).segments[-1].end + 0.5)
-        result = simulate(scenario)
-    except (ScenarioError, RuntimeError) as exc:
-        return row | {"error": " ".join(str(exc).split())[:200], "ok": False}
-    m = result.metrics
-    e_tf = [s["e_tf_norm"] for s in m["segments"] if s["e_tf_norm"] is not None]
-    return row | {"e0": max((s["e0_norm"] or 0.0) for s in m["segments"]), "e_tf": max(e_tf, default=None),
-                  "peak_torque": float(np.max(m["torque_peak"])),
-                  "peak_torque_after_startup": float(np.max(m["torque_peak_after_startup"])),
-                  "realtime_factor": m["sim"]["realtime_factor"], "steps": m["sim"]["steps"],
-                  "ok": m["status"] == "ok"}
 
 
 def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, workers: int = None,

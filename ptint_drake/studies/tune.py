@@ -36,6 +36,7 @@ from ptint_drake.metrics import segment_reasons
 from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, check_variants, parse_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.worlds.registry import world_of
 
 GAINS = ("K", "Lambda", "phi", "rot_scale")
 POSE_GAINS = ("rot_scale",)  # only for a controller.task other than position
@@ -185,9 +186,9 @@ def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=
     content of tune.json (plus ``scenario`` for tuned.yaml)."""
     t0 = time.perf_counter()
     text, name, scenario = loaded.text, loaded.name, loaded.scenario
-    if scenario.pick is not None:  # its verdict is the picks', not the segments' criteria tune reads
-        raise ScenarioError(f"scenario: {name} is a pick and place, which tune does not search; tune the "
-                            f"interception of its parts instead (e.g. conveyor_yaw) and use those gains")
+    refusal = world_of(scenario).tune_refusal(name)  # a verdict tune cannot read (the picks')
+    if refusal:
+        raise ScenarioError(refusal)
     check_variants(scenario, settings.variants)
     check_gain(settings.gain, settings.bracket)
     check_task_gain(scenario, settings.gain)

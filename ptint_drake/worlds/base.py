@@ -131,3 +131,30 @@ class World:
     def floor_diagram(self, scenario: Scenario, kind: str):
         """``ptint bench``'s floor diagrams (``studies.benchmark.floors``), or None."""
         return None
+
+    # Hooks of the studies and the command line: None (or {}) where the world takes the common path.
+
+    def report(self, scenario: Scenario, metrics: dict, out) -> Optional[int]:
+        """Print ``ptint run``'s lines of a finished run and return the exit code, or None."""
+        return None
+
+    def tune_refusal(self, name: str) -> Optional[str]:
+        """Why ``ptint tune`` cannot search this world's scenario ``name`` (None: it can)."""
+        return None
+
+    def robust_sample(self, scenario: Scenario, name: str, seed: int, u) -> Optional[tuple]:
+        """(scenario, params) of a ``robust`` sample drawn with ``u(key, size=None)``, or None."""
+        return None
+
+    def robust_row(self, seed: int, params: dict, metrics: dict) -> Optional[dict]:
+        """What a ``robust`` sample keeps of its metrics, or None."""
+        return None
+
+    def robust_summary(self, rows: list) -> dict:
+        """This world's entries of robust.json's summary."""
+        return {}
+
+    def sweep_point(self, row: dict, scenario: Scenario, beta: float, tf: float, simulate, validate
+                    ) -> Optional[dict]:
+        """A ``sweep`` grid point (β of every segment, tf), simulated, or None."""
+        return None

@@ -64,7 +64,8 @@ def _advance(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: 
             break
         run.at_stop(context, t_stop)
         if progress is not None:
-            progress(context.get_time(), scenario.duration, int(simulator.get_integrator().get_num_steps_taken()))
+            steps = int(simulator.get_integrator().get_num_steps_taken())
+            progress(context.get_time(), scenario.duration, steps)
     return failure, wall
 
 
@@ -104,7 +105,8 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
                 "warnings_before_run": n_before,
                 "controller": {"type": run.controller.name, "notes": run.controller.notes,
                                "model_based": run.controller.model_based}}
-    metrics["sim"] = _sim_info(scenario, run, integrator, context.get_time(), time.perf_counter() - t_start, wall)
+    total = time.perf_counter() - t_start
+    metrics["sim"] = _sim_info(scenario, run, integrator, context.get_time(), total, wall)
     return RunResult(scenario, metrics, series)
 
 

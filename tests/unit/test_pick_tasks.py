@@ -5,7 +5,8 @@ import pytest
 
 from ptint_drake.worlds.pick.config import BeltConfig, PartConfig, SlotConfig, TrayConfig
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
-from ptint_drake.worlds.pick.tasks import PHASES, MoveConfig, PickConfig, PickTaskConfig, check_tasks, pick_plan
+from ptint_drake.worlds.pick.tasks import (PHASES, MoveConfig, PickConfig, PickTaskConfig, check_tasks,
+                                           pick_plan)
 from ptint_drake.validation import ScenarioError
 
 

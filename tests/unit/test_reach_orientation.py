@@ -37,7 +37,7 @@ interceptions:
 @pytest.mark.parametrize("name", ["conveyor_yaw", "curve_pose"])
 def test_the_bundled_orientation_scenarios_are_reachable(name):
     scenario = load_scenario(name)
-    check_reachable(make_plant(scenario), scenario, schedule_of(scenario), world_of(scenario).objects(scenario))
+    reach(scenario)
 
 
 def test_an_unreachable_top_down_grasp_is_one_line_exit_2(tmp_path, capsys):
@@ -52,7 +52,7 @@ def test_an_unreachable_top_down_grasp_is_one_line_exit_2(tmp_path, capsys):
     assert "t = 0.500 s" in err and not out.exists()
     # the position alone is reachable: the same point with task position passes the check
     scenario = parse_scenario(FAR_OUT.replace("task: top_down", "task: position"))
-    check_reachable(make_plant(scenario), scenario, schedule_of(scenario), world_of(scenario).objects(scenario))
+    reach(scenario)
 
 
 def test_an_unreachable_pose_names_the_orientation():
@@ -60,7 +60,7 @@ def test_an_unreachable_pose_names_the_orientation():
     assert scenario.controller.task == "pose" and scenario.robot.model == "rvm1_6dof"
     with pytest.raises(ScenarioError, match=r"^interceptions\[0\]\.target\.orientation: the arm cannot "
                                             r"reach the orientation rpy \[0\.0, -90\.0, 0\.0\] deg"):
-        check_reachable(make_plant(scenario), scenario, schedule_of(scenario), world_of(scenario).objects(scenario))
+        reach(scenario)
 
 
 @pytest.mark.parametrize("angles, hint", [("", True), (", initial_q_deg: [22.5, 45.0, 30.0, 0.0]", False)])
@@ -72,3 +72,9 @@ def test_a_joint_count_mismatch_names_the_field_and_says_when_it_is_the_default(
     message = str(error.value)
     assert message.startswith("robot.initial_q_deg: the model has 5 joints, got ")
     assert ("the default, the 3-joint rvm1's" in message) == hint and "\n" not in message
+
+
+def reach(scenario) -> None:
+    """``check_reachable`` with the interception world's schedule and objects."""
+    check_reachable(make_plant(scenario), scenario, schedule_of(scenario),
+                    world_of(scenario).objects(scenario))

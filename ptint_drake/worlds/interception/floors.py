@@ -65,8 +65,8 @@ def floor_diagram(scenario: Scenario, kind: str, schedule: Schedule):
         ports = []
         if kind == "python_camera":
             view = TargetView(builder, system, scenario, schedule, station.true_targets)
-            ports = [view.port()] + ([view.rotation_port()] if measures_orientation(scenario, station.true_targets)
-                                     else [])
+            measured = measures_orientation(scenario, station.true_targets)
+            ports = [view.port()] + ([view.rotation_port()] if measured else [])
         source = builder.AddSystem(_ZeroTorque(station.plant.num_multibody_states(), n_act,
                                                [p.size() for p in ports]))
         builder.Connect(system.GetOutputPort("state"), source.get_input_port(0))

@@ -50,7 +50,8 @@ def view_tasks(scenario: Scenario, targets: list, series: dict, metrics: dict, s
     from ptint_drake.figures import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
 
     formats = ("png", "svg") if svg else ("png",)
-    replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario), scenario.robot.end_effector,
+    replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
+                   scenario.robot.end_effector,
                    object_rotations(scenario, targets, series) if replay else None)
     stems = run_figure_stems(scenario.controller.task)
     names = [n for n in VIEW_ORDER if (n == "replay" and replay) or (n in stems and figures)]

@@ -67,7 +67,8 @@ def AddController(builder: DiagramBuilder, station_system, station: Station, sce
     return AddControllerTo(builder, plant=plant, frame=plant.GetFrameByName(scenario.robot.end_effector),
                            schedule=schedule, state=station_system.GetOutputPort("state"),
                            actuation=station_system.GetInputPort("actuation"), scenario=scenario,
-                           target=TargetView(builder, station_system, scenario, schedule, station.true_targets),
+                           target=TargetView(builder, station_system, scenario, schedule,
+                                             station.true_targets),
                            targets=station.true_targets)
 
 
@@ -162,7 +163,8 @@ class InterceptionRun(WorldRun):
         s, built = self.scenario, self.built
         series = collect_series(built, context, self.kinematics)
         if s.controller.task != "position":
-            series |= orientation_series(s.controller.task, self.kinematics, series, built.station.true_targets,
+            series |= orientation_series(s.controller.task, self.kinematics, series,
+                                         built.station.true_targets,
                                          built.schedule, s.duration)
         metrics = run_metrics(s, built.schedule, self._samples, series, built.station.effort_limits)
         warnings = singularity_warnings(s, series) + joint_limit_warnings(built.plant, series)

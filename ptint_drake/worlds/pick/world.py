@@ -20,6 +20,7 @@ from ptint_drake.mass_scaling import scale_in_context
 from ptint_drake.metrics import Reason, drive_metrics
 from ptint_drake.run_warnings import sampled_control_warnings
 from ptint_drake.worlds.base import World, WorldRun
+from ptint_drake.worlds.pick import studies
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
@@ -94,7 +95,8 @@ class PickWorld(World):
             raise ScenarioError("measurement: a pick scenario aims at the parts' simulated poses; a camera "
                                 "is not modelled there (leave measurement out)")
         if s.controller.task != "top_down":
-            raise ScenarioError(f"controller.task: a pick grasps from above: top_down, got {s.controller.task!r}")
+            raise ScenarioError(f"controller.task: a pick grasps from above: top_down, "
+                                f"got {s.controller.task!r}")
         if not s.controller.control_period > 0.0:
             raise ScenarioError("controller.control_period: a pick runs on a discrete plant with contact and "
                                 "needs sampled control: set it > 0 (e.g. 0.001)")
@@ -137,3 +139,23 @@ class PickWorld(World):
 
     def floor_diagram(self, scenario: Scenario, kind: str):
         return None
+
+    def report(self, scenario: Scenario, metrics: dict, out) -> int:
+        return studies.report(scenario, metrics, out)
+
+    def tune_refusal(self, name: str) -> str:
+        return (f"scenario: {name} is a pick and place, which tune does not search; tune the "
+                f"interception of its parts instead (e.g. conveyor_yaw) and use those gains")
+
+    def robust_sample(self, scenario: Scenario, name: str, seed: int, u) -> tuple:
+        return studies.robust_sample(scenario, name, seed, u)
+
+    def robust_row(self, seed: int, params: dict, metrics: dict) -> dict:
+        return studies.robust_row(seed, params, metrics)
+
+    def robust_summary(self, rows: list) -> dict:
+        return studies.robust_summary(rows)
+
+    def sweep_point(self, row: dict, scenario: Scenario, beta: float, tf: float, simulate, validate) -> dict:
+        return studies.sweep_point(row, scenario, beta, tf, simulate, validate,
+                                   lambda s: self.schedule(s).segments[-1].end)

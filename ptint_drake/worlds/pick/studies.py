@@ -1,0 +1,108 @@
+"""The pick world's parts of the studies and of ``ptint run``'s lines: what ``robust`` draws for a
+sample and keeps of it, a ``sweep`` point, why ``tune`` does not search a pick, and the lines
+``ptint run`` prints (each a hook of ``worlds.base.World``)."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from ptint_drake.config.pick import PHASES
+
+
+def mm_text(value) -> str:
+    """A length in m as mm text ("n/a" when there is none)."""
+    return "n/a" if value is None else f"{value * 1e3:.4g} mm"
+
+
+def robust_sample(scenario, name: str, seed: int, u):
+    """A pick scenario's sample: link masses, every part's mass and friction, every belt's speed."""
+    scenario.plant.mass_scale = float(u("mass"))
+    pick = scenario.pick
+    for part in pick.parts:
+        part.mass, part.friction = float(u("part_mass")), float(u("part_friction"))
+    for belt in pick.belts:
+        belt.speed *= float(u("belt_speed"))
+    scenario.name = f"{name}_seed{seed}"
+    return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
+                      "part_friction": [p.friction for p in pick.parts],
+                      "belt_speed": [b.speed for b in pick.belts]}
+
+
+def robust_row(seed: int, params: dict, m: dict) -> dict:
+    """What a pick sample keeps of its metrics: the picks, the reasons."""
+    e_tf = [s["e_tf_norm"] for s in m["segments"]]
+    return {"seed": seed, "params": params, "ok": m["status"] == "ok", "status": m["status"],
+                "e_tf": e_tf,
+                "e_tf_max": max((v for v in e_tf if v is not None), default=None),
+                "picks": [{k: p[k] for k in ("part", "grasped", "placed", "place_error_mm", "place_error_deg",
+                                             "slip_mm", "t_grasp", "collision")} for p in m["picks"]],
+                "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
+                "warnings": m["warnings"]}
+
+
+def robust_summary(rows: list) -> dict:
+    """``pick_success_rate`` (placed parts over all parts; a sample that could not run places none)
+    and ``failures_by_reason`` ({reason code: count}) of a pick study; {} otherwise."""
+    if not any("picks" in r for r in rows):
+        return {}
+    per_sample = [len(r["picks"]) for r in rows if "picks" in r]
+    parts = max(per_sample) if per_sample else 0
+    placed = sum(p["placed"] for r in rows for p in r.get("picks", []))
+    reasons = {}
+    for r in rows:
+        for reason in r.get("reasons", []) or ([f"error: {r['error']}"] if r.get("error") else []):
+            code = reason.split(": ", 1)[-1] if reason.startswith("pick ") else reason
+            reasons[code] = reasons.get(code, 0) + 1
+    return {"pick_success_rate": placed / (parts * len(rows)) if parts else 0.0,
+            "failures_by_reason": reasons}
+
+
+def sweep_point(row: dict, scenario, beta: float, tf: float, simulate, validate, schedule_end) -> dict:
+    """A pick scenario's grid point (module docstring)."""
+
+    for task in scenario.pick.tasks:
+        for phase in PHASES:
+            getattr(task, phase).beta = beta
+        task.approach.tf = tf
+    try:
+        validate(scenario)
+        scenario.duration = max(scenario.duration, schedule_end(scenario) + 0.5)
+        result = simulate(scenario)
+    except (ValueError, RuntimeError) as exc:  # a ScenarioError is a ValueError
+        return row | {"error": " ".join(str(exc).split())[:200], "ok": False}
+    m = result.metrics
+    e_tf = [s["e_tf_norm"] for s in m["segments"] if s["e_tf_norm"] is not None]
+    return row | {"e0": max((s["e0_norm"] or 0.0) for s in m["segments"]), "e_tf": max(e_tf, default=None),
+                  "peak_torque": float(np.max(m["torque_peak"])),
+                  "peak_torque_after_startup": float(np.max(m["torque_peak_after_startup"])),
+                  "realtime_factor": m["sim"]["realtime_factor"], "steps": m["sim"]["steps"],
+                  "ok": m["status"] == "ok"}
+
+
+def report(scenario, metrics: dict, out) -> int:
+    """A pick scenario's output: one line per segment and per pick, the verdict (exit 1 unless ok)."""
+    for i, seg in enumerate(metrics["segments"]):
+        print(f"{scenario.name} segment {i} (task {seg['task']} {seg['phase']}): "
+              f"e0 = {mm_text(seg['e0_norm'])}, "
+              f"e(tf) = {mm_text(seg['e_tf_norm'])}, {seg['e_rot_tf_deg'] or 0.0:.2f}°")
+    for k, p in enumerate(metrics["picks"]):
+        grasp = "never" if p["t_grasp"] is None else \
+            f"{p['t_grasp']:.3f} s (prescribed {p['t_grasp_prescribed']:.3f} s)"
+        print(f"{scenario.name} pick {k} ({p['part']} → slot {p['slot']}): grasped at {grasp}, "
+              f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
+              f"{p['place_error_deg']:.2f}°"
+              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, grip {p['peak_grip_force_N']:.1f} N"
+              + (", COLLISION before the close" if p["collision"] else ""))
+    sim = metrics["sim"]
+    print(f"realtime factor {sim['realtime_factor']:.2f} end to end ({sim['contact_approximation']}, "
+          f"{sim['contact_model']} contact, {1e3 * sim['plant_time_step']:g} ms plant); wrote {out}/")
+    if metrics["status"] == "failed":
+        print(f"ptint: error: run failed: {metrics['failure']['message']}", file=sys.stderr)
+        return 1
+    if metrics["status"] == "missed":
+        print(f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])})")
+        return 1
+    print(f"{scenario.name}: ok (every part placed)")
+    return 0
