@@ -16,11 +16,17 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ptint_drake.systems.tbg import gamma_gain
+from scipy.special import beta as beta_function
 
 
 # One-shot timed events are periodic events whose period exceeds any simulation.
 ONE_SHOT_PERIOD = 1.0e9
+
+
+def gamma_gain(tf: float, beta: float) -> float:
+    """γ = Γ(1−β)² / (tf Γ(2−2β)) = B(1−β, 1−β) / tf  (paper eq. 8): the TBG's constant of a
+    segment (``tbg``), here so that planning a schedule does not load the compiled kernels."""
+    return float(beta_function(1.0 - beta, 1.0 - beta)) / tf
 
 
 @dataclass(frozen=True)

@@ -26,9 +26,9 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import get_cython_function_address, intrinsic
 from pydrake.systems.framework import LeafSystem
-from scipy.special import beta as beta_function
 
 from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.schedule import gamma_gain  # noqa: F401  (γ of eq. 8, named here too)
 from ptint_drake.systems.signals import TBG, TBG_PROFILE
 
 if TYPE_CHECKING:
@@ -51,11 +51,6 @@ def _betaincinv(typingctx, a, b, y):
             builder.module, ir.FunctionType(double, [double] * 3 + [ir.IntType(32)]), _BETAINCINV)
         return builder.call(fn, [*args, ir.Constant(ir.IntType(32), 0)])
     return types.float64(types.float64, types.float64, types.float64), codegen
-
-
-def gamma_gain(tf: float, beta: float) -> float:
-    """γ = Γ(1−β)² / (tf Γ(2−2β)) = B(1−β, 1−β) / tf  (paper eq. 8)."""
-    return float(beta_function(1.0 - beta, 1.0 - beta)) / tf
 
 
 @njit(cache=True, inline="always")

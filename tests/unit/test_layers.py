@@ -49,3 +49,9 @@ def test_a_world_import_outside_the_registry_breaks_a_contract(tmp_path):
                           env={"PYTHONPATH": str(tmp_path), "PATH": "/usr/bin:/bin"})
     assert done.returncode != 0
     assert "Only the world registry imports the worlds BROKEN" in done.stdout
+
+
+def test_design_md_draws_the_same_layers():
+    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "layers_doc.py"), "--check"], cwd=ROOT,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, "docs/design.md's layers differ: run scripts/layers_doc.py"
