@@ -32,7 +32,8 @@ def test_the_schema_validation_and_compare_read_the_one_registry():
     assert CONTROLLERS == tuple(REGISTRY) == DEFAULT_CONTROLLERS
     assert CONTROLLERS[0] == "ptsmc"
     blocks = {f.name: f.type for f in fields(ControllerConfig)}
-    own = {name for name, kind in blocks.items() if isinstance(kind, type) and hasattr(kind, "__dataclass_fields__")}
+    own = {name for name, kind in blocks.items()
+           if isinstance(kind, type) and hasattr(kind, "__dataclass_fields__")}
     assert own == {e.name for e in REGISTRY.values() if e.config is not None}  # declared = registered
     for entry in REGISTRY.values():
         if entry.config is not None:
