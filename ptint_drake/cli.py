@@ -57,6 +57,7 @@ def make_parser() -> argparse.ArgumentParser:
     _add_grid_parsers(sub)
     _add_design_parsers(sub)
     _add_camera_parsers(sub)
+    _add_bench_parser(sub)
     return parser
 
 
@@ -112,10 +113,11 @@ def _add_grid_parsers(sub) -> None:
                     "(paper eq. 6), every segment getting the grid's values; writes sweep.csv "
                     "and heat maps (docs/sweeps.md).", epilog=RESULTS)
     sw.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
-    sw.add_argument("--beta", type=opt.betas, default="0.25,0.5,0.75",
-                    help="comma-separated β values in (0, 1) (paper eq. 6; default %(default)s)")
-    sw.add_argument("--tf", type=opt.final_times, default="1.2,1.5,1.9",
-                    help="comma-separated prescribed times tf in s (default %(default)s)")
+    sw.add_argument("--beta", type=opt.betas, action=opt.Items, default="0.25,0.5,0.75",
+                    help="β values in (0, 1), comma-separated or repeated (paper eq. 6; "
+                         "default %(default)s)")
+    sw.add_argument("--tf", type=opt.final_times, action=opt.Items, default="1.2,1.5,1.9",
+                    help="prescribed times tf in s, comma-separated or repeated (default %(default)s)")
     _study_arguments(sw, "out/sweep_NAME")
     sw.set_defaults(func=cmd_sweep)
 
@@ -144,11 +146,13 @@ def _add_design_parsers(sub) -> None:
                     "compare.json, compare.csv, compare.md and compare.png. Exit 0 when every run "
                     "completed (a miss is a result), 2 on bad input.")
     cmp_.add_argument("scenario", help="a bundled scenario name or a YAML file")
-    cmp_.add_argument("--controllers", type=opt.controller_list, default=",".join(CONTROLLERS),
-                      help="comma-separated, default every registered one: "
+    cmp_.add_argument("--controllers", type=opt.controller_list, action=opt.Items,
+                      default=",".join(CONTROLLERS),
+                      help="comma-separated or repeated, default every registered one: "
                            + "; ".join(describe().splitlines()))
-    cmp_.add_argument("--variants", type=opt.variant_list, default="nominal,mass_x0.7,mass_x1.5",
-                      help="comma-separated plant variants: nominal, mass_xF, payload_Mkg")
+    cmp_.add_argument("--variants", type=opt.variant_list, action=opt.Items,
+                      default="nominal,mass_x0.7,mass_x1.5",
+                      help="plant variants, comma-separated or repeated: nominal, mass_xF, payload_Mkg")
     _study_arguments(cmp_, "out/compare_NAME")
     cmp_.set_defaults(func=cmd_compare)
 
@@ -166,8 +170,9 @@ def _add_design_parsers(sub) -> None:
                          "plugin controller (with --range)")
     tn.add_argument("--range", type=opt.gain_range, default=None, metavar="LO,HI",
                     help="the search range (default: derived from the model at the start pose)")
-    tn.add_argument("--variants", type=opt.variant_list, default="nominal,mass_x0.7,mass_x1.5",
-                    help="comma-separated plant variants: nominal, mass_xF, payload_Mkg")
+    tn.add_argument("--variants", type=opt.variant_list, action=opt.Items,
+                    default="nominal,mass_x0.7,mass_x1.5",
+                    help="plant variants, comma-separated or repeated: nominal, mass_xF, payload_Mkg")
     tn.add_argument("--margin", type=opt.margin, default=2.0,
                     help="e(tf) ≤ 1 mm / M, hold ≤ 3 mm / M (default 2)")
     tn.add_argument("--max-saturation", type=opt.saturation_fraction, default=0.05,
@@ -177,7 +182,7 @@ def _add_design_parsers(sub) -> None:
 
 
 def _add_camera_parsers(sub) -> None:
-    """study (camera, --filter-floor) and bench."""
+    """study (camera, --filter-floor)."""
     st = sub.add_parser(
         "study", help="studies: camera (|e(tf)| against noise × latency × estimator)",
         description="camera: |e(tf)| on conveyor_pair_camera over noise × latency × estimator "
@@ -199,27 +204,65 @@ def _add_camera_parsers(sub) -> None:
                          "(or --set measurement.estimator=kalman_cv) per process noise")
     st.add_argument("--scenario", help="with --filter-floor: a camera scenario (bundled name or YAML "
                                        "file with a camera; default curve_camera)")
-    st.add_argument("--process-noise", metavar="Q,..", type=opt.process_noises,
-                    help="with --filter-floor: comma-separated process noises q > 0 "
+    st.add_argument("--process-noise", metavar="Q,..", type=opt.process_noises, action=opt.Items,
+                    help="with --filter-floor: process noises q > 0, comma-separated or repeated "
                          "(default 0.003,0.01,0.03,0.1,0.3)")
     st.add_argument("--set", action="append", metavar="KEY=VALUE",
                     help="with --filter-floor: " + SET_HELP)
     st.set_defaults(func=cmd_study)
-    # `ptint bench ARGS` hands ARGS (--help included) to the benchmark's own parser (see main)
-    bench = sub.add_parser("bench", help="speed/accuracy benchmark as JSON (ptint bench --help)",
-                           add_help=False)
-    bench.add_argument("rest", nargs=argparse.REMAINDER)
+
+
+def _add_bench_parser(sub) -> None:
+    """bench: speed and accuracy as JSON (``studies.benchmark``), options checked like the others'."""
+    from ptint_drake.studies.benchmark import BEFORE, CONFIGS  # noqa: PLC0415
+
+    bench = sub.add_parser(
+        "bench", help="speed/accuracy benchmark as JSON on stdout (docs/speed.md)",
+        description="Speed and accuracy of the bundled scenarios (or the SCENARIOs) as JSON on stdout: per "
+                    "scenario and configuration the realtime factor, integrator steps, derivative "
+                    "evaluations, µs per evaluation and e(tf) next to a tight-tolerance reference run "
+                    "(runge_kutta5, accuracy 1e-10). --schemes, --pair and --floors print their studies "
+                    "instead. Progress on stderr; exit 0, 2 on bad input (docs/speed.md).")
+    bench.add_argument("scenarios", nargs="*", type=opt.scenario_source, metavar="SCENARIO",
+                       help="bundled scenario names or YAML files (default: every bundled scenario)")
+    bench.add_argument("--configs", type=opt.bench_configs, action=opt.Items, default=",".join(CONFIGS),
+                       help="configurations, comma-separated or repeated: default (fused, tanh), blocks "
+                            "(the five wired blocks), sign (the paper's law) (default %(default)s)")
+    bench.add_argument("--no-reference", action="store_true", help="skip the tight reference runs")
+    bench.add_argument("--sweep", action="store_true",
+                       help="also time a 3 x 3 sweep with 1 and 2 worker processes")
+    bench.add_argument("--schemes", type=opt.integration_schemes, action=opt.Items, metavar="LIST",
+                       help="scheme × accuracy table instead: integration schemes, comma-separated or "
+                            "repeated (e.g. runge_kutta3,radau3)")
+    bench.add_argument("--accuracies", type=opt.accuracies, action=opt.Items, default="1e-3,1e-4",
+                       metavar="LIST", help="with --schemes: accuracies > 0, comma-separated or repeated "
+                                            "(default %(default)s)")
+    bench.add_argument("--simulator-extra", type=opt.yaml_mapping("--simulator-extra", inline=True),
+                       default="", metavar="YAML",
+                       help="with --schemes: more simulator fields, e.g. 'max_step_size: 0.02'")
+    bench.add_argument("--pair", nargs=2, type=opt.yaml_mapping("--pair"), metavar=("A", "B"),
+                       help=f"time two override mappings side by side (interleaved), e.g. '{{}}' '{BEFORE}'")
+    bench.add_argument("--repeats", type=opt.count("--repeats"), default=5,
+                       help="with --pair: pairs per scenario; with --floors: runs per diagram, at most 3 "
+                            "(default 5)")
+    bench.add_argument("--floors", action="store_true",
+                       help="instead: µs per derivative evaluation of the plant with a C++ constant "
+                            "actuation, with a do-nothing Python controller, and with the scenario's "
+                            "controller (with a camera also the do-nothing controller fed by the "
+                            "camera's estimates)")
     bench.set_defaults(func=cmd_bench)
+
+
+def command_parser(name: str) -> argparse.ArgumentParser:
+    """The parser of ``ptint NAME`` (a subcommand of ``make_parser``)."""
+    return make_parser()._subparsers._group_actions[0].choices[name]
 
 
 def _run(argv) -> int:
     """The command of ``argv``; its exit code, with bad input as one line (exit 2)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        if argv[:1] == ["bench"]:  # everything after it, --help included, is the benchmark's
-            args = argparse.Namespace(func=cmd_bench, rest=argv[1:])
-        else:  # the option types check each value (cli_options), raising OptionError
-            args = make_parser().parse_args(argv)
+        args = make_parser().parse_args(argv)  # the option types check each value (cli_options)
         return args.func(args)
     except (ScenarioError, opt.OptionError) as exc:
         print(f"ptint: error: {exc}", file=sys.stderr)

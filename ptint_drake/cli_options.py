@@ -3,8 +3,10 @@
 A value that fails its check raises ``OptionError``, which ``cli.main`` prints as the one line
 ``ptint: error: FLAG: ...`` (exit 2), the form of every other bad input; a value of the wrong
 type (``--workers abc``) keeps argparse's own message and usage.  Each parser returns the
-value the command uses (a list of floats, a (name, (low, high)) pair, ...).  ``out_folder``
-checks an ``--out`` folder (the file system, not the text, decides).
+value the command uses (a list of floats, a (name, (low, high)) pair, ...).  A list option
+takes ``action=Items``: comma-separated (``--configs default,sign``), repeated (``--configs
+default --configs sign``) or both.  ``out_folder`` checks an ``--out`` folder (the file system,
+not the text, decides).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import argparse
 import functools
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 from ptint_drake.scenario import ScenarioError
@@ -20,6 +23,18 @@ from ptint_drake.scenario import ScenarioError
 class OptionError(Exception):
     """An option value that fails its check; the message starts with the flag.  Not a
     ValueError: argparse would turn that into its own "invalid ... value" message."""
+
+
+class Items(argparse.Action):
+    """A list option (its type parses comma-separated text into a list): each use adds its items,
+    the first replaces the default, an item given twice counts once."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: list,
+                 option_string: str | None = None) -> None:
+        current = getattr(namespace, self.dest, None)
+        if current is None or current is self.default:  # the first use replaces the default
+            current = []
+        setattr(namespace, self.dest, list(dict.fromkeys([*current, *values])))
 
 
 def _option(parse):
@@ -86,14 +101,19 @@ def final_times(text: str) -> list[float]:
 @_option
 def process_noises(text: str) -> list[float]:
     """``--process-noise``: the Kalman filter's process noises q, each > 0 and finite."""
-    values = floats(text, "--process-noise")
+    return positive_floats(text, "--process-noise")
+
+
+def positive_floats(text: str, flag: str) -> list[float]:
+    """Comma-separated numbers, each > 0 and finite (ScenarioError naming ``flag`` otherwise)."""
+    values = floats(text, flag)
     for q in values:
         if not (q > 0.0 and q != math.inf):  # NaN fails the first test
-            raise ScenarioError(f"--process-noise: every value must be > 0 and finite, got {q:g}")
+            raise ScenarioError(f"{flag}: every value must be > 0 and finite, got {q:g}")
     return values
 
 
-def count(flag: str):
+def count(flag: str) -> Callable[[str], int]:
     """An argparse type for a count ``flag`` (``--workers``, ``--samples``, ``--seeds``): an int >= 1."""
     def parse(text: str) -> int:
         value = _number(int, text)
@@ -173,6 +193,55 @@ def saturation_fraction(text: str) -> float:
     if not 0.0 <= value <= 1.0:
         raise OptionError(f"--max-saturation: must be in [0, 1], got {value}")
     return value
+
+
+@_option
+def scenario_source(text: str) -> str:
+    """A scenario argument checked when parsed (``bench``'s list): a bundled name or a file."""
+    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+
+    scenario_text(text)  # ScenarioError: "scenario: 'x' is neither a bundled scenario ... nor a file"
+    return text
+
+
+@_option
+def bench_configs(text: str) -> list[str]:
+    """``--configs`` of ``bench``: names of ``benchmark.CONFIGS``."""
+    from ptint_drake.studies.benchmark import CONFIGS  # noqa: PLC0415
+
+    return names(text, "--configs", list(CONFIGS))
+
+
+@_option
+def integration_schemes(text: str) -> list[str]:
+    """``--schemes`` of ``bench``: Drake's integration schemes (``GetIntegrationSchemes``)."""
+    from pydrake.systems.analysis import GetIntegrationSchemes  # noqa: PLC0415
+
+    return names(text, "--schemes", GetIntegrationSchemes())
+
+
+@_option
+def accuracies(text: str) -> list[float]:
+    """``--accuracies`` of ``bench``: integrator accuracies, each > 0."""
+    return positive_floats(text, "--accuracies")
+
+
+def yaml_mapping(flag: str, inline: bool = False) -> Callable[[str], str]:
+    """An argparse type for YAML mapping text (``--pair``: ``'controller: {K: 40}'``); with
+    ``inline`` the fields that go inside a flow mapping's braces (``--simulator-extra``:
+    ``'max_step_size: 0.02'``).  The text itself is the value."""
+    def parse(text: str) -> str:
+        import yaml  # noqa: PLC0415
+
+        try:
+            tree = yaml.safe_load("{" + text + "}" if inline else text)
+        except yaml.YAMLError:
+            tree = []
+        if tree is not None and not isinstance(tree, dict):
+            form = "FIELD: VALUE, .. (the fields inside {})" if inline else "a YAML mapping"
+            raise OptionError(f"{flag}: expected {form}, got {text!r}")
+        return text
+    return parse
 
 
 def out_folder(value, default: Path) -> Path:

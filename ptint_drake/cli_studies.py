@@ -154,7 +154,11 @@ def _filter_floor(args: argparse.Namespace, report) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    """``ptint bench ARGS``: the benchmark's own command line."""
-    from ptint_drake.studies.benchmark import main as bench_main  # noqa: PLC0415
+    """``ptint bench``: the benchmark's JSON on stdout, progress on stderr."""
+    import json  # noqa: PLC0415
 
-    return bench_main(args.rest)
+    from ptint_drake.studies import benchmark  # noqa: PLC0415
+
+    result = benchmark.from_options(args, lambda step: print(f"bench: {step}", file=sys.stderr))
+    print(json.dumps(result, indent=2))
+    return 0

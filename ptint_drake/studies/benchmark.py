@@ -1,4 +1,5 @@
-"""Speed and accuracy of the bundled scenarios, as JSON (``ptint bench``, ``scripts/benchmark.py``).
+"""Speed and accuracy of the bundled scenarios, as JSON (``ptint bench``, ``scripts/benchmark.py``,
+``python -m ptint_drake.studies.benchmark``: one command line, ``cli.make_parser``).
 
 For every scenario and configuration it reports the realtime factor (simulated s
 / wall s of the simulation), integrator steps, derivative evaluations, µs per
@@ -10,9 +11,10 @@ wired blocks (``blocks``), and the paper's ``sign`` law.
 
 from __future__ import annotations
 
-import json
 import platform
 import time
+from argparse import Namespace
+from collections.abc import Callable
 
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
@@ -271,67 +273,43 @@ def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
 
 
 def _parser():
-    import argparse
+    """``ptint bench``'s parser: declared with the other commands (``cli.make_parser``), its
+    values checked by the option types of ``cli_options``; the documentation's reference reads it."""
+    from ptint_drake.cli import command_parser
 
-    parser = argparse.ArgumentParser(prog="ptint bench", description=__doc__.split("\n")[0])
-    parser.add_argument("scenarios", nargs="*", help="default: every bundled scenario")
-    parser.add_argument("--configs", default="default,blocks,sign",
-                        help="comma-separated subset of " + ",".join(CONFIGS))
-    parser.add_argument("--no-reference", action="store_true", help="skip the tight reference runs")
-    parser.add_argument("--sweep", action="store_true",
-                        help="also time a 3 x 3 sweep with 1 and 2 worker processes")
-    parser.add_argument("--schemes", metavar="LIST",
-                        help="scheme × accuracy table instead: comma-separated integration schemes")
-    parser.add_argument("--accuracies", default="1e-3,1e-4", metavar="LIST",
-                        help="with --schemes: comma-separated accuracies (default 1e-3,1e-4)")
-    parser.add_argument("--simulator-extra", default="", metavar="YAML",
-                        help="with --schemes: more simulator fields, e.g. 'max_step_size: 0.02'")
-    parser.add_argument("--pair", nargs=2, metavar=("A", "B"),
-                        help="time two override mappings side by side (interleaved), e.g. "
-                             f"'{{}}' '{BEFORE}'")
-    parser.add_argument("--repeats", type=int, default=5, help="with --pair: pairs per scenario")
-    parser.add_argument("--floors", action="store_true",
-                        help="instead: µs per derivative evaluation of the plant with a C++ constant "
-                             "actuation, with a do-nothing Python controller, and with the scenario's "
-                             "controller (with a camera also the do-nothing controller fed by the "
-                             "camera's estimates)")
-    return parser
+    return command_parser("bench")
 
 
-def _studies(args, say) -> dict:
-    """``--floors``, ``--schemes`` and ``--pair`` (any of them) with the machine's description."""
+def from_options(args: Namespace, say: "Callable[[str], None] | None" = None) -> dict:
+    """The JSON ``ptint bench`` prints for its parsed options (``args``: lists already split and
+    checked): ``--floors``, ``--schemes`` and ``--pair`` (any of them) with the machine's
+    description, else every configuration against the reference run (and ``--sweep``)."""
+    names = args.scenarios or None
+    if not (args.floors or args.schemes or args.pair):
+        result = benchmark(names, args.configs, not args.no_reference, progress=say)
+        if args.sweep:
+            result["sweep"] = sweep_benchmark()
+        return result
     result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
                           "cpus": __import__("os").cpu_count(), "drake": drake_version()}}
     if args.floors:
-        result["floors"] = floors(args.scenarios or None, min(args.repeats, 3), say)
+        result["floors"] = floors(names, min(args.repeats, 3), say)
     if args.schemes:
-        result["schemes"] = scheme_table(
-            args.scenarios or None, [s for s in args.schemes.split(",") if s],
-            [float(a) for a in args.accuracies.split(",") if a], args.simulator_extra, say)
+        result["schemes"] = scheme_table(names, args.schemes, args.accuracies, args.simulator_extra, say)
     if args.pair:
-        result["paired"] = paired(args.scenarios or None, args.pair[0], args.pair[1],
-                                  args.repeats, say)
+        result["paired"] = paired(names, args.pair[0], args.pair[1], args.repeats, say)
     return result
 
 
-def main(argv=None) -> int:
-    """``ptint bench ARGS``: parse ``argv`` with the benchmark's parser, print the JSON; the exit
-    code."""
-    parser = _parser()
-    args = parser.parse_args(argv)
-    if args.repeats < 1:
-        parser.error(f"--repeats: must be >= 1, got {args.repeats}")
-    say = lambda s: print(f"bench: {s}", file=__import__("sys").stderr)  # noqa: E731
-    if args.schemes or args.pair or args.floors:
-        print(json.dumps(_studies(args, say), indent=2))
-        return 0
-    configs = [c for c in args.configs.split(",") if c]
-    unknown = [c for c in configs if c not in CONFIGS]
-    if unknown:
-        parser.error(f"--configs: unknown {', '.join(unknown)}")
-    result = benchmark(args.scenarios or None, configs, not args.no_reference,
-                       progress=lambda s: print(f"bench: {s}", file=__import__("sys").stderr))
-    if args.sweep:
-        result["sweep"] = sweep_benchmark()
-    print(json.dumps(result, indent=2))
-    return 0
+def main(argv: "list[str] | None" = None) -> int:
+    """``python -m ptint_drake.studies.benchmark ARGS`` and ``scripts/benchmark.py ARGS``: the
+    command ``ptint bench ARGS`` (``sys.argv`` by default), its exit code."""
+    import sys
+
+    from ptint_drake.cli import main as ptint
+
+    return ptint(["bench", *(sys.argv[1:] if argv is None else argv)])
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

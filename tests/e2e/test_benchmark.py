@@ -70,6 +70,24 @@ def test_cli_bad_repeats_is_one_line(ptint_here):
     assert "Traceback" not in out.stderr and "--repeats: must be >= 1" in out.stderr
 
 
+@pytest.mark.parametrize("entry", [["scripts/benchmark.py"], ["-m", "ptint_drake.studies.benchmark"]])
+def test_entry_points_are_ptint_bench(entry):
+    """``scripts/benchmark.py`` and ``python -m ptint_drake.studies.benchmark`` run ``ptint bench``:
+    its help, its option checks (one line naming the option, exit 2)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    run = functools.partial(subprocess.run, cwd=root, capture_output=True, text=True, timeout=300)
+    out = run([sys.executable, *entry, "--help"])
+    assert out.returncode == 0 and out.stdout.startswith("usage: ptint bench"), out.stderr
+    assert "--floors" in out.stdout and "--simulator-extra" in out.stdout
+    out = run([sys.executable, *entry, "--configs", "fast"])
+    assert out.returncode == 2 and out.stdout == ""
+    assert out.stderr == "ptint: error: --configs: unknown 'fast' (one of default, blocks, sign)\n"
+
+
 @pytest.mark.parametrize("name", ["conveyor_yaw_camera", "conveyor_yaw", "conveyor_pair_camera"])
 def test_kernel_cost_takes_the_law_inputs_as_the_simulation_does(name):
     """``kernels_us`` of ``bench --floors`` for a pose task fed by a camera (target and

@@ -63,6 +63,78 @@ def test_main_prints_it_as_one_line_exit_2(capsys, argv, message):
     assert err.startswith(f"ptint: error: {message}") and err.count("\n") == 1, err
 
 
+def test_a_list_option_is_comma_separated_repeated_or_both():
+    """Every list option (``cli_options.Items``): the first use replaces the default, each use
+    adds its items, an item given twice counts once."""
+    args = parse("sweep", "x", "--beta", "0.5", "--beta", "0.25,0.5", "--tf", "1.2,1.5")
+    assert args.beta == [0.5, 0.25] and args.tf == [1.2, 1.5]
+    args = parse("compare", "x", "--controllers", "pd", "--controllers", "ptsmc", "--variants", "nominal")
+    assert args.controllers == ["pd", "ptsmc"] and args.variants == ["nominal"]
+
+
+def test_bench_is_a_command_of_the_main_parser():
+    """``ptint bench`` parses like the other commands (it handed its arguments to a parser of its
+    own before): lists arrive split, comma-separated or repeated, and checked."""
+    defaults = parse("bench")
+    assert (defaults.scenarios, defaults.configs, defaults.accuracies, defaults.repeats) == (
+        [], ["default", "blocks", "sign"], [1e-3, 1e-4], 5)
+    assert defaults.schemes is None and defaults.pair is None and defaults.simulator_extra == ""
+    args = parse("bench", "--configs", "default,sign", "--configs", "blocks", "--schemes", "runge_kutta3",
+                 "--schemes", "radau3,runge_kutta3", "--accuracies", "1e-4", "--simulator-extra",
+                 "max_step_size: 0.02", "--pair", "{}", "controller: {K: 40}", "--repeats", "2",
+                 "curve_b075_tf15", "assembly")
+    assert args.configs == ["default", "sign", "blocks"] and args.schemes == ["runge_kutta3", "radau3"]
+    assert args.accuracies == [1e-4] and args.simulator_extra == "max_step_size: 0.02"
+    assert args.pair == ["{}", "controller: {K: 40}"] and args.repeats == 2
+    assert args.scenarios == ["curve_b075_tf15", "assembly"] and args.func is cli.cmd_bench
+
+
+def test_bench_help_lists_every_option():
+    text = cli.command_parser("bench").format_help()
+    for option in ("SCENARIO", "--configs", "--no-reference", "--sweep", "--schemes", "--accuracies",
+                   "--simulator-extra", "--pair A B", "--repeats", "--floors"):
+        assert option in text, option
+    assert "bench" in cli.make_parser().format_help()
+
+
+BAD_BENCH = [
+    (("bench", "--configs", "default,fast"), "--configs: unknown 'fast' (one of default, blocks, sign)"),
+    (("bench", "--schemes", "runge_kutta3", "--schemes", "rk3"), "--schemes: unknown 'rk3' (one of "),
+    (("bench", "--accuracies", "1e-4,0"), "--accuracies: every value must be > 0 and finite, got 0"),
+    (("bench", "--repeats", "0"), "--repeats: must be >= 1, got 0"),
+    (("bench", "--pair", "{}", "[1, 2]"), "--pair: expected a YAML mapping, got '[1, 2]'"),
+    (("bench", "--simulator-extra", "max_step_size: ["), "--simulator-extra: expected FIELD: VALUE"),
+    (("bench", "curve_b075_tf15", "no_such"), "scenario: 'no_such' is neither a bundled scenario"),
+]
+
+
+@pytest.mark.parametrize("argv, message", BAD_BENCH, ids=[" ".join(a[1:]) for a, _ in BAD_BENCH])
+def test_a_bad_bench_option_is_one_line_naming_it_exit_2(capsys, argv, message):
+    """Checked when parsed: nothing is simulated (``benchmark.from_options`` is never called)."""
+    with pytest.raises(cli_options.OptionError) as err:
+        parse(*argv)
+    assert str(err.value).startswith(message), str(err.value)
+    assert cli.main(list(argv)) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"ptint: error: {message}") and err.count("\n") == 1, err
+
+
+def test_bench_hands_the_parsed_lists_to_the_benchmark(monkeypatch, capsys):
+    from ptint_drake.studies import benchmark
+
+    calls = {}
+    monkeypatch.setattr(benchmark, "scheme_table", lambda *a: calls.setdefault("schemes", a) and "s")
+    monkeypatch.setattr(benchmark, "paired", lambda *a: calls.setdefault("paired", a) and "p")
+    monkeypatch.setattr(benchmark, "benchmark", lambda *a, **k: {"configs": a[1], "reference": a[2]})
+    assert cli.main(["bench", "--schemes", "radau3", "--accuracies", "1e-3", "--accuracies", "1e-5",
+                     "--pair", "{}", "{}", "--repeats", "3", "curve_b075_tf12"]) == 0
+    assert calls["schemes"][:4] == (["curve_b075_tf12"], ["radau3"], [1e-3, 1e-5], "")
+    assert calls["paired"][:4] == (["curve_b075_tf12"], "{}", "{}", 3)
+    assert '"schemes": "s"' in capsys.readouterr().out
+    assert cli.main(["bench", "--configs", "sign", "--no-reference"]) == 0
+    assert '"configs": [\n    "sign"\n  ],\n  "reference": false' in capsys.readouterr().out
+
+
 def test_a_value_that_is_no_number_keeps_argparses_message(capsys):
     with pytest.raises(SystemExit) as stop:
         cli.main(["tune", "x", "--margin", "two"])
