@@ -1,11 +1,12 @@
-"""Benchmark the bundled scenarios; prints JSON (see ptint_drake/benchmark.py).
+"""Benchmark the bundled scenarios; prints JSON: the command ``ptint bench`` (its options:
+``ptint bench --help``; ``ptint_drake/studies/benchmark.py`` does the work).
 
     .venv/bin/python scripts/benchmark.py [SCENARIO ...] [--configs default,blocks,sign] [--no-reference]
 """
 
 import sys
 
-from ptint_drake.studies.benchmark import main
+from ptint_drake.cli import main
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(["bench", *sys.argv[1:]]))

@@ -1,8 +1,7 @@
 """The documentation pages generated from the code, so that they cannot drift from it.
 
 - ``cli_markdown()``: the command-line reference, read from ``ptint_drake.cli.make_parser()``
-  (every subcommand, its usage, description and options) and from the benchmark's own parser
-  (``ptint bench`` hands its arguments to it), i.e. what ``ptint --help`` and
+  (every subcommand, its usage, description and options), i.e. what ``ptint --help`` and
   ``ptint CMD --help`` print.
 - ``schema_markdown()``: the scenario schema, one row per field of ``scenario.Scenario`` and
   its nested dataclasses (Drake's ``SimulatorConfig`` through its ``__fields__``), with the
@@ -34,14 +33,11 @@ def _subparsers(parser: argparse.ArgumentParser) -> dict:
 
 
 def command_parsers() -> dict:
-    """Every ``ptint`` command → the parser that reads its arguments (``ptint bench``: the
-    benchmark's own, as the command line hands it everything after ``bench``)."""
+    """Every ``ptint`` command → the parser that reads its arguments (``bench`` included: one
+    parser for every command)."""
     from ptint_drake.cli import make_parser
-    from ptint_drake.studies.benchmark import _parser as bench_parser
 
-    commands = _subparsers(make_parser())
-    commands["bench"] = bench_parser()
-    return commands
+    return _subparsers(make_parser())
 
 
 def options(parser: argparse.ArgumentParser) -> list:

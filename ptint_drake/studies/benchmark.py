@@ -272,14 +272,6 @@ def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
             "speedup_2_vs_1": round(walls[1] / walls[2], 2) if 1 in walls and 2 in walls else None}
 
 
-def _parser():
-    """``ptint bench``'s parser: declared with the other commands (``cli.make_parser``), its
-    values checked by the option types of ``cli_options``; the documentation's reference reads it."""
-    from ptint_drake.cli import command_parser
-
-    return command_parser("bench")
-
-
 def from_options(args: Namespace, say: "Callable[[str], None] | None" = None) -> dict:
     """The JSON ``ptint bench`` prints for its parsed options (``args``: lists already split and
     checked): ``--floors``, ``--schemes`` and ``--pair`` (any of them) with the machine's
@@ -299,17 +291,3 @@ def from_options(args: Namespace, say: "Callable[[str], None] | None" = None) ->
     if args.pair:
         result["paired"] = paired(names, args.pair[0], args.pair[1], args.repeats, say)
     return result
-
-
-def main(argv: "list[str] | None" = None) -> int:
-    """``python -m ptint_drake.studies.benchmark ARGS`` and ``scripts/benchmark.py ARGS``: the
-    command ``ptint bench ARGS`` (``sys.argv`` by default), its exit code."""
-    import sys
-
-    from ptint_drake.cli import main as ptint
-
-    return ptint(["bench", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -70,9 +70,9 @@ def test_cli_bad_repeats_is_one_line(ptint_here):
     assert "Traceback" not in out.stderr and "--repeats: must be >= 1" in out.stderr
 
 
-@pytest.mark.parametrize("entry", [["scripts/benchmark.py"], ["-m", "ptint_drake.studies.benchmark"]])
+@pytest.mark.parametrize("entry", [["scripts/benchmark.py"], ["-m", "ptint_drake", "bench"]])
 def test_entry_points_are_ptint_bench(entry):
-    """``scripts/benchmark.py`` and ``python -m ptint_drake.studies.benchmark`` run ``ptint bench``:
+    """``scripts/benchmark.py`` and ``python -m ptint_drake bench`` run ``ptint bench``:
     its help, its option checks (one line naming the option, exit 2)."""
     import subprocess
     import sys
