@@ -51,7 +51,6 @@ from ptint_drake.config.schema import (BallisticConfig, DisturbanceConfig, Inter
                                        LinearConfig, OrientationConfig, PlantConfig, RobotConfig, Scenario,
                                        SinusoidConfig, TargetConfig, WaypointsConfig, default_simulator)
 from ptint_drake.config.yaml_io import dump_dataclass, dump_yaml, yaml_error
-from ptint_drake.controllers import plugin
 from ptint_drake.validation import TARGET_KINDS, validate
 
 __all__ = ["TARGET_KINDS", "BallisticConfig", "ControllerConfig", "Criteria", "DisturbanceConfig",
@@ -59,7 +58,7 @@ __all__ = ["TARGET_KINDS", "BallisticConfig", "ControllerConfig", "Criteria", "D
            "ParamValue", "PlantConfig", "RobotConfig", "Scenario", "ScenarioError", "SinusoidConfig",
            "TargetConfig", "WaypointsConfig", "apply_variant", "bundled_scenarios", "check_variants",
            "default_simulator", "dump_dataclass", "dump_yaml", "load_scenario", "parse_scenario",
-           "parse_with_overrides", "scenario_text", "validate"]
+           "parse_with_overrides", "scenario_folders", "scenario_text", "validate"]
 
 
 def bundled_scenarios() -> "list[str]":
@@ -78,24 +77,34 @@ def scenario_text(name_or_file: str) -> "tuple[str, str]":
         raise ScenarioError(
             f"scenario: {name_or_file!r} is neither a bundled scenario "
             f"({', '.join(bundled_scenarios())}) nor a file")
-    plugin.remember_folder(path.parent)  # a plugin controller's module may sit beside the file
     return path.stem, path.read_text()
+
+
+def scenario_folders(name_or_file: str) -> tuple:
+    """The folder a plugin controller's module may sit in beside a scenario file (none for a
+    bundled scenario)."""
+    if name_or_file in bundled_scenarios() or not Path(name_or_file).is_file():
+        return ()
+    return (str(Path(name_or_file).resolve().parent),)
 
 
 def load_scenario(name_or_file: str) -> Scenario:
     """The validated ``Scenario`` of a bundled name or a YAML file (``ScenarioError`` if bad)."""
     name, text = scenario_text(name_or_file)
-    return parse_scenario(text, name)
+    return parse_scenario(text, name, scenario_folders(name_or_file))
 
 
-def parse_scenario(text: str, name: str = "scenario") -> Scenario:
-    """Parse and validate YAML text; raises ScenarioError naming the field."""
+def parse_scenario(text: str, name: str = "scenario", folders: tuple = ()) -> Scenario:
+    """Parse and validate YAML text; raises ScenarioError naming the field.  ``folders``: where
+    a plugin controller's module is looked for first (``Scenario.plugin_folders``)."""
     try:
         scenario = yaml_load_typed(schema=Scenario, data=text)
     except Exception as exc:  # yaml_load_typed raises several types; keep one line
         raise ScenarioError(yaml_error(text, Scenario, exc)) from None
     if not scenario.name:
         scenario.name = name
+    if folders:
+        scenario.plugin_folders = tuple(folders)
     validate(scenario)
     return scenario
 
@@ -145,20 +154,23 @@ def parse_with_overrides(text: str, overrides, name: str = "scenario") -> Scenar
 class LoadedScenario:
     """A scenario parsed once for a command: ``name`` (the bundled name or file stem, the
     fallback of ``scenario.name``), ``text`` (its YAML with every override applied: what
-    worker processes rebuild it from) and the validated ``scenario`` (not to be mutated)."""
+    worker processes rebuild it from), the validated ``scenario`` (not to be mutated) and the
+    ``folders`` a plugin controller's module is looked for in (the scenario file's; a study hands
+    them to its workers)."""
 
     name: str
     text: str
     scenario: Scenario
+    folders: tuple = ()
 
     @classmethod
     def load(cls, name_or_file: str, overrides=()) -> "LoadedScenario":
         """A bundled scenario name or a scenario file, with ``overrides`` (``parse``)."""
         name, text = scenario_text(name_or_file)
-        return cls.parse(text, name, overrides)
+        return cls.parse(text, name, overrides, scenario_folders(name_or_file))
 
     @classmethod
-    def parse(cls, text: str, name: str = "scenario", overrides=()) -> "LoadedScenario":
+    def parse(cls, text: str, name: str = "scenario", overrides=(), folders: tuple = ()) -> "LoadedScenario":
         """YAML ``text`` with ``overrides`` applied (``scenario_yaml.override_text``), validated.
         A bad override is one line naming its key (``--set KEY: ...``) or, when the file
         itself is valid, the field it made invalid (``--set: FIELD: ...``)."""
@@ -166,9 +178,9 @@ class LoadedScenario:
 
         changed = override_text(text, overrides)
         if changed is text:
-            return cls(name, text, parse_scenario(text, name))
+            return cls(name, text, parse_scenario(text, name, folders), tuple(folders))
         try:
-            return cls(name, changed, parse_scenario(changed, name))
+            return cls(name, changed, parse_scenario(changed, name, folders), tuple(folders))
         except ScenarioError as exc:
-            parse_scenario(text, name)  # an error of the file itself is reported as such
+            parse_scenario(text, name, folders)  # an error of the file itself is reported as such
             raise ScenarioError(f"--set: {exc}") from None

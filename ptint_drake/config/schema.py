@@ -11,7 +11,7 @@ the field types.)
 """
 
 from dataclasses import dataclass, field
-from typing import List, Optional
+from typing import ClassVar, List, Optional
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
@@ -145,3 +145,7 @@ class Scenario:
     # ``interceptions`` (None: an interception scenario)
     pick: Optional[PickConfig] = None
     name: str = ""
+    # not a YAML field: the folder of the file the scenario was loaded from, where a plugin
+    # controller's module is looked for first (``controllers.plugin``); set by loading, carried
+    # with the object (copies, pickles to worker processes)
+    plugin_folders: ClassVar[tuple] = ()

@@ -17,12 +17,13 @@ estimate of it, as the paper's controller gets it), and an output ``actuation`` 
 actuator of the arm, in the plant's actuator order).  ``plant`` is for the plugin's
 kinematics; a plugin that uses its dynamics is model-based and should say so.
 
-The module is looked up in the folders of the scenario files this process loaded (most recent
-first), then the current directory, then ``sys.path`` (``PYTHONPATH``).  The study runner hands
-the same folders to its worker processes and Dask workers (``search_folders`` /
-``use_search_folders``).  An import failure, a constructor that raises, a missing port or a
-port of the wrong size is a ``ScenarioError`` naming the controller (exit 2 on the command
-line); an exception raised inside the plugin while simulating ends that run as ``failed``.
+The module is looked up in the folder of the scenario file (``Scenario.plugin_folders``, set
+when the file is loaded: the folders travel with the loaded scenario), then the current
+directory, then ``sys.path`` (``PYTHONPATH``). A study hands the same folders to its worker
+processes and Dask workers with each task (``studies.runner.run_tasks(folders=...)``,
+``searching``). An import failure, a constructor that raises, a missing port or a port of the
+wrong size is a ``ScenarioError`` naming the controller (exit 2 on the command line); an
+exception raised inside the plugin while simulating ends that run as ``failed``.
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ import importlib
 import os
 import re
 import sys
-from pathlib import Path
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Sequence
 
 from ptint_drake.config.errors import ScenarioError
@@ -44,7 +46,9 @@ from ptint_drake.systems.signals import TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
 PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*$")
 FORM = "'module:Class' (a LeafSystem in your own file)"
 
-_folders: list[str] = []  # the scenario files' folders this process loaded, most recent first
+# the folders of the study a worker runs a task of (``searching``): set per task by the study
+# runner, which hands each task its scenario's folders (``studies.runner.run_tasks(folders=...)``)
+_TASK_FOLDERS: ContextVar[tuple] = ContextVar("ptint_plugin_task_folders", default=())
 
 
 def is_plugin(type_: str) -> bool:
@@ -52,34 +56,34 @@ def is_plugin(type_: str) -> bool:
     return bool(PATTERN.match(type_))
 
 
-def remember_folder(folder) -> None:
-    """Look for plugin modules in ``folder`` (a loaded scenario file's folder) first."""
-    folder = str(Path(folder).resolve())
-    if folder in _folders:
-        _folders.remove(folder)
-    _folders.insert(0, folder)
+def search_folders(scenario=None) -> list[str]:
+    """Where plugin modules are looked for before ``sys.path``: the folder of the file
+    ``scenario`` was loaded from (``Scenario.plugin_folders``), the running task's folders
+    (``searching``), then the current directory."""
+    own = [str(f) for f in getattr(scenario, "plugin_folders", ())]
+    return [*own, *(f for f in _TASK_FOLDERS.get() if f not in own), os.getcwd()]
 
 
-def search_folders() -> list[str]:
-    """Where plugin modules are looked for before ``sys.path``: scenario folders, then cwd."""
-    return [*_folders, os.getcwd()]
-
-
-def use_search_folders(folders: Sequence[str]) -> None:
-    """Adopt another process's ``search_folders()`` (in a study worker)."""
-    for folder in reversed(list(folders)):
-        remember_folder(folder)
+@contextmanager
+def searching(folders: Sequence[str]):
+    """Look in ``folders`` too while the block runs (a study's task in a worker process)."""
+    token = _TASK_FOLDERS.set(tuple(folders))
+    try:
+        yield
+    finally:
+        _TASK_FOLDERS.reset(token)
 
 
 def _error(message: str):
     return ScenarioError(" ".join(message.split()))
 
 
-def load_class(type_: str) -> type:
-    """The class named by ``module:Class``; ScenarioError (one line) if it cannot be had."""
+def load_class(type_: str, folders: Sequence[str] = ()) -> type:
+    """The class named by ``module:Class``, its module looked for in ``folders`` first (then
+    ``sys.path``); ScenarioError (one line) if it cannot be had."""
     module_name, _, class_name = type_.partition(":")
     saved = list(sys.path)
-    sys.path[:0] = search_folders()
+    sys.path[:0] = list(folders)
     try:
         module = importlib.import_module(module_name)
     except Exception as exc:  # any failure of the user's module is one line
@@ -116,9 +120,10 @@ def plugin_params(controller) -> dict:
     return params if controller.task == "position" else params | {"task": controller.task}
 
 
-def make_plugin(type_: str, plant, end_effector: str, params: dict):
-    """Construct the plugin and check its ports against ``plant``; returns the system."""
-    cls = load_class(type_)
+def make_plugin(type_: str, plant, end_effector: str, params: dict, folders: Sequence[str] = ()):
+    """Construct the plugin (its module looked for in ``folders`` first) and check its ports
+    against ``plant``; returns the system."""
+    cls = load_class(type_, folders)
     try:
         system = cls(plant=plant, end_effector=end_effector, params=dict(params))
     except Exception as exc:
@@ -152,14 +157,16 @@ def check(type_: str, scenario) -> None:
     """Import and construct the plugin of ``scenario`` once (before any run): ScenarioError if
     it cannot be used."""
     plant = nominal_plant(scenario)
-    make_plugin(type_, plant, scenario.robot.end_effector, plain_params(plugin_params(scenario.controller)))
+    make_plugin(type_, plant, scenario.robot.end_effector, plain_params(plugin_params(scenario.controller)),
+                search_folders(scenario))
 
 
 def AddPlugin(slot: ControllerSlot, params: dict, target: TargetView, *, type_: str) -> ControllerHandles:
     """Add the user's controller ``type_`` to the slot (ports in the module docstring); the
     registry's adapter (``controllers.controller_type``) binds ``type_``."""
     builder = slot.builder
-    system = make_plugin(type_, slot.nominal_plant(), slot.frame.name(), plain_params(params))
+    system = make_plugin(type_, slot.nominal_plant(), slot.frame.name(), plain_params(params),
+                         search_folders(slot.scenario))
     if not system.get_name():
         system.set_name(type_.partition(":")[2])
     builder.AddSystem(system)

@@ -81,7 +81,8 @@ def run_compare(loaded: LoadedScenario, controllers=DEFAULT_CONTROLLERS, variant
     text); the content of compare.json (rows keep their curves)."""
     t0 = time.perf_counter()
     tasks = [(loaded.text, loaded.name, c, v) for c, v in pairs(controllers, variants)]
-    rows = run_tasks(compare_run, tasks, workers=workers, dask=dask, progress=progress)
+    rows = run_tasks(compare_run, tasks, workers=workers, dask=dask, progress=progress,
+                     folders=loaded.folders)
     return comparison(loaded.scenario, loaded.name, controllers, variants, rows,
                       time.perf_counter() - t0)
 

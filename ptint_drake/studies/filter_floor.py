@@ -186,7 +186,8 @@ def filter_floor(loaded: LoadedScenario, process_noises=FLOOR_PROCESS_NOISES, se
     t0 = time.perf_counter()
     cases = [(loaded.text, loaded.name, {**overrides, **setting}, seed, sample_hz)
              for setting in settings for seed in range(1, seeds + 1)]
-    rows = run_tasks(floor_case, cases, workers=workers, dask=dask, progress=progress)
+    rows = run_tasks(floor_case, cases, workers=workers, dask=dask, progress=progress,
+                     folders=loaded.folders)
     table = [{**setting, "summary": summarize_floor(rows[j * seeds:(j + 1) * seeds])}
              for j, setting in enumerate(settings)]
     ranked = [row for row in table[1:] if "hold_max_median" in row["summary"]]

@@ -148,7 +148,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
     text, name = loaded.text, loaded.name
     rows = run_tasks(robust_sample, [(text, name, seed + i, ranges) for i in range(samples)],
                      workers=workers or (None if executor or dask else 1), dask=dask,
-                     executor=executor, progress=report, stats=stats)
+                     executor=executor, progress=report, stats=stats, folders=loaded.folders)
     wall = time.perf_counter() - t0
     finished = [r for r in rows if r.get("e_tf_max") is not None and "torque_peak" in r]
     failed_first = sorted(rows, key=lambda r: (r["ok"], -(r.get("e_tf_max") or np.inf)))

@@ -86,18 +86,17 @@ def _rss_mb() -> float:
         return 0.0
 
 
-def _with_plugin_folders(fn):
-    """``fn`` that first adopts this process's plugin-controller folders (a scenario file's
-    folder, the current directory) in whatever process runs it, Dask workers included.  A
-    function of ``__main__`` is left as it is: it is forked, and a fork has them already."""
-    if getattr(fn, "__module__", None) == "__main__":
+def _with_plugin_folders(fn, folders: tuple):
+    """``fn`` that looks for plugin controllers in ``folders`` (the scenario file's, which the
+    study hands over) in whatever process runs it, Dask workers included."""
+    if not folders:
         return fn
-    return functools.partial(_in_plugin_folders, fn, tuple(plugin.search_folders()))
+    return functools.partial(_in_plugin_folders, fn, tuple(folders))
 
 
 def _in_plugin_folders(fn, folders, *args):
-    plugin.use_search_folders(folders)
-    return fn(*args)
+    with plugin.searching(folders):
+        return fn(*args)
 
 
 def _call(fn, args):
@@ -109,8 +108,9 @@ def _call(fn, args):
 def run_tasks(fn, tasks, *, workers: int | None = None, dask: str | None = None,
               executor: cf.Executor | None = None, progress=None,
               max_tasks_per_child: int | None = MAX_TASKS_PER_CHILD, window: int | None = None,
-              stats: dict | None = None) -> list:
-    """``[fn(*t) for t in tasks]`` computed in parallel; see the module docstring.
+              stats: dict | None = None, folders: tuple = ()) -> list:
+    """``[fn(*t) for t in tasks]`` computed in parallel; see the module docstring.  ``folders``:
+    where a plugin controller's module is looked for in each task (``LoadedScenario.folders``).
 
     At most one of ``dask`` and ``executor``; neither: ``workers`` local processes
     (default: CPU count).  ``executor`` is used as given and left open.  ``window``
@@ -118,7 +118,7 @@ def run_tasks(fn, tasks, *, workers: int | None = None, dask: str | None = None,
     ``max_tasks_per_child`` (local pool only; ``None``: never recycle).
     """
     tasks = [tuple(t) for t in tasks]
-    fn = _with_plugin_folders(fn)
+    fn = _with_plugin_folders(fn, folders)
     if dask is not None and executor is not None:
         raise ValueError("give dask= or executor=, not both")
     if workers is not None and workers < 1:

@@ -80,7 +80,7 @@ def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, wor
     points = [(loaded.text, loaded.name, float(b), float(tf)) for b in betas for tf in tfs]
     report = (lambda done, total, index, row: progress(done, total)) if progress else None
     return run_tasks(sweep_point, points, workers=workers, dask=dask, executor=executor,
-                     progress=report)
+                     progress=report, folders=loaded.folders)
 
 
 def write_csv(rows, path: Path) -> None:

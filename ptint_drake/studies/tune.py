@@ -156,11 +156,12 @@ def model_bracket(scenario, gain: str) -> tuple[float, float]:
     return lo, max(hi, 10.0 * lo)
 
 
-def _evaluate(text, name, settings: TuneSettings, values, workers, dask, progress, tried) -> dict:
-    """ok of every value (all variants), running values × variants in parallel."""
+def _evaluate(text, name, settings: TuneSettings, values, workers, dask, progress, tried, folders=()) -> dict:
+    """ok of every value (all variants), running values × variants in parallel (``folders``: where
+    a plugin controller's module is looked for)."""
     tasks = [(text, name, settings.gain, v, variant, settings.margin, settings.max_saturation)
              for v in values for variant in settings.variants]
-    rows = run_tasks(tune_run, tasks, workers=workers, dask=dask, progress=progress)
+    rows = run_tasks(tune_run, tasks, workers=workers, dask=dask, progress=progress, folders=folders)
     tried.extend(rows)
     n = len(settings.variants)
     return {v: all(r["ok"] for r in rows[i * n:(i + 1) * n]) for i, v in enumerate(values)}
@@ -198,14 +199,14 @@ def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=
     tried: list = []
     say(f"tune: {settings.gain} in [{lo:.4g}, {hi:.4g}] (grid of {len(grid)}), variants "
         f"{', '.join(settings.variants)}, margin {settings.margin:g}")
-    ok = _evaluate(text, name, settings, grid, workers, dask, progress, tried)
+    ok = _evaluate(text, name, settings, grid, workers, dask, progress, tried, loaded.folders)
     fails, works = _first_bracket(grid, ok, smallest)
     steps = 0
     while works is not None and fails is not None and steps < settings.max_bisections \
             and max(works, fails) / min(works, fails) > 1.0 + settings.tolerance:
         mid = math.sqrt(works * fails)
         say(f"tune: bisect {settings.gain} between {min(works, fails):.4g} and {max(works, fails):.4g}")
-        if _evaluate(text, name, settings, [mid], workers, dask, progress, tried)[mid]:
+        if _evaluate(text, name, settings, [mid], workers, dask, progress, tried, loaded.folders)[mid]:
             works = mid
         else:
             fails = mid

@@ -10,7 +10,6 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.primitives import ZeroOrderHold
 
 from ptint_drake import cli
-from ptint_drake.controllers import plugin
 from ptint_drake.controllers.hold import HOLD_NAME
 from ptint_drake.robot import make_plant
 from ptint_drake.run_warnings import sampled_control_warnings
@@ -94,8 +93,8 @@ CONTROLLERS = [("ptsmc", ("controller.implementation=fused",), "interceptor"),
 
 @pytest.mark.parametrize("type_, extra, controller", CONTROLLERS, ids=[f"{c[0]} {c[1]}" for c in CONTROLLERS])
 def test_every_controller_drives_the_station_through_the_hold(type_, extra, controller):
-    plugin.remember_folder(EXAMPLES)
     s = scenario(f"controller.type={type_}", "controller.control_period=0.004", *extra)
+    s.plugin_folders = (str(EXAMPLES),)  # as loading a scenario file in that folder sets it
     built = build(s, log=True)
     hold, source, dests = _hold_wiring(built.diagram)
     assert isinstance(hold, ZeroOrderHold) and hold.period() == 0.004 and hold.offset() == 0.0
