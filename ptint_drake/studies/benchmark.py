@@ -175,6 +175,23 @@ def paired(names=None, a: str = "{}", b: str = BEFORE, repeats: int = 5, progres
     return out
 
 
+def _floor_timing(built, scenario, repeats: int) -> dict:
+    """µs per derivative evaluation of ``built``'s diagram over the scenario's duration (the
+    fastest of ``repeats``), its evaluations, steps and wall time."""
+    best, evals, steps = float("inf"), 0, 0
+    for _ in range(repeats):
+        simulator = Simulator(built.diagram)
+        ApplySimulatorConfig(scenario.simulator, simulator)
+        simulator.Initialize()
+        t0 = time.perf_counter()
+        simulator.AdvanceTo(scenario.duration)
+        best = min(best, time.perf_counter() - t0)
+        integrator = simulator.get_integrator()
+        evals, steps = integrator.get_num_derivative_evaluations(), integrator.get_num_steps_taken()
+    return {"us_per_evaluation": round(1e6 * best / evals, 2), "evaluations": int(evals),
+            "steps": int(steps), "wall_s": round(best, 4)}
+
+
 def floors(names=None, repeats: int = 3, progress=None) -> dict:
     """What one derivative evaluation of the closed loop costs, taken apart, per scenario.
 
@@ -211,19 +228,7 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
         row = {}
         camera = not uses_analytic_targets(scenario)
         for kind in ("controller", "python", "cpp") + (("python_camera",) if camera else ()):
-            built = world.floor_diagram(scenario, kind)
-            best, evals, steps = float("inf"), 0, 0
-            for _ in range(repeats):
-                simulator = Simulator(built.diagram)
-                ApplySimulatorConfig(scenario.simulator, simulator)
-                simulator.Initialize()
-                t0 = time.perf_counter()
-                simulator.AdvanceTo(scenario.duration)
-                best = min(best, time.perf_counter() - t0)
-                integrator = simulator.get_integrator()
-                evals, steps = integrator.get_num_derivative_evaluations(), integrator.get_num_steps_taken()
-            row[kind] = {"us_per_evaluation": round(1e6 * best / evals, 2), "evaluations": int(evals),
-                         "steps": int(steps), "wall_s": round(best, 4)}
+            row[kind] = _floor_timing(world.floor_diagram(scenario, kind), scenario, repeats)
         row["python_crossing_us"] = round(
             row["python"]["us_per_evaluation"] - row["cpp"]["us_per_evaluation"], 2)
         row["controller_work_us"] = round(
