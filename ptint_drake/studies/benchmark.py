@@ -16,7 +16,6 @@ import time
 from argparse import Namespace
 from collections.abc import Callable
 
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from ptint_drake.config.yaml_io import drake_version
 from ptint_drake.controllers.slot import uses_analytic_targets
@@ -180,8 +179,7 @@ def _floor_timing(built, scenario, repeats: int) -> dict:
     fastest of ``repeats``), its evaluations, steps and wall time."""
     best, evals, steps = float("inf"), 0, 0
     for _ in range(repeats):
-        simulator = Simulator(built.diagram)
-        ApplySimulatorConfig(scenario.simulator, simulator)
+        simulator = make_simulator(built)
         simulator.Initialize()
         t0 = time.perf_counter()
         simulator.AdvanceTo(scenario.duration)

@@ -23,6 +23,7 @@ class FloorBuilt:
 
     diagram: object
     station: Station
+    simulator_config: object  # the scenario's (``worlds.runner.make_simulator`` reads it)
 
 
 class _ZeroTorque(LeafSystem):
@@ -75,6 +76,6 @@ def floor_diagram(scenario: Scenario, kind: str, schedule: Schedule):
     builder.Connect(source.get_output_port(), system.GetInputPort("actuation"))
     diagram = builder.Build()
     install_stateless_derivatives(diagram)  # the same treatment as ``build`` gives the controller
-    return FloorBuilt(diagram, station)
+    return FloorBuilt(diagram, station, scenario.simulator)
 
 
