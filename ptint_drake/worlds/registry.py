@@ -19,7 +19,8 @@ WORLDS: dict[str, World] = {w.name: w for w in (
     PickWorld(),
 )}
 
-__all__ = ["TARGET_KINDS", "WORLDS", "RunResult", "World", "schedule_of", "world_of", "world_named"]
+__all__ = ["TARGET_KINDS", "WORLDS", "RunResult", "World", "objects_of", "schedule_of", "world_of",
+           "world_named"]
 
 
 def world_of(scenario: Scenario) -> World:
@@ -38,3 +39,8 @@ def world_named(name: str) -> World:
 def schedule_of(scenario: Scenario) -> Schedule:
     """The interceptor's segments of ``scenario``, from its world."""
     return world_of(scenario).schedule(scenario)
+
+
+def objects_of(scenario: Scenario) -> list:
+    """The analytic motions of ``scenario``'s objects, from its world ([] where none exist)."""
+    return world_of(scenario).objects(scenario)

@@ -10,6 +10,7 @@ from ptint_drake.systems.camera import Camera, MeasurementConfig
 from ptint_drake.systems.interceptor import PrescribedTimeInterceptor
 from ptint_drake.systems.kalman import TargetKalmanFilter
 from ptint_drake.systems.targets import LinearTarget, TargetSource
+from ptint_drake.worlds.registry import objects_of
 
 CAMERA_SCENARIOS = ("conveyor_pair_camera", "curve_camera", "conveyor_speedup_camera",
                     "conveyor_dropout_camera")
@@ -41,7 +42,7 @@ def test_estimator_mode_interceptor_has_no_target_object():
 def test_filters_are_primed_at_t0_from_samples_seen_before_the_run():
     built = build(load_scenario("conveyor_pair_camera"), log=False)
     context = built.diagram.CreateDefaultContext()
-    truths = load_scenario("conveyor_pair_camera").targets()
+    truths = objects_of(load_scenario("conveyor_pair_camera"))
     for i, truth in enumerate(truths):
         kf = built.diagram.GetSubsystemByName(f"target_filter_{i}")
         out = kf.get_target_output_port().Eval(kf.GetMyContextFromRoot(context))

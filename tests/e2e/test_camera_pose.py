@@ -6,6 +6,7 @@ import numpy as np
 from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
 from ptint_drake.systems.orientation import rotation_angle, target_rotation_values
+from ptint_drake.worlds.registry import objects_of, schedule_of
 
 
 def test_conveyor_yaw_camera_meets_position_and_orientation_on_camera_data():
@@ -19,7 +20,7 @@ def test_conveyor_yaw_camera_meets_position_and_orientation_on_camera_data():
         assert s["e_rot_tf_deg"] <= 3.0
     # what the controller was given is the estimate, not the truth: off by a fraction of the
     # camera's 1° noise while each part is chased
-    series, schedule, targets = result.series, scenario.schedule(), scenario.targets()
+    series, schedule, targets = result.series, schedule_of(scenario), objects_of(scenario)
     off = []
     for t, seen in zip(series["t"][::50], series["target_rotation"][::50]):
         truth = target_rotation_values(targets[max(schedule.active(t), 0)], t)

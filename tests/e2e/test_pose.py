@@ -202,7 +202,7 @@ def test_bad_orientation_input_is_one_line_exit_2(tmp_path, overrides, field, pt
 
 
 def test_waypoint_orientation_is_slerped_and_checked():
-    from ptint_drake.scenario import make_target
+    from ptint_drake.worlds.interception.objects import make_target
     from ptint_drake.scenario import TargetConfig, WaypointsConfig
 
     target = make_target(TargetConfig(waypoints=WaypointsConfig(

@@ -16,6 +16,7 @@ from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.studies.robust import RANGES, sample_scenario
 from ptint_drake.scenario import parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
+from ptint_drake.worlds.registry import objects_of
 
 HERE = Path(__file__).parent
 NAME, TEXT = scenario_text("curve_b075_tf15")
@@ -51,7 +52,7 @@ def test_metrics_use_the_true_target():
     seg = result.metrics["segments"][0]
     k = np.argmin(np.abs(result.series["t"] - 1.5))
     assert np.linalg.norm(result.series["e"][k]) < 1.5e-3  # what the controller sees
-    speed = np.linalg.norm(parse_scenario(TEXT, NAME).targets()[0].evaluate(1.5)[3:6])
+    speed = np.linalg.norm(objects_of(parse_scenario(TEXT, NAME))[0].evaluate(1.5)[3:6])
     assert seg["e_tf_norm"] == pytest.approx(speed * 0.02, rel=0.05)  # ≈ 3.5 mm
     scenario.measurement.compensate_latency = True
     assert simulate(scenario).metrics["segments"][0]["e_tf_norm"] < 1e-3
