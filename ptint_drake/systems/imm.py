@@ -26,7 +26,7 @@ P⁰ⱼ = Σᵢ μᵢ|ⱼ (Pᵢ + (χᵢ − χ⁰ⱼ)(χᵢ − χ⁰ⱼ)ᵀ); 
 its likelihood is N(y; 0, S); μⱼ ∝ c_j N(y; 0, S) (in logs).  Π: stay with probability
 exp(−Δ/SOJOURN), else switch to either other model.  A dropout (no new sample at an
 update) mixes and predicts only (μⱼ = c_j).  The timing (latency compensation, priming
-with pre-run samples, update instants) is ``kalman.TargetKalmanFilter``'s.
+with pre-run samples, update instants) is ``sampled_estimator.SampledEstimator``'s.
 
 Output ``target`` (9) = [p̂ + v̂Δt + âΔt²/2, v̂ + âΔt, â] of the combined estimate
 χ̂ = Σ μⱼ χⱼ, Δt = t − t_est (the same layout as the Kalman filter); ``probabilities`` (4, μ of ``MODELS``).
@@ -55,41 +55,32 @@ cycle without a sample; compiling the kernels cold takes ~15 s (``warm_up``).
 from __future__ import annotations
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.systems.camera import TIME_TOL, MeasurementConfig, validate_measurement
+from ptint_drake.systems.camera import MeasurementConfig
 from ptint_drake.systems.imm_kernels import (MODELS, MU0, NO_SAMPLE, R_MIN, N, imm_cycle,
                                              initial_state)
+from ptint_drake.systems.sampled_estimator import SampledEstimator
 
 
-class AdaptiveTargetEstimator(LeafSystem):
+class AdaptiveTargetEstimator(SampledEstimator):
     """The IMM filter of one object's motion as a Drake system (``estimator: auto``).
 
     Input port ``measurement`` (5): [stamp, x, y, z, valid] from a ``Camera``.
     Output ports ``target`` (9): [p, v, a] of the combined estimate predicted to t (zeros
     before the first sample); ``probabilities`` (4): μ of ``MODELS``; ``polynomial`` (28): the
-    state of that name (``target_prediction.PolynomialTargetSelector`` evaluates it, compiled).
+    state of that name (``target_prediction.ActiveTargetSelector`` evaluates it, compiled).
     Discrete state groups (``groups`` maps the names to indices): ``meta`` = [initialised,
     t_est, last stamp consumed, t of the last update], ``estimates`` = χⱼ (4×10 row-major),
     ``covariances`` = Pⱼ (4×10×10), ``probabilities`` = μ (4), ``polynomial`` = [t_est, c₀, c₁,
     c₂] (1 + 3·9: the output is c₀ + Δt c₁ + Δt² c₂, zeros before the first sample), stored at
     each update from χ̂ = Σ μⱼ χⱼ so that an evaluation of the output only extrapolates.
-    ``prior``: pre-run samples [(t_k, z_k), …] consumed as in ``TargetKalmanFilter``.
+    ``prior``: pre-run samples [(t_k, z_k), …] consumed as ``SampledEstimator`` consumes them.
     """
 
     def __init__(self, *, config: MeasurementConfig, prior=None):
-        super().__init__()
-        validate_measurement(config)
+        super().__init__(config=config, input_name="measurement", input_size=5)
         self._R = max(float(config.noise_std) ** 2, R_MIN)
-        self._latency = float(config.latency)
-        self._compensate = bool(config.compensate_latency)
-        self._z_in = self.DeclareVectorInputPort("measurement", 5)
-        state = self._prior_state(prior)
-        self.groups = {name: self.DeclareDiscreteState(value.ravel())
-                       for name, value in zip(("meta", "estimates", "covariances", "probabilities"),
-                                              state)}
-        self.groups["polynomial"] = self.DeclareDiscreteState(_polynomial(state[0], state[3] @ state[1]))
-        self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
+        self._declare_state(("estimates", "covariances", "probabilities"), prior)
         ticket = {self.time_ticket(), self.xd_ticket()}
         self._target_out = self.DeclareVectorOutputPort(
             "target", 9, lambda c, o: o.SetFromVector(self._predict_target(c)),
@@ -113,52 +104,25 @@ class AdaptiveTargetEstimator(LeafSystem):
     def get_probabilities_output_port(self):
         return self._mu_out
 
-    def state(self, context) -> tuple:
-        """(meta, X as 4×10, Ps as 4×10×10, μ) from a context (copies)."""
-        value = [context.get_discrete_state(self.groups[name]).value().copy()
-                 for name in ("meta", "estimates", "covariances", "probabilities")]
+    def _initial_estimate(self) -> tuple:
+        """X = 0 (4×10), Ps = I (4×10×10), μ = MU0."""
         m = len(MODELS)
-        return value[0], value[1].reshape(m, N), value[2].reshape(m, N, N), value[3]
+        return np.zeros((m, N)), np.tile(np.eye(N), (m, 1, 1)), MU0.copy()
 
-    def step(self, meta, X, Ps, mu, t: float, z: np.ndarray):
-        """One update at time t with the camera's output z: (meta, X, Ps, μ) after it, or None
-        when nothing changes (no sample seen yet).  ``TargetKalmanFilter.step``'s timing."""
-        initialised, t_est, last_stamp, _ = meta
-        stamp = z[0]
-        if z[4] > 0.5 and (initialised < 0.5 or stamp > last_stamp + TIME_TOL):
-            t_meas = stamp if self._compensate else t
-            if initialised < 0.5:
-                X, Ps, mu = initial_state(z[1:4], self._R)
-            else:
-                X, Ps, mu = imm_cycle(X, Ps, mu, max(t_meas - t_est, 0.0), z[1:4], self._R)
-            return np.array([1.0, t_meas, stamp, t]), X, Ps, mu
-        if initialised < 0.5:
-            return None
-        t_pred = t - self._latency if self._compensate else t
-        X, Ps, mu = imm_cycle(X, Ps, mu, max(t_pred - t_est, 0.0), NO_SAMPLE, self._R)
-        return np.array([1.0, max(t_pred, t_est), last_stamp, t]), X, Ps, mu
+    def _first_estimate(self, z: np.ndarray) -> tuple:
+        return initial_state(z[1:4], self._R)
 
-    def _update(self, context, discrete_state) -> None:
-        result = self.step(*self.state(context), context.get_time(), self._z_in.Eval(context))
-        if result is None:
-            return
-        for name, value in zip(("meta", "estimates", "covariances", "probabilities"), result):
-            discrete_state.get_mutable_vector(self.groups[name]).SetFromVector(value.ravel())
-        discrete_state.get_mutable_vector(self.groups["polynomial"]).SetFromVector(
-            _polynomial(result[0], result[3] @ result[1]))
+    def _corrected(self, estimate: tuple, dt: float, z: np.ndarray) -> tuple:
+        """One IMM cycle with the sample: mixing, each model's prediction and correction, μ."""
+        return imm_cycle(*estimate, dt, z[1:4], self._R)
 
-    def _prior_state(self, prior) -> tuple:
-        """The state at t = 0 after the pre-run samples, each consumed when it became visible."""
-        m = len(MODELS)
-        state = (np.zeros(4), np.zeros((m, N)), np.tile(np.eye(N), (m, 1, 1)), MU0.copy())
-        for t_k, z_k in prior or []:
-            t_seen = t_k + self._latency
-            if t_seen > TIME_TOL:
-                raise ValueError(f"prior: a sample taken at {t_k} s is not visible before t = 0")
-            result = self.step(*state, t_seen, np.array([t_k, *z_k, 1.0]))
-            if result is not None:
-                state = result
-        return state
+    def _predicted(self, estimate: tuple, dt: float) -> tuple:
+        """One IMM cycle without a sample: mixing and prediction, μⱼ = c_j."""
+        return imm_cycle(*estimate, dt, NO_SAMPLE, self._R)
+
+    def _derived(self, state: tuple) -> dict:
+        """``polynomial`` of the combined estimate χ̂ = Σ μⱼ χⱼ."""
+        return {"polynomial": _polynomial(state[0], state[3] @ state[1])}
 
     def _predict_target(self, context) -> np.ndarray:
         """[p + vΔt + aΔt²/2, v + aΔt, a] of Σ μⱼ χⱼ, Δt = t − t_est (zeros before a sample)."""

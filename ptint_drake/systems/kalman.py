@@ -19,28 +19,11 @@ spectral density q = ``process_noise``.  Over a step Δ:
 The axes share F, Q, R, P₀ and the measurement times, so their covariances are equal:
 the filter keeps one n×n P (n = 2 or 3) and an n×3 estimate (one column per axis).
 
-Timing.  The filter updates periodically at ``rate_hz`` with offset ``latency``, i.e.
-exactly when the camera's sample k becomes visible (see ``camera``).  At an update at
-time t, with the camera's sample [stamp, z, valid]:
-
-- a new valid sample (stamp later than the last one consumed): predict to its
-  measurement time and correct; the measurement time is the stamp with
-  ``compensate_latency`` and the update time t without (the delay is then not known
-  to the filter: it treats the sample as taken when it sees it);
-- no new sample (a dropout): predict only, to t − latency (compensating) or t, so P
-  grows;
-- the first valid sample initialises χ = [z, 0(, 0)], P₀ = diag(R, V0², A0²) with
-  V0 = 1 m/s and A0 = 10 m/s² (large against the targets here, ≤ 0.2 m/s, ≤ 0.3 m/s²).
-
-Priming (``prior``).  In a scenario every object is on its conveyor before its segment
-starts, so the camera has had it in view before the run (``measurement.prior_window``,
-default 1 s; ``Camera`` with a ``history``): the samples t_k = k/rate < 0 that were
-visible by t = 0 (t_k + L ≤ 0) are consumed, in order, at their visibility times by the
-same update rule, and the result is the filter's *default* state.  So at t = 0 the
-estimate is already a filtered position and velocity (not zeros, not one raw sample),
-which matters because the interceptor captures s(t0) from it at initialisation.
-Nothing else changes: during the run sample k is still seen at t_k + L, and a filter
-without a prior outputs zeros until its first sample.
+Timing and priming are ``sampled_estimator.SampledEstimator``'s (the rule every camera
+estimator shares: an update when the camera's sample k becomes visible, predict and
+correct at a new sample, predict only in a dropout, the pre-run samples consumed before
+t = 0).  The first valid sample initialises χ = [z, 0(, 0)], P₀ = diag(R, V0², A0²) with
+V0 = 1 m/s and A0 = 10 m/s² (large against the targets here, ≤ 0.2 m/s, ≤ 0.3 m/s²).
 
 Output ``target`` (9) = [p̂ + v̂Δt + âΔt²/2,  v̂ + âΔt,  â] with Δt = t − t_est, t_est
 the time the estimate refers to: continuous in t between updates (for ``cv`` â = 0);
@@ -82,9 +65,9 @@ position std from the DARE):
 - the paper's curve, ``kalman_ca`` q = 0.03 m²/s⁵ (jerk ≤ 0.34 m/s³): 1.27 mm per
   axis; 0.003 lags, 0.1–0.3 is noisier (open-loop RMS 3.3–3.7 mm against 3.1 mm).
 
-``ActiveTargetSelector`` passes on the estimate of the segment active at t; ``AddCameraEstimators``
-wires a camera and an estimator per object (``auto``: the IMM of ``imm``, whose polynomials
-``target_prediction.PolynomialTargetSelector`` selects and evaluates, compiled; ``kalman_cv`` /
+``AddCameraEstimators`` wires a camera and an estimator per object and one
+``target_prediction.ActiveTargetSelector`` passing on the active segment's estimate (``auto``: the
+IMM of ``imm``, whose polynomials the selector evaluates, compiled; ``kalman_cv`` /
 ``kalman_ca``: this filter).
 """
 
@@ -97,17 +80,12 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
 from pydrake.systems.primitives import Demultiplexer
 
-from ptint_drake.systems.camera import (
-    TIME_TOL,
-    Camera,
-    MeasurementConfig,
-    process_noise,
-    validate_measurement,
-)
+from ptint_drake.systems.camera import Camera, MeasurementConfig, process_noise, validate_measurement
 from ptint_drake.systems.imm import AdaptiveTargetEstimator
+from ptint_drake.systems.sampled_estimator import SampledEstimator
 from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.target_prediction import PolynomialTargetSelector
 from ptint_drake.systems.signals import TARGET_PORT_SIZE
+from ptint_drake.systems.target_prediction import ActiveTargetSelector
 
 MODELS = ("cv", "ca")
 R_MIN = 1.0e-12  # m², floor of the measurement variance: (1 µm)²
@@ -150,11 +128,12 @@ def initial_covariance(model: str, R: float) -> np.ndarray:
     return np.diag([R, V0 * V0, A0 * A0][:model_order(model)])
 
 
-class TargetKalmanFilter(LeafSystem):
+class TargetKalmanFilter(SampledEstimator):
     """Kalman filter of one object's motion from its camera (see the module docstring).
 
     Input port ``measurement`` (5): [stamp, x, y, z, valid] from a ``Camera``.
     Output ports ``target`` (9): [p, v, a] predicted to t; ``covariance`` (n²).
+    Discrete state groups (``groups``): ``meta``, ``estimate`` (χ, n×3), ``covariance`` (P, n×n).
 
     ``prior``: the camera's samples seen before t = 0 (``Camera.pre_run_samples()``,
     [(t_k, z_k), …] oldest first); the default state is what the update rule makes of
@@ -162,25 +141,18 @@ class TargetKalmanFilter(LeafSystem):
     """
 
     def __init__(self, *, config: MeasurementConfig, model: str, prior=None):
-        super().__init__()
-        self._n = n = model_order(model)
+        n = model_order(model)
         config = dataclasses.replace(config, estimator=f"kalman_{model}")  # this filter, whatever named
-        validate_measurement(config)
+        super().__init__(config=config, input_name="measurement", input_size=5)
+        self._n = n
         self._model = model
         self._config = config
         self._q = process_noise(config)
         self._R = measurement_variance(config)
-        self._latency = float(config.latency)
-        self._compensate = bool(config.compensate_latency)
         self._H = np.zeros(n)
         self._H[0] = 1.0
-
-        self._z_in = self.DeclareVectorInputPort("measurement", 5)
-        meta, X, P = self._prior_state(prior)
-        self._meta = self.DeclareDiscreteState(meta)
-        self._estimate = self.DeclareDiscreteState(X.ravel())
-        self._covariance = self.DeclareDiscreteState(P.ravel())
-        self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
+        self._declare_state(("estimate", "covariance"), prior)
+        self._meta, self._estimate, self._covariance = self.groups.values()
 
         state_and_time = {self.time_ticket(), self.xd_ticket()}
         # ``target`` is read at every derivative evaluation; ``covariance`` (figures) only
@@ -214,73 +186,35 @@ class TargetKalmanFilter(LeafSystem):
     def get_covariance_output_port(self):
         return self._covariance_out
 
-    def state(self, context) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(meta, χ as n×3, P as n×n) from a context (copies)."""
-        n = self._n
-        return (context.get_discrete_state(self._meta).value().copy(),
-                context.get_discrete_state(self._estimate).value().reshape(n, 3).copy(),
-                context.get_discrete_state(self._covariance).value().reshape(n, n).copy())
-
     def gain(self, P_prior: np.ndarray) -> np.ndarray:
         """K = P Hᵀ / (H P Hᵀ + R) for an a-priori covariance P."""
         return P_prior[:, 0] / (P_prior[0, 0] + self._R)
 
-    def _predict(self, X, P, dt):
+    def _initial_estimate(self) -> tuple:
+        """χ = 0 (n×3), P₀."""
+        return np.zeros((self._n, 3)), initial_covariance(self._model, self._R)
+
+    def _first_estimate(self, z: np.ndarray) -> tuple:
+        """χ = [z, 0(, 0)], P₀."""
+        X = np.zeros((self._n, 3))
+        X[0] = z[1:4]
+        return X, initial_covariance(self._model, self._R)
+
+    def _predicted(self, estimate: tuple, dt: float) -> tuple:
+        """χ ← F χ,  P ← F P Fᵀ + Q (symmetrised)."""
+        X, P = estimate
         F = transition(self._model, dt)
         P = F @ P @ F.T + process_covariance(self._model, dt, self._q)
         return F @ X, 0.5 * (P + P.T)
 
-    def step(self, meta, X, P, t: float, z: np.ndarray):
-        """One update at time t with the camera's output z: (meta, χ, P) after it, or None
-        when nothing changes (no sample seen yet).  The rule of the module docstring."""
-        initialised, t_est, last_stamp, _ = meta
-        stamp = z[0]
-        new = z[4] > 0.5 and (initialised < 0.5 or stamp > last_stamp + TIME_TOL)
-        if new:
-            t_meas = stamp if self._compensate else t
-            if initialised < 0.5:
-                X = np.zeros((self._n, 3))
-                X[0] = z[1:4]
-                P = initial_covariance(self._model, self._R)
-            else:
-                X, P = self._predict(X, P, max(t_meas - t_est, 0.0))
-                K = self.gain(P)
-                X = X + np.outer(K, z[1:4] - X[0])
-                A = np.eye(self._n) - np.outer(K, self._H)
-                P = A @ P @ A.T + self._R * np.outer(K, K)
-                P = 0.5 * (P + P.T)
-            initialised, t_est, last_stamp = 1.0, t_meas, stamp
-        elif initialised > 0.5:
-            t_pred = t - self._latency if self._compensate else t
-            X, P = self._predict(X, P, max(t_pred - t_est, 0.0))
-            t_est = max(t_pred, t_est)
-        else:
-            return None
-        return np.array([initialised, t_est, last_stamp, t]), X, P
-
-    def _update(self, context, discrete_state) -> None:
-        meta, X, P = self.state(context)
-        result = self.step(meta, X, P, context.get_time(), self._z_in.Eval(context))
-        if result is None:
-            return
-        meta, X, P = result
-        discrete_state.get_mutable_vector(self._meta).SetFromVector(meta)
-        discrete_state.get_mutable_vector(self._estimate).SetFromVector(X.ravel())
-        discrete_state.get_mutable_vector(self._covariance).SetFromVector(P.ravel())
-
-    def _prior_state(self, prior):
-        """The state at t = 0 after the pre-run samples [(t_k, z_k), …] (oldest first), each
-        consumed at the time it became visible, t_k + latency ≤ 0, by ``step``."""
-        n = self._n
-        meta, X, P = np.zeros(4), np.zeros((n, 3)), initial_covariance(self._model, self._R)
-        for t_k, z_k in prior or []:
-            t_seen = t_k + self._latency
-            if t_seen > TIME_TOL:
-                raise ValueError(f"prior: a sample taken at {t_k} s is not visible before t = 0")
-            result = self.step(meta, X, P, t_seen, np.array([t_k, *z_k, 1.0]))
-            if result is not None:
-                meta, X, P = result
-        return meta, X, P
+    def _corrected(self, estimate: tuple, dt: float, z: np.ndarray) -> tuple:
+        """Predicted over dt, then K = P Hᵀ / S, χ ← χ + K (z − H χ), P in Joseph form."""
+        X, P = self._predicted(estimate, dt)
+        K = self.gain(P)
+        X = X + np.outer(K, z[1:4] - X[0])
+        A = np.eye(self._n) - np.outer(K, self._H)
+        P = A @ P @ A.T + self._R * np.outer(K, K)
+        return X, 0.5 * (P + P.T)
 
     def _predict_target(self, context) -> np.ndarray:
         """[p + vΔt + aΔt²/2, v + aΔt, a], Δt = t − t_est (zeros before the first sample)."""
@@ -306,30 +240,6 @@ class TargetKalmanFilter(LeafSystem):
         return (F @ P @ F.T + process_covariance(self._model, dt, self._q)).ravel()
 
 
-class ActiveTargetSelector(LeafSystem):
-    """Input ports ``target_0`` … ``target_{count-1}`` (``size`` each, default 9); output
-    ``target``: the input of the segment active at t (``schedule.active(t)``; the first
-    before any start).  ``size`` 15 selects orientations (``signals.TARGET_ROTATION``)."""
-
-    def __init__(self, *, schedule: Schedule, count: int, size: int = TARGET_PORT_SIZE):
-        super().__init__()
-        if count != len(schedule):
-            raise ValueError(f"count: one target per segment is needed, got {count} "
-                             f"for {len(schedule)} segments")
-        self._schedule = schedule
-        self._inputs = [self.DeclareVectorInputPort(f"target_{i}", size) for i in range(count)]
-        self._target_out = self.DeclareVectorOutputPort(
-            "target", size, self._select,
-            prerequisites_of_calc={self.time_ticket(), self.all_input_ports_ticket()})
-
-    def get_target_output_port(self):
-        return self._target_out
-
-    def _select(self, context, output) -> None:
-        i = max(self._schedule.active(context.get_time()), 0) if len(self._inputs) > 1 else 0
-        output.SetFromVector(self._inputs[i].Eval(context))
-
-
 def _estimator(config: MeasurementConfig, prior) -> LeafSystem:
     """The estimator ``config.estimator`` names, primed with ``prior``."""
     if config.estimator == "auto":
@@ -344,7 +254,7 @@ class CameraEstimators:
     target_port: OutputPort
     cameras: list
     filters: list
-    selector: "ActiveTargetSelector | PolynomialTargetSelector"
+    selector: ActiveTargetSelector
 
 
 def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | None = None,
@@ -361,7 +271,7 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     for ``config.prior_window`` s before t = 0 and its filter starts from those samples
     (priming); without it the cameras start seeing at t = 0.
     ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object, selected in C++
-    by a ``PolynomialTargetSelector``), or ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
+    by a polynomial ``ActiveTargetSelector``), or ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
     ``rotations_port`` (9 per object, e.g. the station's ``object_rotations``): measured too.
     """
     validate_measurement(config)
@@ -378,9 +288,9 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     if rotations_port is not None:
         rotations = builder.AddNamedSystem("object_rotations", Demultiplexer([9] * len(schedule)))
         builder.Connect(rotations_port, rotations.get_input_port())
-    kind = PolynomialTargetSelector if config.estimator == "auto" else ActiveTargetSelector
-    count = len(true_position_ports)
-    selector = builder.AddNamedSystem("target_selector", kind(schedule=schedule, count=count))
+    polynomial = config.estimator == "auto"
+    selector = builder.AddNamedSystem("target_selector", ActiveTargetSelector(
+        schedule=schedule, count=len(true_position_ports), polynomial=polynomial))
     if histories is not None and len(histories) != len(true_position_ports):
         raise ValueError(f"histories: one per object is needed, got {len(histories)} "
                          f"for {len(true_position_ports)} objects")
@@ -394,7 +304,7 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         kf = builder.AddNamedSystem(f"target_filter_{i}", _estimator(config, camera.pre_run_samples()))
         builder.Connect(port, camera.get_x_true_input_port())
         builder.Connect(camera.get_measurement_output_port(), kf.get_measurement_input_port())
-        get = kf.get_target_output_port if kind is ActiveTargetSelector else kf.get_polynomial_output_port
+        get = kf.get_polynomial_output_port if polynomial else kf.get_target_output_port
         builder.Connect(get(), selector.get_input_port(i))
         cameras.append(camera)
         filters.append(kf)

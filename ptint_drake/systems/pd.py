@@ -27,19 +27,11 @@ never the mass matrix, Coriolis, gravity or inverse dynamics.
 
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.systems.baseline_common import (
-    DeclareControllerOutputs,
-    layout_size,
-    make_layout,
-    segment_index,
-)
-from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.config.controller import PDConfig
-from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
-from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
+from ptint_drake.systems.baseline_common import TaskSpaceBaseline, make_layout
+from ptint_drake.systems.schedule import Schedule
+
 
 def pd_layout(nv: int) -> dict:
     """name -> slice of the PD controller's ``telemetry``."""
@@ -47,50 +39,29 @@ def pd_layout(nv: int) -> dict:
                         ("gains", 3), ("force", 3), ("tau", nv)])
 
 
-class PDController(LeafSystem):
+class PDController(TaskSpaceBaseline):
     """Inputs ``state`` (nq + nv), ``target`` ([x_r, ẋ_r, ẍ_r], ``signals.TARGET_PORT``); outputs
     ``u`` (nu), ``tau`` (nv), ``telemetry`` (``layout``).  State: ∫e (continuous, 3),
-    [segment, Kp, Kd, Ki] (discrete)."""
+    [segment, Kp, Kd, Ki] (discrete); ports, segment starts and e, ė: ``TaskSpaceBaseline``."""
 
     def __init__(self, *, plant, frame, schedule: Schedule, config: PDConfig):
-        super().__init__()
         config.validate()
+        layout = pd_layout(plant.num_velocities())
+        super().__init__(plant=plant, frame=frame, schedule=schedule, layout=layout, name="pd", values=3,
+                         reset=config.integral_policy == "reset", derivative=layout["e"])
         self._config = config
-        self._schedule = schedule
-        self._nq, self._nv = plant.num_positions(), plant.num_velocities()
-        self._kinematics = FrameKinematics(plant, frame)
-        self.layout = pd_layout(self._nv)
-        self._state_in = self.DeclareVectorInputPort("state", self._nq + self._nv)
-        self._target_in = self.DeclareVectorInputPort("target", TARGET_PORT_SIZE)
-        self._integral_index = self.DeclareContinuousState(3)
-        self._gains_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0, 0.0]))
-        DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
-        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(),
-                self.all_input_ports_ticket()}
-        self._eval = DeclareVectorCache(self, "pd", layout_size(self.layout), self._calc, deps)
-        DeclareControllerOutputs(self, plant, self.layout, self._eval, deps)
 
     def gains_for(self, tf: float) -> dict:
         """The gains this controller uses on a segment of duration tf (s)."""
         return self._config.gains_for(tf)
 
-    def _on_segment_start(self, context, state) -> None:
-        i = segment_index(self._schedule, context.get_time())
-        g = self.gains_for(self._schedule[i].tf)
-        state.get_mutable_discrete_state(self._gains_index).SetFromVector(
-            [i, g["Kp"], g["Kd"], g["Ki"]])
-        if self._config.integral_policy == "reset":
-            state.get_mutable_continuous_state().get_mutable_vector().SetZero()
+    def _segment_values(self, tf: float) -> list:
+        """[Kp, Kd, Ki] of a segment of duration tf (s)."""
+        g = self.gains_for(tf)
+        return [g["Kp"], g["Kd"], g["Ki"]]
 
     def _calc(self, context) -> np.ndarray:
-        qv = self._state_in.Eval(context)
-        target = self._target_in.Eval(context)
-        x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
-        e, edot = x - target[TARGET.x], xdot - target[TARGET.xdot]
-        integral = context.get_continuous_state_vector().CopyToVector()
-        _, Kp, Kd, Ki = context.get_discrete_state(self._gains_index).value()
-        force = -(Kp * e + Kd * edot + Ki * integral)
-        return np.concatenate([x, xdot, e, edot, integral, [Kp, Kd, Ki], force, J.T @ force])
-
-    def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self.layout["e"]])
+        r = self.read(context)
+        _, Kp, Kd, Ki = r.segment
+        force = -(Kp * r.e + Kd * r.edot + Ki * r.memory)
+        return np.concatenate([r.x, r.xdot, r.e, r.edot, r.memory, [Kp, Kd, Ki], force, r.J.T @ force])

@@ -25,7 +25,7 @@ every derivative evaluation of a run, where Drake's ``AngleAxis`` cost 8 µs a c
 re-projected onto SO(3) (Drake's ``ProjectToRotationMatrix``) at every update.  The timing — update
 instants at the camera's rate offset by its latency, the latency compensated by
 predicting from the sample's stamp, predict-only during dropouts, priming with the pre-run
-samples — is ``kalman.TargetKalmanFilter``'s.  The first sample sets R̂ = Z, ω̂ = 0,
+samples — is ``sampled_estimator.SampledEstimator``'s.  The first sample sets R̂ = Z, ω̂ = 0,
 P₀ = diag(R_θ, W0²).
 
 Output ``target_rotation`` (15, ``signals.TARGET_ROTATION``) = [exp([ω̂ Δt]×) R̂ (row-major),
@@ -47,13 +47,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 from pydrake.math import RotationMatrix
-from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.framework import DiagramBuilder, OutputPort
 
-from ptint_drake.systems.camera import TIME_TOL, MeasurementConfig, rotation_noise, validate_measurement
-from ptint_drake.systems.kalman import ActiveTargetSelector, process_covariance, transition
+from ptint_drake.systems.camera import MeasurementConfig, rotation_noise
+from ptint_drake.systems.kalman import process_covariance, transition
 from ptint_drake.systems.orientation import ROTATION_WIDTH, rotation_exp, rotation_log, rotation_row
+from ptint_drake.systems.sampled_estimator import SampledEstimator
 from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.signals import TARGET_ROTATION_SIZE
+from ptint_drake.systems.target_prediction import ActiveTargetSelector
 
 Q_SPIN = 1.0e-3  # rad²/s³, white angular acceleration
 W0 = 1.0  # rad/s, initial angular-velocity standard deviation
@@ -81,7 +83,7 @@ def predicted_rotation(t: float, meta, R, w, out) -> None:
     rotation_row(c, t - meta[1], out)
 
 
-class RotationEstimator(LeafSystem):
+class RotationEstimator(SampledEstimator):
     """The orientation filter of one object (see the module docstring).
 
     Input port ``measured_rotation`` (11): [stamp, Z row-major, valid] from a ``Camera``.
@@ -90,21 +92,14 @@ class RotationEstimator(LeafSystem):
     t of the last update], ``rotation`` = R̂ (row-major), ``rate`` = ω̂ (3), ``covariance`` =
     P (2×2 row-major) at t_est.
     ``prior``: the camera's pre-run orientation samples [(t_k, Z_k), …]
-    (``Camera.pre_run_rotations()``), consumed as ``TargetKalmanFilter`` consumes its prior.
+    (``Camera.pre_run_rotations()``), consumed as ``SampledEstimator`` consumes a prior.
     """
 
     def __init__(self, *, config: MeasurementConfig, prior=None, q: float = Q_SPIN):
-        super().__init__()
-        validate_measurement(config)
+        super().__init__(config=config, input_name="measured_rotation", input_size=MEASURED_ROTATION_SIZE)
         self._R = max(rotation_noise(config) ** 2, R_MIN)
         self._q = float(q)
-        self._latency = float(config.latency)
-        self._compensate = bool(config.compensate_latency)
-        self._z_in = self.DeclareVectorInputPort("measured_rotation", MEASURED_ROTATION_SIZE)
-        state = self._prior_state(prior)
-        self.groups = {name: self.DeclareDiscreteState(np.ravel(value))
-                       for name, value in zip(("meta", "rotation", "rate", "covariance"), state)}
-        self.DeclarePeriodicDiscreteUpdateEvent(1.0 / config.rate_hz, self._latency, self._update)
+        self._declare_state(("rotation", "rate", "covariance"), prior)
         self._out = self.DeclareVectorOutputPort(
             "target_rotation", TARGET_ROTATION_SIZE, self._calc_prediction,
             prerequisites_of_calc={self.time_ticket(), self.xd_ticket()})
@@ -121,66 +116,31 @@ class RotationEstimator(LeafSystem):
     def get_target_rotation_output_port(self):
         return self._out
 
-    def state(self, context) -> tuple:
-        """(meta, R̂ as 3×3, ω̂, P as 2×2) from a context (copies)."""
-        meta, R, w, P = (context.get_discrete_state(self.groups[name]).value().copy()
-                         for name in ("meta", "rotation", "rate", "covariance"))
-        return meta, R.reshape(3, 3), w, P.reshape(2, 2)
-
-    def _initial(self) -> tuple:
+    def _initial_estimate(self) -> tuple:
+        """R̂ = I, ω̂ = 0, P₀ = diag(R_θ, W0²)."""
         return np.eye(3), np.zeros(3), np.diag([self._R, W0 * W0])
 
-    def _predict(self, R, w, P, dt: float) -> tuple:
+    def _first_estimate(self, z: np.ndarray) -> tuple:
+        """R̂ = Z (projected onto SO(3)), ω̂ = 0, P₀."""
+        _, w, P = self._initial_estimate()
+        return RotationMatrix.ProjectToRotationMatrix(np.reshape(z[1:10], (3, 3))).matrix(), w, P
+
+    def _predicted(self, estimate: tuple, dt: float) -> tuple:
+        """R̂ ← exp([ω̂ Δ]×) R̂, P ← F P Fᵀ + Q."""
+        R, w, P = estimate
         F = transition("cv", dt)
         P = F @ P @ F.T + process_covariance("cv", dt, self._q)
         return _turned(R, w * dt), w, 0.5 * (P + P.T)
 
-    def _correct(self, R, w, P, Z) -> tuple:
-        y = rotation_log(Z @ R.T)
+    def _corrected(self, estimate: tuple, dt: float, z: np.ndarray) -> tuple:
+        """Predicted over dt, then corrected with Z: y = log(Z R̂ᵀ)^∨, [δθ; ω̂] ← K y, Joseph form."""
+        R, w, P = self._predicted(estimate, dt)
+        y = rotation_log(np.reshape(z[1:10], (3, 3)) @ R.T)
         K = P[:, 0] / (P[0, 0] + self._R)
         R = RotationMatrix.ProjectToRotationMatrix(_turned(R, K[0] * y)).matrix()
         A = np.eye(2) - np.outer(K, _H)
         P = A @ P @ A.T + self._R * np.outer(K, K)
         return R, w + K[1] * y, 0.5 * (P + P.T)
-
-    def step(self, meta, R, w, P, t: float, z: np.ndarray):
-        """One update at time t with the camera's output z: (meta, R̂, ω̂, P) after it, or None
-        when nothing changes (no sample seen yet).  ``TargetKalmanFilter.step``'s timing."""
-        initialised, t_est, last_stamp, _ = meta
-        stamp = z[0]
-        if z[10] > 0.5 and (initialised < 0.5 or stamp > last_stamp + TIME_TOL):
-            t_meas = stamp if self._compensate else t
-            Z = np.reshape(z[1:10], (3, 3))
-            if initialised < 0.5:
-                R, w, P = self._initial()
-                R = RotationMatrix.ProjectToRotationMatrix(Z).matrix()
-            else:
-                R, w, P = self._correct(*self._predict(R, w, P, max(t_meas - t_est, 0.0)), Z)
-            return np.array([1.0, t_meas, stamp, t]), R, w, P
-        if initialised < 0.5:
-            return None
-        t_pred = t - self._latency if self._compensate else t
-        R, w, P = self._predict(R, w, P, max(t_pred - t_est, 0.0))
-        return np.array([1.0, max(t_pred, t_est), last_stamp, t]), R, w, P
-
-    def _update(self, context, discrete_state) -> None:
-        result = self.step(*self.state(context), context.get_time(), self._z_in.Eval(context))
-        if result is None:
-            return
-        for name, value in zip(("meta", "rotation", "rate", "covariance"), result):
-            discrete_state.get_mutable_vector(self.groups[name]).SetFromVector(np.ravel(value))
-
-    def _prior_state(self, prior) -> tuple:
-        """The state at t = 0 after the pre-run samples, each consumed when it became visible."""
-        state = (np.zeros(4), *self._initial())
-        for t_k, Z_k in prior or []:
-            t_seen = t_k + self._latency
-            if t_seen > TIME_TOL:
-                raise ValueError(f"prior: a sample taken at {t_k} s is not visible before t = 0")
-            result = self.step(*state, t_seen, np.array([t_k, *np.ravel(Z_k), 1.0]))
-            if result is not None:
-                state = result
-        return state
 
     def _calc_prediction(self, context, output) -> None:
         """``target_rotation``: ``predicted_rotation`` of the state at t, into the output."""

@@ -21,19 +21,10 @@ never the mass matrix, Coriolis, gravity or inverse dynamics.
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.systems.baseline_common import (
-    DeclareControllerOutputs,
-    layout_size,
-    make_layout,
-    segment_index,
-)
-from ptint_drake.systems.cache import DeclareVectorCache
+from ptint_drake.systems.baseline_common import TaskSpaceBaseline, layout_size, make_layout
 from ptint_drake.systems.controller import smc_torque
-from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
-from ptint_drake.systems.signals import TARGET, TARGET_PORT_SIZE
+from ptint_drake.systems.schedule import Schedule
 from ptint_drake.systems.sliding_surface import SIGMA_POLICIES, switching_law
 
 _SHARED = ("K", "Lambda", "switching", "phi", "sigma_policy", "pinv_damping")
@@ -72,58 +63,37 @@ def smc_layout(nv: int) -> dict:
                         ("s_x", 3), ("sigma", 3), ("tau", nv)])
 
 
-class FirstOrderSMC(LeafSystem):
+class FirstOrderSMC(TaskSpaceBaseline):
     """Inputs ``state`` (nq + nv), ``target`` ([x_r, ẋ_r, ẍ_r], ``signals.TARGET_PORT``); outputs
     ``u`` (nu), ``tau`` (nv), ``telemetry`` (``layout``).  State: σ (continuous, 3),
-    [segment, λ] (discrete)."""
+    [segment, λ] (discrete); ports, segment starts and e, ė: ``TaskSpaceBaseline``."""
 
     def __init__(self, *, plant, frame, schedule: Schedule, config: SMCConfig):
-        super().__init__()
         config.validate()
+        nv = plant.num_velocities()
+        layout = smc_layout(nv)
+        size = layout_size(layout)
+        # the cache holds the telemetry, then σ̇ (3)
+        super().__init__(plant=plant, frame=frame, schedule=schedule, layout=layout, name="smc", values=1,
+                         reset=config.sigma_policy == "reset", derivative=slice(size, size + 3), extra=3)
         self._config = config
-        self._schedule = schedule
-        self._nq, self._nv = plant.num_positions(), plant.num_velocities()
-        self._K_floats = np.broadcast_to(np.asarray(config.K, dtype=float), (self._nv,)).tolist()
+        self._K_floats = np.broadcast_to(np.asarray(config.K, dtype=float), (nv,)).tolist()
         self._Lambda = np.broadcast_to(np.asarray(config.Lambda, dtype=float), (3,)).copy()
         self._switch = switching_law(config.switching, float(config.phi))
-        self._kinematics = FrameKinematics(plant, frame)
-        self.layout = smc_layout(self._nv)
-        self._state_in = self.DeclareVectorInputPort("state", self._nq + self._nv)
-        self._target_in = self.DeclareVectorInputPort("target", TARGET_PORT_SIZE)
-        self._sigma_index = self.DeclareContinuousState(3)
-        self._lambda_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
-        DeclareSegmentStartEvents(self, schedule, self._on_segment_start)
-        deps = {self.time_ticket(), self.xc_ticket(), self.xd_ticket(),
-                self.all_input_ports_ticket()}
-        size = layout_size(self.layout)
-        # the cache holds the telemetry, then σ̇ (3)
-        self._sigma_dot = slice(size, size + 3)
-        self._eval = DeclareVectorCache(self, "smc", size + 3, self._calc, deps)
-        DeclareControllerOutputs(self, plant, self.layout, self._eval, deps)
 
     def lambda_for(self, tf: float) -> float:
         """λ (1/s) on a segment of duration tf (s)."""
         return self._config.lambda_factor / tf
 
-    def _on_segment_start(self, context, state) -> None:
-        i = segment_index(self._schedule, context.get_time())
-        state.get_mutable_discrete_state(self._lambda_index).SetFromVector(
-            [i, self.lambda_for(self._schedule[i].tf)])
-        if self._config.sigma_policy == "reset":
-            state.get_mutable_continuous_state().get_mutable_vector().SetZero()
+    def _segment_values(self, tf: float) -> list:
+        """[λ] of a segment of duration tf (s)."""
+        return [self.lambda_for(tf)]
 
     def _calc(self, context) -> np.ndarray:
-        qv = self._state_in.Eval(context)
-        target = self._target_in.Eval(context)
-        x, xdot, J = self._kinematics.compute(qv[: self._nq], qv[self._nq:])
-        e, edot = x - target[TARGET.x], xdot - target[TARGET.xdot]
-        lam = context.get_discrete_state(self._lambda_index).value()[1]
-        sigma = context.get_continuous_state_vector().CopyToVector()
-        s = edot + lam * e
-        s_x = s + self._Lambda * sigma
-        tau = smc_torque(self._K_floats, J, s_x, self._config.pinv_damping)
+        r = self.read(context)
+        lam = r.segment[1]
+        s = r.edot + lam * r.e
+        s_x = s + self._Lambda * r.memory
+        tau = smc_torque(self._K_floats, r.J, s_x, self._config.pinv_damping)
         sigma_dot = self._switch(s.tolist())
-        return np.concatenate([x, xdot, e, edot, [lam], s, s_x, sigma, tau, sigma_dot])
-
-    def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.get_mutable_vector().SetFromVector(self._eval(context)[self._sigma_dot])
+        return np.concatenate([r.x, r.xdot, r.e, r.edot, [lam], s, s_x, r.memory, tau, sigma_dot])

@@ -11,6 +11,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
 from ptint_drake import rvm1
+from ptint_drake.systems.baseline_common import TaskSpaceBaseline
 from ptint_drake.systems.builder import ControllerGains
 from ptint_drake.systems.ct_quintic import (
     CtQuinticConfig,
@@ -107,7 +108,8 @@ def test_smc_law_on_fixed_inputs():
 @pytest.mark.parametrize("kind, policy", [("pd", "integral_policy"), ("smc", "sigma_policy")])
 @pytest.mark.parametrize("value", ["keep", "reset"])
 def test_segment_start_events(kind, policy, value):
-    """A second segment re-triggers: new gains / λ in the discrete state, state kept or reset."""
+    """A second segment re-triggers: new gains / λ in the discrete state, state kept or reset
+    (the one handler of ``baseline_common.TaskSpaceBaseline``)."""
     schedule = Schedule([Segment(0.0, 1.5, 0.75), Segment(2.0, 1.0, 0.75)])
     plant = _plant()
     frame = plant.GetFrameByName(rvm1.END_EFFECTOR)
@@ -119,6 +121,7 @@ def test_segment_start_events(kind, policy, value):
         system = FirstOrderSMC(plant=plant, frame=frame, schedule=schedule,
                                config=SMCConfig(**{policy: value}))
         expected = [1, 4.0 / 1.0]
+    assert isinstance(system, TaskSpaceBaseline)
     sim = Simulator(system)
     ctx = sim.get_mutable_context()
     system.GetInputPort("state").FixValue(ctx, np.concatenate([THETA0, np.zeros(3)]))

@@ -11,13 +11,13 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.systems.camera import Camera, MeasurementConfig
 from ptint_drake.systems.kalman import (
-    ActiveTargetSelector,
     AddCameraEstimators,
     TargetKalmanFilter,
     process_covariance,
     transition,
 )
 from ptint_drake.systems.schedule import Schedule, Segment
+from ptint_drake.systems.target_prediction import ActiveTargetSelector
 
 START = np.array([0.3, -0.15, 0.15])
 VELOCITY = np.array([0.05, 0.1, -0.02])
