@@ -49,7 +49,6 @@ def page_options(section: str) -> set:
 
 def test_cli_page_lists_exactly_what_help_prints():
     from ptint_drake.cli import make_parser
-    from ptint_drake.studies.benchmark import _parser as bench_parser
 
     top = make_parser()
     commands = re.search(r"\{([\w,]+)\}", top.format_usage()).group(1).split(",")
@@ -58,7 +57,7 @@ def test_cli_page_lists_exactly_what_help_prints():
     assert page_options(sections[""]) == help_options(top.format_help())
     subparsers = next(a for a in top._actions if a.__class__.__name__ == "_SubParsersAction").choices
     for name in commands:
-        parser = bench_parser() if name == "bench" else subparsers[name]
+        parser = subparsers[name]
         expected = help_options(parser.format_help())
         assert expected, name
         assert page_options(sections[name]) == expected, name

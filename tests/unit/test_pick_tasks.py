@@ -73,7 +73,8 @@ def test_targets_follow_the_simulated_part_then_latch_and_place():
 
 def test_robust_samples_a_pick_scenario_within_its_ranges():
     from ptint_drake.scenario import scenario_text
-    from ptint_drake.studies.robust import RANGES, _pick_summary, sample_scenario
+    from ptint_drake.studies.robust import RANGES, sample_scenario
+    from ptint_drake.worlds.pick.studies import robust_summary
 
     _, text = scenario_text("conveyor_pick_place")
     for seed in range(5):
@@ -85,6 +86,6 @@ def test_robust_samples_a_pick_scenario_within_its_ranges():
         assert 0.08 <= belt.speed <= 0.12 and params["belt_speed"] == [belt.speed]
     rows = [{"picks": [{"placed": True}, {"placed": False}], "reasons": ["pick 1: dropped"]},
             {"error": "boom", "ok": False}]
-    summary = _pick_summary(rows)
+    summary = robust_summary(rows)
     assert summary["pick_success_rate"] == 0.25
     assert summary["failures_by_reason"] == {"dropped": 1, "error: boom": 1}
