@@ -43,7 +43,7 @@ def mm(v, digits: int = 4) -> str:
 
 def results_table() -> str:
     """The paper scenarios: both hold columns and the torque peaks with and without start-up."""
-    from ptint_drake.paper_report import paper_task  # noqa: PLC0415
+    from ptint_drake.report.paper_report import paper_task  # noqa: PLC0415
     from ptint_drake.scenario import load_scenario  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
 

@@ -155,7 +155,7 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
 def test_views_in_workers_equal_views_drawn_here(tmp_path):
     """Figures drawn by forked workers are byte for byte those drawn in this process; the
     default is PNG only, ``svg=True`` adds the SVGs; the replay is written either way."""
-    from ptint_drake.run_outputs import can_fork, write_views
+    from ptint_drake.report.run_outputs import can_fork, write_views
     from ptint_drake.scenario import load_scenario
     from ptint_drake.simulation import simulate
 

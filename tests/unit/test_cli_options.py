@@ -3,7 +3,8 @@ is one line ``ptint: error: FLAG: ...`` with exit 2 before any scenario is read.
 
 import pytest
 
-from ptint_drake import cli, cli_options
+from ptint_drake import cli
+from ptint_drake.cli import options as cli_options
 
 
 def parse(*argv):

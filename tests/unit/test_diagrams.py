@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from ptint_drake.run_outputs import write_diagram
+from ptint_drake.report.run_outputs import write_diagram
 
 ROOT = Path(__file__).resolve().parents[2]
 DIAGRAMS = ROOT / "diagrams"

@@ -5,7 +5,7 @@ four they were and its replay gets no orientation."""
 import numpy as np
 
 from ptint_drake.figures import run_figure
-from ptint_drake.run_outputs import run_metrics, view_tasks
+from ptint_drake.report.run_outputs import run_metrics, view_tasks
 from ptint_drake.scenario import load_scenario
 
 POSITION_FIGURES = ["axes.png", "errors.png", "joints.png", "paths3d.png"]

@@ -7,7 +7,7 @@ import types
 
 import pytest
 
-from ptint_drake import run_outputs
+from ptint_drake.report import run_outputs
 from ptint_drake.scenario import ScenarioError
 
 pytestmark = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(),

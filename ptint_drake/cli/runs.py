@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ptint_drake.cli_options import out_folder, scenario_and_out
+from ptint_drake.cli.options import out_folder, scenario_and_out
 from ptint_drake.worlds.registry import world_of
 from ptint_drake.scenario import LoadedScenario, bundled_scenarios, scenario_text
 
@@ -72,7 +72,7 @@ def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """One scenario: its outputs, a line per segment; exit 1 when a segment missed or the run failed."""
-    from ptint_drake.run_outputs import run_and_write  # noqa: PLC0415
+    from ptint_drake.report.run_outputs import run_and_write  # noqa: PLC0415
 
     loaded, out = scenario_and_out(args)
     scenario = loaded.scenario
@@ -107,7 +107,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_diagram(args: argparse.Namespace) -> int:
     """The scenario's diagram as Graphviz .dot and .svg."""
-    from ptint_drake.run_outputs import write_diagram  # noqa: PLC0415
+    from ptint_drake.report.run_outputs import write_diagram  # noqa: PLC0415
 
     scenario = LoadedScenario.load(args.scenario, args.set).scenario
     out = out_folder(args.out, Path("out") / scenario.name)
@@ -118,7 +118,7 @@ def cmd_diagram(args: argparse.Namespace) -> int:
 
 def cmd_paper(args: argparse.Namespace) -> int:
     """Every paper scenario, the TBG figures and index.html."""
-    from ptint_drake.paper_report import write_paper  # noqa: PLC0415
+    from ptint_drake.report.paper_report import write_paper  # noqa: PLC0415
 
     index = write_paper(out_folder(args.out, Path("out/paper")),
                         progress_factory=None if args.quiet else progress, svg=args.svg)

@@ -1,9 +1,9 @@
 """The commands that run many simulations, on worker processes or Dask: ``ptint sweep``, ``robust``,
 ``compare``, ``tune``, ``study camera`` (and ``--filter-floor``), ``bench``.
 
-Each loads its scenario once (``cli_options.scenario_and_out``) and hands the
+Each loads its scenario once (``options.scenario_and_out``) and hands the
 ``LoadedScenario`` to its study; the workers rebuild it from its text.  Option values arrive
-checked by their argparse types (``cli_options``).
+checked by their argparse types (``cli.options``).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ptint_drake.cli_options import out_folder, scenario_and_out
+from ptint_drake.cli.options import out_folder, scenario_and_out
 from ptint_drake.scenario import ScenarioError
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from ptint_drake.figures import preload, tbg_family_figure
 from ptint_drake.metrics import segment_reasons
 from ptint_drake.outputs import staged_output, write_text_atomic
-from ptint_drake.run_outputs import frozen_heap, run_and_write
+from ptint_drake.report.run_outputs import frozen_heap, run_and_write
 from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
 

@@ -22,9 +22,9 @@ import gc
 import os
 import sys
 
-from ptint_drake import cli_options as opt
-from ptint_drake.cli_runs import cmd_diagram, cmd_list, cmd_paper, cmd_run
-from ptint_drake.cli_studies import cmd_bench, cmd_compare, cmd_robust, cmd_study, cmd_sweep, cmd_tune
+from ptint_drake.cli import options as opt
+from ptint_drake.cli.runs import cmd_diagram, cmd_list, cmd_paper, cmd_run
+from ptint_drake.cli.studies import cmd_bench, cmd_compare, cmd_robust, cmd_study, cmd_sweep, cmd_tune
 from ptint_drake.controllers import CONTROLLERS, describe
 from ptint_drake.scenario import ScenarioError
 
@@ -47,7 +47,7 @@ def _study_arguments(parser, default_out: str, workers_default: str = "CPU count
 
 def make_parser() -> argparse.ArgumentParser:
     """``ptint``'s parser: each subcommand with its options, each option value checked by its
-    type (``cli_options``), ``func`` the command (``cli_runs``, ``cli_studies``)."""
+    type (``cli.options``), ``func`` the command (``cli.runs``, ``cli.studies``)."""
     parser = argparse.ArgumentParser(
         prog="ptint", description=__doc__.split("\n")[0],
         epilog="Paper: Flores-Campos et al., Robotics 2024, 13(10), 145. "
@@ -262,7 +262,7 @@ def _run(argv) -> int:
     """The command of ``argv``; its exit code, with bad input as one line (exit 2)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = make_parser().parse_args(argv)  # the option types check each value (cli_options)
+        args = make_parser().parse_args(argv)  # the option types check each value (cli.options)
         return args.func(args)
     except (ScenarioError, opt.OptionError) as exc:
         print(f"ptint: error: {exc}", file=sys.stderr)
