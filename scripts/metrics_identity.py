@@ -39,6 +39,10 @@ Their presence is still checked (a key missing on one side is a difference); eve
 The exit code of ``ptint run`` and the set of file names written in the output folder are
 compared too.
 
+Cost (a6270f8, 2 busy cores): a fresh worktree's warm-up 3.5-7.5 min, then the 18 scenarios 4-52 s
+each (about 2.5 min per side with 2 jobs); a cached base needs neither.  Three independent runs
+of a6270f8 (two worktrees and a working tree) gave value-identical metrics.json for every scenario.
+
 Output: JSON on stdout (and in ``--out FILE.json``): per scenario ``identical``, the differing
 paths with both values, the files, exit codes and wall times of each side; a ``summary``.  Exit
 code 0 when every scenario is identical, 1 when any differs (or could not run), 2 on a bad
