@@ -56,6 +56,9 @@ class WorldRun:
     controller: object
     simulator_config: object
     plant_time_step: float = 0.0
+    # call ``AdvanceTo`` at a stop the context has reached already (t = 0): a discrete plant then
+    # takes its update at that time before the stop is measured, as the pick world always did
+    advance_at_reached_stops: bool = False
 
     def pre_run_warnings(self) -> list[str]:
         """Checks before the run: raise ``ScenarioError``, or return warnings."""

@@ -45,7 +45,7 @@ def _advance(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: 
     failure, wall = None, 0.0
     simulator.Initialize()
     for t_stop in run.stops():
-        if t_stop > context.get_time():
+        if t_stop > context.get_time() or run.advance_at_reached_stops:
             t0 = time.perf_counter()
             try:
                 simulator.AdvanceTo(t_stop)

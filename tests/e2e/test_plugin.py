@@ -112,22 +112,19 @@ def test_compare_runs_the_plugin_beside_ptsmc_named_by_its_type_string(user_fold
 ])
 def test_a_broken_plugin_is_one_line_exit_2_and_writes_nothing(user_folder, type_, message, ptint_here,
                                                               monkeypatch):
-    """``run`` and ``compare`` in this process, its module search reset as in a fresh one (the
-    tests above run the plugin's commands as real ones)."""
+    """``run`` and ``compare`` in this process (the tests above run the plugin's commands as real
+    ones); the module search is the loaded scenario's folder and the current directory, so no
+    state of this process carries over between the two."""
     import re  # noqa: PLC0415
-
-    from ptint_drake.controllers import plugin  # noqa: PLC0415
 
     (user_folder / "bad.yaml").write_text(SCENARIO % type_)
     out = user_folder / "out_bad"
-    monkeypatch.setattr(plugin, "_folders", [])  # this process's module search, as a fresh one
     monkeypatch.chdir(user_folder)
     done = ptint_here("run", "bad.yaml", "--out", str(out))
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and re.search(message, lines[0]), done.stderr
     assert not out.exists()
-    monkeypatch.setattr(plugin, "_folders", [])
     compare = ptint_here("compare", "curve_b075_tf15", "--controllers", f"ptsmc,{type_}", "--out", str(out))
     assert compare.returncode == 2 and len(compare.stderr.strip().splitlines()) == 1, compare.stderr
 

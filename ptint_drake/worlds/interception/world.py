@@ -214,7 +214,7 @@ class InterceptionWorld(World):
 
     def floor_diagram(self, scenario: Scenario, kind: str):
         if kind == "controller":
-            return build(scenario, log=False)
+            return InterceptionRun(scenario, log=False)
         return floor_diagram(scenario, kind, interception_schedule(scenario))
 
 

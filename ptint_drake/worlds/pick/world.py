@@ -32,6 +32,8 @@ from ptint_drake.worlds.pick.tasks import check_tasks, pick_plan
 class PickRun(WorldRun):
     """A pick scenario's diagram driven by the runner (``worlds.base.WorldRun``)."""
 
+    advance_at_reached_stops = True  # the discrete plant's update at t = 0 before the first aims
+
     def __init__(self, scenario: Scenario):
         check_pick_plant(scenario)
         self.scenario = scenario
