@@ -316,6 +316,3 @@ def console() -> int:
     gc.freeze()
     return code
 
-
-if __name__ == "__main__":
-    sys.exit(console())
