@@ -89,7 +89,7 @@ def _orientation_reasons(seg: dict, criteria: Criteria, margin: float, early: bo
 @dataclass(frozen=True)
 class Reason:
     """Why a run did not pass, as data: segment ``segment`` failed the criterion ``code``
-    (``late``, ``early``, ``hold``), or — ``segment`` None — the run ended without a verdict
+    (``late``, ``early``, ``hold``, ``orientation``), or — ``segment`` None — the run ended without a verdict
     (``code`` ``failed``: the divergence watchdog; ``error``: it could not run) for the
     reason ``message``.  ``str()`` is the printed form (metrics.json's ``reasons``)."""
 
