@@ -70,13 +70,14 @@ def results_table() -> str:
         "RTF (end-to-end realtime factor) depends on the machine.\n"
 
 
-def compare_table(name: str, workers: int, controllers=None) -> str:
+def compare_table(name: str, workers: int, controllers=None, folders: tuple = ()) -> str:
     """The compare study of ``name`` condensed: e(tf), t_arrive and the verdict per variant
-    (``controllers``: the registry's by default)."""
-    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+    (``controllers``: the registry's by default; ``folders``: where a plugin's module is)."""
+    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
     from ptint_drake.studies.compare import DEFAULT_CONTROLLERS, run_compare, table_rows  # noqa: PLC0415
 
-    result = run_compare(LoadedScenario.load(name), controllers or DEFAULT_CONTROLLERS, workers=workers)
+    loaded = LoadedScenario.parse(scenario_text(name)[1], name, (), folders)
+    result = run_compare(loaded, controllers or DEFAULT_CONTROLLERS, workers=workers)
     variants = result["variants"]
     header = " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants)
     lines = ["| controller | seg | " + header + " |",
@@ -155,11 +156,8 @@ def main() -> None:
     text = replace(text, "results", results_table())
     for name in ("curve_b075_tf15", "assembly"):
         text = replace(text, f"compare_{name}", compare_table(name, args.workers))
-    from ptint_drake.controllers import plugin  # noqa: PLC0415
-
-    plugin.remember_folder(ROOT / "examples")  # docs/own_controller.md's plugin example
-    text = replace(text, "compare_plugin", compare_table(
-        "curve_b075_tf15", args.workers, ["ptsmc", "task_space_pd:TaskSpacePD"]))
+    text = replace(text, "compare_plugin", compare_table(  # docs/own_controller.md's plugin example
+        "curve_b075_tf15", args.workers, ["ptsmc", "task_space_pd:TaskSpacePD"], (str(ROOT / "examples"),)))
     if args.all:
         text = replace(text, "tune", tune_table(args.workers))
         text = replace(text, "camera", camera_table(args.workers))
