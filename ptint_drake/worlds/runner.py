@@ -20,6 +20,7 @@ from typing import Callable, Optional
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from ptint_drake.config.schema import Scenario
+from ptint_drake.systems.jit_notice import compile_notice
 from ptint_drake.worlds.base import Progress, RunResult, WorldRun
 from ptint_drake.worlds.registry import world_of
 
@@ -74,12 +75,15 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
     """Run a scenario in its world; returns its metrics (with the verdict) and logged series.
 
     ``progress(t, duration, steps)`` is called while it runs; ``warn(message)`` for each warning
-    known before the simulation starts, as soon as it is known.  A run stopped by the watchdog or
-    an integrator failure returns normally with ``status == "failed"``.
+    known before the simulation starts, as soon as it is known; with ``progress``, one line on
+    stderr while numba compiles the controller's equations (an empty JIT cache,
+    ``systems.jit_notice``).  A run stopped by the watchdog or an integrator failure returns
+    normally with ``status == "failed"``.
     """
     world = world_of(scenario)
-    run = world.prepare(scenario)
-    warnings = run.pre_run_warnings() if check else []
+    with compile_notice(enabled=progress is not None):  # the kernels load (or compile) here
+        run = world.prepare(scenario)
+        warnings = run.pre_run_warnings() if check else []
     for message in warnings if warn is not None else ():
         warn(message)
     n_before = len(warnings)
