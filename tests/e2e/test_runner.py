@@ -247,20 +247,21 @@ def test_why_workers_are_recycled_a_simulation_is_never_freed(monkeypatch):
     from ptint_drake import simulation
     from ptint_drake.systems.orientation import ObjectRotations
     from ptint_drake.systems.targets import TargetSource
+    from ptint_drake.worlds import runner
+    from ptint_drake.worlds.registry import objects_of, schedule_of
 
     diagrams = []
-    build = simulation.build
+    make = runner.make_simulator
 
-    def build_and_watch(*args, **kwargs):
-        built = build(*args, **kwargs)
-        diagrams.append(weakref.ref(built.diagram))
-        return built
+    def make_and_watch(run):
+        diagrams.append(weakref.ref(run.diagram))
+        return make(run)
 
-    monkeypatch.setattr(simulation, "build", build_and_watch)
+    monkeypatch.setattr(runner, "make_simulator", make_and_watch)
     scenario = parse_with_overrides(TEXT, (), NAME)
     assert simulation.simulate(scenario).ok
-    source = weakref.ref(TargetSource(scenario.schedule(), scenario.targets()))
-    rotations = weakref.ref(ObjectRotations(scenario.targets()))
+    source = weakref.ref(TargetSource(schedule_of(scenario), objects_of(scenario)))
+    rotations = weakref.ref(ObjectRotations(objects_of(scenario)))
     gc.collect()
     assert len(diagrams) == 1 and diagrams[0]() is not None  # the run's diagram, plant and all
     assert source() is not None  # a leaf with a cache entry, alone
