@@ -8,7 +8,10 @@ exercise the kernels with the very types a ``ptint run`` passes: the fused posit
 curve, a line and a thrown object, a target from a filter, the pose task (``pose_row``) and the
 five blocks, the IMM of ``estimator: auto`` (``imm_kernels.imm_cycle``, ``initial_state``, in the
 camera runs); then the orientation equations as the blocks and the metrics call them, and the
-IMM's kernels once more directly (a cycle with a sample and one without).
+IMM's kernels once more directly (a cycle with a sample and one without).  The fused kernels'
+general versions too (``InterceptorLaw.load_general_kernels``), which a run calls only where the
+lean ones cannot solve (a singular J: ``controller.pinv_solve_into``); without the warm-up such a
+run compiles them when it first needs them (``jit_notice``).
 """
 
 from __future__ import annotations
@@ -48,6 +51,8 @@ def warm_up(duration: float = 0.05) -> float:
         simulator.AdvanceTo(duration)
         law = getattr(built.controller.system, "law", None)
         system = built.controller.system
+        if law is not None:
+            law.load_general_kernels()
         if law is not None and not system.has_target_input and not system.has_rotation_input:
             context = law.GetMyContextFromRoot(simulator.get_context())
             qv, sigma, captured, _ = law.loop_values(context)

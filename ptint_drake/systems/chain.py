@@ -49,21 +49,22 @@ def axis_rotation(a, angle, out):
 
 
 @njit(cache=True)
-def chain_kinematics(q, kinds, q_index, v_index, fixed, axes, nv):
+def chain_kinematics(q, joints, geometry, nv):
     """(x, R, J_v, J_ω) of the chain's end frame at the plant's positions q: its origin in the
     world (3), orientation (3 × 3) and translational / rotational Jacobians (3 × nv).
 
-    ``fixed`` (n + 1, 4, 3): X_0 … X_n as [R; pᵀ]; ``axes`` (n, 3): each joint's unit axis in
-    its frame F; ``kinds``: ``REVOLUTE`` or ``PRISMATIC``; ``q_index``, ``v_index``: each joint's
-    position and velocity in the plant's q and v (``chain_kinematics_into`` in new arrays)."""
-    n = len(kinds)
+    ``joints`` (3 × n, floats): each joint's kind (``REVOLUTE`` or ``PRISMATIC``), position in
+    the plant's q and velocity in its v; ``geometry`` (n + 1, 5, 3): X_0 … X_n as [R; pᵀ] with
+    row 4 the next joint's unit axis in its frame F (``KinematicChain``; ``chain_kinematics_into``
+    in new arrays, called with the argument types the fused kernel passes: one compiled version)."""
+    n = joints.shape[1]
     x, R, J_v, J_w = np.empty(3), np.empty((3, 3)), np.empty((3, nv)), np.empty((3, nv))
-    chain_kinematics_into(q, kinds, q_index, v_index, fixed, axes, x, R, J_v, J_w,
-                          np.empty((2 * n + 5, 3)))
+    chain_kinematics_into(q, joints[0], joints[1], joints[2], geometry[:, :4], geometry[:-1, 4], x, R, J_v,
+                          J_w, np.empty((2 * n + 5, 3)))
     return x, R, J_v, J_w
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def chain_kinematics_into(q, kinds, q_index, v_index, fixed, axes, x, R, J_v, J_w, work) -> None:
     """x (3), R (3 × 3), J_v, J_ω (3 × nv) ← ``chain_kinematics`` without allocating: ``work``
     is a scratch block of ≥ 2n + 5 rows of 3 (n joints).  ``kinds``, ``q_index`` and ``v_index``
@@ -112,7 +113,9 @@ def _pose(X) -> np.ndarray:
 
 
 class KinematicChain:
-    """The joints from the world to one frame, as arrays for ``chain_kinematics``."""
+    """The joints from the world to one frame, as arrays for ``chain_kinematics``: ``joints``
+    [kinds; q index; v index] (3 × n, whole numbers as floats) and ``geometry``, the fixed
+    transforms X_0 … X_n as [R; pᵀ] with row 4 = the next joint's axis ((n + 1) × 5 × 3)."""
 
     def __init__(self, kinds, q_index, v_index, fixed, axes, nv: int):
         self.kinds = np.asarray(kinds, dtype=np.int64)
@@ -121,6 +124,10 @@ class KinematicChain:
         self.fixed = np.ascontiguousarray(fixed, dtype=float)
         self.axes = np.ascontiguousarray(axes, dtype=float).reshape(-1, 3)
         self.nv = int(nv)
+        self.joints = np.array([self.kinds, self.q_index, self.v_index], dtype=float).reshape(3, -1)
+        self.geometry = np.zeros((len(self.fixed), 5, 3))
+        self.geometry[:, :4] = self.fixed
+        self.geometry[:-1, 4] = self.axes
 
     @classmethod
     def of(cls, plant, frame) -> Optional["KinematicChain"]:
@@ -162,6 +169,5 @@ class KinematicChain:
 
     def evaluate(self, q) -> tuple:
         """(x, R, J_v, J_ω) at the plant's positions q (``chain_kinematics``)."""
-        return chain_kinematics(np.asarray(q, dtype=float), self.kinds, self.q_index, self.v_index,
-                                self.fixed, self.axes, self.nv)
+        return chain_kinematics(np.asarray(q, dtype=float), self.joints, self.geometry, self.nv)
 

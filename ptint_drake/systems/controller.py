@@ -14,12 +14,14 @@ from pydrake.systems.framework import LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.task import TASK_DIM
+from ptint_drake.systems.views import borrow
 
 
 @njit(cache=True, inline="always")
-def _solve3(A, b, out) -> None:
+def _solve3(A, b, out, general=None) -> bool:
     """``out`` ← A⁻¹ b for a 3 × 3 A by Cramer's rule; the least-squares solution when A is
-    numerically singular."""
+    numerically singular (``general`` given, else False and ``out`` not written: see
+    ``pinv_solve_into``)."""
     a, b_, c = A[0, 0], A[0, 1], A[0, 2]
     d, e, f = A[1, 0], A[1, 1], A[1, 2]
     g, h, i = A[2, 0], A[2, 1], A[2, 2]
@@ -32,12 +34,15 @@ def _solve3(A, b, out) -> None:
     if scale == 0.0:
         scale = 1.0
     if abs(det) <= 1e-12 * scale**3:
+        if general is None:
+            return False
         out[:] = np.linalg.lstsq(A, b.copy())[0]
-        return
+        return True
     x, y, z = b[0], b[1], b[2]
     out[0] = (co0 * x + (c * h - b_ * i) * y + (b_ * f - c * e) * z) / det
     out[1] = (co1 * x + (a * i - c * g) * y + (c * d - a * f) * z) / det
     out[2] = (co2 * x + (b_ * g - a * h) * y + (a * e - b_ * d) * z) / det
+    return True
 
 
 @njit(cache=True)
@@ -147,24 +152,73 @@ def pinv_solve(J, b, damping: float):
     (``pinv_solve_into`` in a new array.)"""
     n, nv = J.shape
     out = np.empty(nv)
-    pinv_solve_into(J, b, damping, out, np.empty(pinv_work_size(n, nv)))
+    pinv_solve_into(J, b, damping, out, np.empty(pinv_work_size(n, nv)), True)
     return out
 
 
-@njit(cache=True, inline="always")
-def pinv_solve_into(J, b, damping: float, out, work) -> None:
+@njit(cache=True)
+def pinv_solve_into(J, b, damping: float, out, work, general=None) -> bool:
     """``out`` (nv) ← ``pinv_solve(J, b, damping)``; ``work``: a scratch vector of
     ``pinv_work_size(n, nv)`` (J Jᵀ and its solve then take no new memory for up to 8 joints,
     nor does a square 3 × 3 J, nor the 6-row undamped solve of a full-rank J:
-    ``_householder_solve``; a rank-deficient one goes to numpy's ``lstsq``)."""
-    n, nv = J.shape
-    if damping <= 0.0 and n != 3:
-        if pinv_work_size(n, nv) > len(work) or not _householder_solve(J, b, out, work):
-            out[:] = np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
-        return
+    ``_householder_solve``; a rank-deficient one goes to numpy's ``lstsq``).  3 rows:
+    ``pinv3_solve_into``; more: ``_pinv_rows_solve_into``.
+
+    Without ``general`` (None) the kernel leaves out numpy's ``lstsq``, ``solve`` and products
+    (half of a cold compile, for cases a run rarely meets): it returns False, ``out`` not
+    written, where it would need them (a numerically singular J, more than 8 joints, a damped
+    6-row solve); called again with ``general=True`` it gives the very same bits as it always
+    did.  True when ``out`` holds the solution."""
+    if J.shape[0] == 3:
+        return pinv3_solve_into(J, b, damping, out, work, general)
+    return _pinv_rows_solve_into(J, b, damping, out, work, general)
+
+
+@njit(cache=True, inline="always")
+def pinv3_solve_into(J, b, damping: float, out, work, general=None) -> bool:
+    """``pinv_solve_into`` for 3 rows (the position task, whose fused kernel calls this one, so
+    that its compilation leaves out the 6-row solves): Cramer's rule for a square undamped J,
+    else Jᵀ (J Jᵀ + λ²I)⁻¹ b with the 3 × 3 solve by Cramer's rule too."""
+    nv = J.shape[1]
     if damping <= 0.0 and nv == 3:
-        _solve3(J, b, out)
-        return
+        return _solve3(J, b, out, general)
+    if nv > 8:
+        if general is None:
+            return False
+        return _dense_pinv_into(J, b, damping, out, work)
+    A = borrow(work, 0, (3, 3))
+    _gram(J, A)
+    for i in range(3):
+        A[i, i] += damping * damping
+    y = work[9:12]
+    if not _solve3(A, b, y, general):
+        return False
+    _transpose_times(J, y, out)
+    return True
+
+
+@njit(cache=True)
+def _pinv_rows_solve_into(J, b, damping: float, out, work, general=None) -> bool:
+    """``pinv_solve_into`` for 6 rows: undamped, the Householder QR (``_householder_solve``) or
+    for a rank-deficient J numpy's ``lstsq``; damped, ``_dense_pinv_into``."""
+    n, nv = J.shape
+    if damping <= 0.0:
+        if pinv_work_size(n, nv) <= len(work) and _householder_solve(J, b, out, work):
+            return True
+        if general is None:
+            return False
+        out[:] = np.linalg.lstsq(np.ascontiguousarray(J), b.copy())[0]
+        return True
+    if general is None:
+        return False
+    return _dense_pinv_into(J, b, damping, out, work)
+
+
+@njit(cache=True)
+def _dense_pinv_into(J, b, damping: float, out, work) -> bool:
+    """``pinv_solve_into``'s damped (or minimum-norm) solve of more than 8 joints or 6 rows:
+    Jᵀ (J Jᵀ + λ²I)⁻¹ b with numpy's products and ``solve``."""
+    n, nv = J.shape
     if nv > 8:
         A = J @ J.T
     else:
@@ -174,13 +228,14 @@ def pinv_solve_into(J, b, damping: float, out, work) -> None:
         A[i, i] += damping * damping
     y = work[n * n:n * n + n]
     if n == 3:
-        _solve3(A, b, y)
+        _solve3(A, b, y, True)
     else:
         y[:] = np.linalg.solve(A, b.copy())
     if nv > 8:
         out[:] = J.T @ y
     else:
         _transpose_times(J, y, out)
+    return True
 
 
 @njit(cache=True, inline="always")
@@ -212,15 +267,24 @@ def sliding_mode_torque(K, J, s_x, damping: float):
     array)."""
     n, nv = J.shape
     tau = np.empty(nv)
-    sliding_mode_torque_into(K, J, s_x, damping, tau, np.empty(pinv_work_size(n, nv)))
+    sliding_mode_torque_into(K, J, s_x, damping, tau, np.empty(pinv_work_size(n, nv)), True)
     return tau
 
 
-@njit(cache=True, inline="always")
-def sliding_mode_torque_into(K, J, s_x, damping: float, tau, work) -> None:
+@njit(cache=True)
+def sliding_mode_torque_into(K, J, s_x, damping: float, tau, work, general=None) -> bool:
     """``tau`` (nv) ← τ = −K J⁺ s_x (eq. 18) without new memory for up to 8 joints
-    (``pinv_solve_into``; ``work`` ≥ n² + n)."""
-    pinv_solve_into(J, s_x, damping, tau, work)
+    (``pinv_solve_into``, then ``gain_torque``; ``work`` ≥ n² + n); False (``tau`` not written)
+    where the solve needs ``general`` (``pinv_solve_into``)."""
+    if not pinv_solve_into(J, s_x, damping, tau, work, general):
+        return False
+    gain_torque(K, tau)
+    return True
+
+
+@njit(cache=True, inline="always")
+def gain_torque(K, tau) -> None:
+    """``tau`` ← −K ⊙ ``tau``: eq. 18's gain on J⁺ s_x."""
     for k in range(len(tau)):
         tau[k] = -K[k] * tau[k]
 

@@ -40,6 +40,7 @@ from ptint_drake.systems.gains import ControllerGains
 from ptint_drake.systems.interceptor_row import (pack_chain, pack_gains, pack_pose, pack_position,
                                                  pose_output, pose_row, pose_rows, position_output,
                                                  position_rows, task_row)
+from ptint_drake.systems.jit_notice import compile_notice
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.orientation import ROTATION_WIDTH, active_rotation_values, compiled_rotations
 from ptint_drake.systems.schedule import DeclareSegmentStartEvents, Schedule
@@ -131,6 +132,7 @@ class InterceptorLaw(LeafSystem):
             self._kernel, self._rows_kernel = pose_output, pose_rows
         # the compiled path end to end: the output's kernel, and ``rows`` in one call
         self._batch = self._kernel is not None and self._null_space is None and not self._python_targets
+        self._general = (n != 3 and gains.pinv_damping > 0.0) or nv > 8  # general kernels only (``_call``)
         self.DeclareVectorOutputPort("tau_sigma_dot", nv + n, self._calc_packed_output if self._batch
                                      else self._calc_output, prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("telemetry", size,
@@ -138,23 +140,32 @@ class InterceptorLaw(LeafSystem):
                                      prerequisites_of_calc=deps)
         self._load_kernels()
 
-    def _load_kernels(self) -> None:
+    def _load_kernels(self, path: str = "lean") -> None:
         """Evaluate the law once, now, on zero inputs (the outputs' own path: ``row`` passes
         the kernels the argument types a simulation does, the ``loop`` input's array marked
         read-only when the bindings hand it out so, as Drake 1.51's do): numba loads the machine
         code from its cache (50-150 ms) while the diagram is built, not at a run's first
         derivative evaluation, and one compiled version serves the simulation and ``row``
         (tests/unit/test_kernel_load.py); ``rows``' batch kernel is loaded here too.  The TBG
-        and target kept for t = 0 are those of t = 0."""
+        and target kept for t = 0 are those of t = 0.  ``path``: the kernels' ``"lean"`` versions
+        (what a run calls), or their ``"general"`` ones (``_call``)."""
         context = self.CreateDefaultContext()
         loop = np.zeros(self._loop_in.size())
         if self._rotation_input:
             loop[self._parts[4]] = IDENTITY_ROTATION
         self._loop_in.FixValue(context, loop)
         self._loop_writeable = bool(self._loop_in.EvalBasicVector(context).value().flags.writeable)
-        self._eval(context)
+        self.row(*self.row_arguments(context), path=path)  # zero inputs: often a singular J
         if self._batch:  # the telemetry's kernel (``rows``)
-            self.rows(np.zeros(1), *(None if p is None else p[None] for p in self.row_arguments(context)[1:]))
+            self.rows(np.zeros(1), *(None if p is None else p[None] for p in self.row_arguments(context)[1:]),
+                      path=path)
+
+    def load_general_kernels(self) -> None:
+        """Load (or compile) the general versions of the law's kernels, those a run falls back to
+        where the lean ones cannot solve (``controller.pinv_solve_into``; ``warm_up`` compiles
+        them at install)."""
+        if self._kernel is not None:
+            self._load_kernels("general")
 
     @property
     def num_tasks(self) -> int:
@@ -196,8 +207,13 @@ class InterceptorLaw(LeafSystem):
         orientation; no null-space term): the ``loop`` input as it is into the kernel that
         ``row`` calls too, which writes [τ; σ̇] into the output's own memory (and the row into a
         reused buffer)."""
-        self._kernel(context.get_time(), self._loop_in.EvalBasicVector(context).value(), self._static,
-                     self._row, output.get_mutable_value())
+        t, out = context.get_time(), output.get_mutable_value()
+        u = self._loop_in.EvalBasicVector(context).value()
+        if self._general:
+            self._kernel(t, u, self._static, self._row, out, True)
+        elif not self._kernel(t, u, self._static, self._row, out):  # (``_call``)
+            with compile_notice():
+                self._kernel(t, u, self._static, self._row, out, True)
 
     def _capture(self, context, state) -> None:
         """Store [index, s(t0), σ0] at a segment start (σ0: σ then, with ``sigma_policy`` reset)."""
@@ -210,11 +226,13 @@ class InterceptorLaw(LeafSystem):
             np.concatenate([[index], row[self.layout["s"]], sigma]))
 
     def row(self, t: float, qv: np.ndarray, sigma: np.ndarray, captured: np.ndarray,
-            target: Optional[np.ndarray], rotation: Optional[np.ndarray] = None) -> np.ndarray:
+            target: Optional[np.ndarray], rotation: Optional[np.ndarray] = None, *,
+            path: str = "auto") -> np.ndarray:
         """The row (telemetry, active segment [index, t0, tf, β, phase], σ̇) from the time, the
         plant state [q; v], the integrator's σ, [index, s(t0), σ0] and the ``target`` (and
         ``target_rotation``) inputs' values (None: the system's own targets).  The compiled
-        position path is the simulation's own kernel (``position_output``) on the same values."""
+        position path is the simulation's own kernel (``position_output``) on the same values.
+        ``path``: which versions of the compiled kernels (``_call``)."""
         n = self._n
         if target is None:
             target = np.array(active_target_values(self._schedule, self._targets, t)[TARGET_PORT]) \
@@ -224,7 +242,7 @@ class InterceptorLaw(LeafSystem):
             parts = [qv, sigma, captured, target] + ([] if rotation is None else [rotation])
             u = np.concatenate(parts)
             u.flags.writeable = self._loop_writeable  # the simulation's argument types (one kernel)
-            self._kernel(float(t), u, self._static, row, np.empty(self._nv + n))
+            self._call(self._kernel, float(t), u, self._static, row, np.empty(self._nv + n), path=path)
         else:
             if self._law.reset_sigma:
                 sigma = sigma - captured[1 + n:]
@@ -236,7 +254,8 @@ class InterceptorLaw(LeafSystem):
         return row
 
     def rows(self, t: np.ndarray, qv: np.ndarray, sigma: np.ndarray, captured: np.ndarray,
-             target: Optional[np.ndarray] = None, rotation: Optional[np.ndarray] = None) -> np.ndarray:
+             target: Optional[np.ndarray] = None, rotation: Optional[np.ndarray] = None, *,
+             path: str = "auto") -> np.ndarray:
         """``row`` at each of k logged samples (arrays with k rows; ``target`` / ``rotation``
         None without those inputs): the compiled path in one call (``position_rows`` or
         ``pose_rows``, the same kernel on the same values), else ``row`` per sample."""
@@ -245,13 +264,25 @@ class InterceptorLaw(LeafSystem):
             parts = [qv, sigma, captured] + [p for p in (target, rotation) if p is not None]
             U = np.ascontiguousarray(np.hstack(parts), dtype=float)
             out = np.empty((k, self._size + 5 + self._n))
-            self._rows_kernel(np.ascontiguousarray(t, dtype=float), U, self._static, out,
-                              np.empty(self._nv + self._n))
+            self._call(self._rows_kernel, np.ascontiguousarray(t, dtype=float), U, self._static, out,
+                       np.empty(self._nv + self._n), path=path)
             return out
         targets = [None] * k if target is None else target
         rotations = [None] * k if rotation is None else rotation
         return np.array([self.row(*values) for values in zip(
             np.asarray(t, dtype=float).tolist(), qv, sigma, captured, targets, rotations)])
+
+    def _call(self, kernel, *args, path: str = "auto") -> None:
+        """``kernel(*args)``, a compiled path (``interceptor_row``): ``path`` ``"auto"`` its lean
+        version, then, where that cannot solve (it returns False), its general one (the very bits
+        the general one alone gives: ``controller.pinv_solve_into``; compiled at its first use,
+        with ``jit_notice``); ``"lean"`` the lean one alone (the row's τ and σ̇ may stay unwritten),
+        ``"general"`` the general one alone (always, for a law that needs it at every call)."""
+        if self._general or path == "general":
+            kernel(*args, True)
+        elif not kernel(*args) and path == "auto":
+            with compile_notice():
+                kernel(*args, True)
 
     @cached_property
     def _rotations(self):

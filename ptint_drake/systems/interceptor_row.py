@@ -3,8 +3,9 @@
 ``position_row`` chains the equation kernels for the position task end to end: the compiled
 kinematic chain (``chain.chain_kinematics_into``, eq. 5), the target (``targets.target_row``, or a
 given one), e = x − x_r (eq. 11), the TBG and α (``tbg.tbg_row``, paper eqs. 6-10, 13), the
-surface (``sliding_surface.surface_law``, eqs. 16-17) and the torque
-(``controller.sliding_mode_torque_into``, eq. 18); ``task_row_into`` the same for any task from
+surface (``sliding_surface.surface_law``, eqs. 16-17) and the torque (eq. 18:
+``controller.pinv3_solve_into`` and ``gain_torque``, ``sliding_mode_torque_into``'s two steps
+for 3 rows); ``task_row_into`` the same for any task from
 the frame's kinematics (with orientation, the target's rotation from ``orientation.rotation_row``
 or a given one, and the error ``task.task_error_of``), ``pose_output`` with the chain.  The
 blocks call the same kernels one by one, so there is one implementation of each equation.
@@ -18,25 +19,33 @@ index, s(t0), σ0; x_r, ẋ_r, ẍ_r], so an evaluation passes five arguments (`
 likewise, ``pack_pose``, with [R_r, ω_r, ω̇_r] last); the same array holds the memo of the last
 call and a scratch block for every intermediate (``chain.chain_kinematics_into``,
 ``controller.sliding_mode_torque_into``), so the simulation's evaluation allocates no memory;
-its views are borrowed (``borrow``: no atomic reference counts), and the equation kernels are
-inlined into it (numba ``inline="always"``: a call between compiled functions passes each array
-as 7-11 words). Every kernel keeps its order of operations, so the bits are those of the blocks
-(tests/unit/test_kernel_identity.py).
+its views are borrowed (``views.borrow``: no atomic reference counts).
+
+numba inlines (``inline="always"``) by typing the callee's code again at every site, so the
+row inlines only what it alone calls in a run (``position_row`` into ``position_output``, the
+TBG, target, surface and 3-row solve), and calls the kernels shared with another entry point
+(the chain, also ``chain.chain_kinematics``; ``task_row_into``, the TBG's ξ), which are then
+compiled once; and the kernels a run calls leave numpy's solvers out (``general`` None: they
+return False where the torque's solve would need them, and the caller calls them again with
+``general=True``, ``InterceptorLaw._call``).  A cold compilation of ``position_output`` took
+≈ 40 s of CPU, ≈ 10 s now, for the same speed (docs/speed.md).  Every kernel keeps its order of
+operations, so the bits are those of the blocks (tests/unit/test_kernel_identity.py).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import carray, njit, types
-from numba.extending import intrinsic
+from numba import njit
 
 from ptint_drake.systems.chain import chain_kinematics, chain_kinematics_into
-from ptint_drake.systems.controller import pinv_work_size, sliding_mode_torque_into
+from ptint_drake.systems.controller import gain_torque, pinv3_solve_into, pinv_work_size, \
+    sliding_mode_torque_into
 from ptint_drake.systems.orientation import ROTATION_WIDTH, rotation_row
 from ptint_drake.systems.sliding_surface import SWITCHING_LAWS, surface_law
 from ptint_drake.systems.targets import target_row
 from ptint_drake.systems.task import POSITION, task_error_of, task_jacobian_of
 from ptint_drake.systems.tbg import tbg_row
+from ptint_drake.systems.views import borrow, copy_into
 
 GAINS_HEAD = 8  # ϵ, δ, α_hold, k, k_hold, law, φ, λ; then Λ (n) and K (nv)
 
@@ -50,47 +59,23 @@ def pack_gains(gains, n: int, K: np.ndarray) -> np.ndarray:
 
 
 def pack_chain(chain) -> tuple:
-    """(joints, geometry) of a ``KinematicChain``: [kinds; q index; v index] (3 × n) and the
+    """(joints, geometry) of a ``KinematicChain``: [kinds; q index; v index] (3 × n, floats) and the
     fixed transforms X_0 … X_n as [R; pᵀ] with row 4 = the next joint's axis ((n + 1) × 5 × 3)."""
-    joints = np.array([chain.kinds, chain.q_index, chain.v_index], dtype=np.int64).reshape(3, -1)
-    geometry = np.zeros((len(chain.fixed), 5, 3))
-    geometry[:, :4] = chain.fixed
-    geometry[:-1, 4] = chain.axes
-    return joints, geometry
-
-
-@intrinsic
-def _address(typingctx, a, start):
-    """The address of a[start] (a 1-D array) as a typed pointer."""
-    def codegen(context, builder, signature, args):
-        data = context.make_array(signature.args[0])(context, builder, args[0]).data
-        return builder.gep(data, [args[1]])
-    return types.CPointer(a.dtype)(a, types.intp), codegen
-
-
-@njit(cache=True, inline="always")
-def borrow(a, start, shape):
-    """a[start:start + size] (a 1-D array) as a C-ordered array of ``shape`` that does not count
-    references: its views cost no atomic reference counting (about a third of an evaluation
-    otherwise) and no reshape.  Valid while ``a`` is; only for views that do not outlive the call."""
-    size = 1
-    for d in shape:
-        size *= d
-    if start < 0 or start + size > len(a):
-        raise IndexError("borrow: outside the array")
-    return carray(_address(a, start), shape)
+    return chain.joints, chain.geometry
 
 
 @njit(cache=True, inline="always")
 def position_row(t, qv, sigma, captured, target, segments, gains, joints, geometry, targets, memo, work,
-                 out):
+                 out, general=None) -> bool:
     """``out`` ← the fused interceptor's row for the position task (``interceptor.telemetry_layout``
     then [index, t0, tf, β, phase] then σ̇): x, ẋ, x_r, ẋ_r, ẍ_r, ξ…ξ⃛, α, s_x, e, ė, s, s_d,
     σ, τ.  ``target``: [x_r, ẋ_r, ẍ_r] (9), or empty to evaluate ``targets`` (one compiled row
     per segment, ``targets.compiled_targets``) at t.  ``memo`` = [t, TBG row (10), target (12)]
     of the last call: the TBG and the compiled target are functions of t alone, and one
     evaluation in three (an RK3 step's first stage) comes at the previous one's time.  ``work``:
-    scratch (``work_size``) for every intermediate, so that a call allocates nothing."""
+    scratch (``work_size``) for every intermediate, so that a call allocates nothing.  False (the
+    torque and σ̇ not written) where the torque's solve needs ``general``
+    (``controller.pinv_solve_into``)."""
     nv, n_joints = len(gains) - GAINS_HEAD - 3, joints.shape[1]
     nq = len(qv) - nv
     x, R, xdot, e, edot = work[0:3], borrow(work, 3, (3, 3)), work[12:15], work[15:18], work[18:21]
@@ -111,16 +96,24 @@ def position_row(t, qv, sigma, captured, target, segments, gains, joints, geomet
             target_row(targets[i], t, ref)
         memo[0] = t
     if len(target) != 0:
-        ref[:9] = target[:9]
+        copy_into(ref, 0, target[:9])
     for i in range(3):
         e[i], edot[i] = x[i] - ref[i], xdot[i] - ref[3 + i]
     surface_law(t, e, edot, tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + 3],
                 gains[3], gains[4], int(gains[5]), gains[6], surface)
-    tau = out[38:38 + nv]
-    sliding_mode_torque_into(gains[GAINS_HEAD + 3:], J_v, surface[:3], gains[7], tau, solve)
-    out[0:3], out[3:6], out[6:15], out[15:20] = x, xdot, ref[:9], tbg[:5]
-    out[20:35], out[35:38] = surface[:15], sigma
-    out[38 + nv:43 + nv], out[43 + nv:46 + nv] = tbg[5:10], surface[15:18]
+    tau = out[38:38 + nv]  # τ = −K J⁺ s_x (``controller.sliding_mode_torque_into``, 3 rows)
+    if not pinv3_solve_into(J_v, surface[:3], gains[7], tau, solve, general):
+        return False
+    gain_torque(gains[GAINS_HEAD + 3:], tau)
+    copy_into(out, 0, x)
+    copy_into(out, 3, xdot)
+    copy_into(out, 6, ref[:9])
+    copy_into(out, 15, tbg[:5])
+    copy_into(out, 20, surface[:15])
+    copy_into(out, 35, sigma)
+    copy_into(out, 38 + nv, tbg[5:10])
+    copy_into(out, 43 + nv, surface[15:18])
+    return True
 
 
 def work_size(nv: int, n_joints: int) -> int:
@@ -139,9 +132,9 @@ def task_work_size(n: int, nv: int) -> int:
     return 15 + 2 * n + n * nv + 6 * n + pinv_work_size(n, nv)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def task_row_into(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
-                  targets, rotations, memo, work, out):
+                  targets, rotations, memo, work, out, general=None) -> bool:
     """``out`` ← the row of any task (``interceptor.telemetry_layout(nv, task)`` then
     [index, t0, tf, β, phase] then σ̇) from the frame's position x, orientation R (3 × 3),
     Jacobians J_v, J_ω (3 × nv) and the joint speeds v.  ``task``: its code (``task.TASKS``);
@@ -149,7 +142,7 @@ def task_row_into(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task,
     ``rotation``: [R_r, ω_r, ω̇_r] (15) or empty to evaluate ``rotations``
     (``orientation.rotation_row``), both at t for the active segment.  ``memo`` (``TASK_MEMO``):
     the TBG, target and rotation of the last call's t, functions of t alone (NaN at first);
-    ``work``: scratch (``task_work_size``)."""
+    ``work``: scratch (``task_work_size``).  False (τ, σ̇ not written): the solve needs ``general``."""
     nv, n = len(v), 3 if task == POSITION else 6
     xdot, omega, R9, err = work[0:3], work[3:6], work[6:15], work[15:15 + 2 * n]
     o = 15 + 2 * n
@@ -174,22 +167,32 @@ def task_row_into(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task,
             rotation_row(rotations[active], t, rot)
         memo[0] = t
     if len(target) != 0:
-        ref[:9] = target[:9]
+        copy_into(ref, 0, target[:9])
     if task != POSITION and len(rotation) != 0:
-        rot[:] = rotation[:15]
+        copy_into(rot, 0, rotation[:15])
     task_error_of(task, rot_scale, x, xdot, ref[0:3], ref[3:6], R9, omega, rot, err)
     task_jacobian_of(J_v, J_w, rot_scale, J)
     surface_law(t, err[:n], err[n:], tbg[4], tbg[5:10], captured, sigma, gains[GAINS_HEAD:GAINS_HEAD + n],
                 gains[3], gains[4], int(gains[5]), gains[6], surface)
     m = 20 + 5 * n
-    sliding_mode_torque_into(gains[GAINS_HEAD + n:], J, surface[:n], gains[7], out[m + n:m + n + nv], solve)
-    out[0:3], out[3:6], out[6:15], out[15:20], out[20:m] = x, xdot, ref[:9], tbg[:5], surface[:5 * n]
-    out[m:m + n] = sigma
+    if not sliding_mode_torque_into(gains[GAINS_HEAD + n:], J, surface[:n], gains[7], out[m + n:m + n + nv],
+                                    solve, general):
+        return False
+    copy_into(out, 0, x)
+    copy_into(out, 3, xdot)
+    copy_into(out, 6, ref[:9])
+    copy_into(out, 15, tbg[:5])
+    copy_into(out, 20, surface[:5 * n])
+    copy_into(out, m, sigma)
     m += n + nv
     if task != POSITION:
-        out[m:m + 9], out[m + 9:m + 12], out[m + 12:m + 27] = R9, omega, rot
+        copy_into(out, m, R9)
+        copy_into(out, m + 9, omega)
+        copy_into(out, m + 12, rot)
         m += 27
-    out[m:m + 5], out[m + 5:m + 5 + n] = tbg[5:10], surface[5 * n:]
+    copy_into(out, m, tbg[5:10])
+    copy_into(out, m + 5, surface[5 * n:])
+    return True
 
 
 @njit(cache=True)
@@ -199,7 +202,8 @@ def task_row(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_
     cannot describe, from Drake's kinematics)."""
     n = 3 if task == POSITION else 6
     task_row_into(t, x, R, J_v, J_w, v, sigma, captured, target, rotation, task, rot_scale, segments, gains,
-                  targets, rotations, np.full(TASK_MEMO, np.nan), np.empty(task_work_size(n, len(v))), out)
+                  targets, rotations, np.full(TASK_MEMO, np.nan), np.empty(task_work_size(n, len(v))), out,
+                  True)
 
 
 @njit(cache=True)
@@ -210,8 +214,7 @@ def pose_row(t, qv, sigma, captured, target, rotation, task, rot_scale, segments
     top-down tasks (or the position task) in one call."""
     nv = len(gains) - GAINS_HEAD - (3 if task == POSITION else 6)
     nq = len(qv) - nv
-    x, R, J_v, J_w = chain_kinematics(qv[:nq], joints[0], joints[1], joints[2], geometry[:, :4],
-                                      geometry[:-1, 4], nv)
+    x, R, J_v, J_w = chain_kinematics(qv[:nq], joints, geometry, nv)
     task_row(t, x, R, J_v, J_w, qv[nq:], sigma, captured, target, rotation, task, rot_scale, segments,
              gains, targets, rotations, out)
 
@@ -266,12 +269,13 @@ def _loop_sigma(u, m, n, captured, reset, sigma) -> None:
 
 
 @njit(cache=True)
-def position_output(t, u, static, row, tau_sigma_dot):
+def position_output(t, u, static, row, tau_sigma_dot, general=None) -> bool:
     """``position_row`` on a packed input: ``u`` = [q; v; σ (the Integrator's); captured
     [index, s(t0), σ0]; the target [x_r, ẋ_r, ẍ_r] when the system has a target input],
     ``static`` from ``pack_position``; ``row`` ← the row, ``tau_sigma_dot`` ← [τ; σ̇]
     (σ − σ0 used with ``sigma_policy`` reset).  Allocates nothing, and its views are borrowed
-    (``borrow``)."""
+    (``borrow``).  False where the torque's solve needs ``general``: call it again with
+    ``general=True`` (``controller.pinv_solve_into``)."""
     nq, nv = int(static[0]), int(static[1])
     segments, gains, joints, geometry, targets, o = _static_parts(static, POSITION_HEAD, 3, nv)
     memo, work = borrow(static, o, (MEMO,)), borrow(static, o + MEMO, (len(static) - o - MEMO,))
@@ -280,19 +284,26 @@ def position_output(t, u, static, row, tau_sigma_dot):
     captured = borrow(u, m + 3, (7,))
     _loop_sigma(u, m, 3, captured, static[6] != 0.0, sigma)
     target = borrow(u, m + 10, (9 if static[7] != 0.0 else 0,))
-    position_row(t, borrow(u, 0, (m,)), sigma, captured, target, segments, gains, joints, geometry,
-                 targets, memo, work, borrow(row, 0, (len(row),)))
-    tau_sigma_dot[:nv] = row[38:38 + nv]
-    tau_sigma_dot[nv:] = row[43 + nv:46 + nv]
+    if not position_row(t, borrow(u, 0, (m,)), sigma, captured, target, segments, gains, joints, geometry,
+                        targets, memo, work, borrow(row, 0, (len(row),)), general):
+        return False
+    copy_into(tau_sigma_dot, 0, row[38:38 + nv])
+    copy_into(tau_sigma_dot, nv, row[43 + nv:46 + nv])
+    return True
 
 
 @njit(cache=True)
-def position_rows(t, U, static, rows, tau_sigma_dot):
+def position_rows(t, U, static, rows, tau_sigma_dot, general=None) -> bool:
     """``position_output`` at each logged sample k: ``rows[k]`` ← the row at time t[k] from the
     ``loop`` input's values U[k] then (the telemetry of a run in one call, not one per sample);
-    ``tau_sigma_dot`` is scratch."""
+    ``tau_sigma_dot`` is scratch.  False where a sample needs ``general``."""
     for k in range(len(t)):
-        position_output(t[k], U[k], static, rows[k], tau_sigma_dot)
+        if general is None:  # (as Python calls it: one compiled version)
+            if not position_output(t[k], U[k], static, rows[k], tau_sigma_dot):
+                return False
+        elif not position_output(t[k], U[k], static, rows[k], tau_sigma_dot, general):
+            return False
+    return True
 
 
 POSE_HEAD = 12  # POSITION_HEAD's, then the task code, c (rot_scale), rotation count, rotation given
@@ -321,12 +332,13 @@ def pack_pose(nq: int, task: int, rot_scale: float, segments, gains, joints, geo
 
 
 @njit(cache=True)
-def pose_output(t, u, static, row, tau_sigma_dot):
+def pose_output(t, u, static, row, tau_sigma_dot, general=None) -> bool:
     """``position_output`` for any task on the compiled chain (the pose and top-down tasks):
     ``u`` = [q; v; σ (n); captured [index, s(t0), σ0] (1 + 2n); the target [x_r, ẋ_r, ẍ_r] (9)
     when the system has a target input; [R_r, ω_r, ω̇_r] (15) when it has a rotation input],
     ``static`` from ``pack_pose``; ``row`` ← the row (``task_row_into``), ``tau_sigma_dot`` ←
-    [τ; σ̇].  Its views are borrowed and its scratch is in ``static``."""
+    [τ; σ̇].  Its views are borrowed and its scratch is in ``static``.  False where the torque's
+    solve needs ``general`` (``position_output``)."""
     nq, nv, n_joints = int(static[0]), int(static[1]), int(static[3])
     task, n_rot = int(static[8]), int(static[10])
     n = 3 if task == POSITION else 6
@@ -350,15 +362,23 @@ def pose_output(t, u, static, row, tau_sigma_dot):
     rotation = borrow(u, p + given_target, (15 if static[11] != 0.0 else 0,))
     chain_kinematics_into(borrow(u, 0, (nq,)), joints[0], joints[1], joints[2], geometry[:, :4],
                           geometry[:-1, 4], x, R, J_v, J_w, chain)
-    task_row_into(t, x, R, J_v, J_w, borrow(u, nq, (nv,)), sigma, captured, target, rotation, task, static[9],
-                  segments, gains, targets, rotations, memo, work[c + n:], borrow(row, 0, (len(row),)))
+    if not task_row_into(t, x, R, J_v, J_w, borrow(u, nq, (nv,)), sigma, captured, target, rotation, task,
+                         static[9], segments, gains, targets, rotations, memo, work[c + n:],
+                         borrow(row, 0, (len(row),)), general):
+        return False
     m = 20 + 6 * n
-    tau_sigma_dot[:nv] = row[m:m + nv]
-    tau_sigma_dot[nv:] = row[len(row) - n:]
+    copy_into(tau_sigma_dot, 0, row[m:m + nv])
+    copy_into(tau_sigma_dot, nv, row[len(row) - n:])
+    return True
 
 
 @njit(cache=True)
-def pose_rows(t, U, static, rows, tau_sigma_dot):
+def pose_rows(t, U, static, rows, tau_sigma_dot, general=None) -> bool:
     """``pose_output`` at each logged sample k (``position_rows`` for any task)."""
     for k in range(len(t)):
-        pose_output(t[k], U[k], static, rows[k], tau_sigma_dot)
+        if general is None:  # (as Python calls it: one compiled version)
+            if not pose_output(t[k], U[k], static, rows[k], tau_sigma_dot):
+                return False
+        elif not pose_output(t[k], U[k], static, rows[k], tau_sigma_dot, general):
+            return False
+    return True

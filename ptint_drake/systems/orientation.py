@@ -34,6 +34,7 @@ from pydrake.trajectories import PiecewiseQuaternionSlerp
 
 from ptint_drake.systems.chain import axis_rotation
 from ptint_drake.systems.signals import IDENTITY_ROTATION
+from ptint_drake.systems.views import copy_into
 
 # A compiled orientation: [R0 (row-major, 9), ω (3)] (``SpinningOrientation.compiled``).
 ROTATION_WIDTH = 12
@@ -86,7 +87,7 @@ def rotation_exp_of(w, out) -> None:
         out[1, 0], out[1, 1], out[1, 2] = w[2], 1.0, -w[0]
         out[2, 0], out[2, 1], out[2, 2] = -w[1], w[0], 1.0
         return
-    axis_rotation(w / th, th, out)
+    axis_rotation(np.array((w[0] / th, w[1] / th, w[2] / th)), th, out)
 
 
 def rotation_exp(w) -> np.ndarray:
@@ -114,14 +115,14 @@ def rotation_row(c, t: float, out) -> None:
     """``out[:15]`` ← [R_r (row-major), ω_r, ω̇_r] at time t of the compiled orientation
     c = [R0, ω] (``ROTATION_WIDTH``): R_r = exp([ω] t) R0, ω_r = ω, ω̇_r = 0."""
     if c[9] == 0.0 and c[10] == 0.0 and c[11] == 0.0:
-        out[0:9] = c[0:9]
+        copy_into(out, 0, c[0:9])
     else:
         E = np.empty((3, 3))
-        rotation_exp_of(c[9:12] * t, E)
+        rotation_exp_of(np.array((c[9] * t, c[10] * t, c[11] * t)), E)
         for i in range(3):
             for j in range(3):
                 out[3 * i + j] = E[i, 0] * c[j] + E[i, 1] * c[3 + j] + E[i, 2] * c[6 + j]
-    out[9:12] = c[9:12]
+    copy_into(out, 9, c[9:12])
     out[12:15] = 0.0
 
 
@@ -225,9 +226,10 @@ def top_down_of(rot_r, tool_yaw: float, out) -> None:
     psi += math.pi * np.rint((tool_yaw - psi) / math.pi)
     num = a0 * ad1 - a1 * ad0
     c, s = math.cos(psi), math.sin(psi)
-    out[0:9] = (c, s, 0.0, s, -c, 0.0, 0.0, 0.0, -1.0)  # Rz(ψ)·Rx(π), row-major
-    out[9:15] = (0.0, 0.0, num / h, 0.0, 0.0,
-                 ((a0 * add1 - a1 * add0) * h - num * 2.0 * (a0 * ad0 + a1 * ad1)) / (h * h))
+    out[0], out[1], out[2], out[3], out[4] = c, s, 0.0, s, -c  # Rz(ψ)·Rx(π), row-major
+    out[5], out[6], out[7], out[8] = 0.0, 0.0, 0.0, -1.0
+    out[9], out[10], out[11], out[12], out[13] = 0.0, 0.0, num / h, 0.0, 0.0
+    out[14] = ((a0 * add1 - a1 * add0) * h - num * 2.0 * (a0 * ad0 + a1 * ad1)) / (h * h)
 
 
 @njit(cache=True)

@@ -53,7 +53,7 @@ def _betaincinv(typingctx, a, b, y):
     return types.float64(types.float64, types.float64, types.float64), codegen
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def tbg_derivatives(tau: float, tf: float, beta: float, gamma: float) -> tuple:
     """(ξ, ξ̇, ξ̈, ξ⃛) at one time τ = t − t0 since the segment start (paper eqs. 6-10);
     ``gamma`` = ``gamma_gain(tf, beta)``, computed once per segment.

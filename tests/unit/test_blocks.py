@@ -229,3 +229,49 @@ def test_smc_torque_is_minus_K_pinv_J_s_x(nv, damping):
         tau = smc_torque(K.tolist(), J.tolist(), s_x.tolist(), damping)
         np.testing.assert_allclose(tau, -K * (pinv @ s_x), rtol=1e-9, atol=1e-12)
         np.testing.assert_array_equal(smc_torque(K, J, s_x, damping), tau)
+
+
+def _lean_and_general(J, b, damping):
+    """``pinv_solve_into`` without ``general`` (its return value, ``out`` after it) and with it."""
+    from ptint_drake.systems.controller import pinv_solve_into, pinv_work_size
+
+    J = np.ascontiguousarray(J, dtype=float)
+    work = np.empty(pinv_work_size(*J.shape))
+    lean, general = np.full(J.shape[1], 7.0), np.full(J.shape[1], 7.0)
+    solved = pinv_solve_into(J, b, damping, lean, work)
+    assert pinv_solve_into(J, b, damping, general, work, True)
+    return solved, lean, general
+
+
+@pytest.mark.parametrize("rows, nv, damping",
+                         [(3, 3, 0.0), (3, 4, 0.0), (3, 3, 0.05), (6, 6, 0.0), (6, 5, 0.0)])
+def test_the_lean_solve_is_the_general_one_where_it_solves(rows, nv, damping):
+    """The kernels a run calls leave numpy's solvers out (``pinv_solve_into`` without
+    ``general``): where they solve, the bits of the general solve."""
+    rng = np.random.default_rng(rows * 10 + nv)
+    for _ in range(20):
+        J, b = rng.normal(size=(rows, nv)), rng.normal(size=rows)
+        solved, lean, general = _lean_and_general(J, b, damping)
+        assert solved
+        np.testing.assert_array_equal(lean, general)
+
+
+def test_the_lean_solve_leaves_what_needs_numpy_to_the_general_one():
+    """A singular 3 × 3 J (Cramer's rule cannot), a rank-deficient 6-row J (Householder cannot),
+    a damped 6-row solve and more than 8 joints: False and ``out`` untouched; the general solve
+    gives ``pinv_solve``'s answer (numpy's least squares for the singular J)."""
+    from ptint_drake.systems.controller import pinv_solve
+
+    rng = np.random.default_rng(4)
+    singular = np.array([[1.0, 2, 3], [2, 4, 6], [0, 1, 1]])
+    deficient = rng.normal(size=(6, 6))
+    deficient[:, 5] = deficient[:, 4]
+    cases = [(singular, 0.0), (deficient, 0.0), (rng.normal(size=(6, 6)), 0.05),
+             (rng.normal(size=(3, 9)), 0.0)]
+    for J, damping in cases:
+        b = rng.normal(size=J.shape[0])
+        solved, lean, general = _lean_and_general(J, b, damping)
+        assert not solved and np.all(lean == 7.0)
+        np.testing.assert_array_equal(general, pinv_solve(np.ascontiguousarray(J), b, damping))
+    np.testing.assert_allclose(_lean_and_general(singular, np.ones(3), 0.0)[2],
+                               np.linalg.lstsq(singular, np.ones(3), rcond=None)[0], atol=1e-12)

@@ -60,6 +60,31 @@ def test_position_output_gives_the_blocks_bits(reset):
         np.testing.assert_array_equal(out, np.r_[expected[38:41], expected[46:49]])
 
 
+def test_a_singular_jacobian_falls_back_to_the_general_kernel():
+    """At a singular J (rvm1's elbow at ±90°) the lean kernel a run calls returns False (its
+    solve needs numpy's least squares, ``controller.pinv_solve_into``); the general one, called
+    next, gives the blocks' bits (their ``smc_torque`` solves in general); the law falls back
+    the same way (tests/unit/test_kernel_load.py)."""
+    plant = parse_model("rvm1")
+    plant.Finalize()
+    chain = KinematicChain.of(plant, plant.GetFrameByName(rvm1.END_EFFECTOR))
+    table = np.array([[0.0], [1.0], [0.75], [gamma_gain(1.0, 0.75)]])
+    target = SinusoidTarget([0.24, 0.0, 0.3], [0.1, 0.1, 0.1], 1.5, [0.0, np.pi / 2, 0.0])
+    law = SurfaceLaw(Lambda=5.0, k=3.0, switching="tanh", phi=0.01, k_hold=50.0)
+    gains = np.r_[EPS, DELTA, 0.0, law.k, law.k_hold, law.code, law.phi, 0.0, law.Lambda, np.full(3, K_GAIN)]
+    static = pack_position(3, table, gains, *pack_chain(chain), np.array([target.compiled]), False, False)
+    q, v, sigma = np.array([0.3, 0.2, np.pi / 2]), np.array([0.1, -0.2, 0.3]), np.array([0.01, 0.0, -0.01])
+    captured = np.r_[0.0, 0.02, -0.01, 0.03, 0.0, 0.0, 0.0]
+    u = BasicVector(np.r_[q, v, sigma, captured]).value()
+    row, out = np.full(49, 7.0), np.full(6, 7.0)
+    assert not position_output(0.4, u, static, row, out)
+    assert np.all(out == 7.0)  # τ and σ̇ not written
+    assert position_output(0.4, u, static, row, out, True)
+    expected = _blocks_row(chain, table, target, law, 0.4, q, v, sigma, captured)
+    np.testing.assert_array_equal(row, expected)
+    np.testing.assert_array_equal(out, np.r_[expected[38:41], expected[46:49]])
+
+
 def test_a_borrowed_view_stays_inside_its_array():
     with pytest.raises(IndexError):
         borrow(np.zeros(5), 3, (3,))

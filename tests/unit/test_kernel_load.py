@@ -52,3 +52,23 @@ def test_the_telemetry_in_one_call_is_the_row_of_each_sample():
     one_by_one = np.array([law.row(*values, None, None) for values in zip(t.tolist(), qv, sigma, captured)])
     assert batch.shape == one_by_one.shape and np.isfinite(batch).all()
     np.testing.assert_array_equal(batch, one_by_one)
+
+
+def test_the_law_falls_back_to_the_general_kernels_at_a_singular_jacobian():
+    """At a singular J (rvm1's elbow at 90°) the lean kernels cannot solve: ``row`` and ``rows``
+    (``InterceptorLaw._call``) then give the general kernels' bits, as at any other state."""
+    import numpy as np
+
+    _, text = scenario_text("curve_b075_tf15")
+    law = build(parse_with_overrides(text, [], "curve_b075_tf15"), log=False).controller.system.law
+    qv = np.array([[0.3, 0.2, np.pi / 2, 0.1, -0.2, 0.3], [0.3, 0.2, 0.9, 0.1, -0.2, 0.3]])
+    sigma = np.array([[0.01, 0.0, -0.01]] * 2)
+    captured = np.array([[0.0, 0.02, -0.01, 0.03, 0.0, 0.0, 0.0]] * 2)
+    t = np.array([0.4, 0.5])
+    for k in range(2):
+        args = (t[k], qv[k], sigma[k], captured[k], None)
+        row = law.row(*args)
+        assert np.isfinite(row).all()
+        np.testing.assert_array_equal(row, law.row(*args, path="general"))
+    np.testing.assert_array_equal(law.rows(t, qv, sigma, captured),
+                                  law.rows(t, qv, sigma, captured, path="general"))
