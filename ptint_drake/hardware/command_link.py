@@ -6,9 +6,10 @@ controller slot in place of the controller and its zero-order hold (``ptint hard
 there through the plugin path, ``controllers.plugin``).  At each tick t_k it reads the plant's
 [q; v], publishes them as an ``lcmt_iiwa_status`` stamped t_k, takes the ``lcmt_iiwa_command``
 answering that status (``HardwareSession.exchange``) and holds its torque until the next tick.
-The plant (discrete, step T) and this system update together, and Drake's simultaneous discrete
-updates read the state before the update: the plant's step at t_k applies the command taken at
-t_{k-1}, computed from the state at t_{k-1} — the same one-period delay as ``ptint run`` with
+The plant is discrete with step T, and Drake's discrete ``MultibodyPlant`` takes its step before
+the other discrete updates of the same time (measured on Drake 1.51.1 and 1.58: a zero-order hold
+at t_k samples the arm after the plant's step at t_k), so the status of t_k is the arm after that
+step and its command acts over the next one — the same timing as ``ptint run`` with
 ``controller.control_period`` = T on a discrete plant (``controllers.hold``).
 
 - **Lockstep** (``lockstep``): each tick waits for its command (re-sending the status every
@@ -109,7 +110,7 @@ class HardwareSession:
         self._pending: Optional[int] = None
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
-        self._handshake_tau: Optional[np.ndarray] = None  # the answer to the hand-shake's status
+        self._after_handshake = False
 
     # -- the protocol -------------------------------------------------------------------------
     def _publish(self, data: bytes) -> float:
@@ -144,9 +145,6 @@ class HardwareSession:
                 f"command rejected at t = {t:.3f} s: joint {j} torque "
                 f"{tau[j]:.3g} N·m beyond its limit {self.limits[j]:.3g} N·m",
             )
-        if utime == 0 and self._handshake_tau is not None and np.array_equal(tau, self._handshake_tau):
-            self.record.duplicates += 1  # a late answer to a re-sent hand-shake status
-            return None
         if utime == self._answered:
             if np.array_equal(tau, self._answered_tau):
                 self.record.duplicates += 1
@@ -220,7 +218,7 @@ class HardwareSession:
         self.record.rtt.clear()  # the start-up wait is no round trip
         self.record.accepted = 0
         # the tick at t = 0 samples the arm after the plant's first step: a new status of t = 0
-        self._handshake_tau, self._answered, self._answered_tau = self._answered_tau, None, None
+        self._answered, self._answered_tau, self._after_handshake = None, None, True
 
     def exchange(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> Optional[np.ndarray]:
         """The tick at ``t``: publish the status, take its command (None: none, keep the last
@@ -228,6 +226,9 @@ class HardwareSession:
         utime = utime_of(t)
         self.record.tick_time.append(t)
         self.record.tick_wall.append(time.perf_counter())
+        if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
+            self._after_handshake = False
+            self.record.duplicates += len(self.endpoint.poll(0.0))
         data = pack_status(t, q, v, tau)
         self._pending = utime
         self._sent[utime] = self._publish(data)

@@ -50,11 +50,12 @@ def url_warning(url: str) -> Optional[str]:
 
 
 class Endpoint:
-    """One ``DrakeLcm`` (``url``, or ``LCM_DEFAULT_URL`` / Drake's default when None), publishing on
-    one channel and collecting another's messages with their arrival times (``inbox``)."""
+    """One ``DrakeLcm`` (``url``, or ``LCM_DEFAULT_URL`` / Drake's default when None; or ``lcm``,
+    shared: two endpoints on one ``memq://`` instance talk inside one process), publishing on one
+    channel and collecting another's messages with their arrival times (``inbox``)."""
 
-    def __init__(self, url: Optional[str], listen: str, publish: str):
-        self.lcm = DrakeLcm(url) if url else DrakeLcm()
+    def __init__(self, url: Optional[str], listen: str, publish: str, lcm: Optional[DrakeLcm] = None):
+        self.lcm = lcm if lcm is not None else DrakeLcm(url) if url else DrakeLcm()
         self.url = self.lcm.get_lcm_url()
         self.listen, self.publish_channel = listen, publish
         self.inbox: list[tuple[float, bytes]] = []
