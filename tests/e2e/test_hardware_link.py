@@ -42,9 +42,15 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     """Acceptance: lockstep across two processes (the drive started second) = ptint run with
     the control period and plant step at 1 ms: same verdict, e(tf) within 0.1 mm (measured:
     within 1e-10 m)."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out",
-                                                 str(tmp_path / "hw"))},
-                    {"name": "drive", "delay": 1.0, "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))}])
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
+            },
+            {"name": "drive", "delay": 1.0, "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))},
+        ]
+    )
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
     reference = run(CURVE, "{controller: {control_period: 0.001}, multibody: {time_step: 0.001}}").metrics
@@ -61,8 +67,12 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
 def test_drive_killed_holds_the_arm(tmp_path):
     """The drive SIGKILLed mid-run (real time, at 30 % of the run): the hardware holds the arm
     within its timeout (joint speeds below 0.05 rad/s within 0.2 s) and exits 1 with the reason."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE, "--out", str(tmp_path / "hw"))},
-                    {"name": "drive", "argv": ptint("drive", CURVE), "kill_when": ["hw", " 30 %"]}])
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE, "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", CURVE), "kill_when": ["hw", " 30 %"]},
+        ]
+    )
     assert out["drive"]["killed"] is not None and out["hw"]["rc"] == 1
     assert "command timeout at t" in one_line(out["hw"]["stderr"])
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
@@ -72,8 +82,12 @@ def test_drive_killed_holds_the_arm(tmp_path):
 
 def test_hardware_killed_stops_the_drive(tmp_path):
     """The hardware SIGKILLed mid-run: the drive exits 1 with one line within its status timeout."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE), "kill_when": ["hw", " 30 %"]},
-                    {"name": "drive", "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))}])
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE), "kill_when": ["hw", " 30 %"]},
+            {"name": "drive", "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))},
+        ]
+    )
     assert out["hw"]["killed"] is not None and out["drive"]["rc"] == 1
     assert "no status from the hardware for 0.5 s" in one_line(out["drive"]["stderr"])
     reaction = out["drive"]["ended"] - out["hw"]["killed"]
@@ -85,10 +99,19 @@ def test_hardware_killed_stops_the_drive(tmp_path):
 def test_bad_commands_rejected_and_held(tmp_path, mode, words):
     """A NaN torque: rejected, reported, the arm held (over-limit torques and a wrong size:
     the same path, tests/unit/test_hardware_link.py with memq://; bad_drive.py has them too)."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out",
-                                                 str(tmp_path / "hw"))},
-                    {"name": "bad", "argv": [sys.executable, str(HERE / "bad_drive.py"), mode, "0.2", "3"],
-                     "timeout": 40.0}])
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
+            },
+            {
+                "name": "bad",
+                "argv": [sys.executable, str(HERE / "bad_drive.py"), mode, "0.2", "3"],
+                "timeout": 40.0,
+            },
+        ]
+    )
     assert out["hw"]["rc"] == 1
     assert words in one_line(out["hw"]["stderr"])
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
@@ -99,11 +122,20 @@ def test_bad_commands_rejected_and_held(tmp_path, mode, words):
 def test_second_sender_detected(tmp_path):
     """A second process answering the statuses too from t = 0.3 s: detected within 10 periods,
     reported, the arm held."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out",
-                                                 str(tmp_path / "hw"))},
-                    {"name": "drive", "argv": ptint("drive", CURVE)},
-                    {"name": "rogue", "argv": [sys.executable, str(HERE / "bad_drive.py"), "rogue", "0.3", "3"],
-                     "timeout": 40.0}])
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
+            },
+            {"name": "drive", "argv": ptint("drive", CURVE)},
+            {
+                "name": "rogue",
+                "argv": [sys.executable, str(HERE / "bad_drive.py"), "rogue", "0.3", "3"],
+                "timeout": 40.0,
+            },
+        ]
+    )
     assert out["hw"]["rc"] == 1
     assert "second sender" in one_line(out["hw"]["stderr"])
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
@@ -113,30 +145,63 @@ def test_second_sender_detected(tmp_path):
 
 def test_dropped_status_completes(tmp_path):
     """20 % of the status messages not sent: the lockstep run completes, the loss is reported."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--drop-status",
-                                                 "0.2", "--set", "duration=1.0", "--set",
-                                                 "interceptions[0].tf=0.8", "--out", str(tmp_path / "hw"))},
-                    {"name": "drive", "argv": ptint("drive", CURVE, "--set", "duration=1.0", "--set",
-                                                    "interceptions[0].tf=0.8")}])
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint(
+                    "hardware",
+                    CURVE,
+                    "--lockstep",
+                    "--quiet",
+                    "--drop-status",
+                    "0.2",
+                    "--set",
+                    "duration=1.0",
+                    "--set",
+                    "interceptions[0].tf=0.8",
+                    "--out",
+                    str(tmp_path / "hw"),
+                ),
+            },
+            {
+                "name": "drive",
+                "argv": ptint("drive", CURVE, "--set", "duration=1.0", "--set", "interceptions[0].tf=0.8"),
+            },
+        ]
+    )
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     assert link["ticks"] == 1000
     total = link["statuses_dropped"] + link["statuses_sent"]
-    assert 0.15 < link["statuses_dropped"] / total < 0.25 and link["status_resends"] >= link["statuses_dropped"] - 1
+    assert (
+        0.15 < link["statuses_dropped"] / total < 0.25
+        and link["status_resends"] >= link["statuses_dropped"] - 1
+    )
 
 
 def test_drive_without_hardware():
     """``ptint drive`` with nobody publishing status: one line after its start-up timeout, exit 1."""
-    out = run_plan([{"name": "drive", "argv": ptint("drive", CURVE, "--startup-timeout", "1", "--out",
-                                                    "/tmp/ptint_lcm_unused")}])
+    out = run_plan(
+        [
+            {
+                "name": "drive",
+                "argv": ptint("drive", CURVE, "--startup-timeout", "1", "--out", "/tmp/ptint_lcm_unused"),
+            }
+        ]
+    )
     assert out["drive"]["rc"] == 1
     assert "within the start-up timeout of 1 s" in one_line(out["drive"]["stderr"])
 
 
 def test_realtime_run_completes(tmp_path):
     """Real time: the run completes with its latency, lateness and late ticks reported."""
-    out = run_plan([{"name": "hw", "argv": ptint("hardware", CURVE, "--quiet", "--out", str(tmp_path / "hw"))},
-                    {"name": "drive", "argv": ptint("drive", CURVE)}])
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE, "--quiet", "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", CURVE)},
+        ]
+    )
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     assert link["mode"] == "realtime" and link["ticks"] == 3000

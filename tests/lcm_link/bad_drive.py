@@ -31,8 +31,11 @@ def main() -> None:
                 continue
             tau = np.zeros(n)
             if late:
-                tau = {"nan": np.array([np.nan] + [0.0] * (n - 1)), "over": np.full(n, 100.0),
-                       "size": np.zeros(n + 1)}[mode]
+                tau = {
+                    "nan": np.array([np.nan] + [0.0] * (n - 1)),
+                    "over": np.full(n, 100.0),
+                    "size": np.zeros(n + 1),
+                }[mode]
             link.publish(pack_command(utime, tau))
 
 

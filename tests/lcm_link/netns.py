@@ -27,8 +27,12 @@ def namespace_problem() -> str | None:
     for tool in ("unshare", "ip"):
         if shutil.which(tool) is None:
             return f"no {tool!r} command"
-    probe = subprocess.run(["unshare", "-rn", "sh", "-c", SETUP + " && ip -o link | wc -l"],
-                           capture_output=True, text=True, timeout=20)
+    probe = subprocess.run(
+        ["unshare", "-rn", "sh", "-c", SETUP + " && ip -o link | wc -l"],
+        capture_output=True,
+        text=True,
+        timeout=20,
+    )
     if probe.returncode != 0:
         return f"unshare -rn failed: {' '.join(probe.stderr.split())[:200]}"
     if probe.stdout.strip() != "1":
@@ -40,13 +44,20 @@ def require_netns() -> None:
     """Skip, loudly (a warning with the reason), when no private namespace can be made."""
     problem = namespace_problem()
     if problem is not None:
-        message = (f"LCM two-process test not run: no private network namespace ({problem}); the "
-                   f"single-process memq:// tests cover the link's checks")
+        message = (
+            f"LCM two-process test not run: no private network namespace ({problem}); the "
+            f"single-process memq:// tests cover the link's checks"
+        )
         warnings.warn(message, stacklevel=2)
         pytest.skip(message)
 
 
 def run_in_netns(argv: list[str], timeout: float, **kwargs) -> subprocess.CompletedProcess:
     """``argv`` inside a fresh loopback-only network namespace (``SETUP``)."""
-    return subprocess.run(["unshare", "-rn", "sh", "-c", SETUP + ' && exec "$@"', "sh", *argv],
-                          capture_output=True, text=True, timeout=timeout, **kwargs)
+    return subprocess.run(
+        ["unshare", "-rn", "sh", "-c", SETUP + ' && exec "$@"', "sh", *argv],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        **kwargs,
+    )

@@ -27,8 +27,13 @@ def main() -> None:
             time.sleep(0.01)
         name = step["name"]
         out, err = open(folder / f"{name}.out", "w"), open(folder / f"{name}.err", "w")
-        procs[name] = {"step": step, "proc": subprocess.Popen(step["argv"], stdout=out, stderr=err),
-                       "started": time.monotonic() - t0, "files": (out, err), "killed": None}
+        procs[name] = {
+            "step": step,
+            "proc": subprocess.Popen(step["argv"], stdout=out, stderr=err),
+            "started": time.monotonic() - t0,
+            "files": (out, err),
+            "killed": None,
+        }
     result: dict = {}
     while len(result) < len(procs):
         for name, p in procs.items():
@@ -46,9 +51,14 @@ def main() -> None:
                 continue
             for f in p["files"]:
                 f.close()
-            result[name] = {"rc": proc.returncode, "stdout": (folder / f"{name}.out").read_text(),
-                            "stderr": (folder / f"{name}.err").read_text(), "started": p["started"],
-                            "ended": now, "killed": p["killed"]}
+            result[name] = {
+                "rc": proc.returncode,
+                "stdout": (folder / f"{name}.out").read_text(),
+                "stderr": (folder / f"{name}.err").read_text(),
+                "started": p["started"],
+                "ended": now,
+                "killed": p["killed"],
+            }
         time.sleep(0.005)
     print(json.dumps(result))
 

@@ -9,8 +9,17 @@ import pytest
 from pydrake.lcm import DrakeLcm
 
 from ptint_drake.hardware.command_link import HardwareSession, LinkSettings
-from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, Endpoint, pack_command, pack_status,
-                                       unpack_command, unpack_status, url_warning, utime_of)
+from ptint_drake.hardware.link import (
+    COMMAND_CHANNEL,
+    STATUS_CHANNEL,
+    Endpoint,
+    pack_command,
+    pack_status,
+    unpack_command,
+    unpack_status,
+    url_warning,
+    utime_of,
+)
 
 N = 3
 LIMITS = np.array([5.0, 12.0, 12.0])
@@ -57,11 +66,14 @@ def test_the_answered_command_is_taken():
     assert session.record.fault is None and session.record.accepted == 1
 
 
-@pytest.mark.parametrize("tau, words", [
-    (np.array([np.nan, 0.0, 0.0]), "non-finite torque"),
-    (np.array([0.0, 12.5, 0.0]), "joint 1 torque 12.5 N·m beyond its limit 12"),
-    (np.zeros(4), "4 torques, the arm has 3"),
-])
+@pytest.mark.parametrize(
+    "tau, words",
+    [
+        (np.array([np.nan, 0.0, 0.0]), "non-finite torque"),
+        (np.array([0.0, 12.5, 0.0]), "joint 1 torque 12.5 N·m beyond its limit 12"),
+        (np.zeros(4), "4 torques, the arm has 3"),
+    ],
+)
 def test_bad_commands_are_faults(tau, words):
     session, _ = pair()
     assert tick(session, 0.002, [pack_command(utime_of(0.002), tau)]) is None
@@ -74,11 +86,17 @@ def test_no_command_is_a_timeout():
     assert session.record.fault == "command timeout at t = 0.003 s (no command for 50 ms)"
 
 
-@pytest.mark.parametrize("second, words", [
-    (lambda: pack_command(utime_of(0.004), np.ones(N)), "two different commands"),  # same stamp, other torque
-    (lambda: pack_command(utime_of(0.001), np.zeros(N)), "went backwards"),
-    (lambda: pack_command(utime_of(0.5), np.zeros(N)), "no status asked for"),
-])
+@pytest.mark.parametrize(
+    "second, words",
+    [
+        (
+            lambda: pack_command(utime_of(0.004), np.ones(N)),
+            "two different commands",
+        ),  # same stamp, other torque
+        (lambda: pack_command(utime_of(0.001), np.zeros(N)), "went backwards"),
+        (lambda: pack_command(utime_of(0.5), np.zeros(N)), "no status asked for"),
+    ],
+)
 def test_a_second_sender_is_a_fault(second, words):
     session, _ = pair()
     tick(session, 0.003, [pack_command(utime_of(0.003), np.zeros(N))])
