@@ -15,6 +15,8 @@ first status, so that the controller's start is the arm's), and the command
 stamped with the status's ``utime`` carries its output.  A status repeated (the hardware re-sends
 an unanswered one) gets the same command again; a second status of the same time with another
 state (the first tick after the hand-shake: the arm after the plant's first step) a new one.
+Torques beyond the actuators' effort limits are clipped to them (``limits.saturate``, the
+default: where ``ptint run``'s station saturates; the hardware side rejects them as a fault).
 It ends when it has answered the last tick
 (t ≥ duration − 1.5 T), or with ``DriveFault`` (one line): no status within the start-up timeout,
 no status for ``status_timeout`` s, or a status of the wrong size.
@@ -44,7 +46,7 @@ from ptint_drake.hardware.link import (
     unpack_status,
     url_warning,
 )
-from ptint_drake.robot import nominal_plant
+from ptint_drake.robot import actuator_effort_limits, nominal_plant
 from ptint_drake.worlds.registry import objects_of, schedule_of
 
 
@@ -77,6 +79,7 @@ class DriveRecord:
     gaps: int = 0  # ticks skipped between two statuses (lost or not sent)
     commands: int = 0
     compute: list = field(default_factory=list)  # s wall: status received → command sent
+    clipped: int = 0  # commands clipped to the actuators' effort limits
     first_t: Optional[float] = None
     last_t: Optional[float] = None
     t: list = field(default_factory=list)
@@ -124,6 +127,9 @@ def run_drive(
     """Answer the hardware's statuses until the scenario's end (module docstring), recording
     into ``record``; returns the URL used."""
     diagram, _, n = DriveDiagram(scenario)
+    # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``): the
+    # hardware side rejects a torque beyond an effort limit as a fault
+    limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
     simulator = Simulator(diagram)
     config = copy.copy(scenario.simulator)
     config.target_realtime_rate = 0.0  # the hardware's status paces the drive
@@ -190,6 +196,9 @@ def run_drive(
                 simulator.AdvanceTo(t + EVENT_STEP)
             state_in.FixValue(context, np.concatenate([q, v]))
             tau = np.array(out.Eval(context), dtype=float)
+            if limits is not None and np.any(np.abs(tau) > limits):
+                record.clipped += 1
+                tau = np.clip(tau, -limits, limits)
             last_q, last_v = q, v
             answer = pack_command(utime, tau)
             sent = endpoint.publish(answer)
@@ -221,6 +230,7 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "first_t": record.first_t,
         "last_t": record.last_t,
         "compute_ms": spread(record.compute, 1e3),
+        "commands_clipped": record.clipped,
     }
 
 
