@@ -62,9 +62,12 @@ class Endpoint:
         self.lcm.Subscribe(listen, lambda data: self.inbox.append((time.perf_counter(), bytes(data))))
 
     def publish(self, data: bytes) -> float:
-        """Publish ``data``; returns the wall time (``perf_counter``) it was sent."""
+        """Publish ``data``; returns the wall time (``perf_counter``) it was handed to LCM (taken
+        before the call: on a busy machine the receiver may run, and answer, before ``Publish``
+        returns to this process)."""
+        sent = time.perf_counter()
         self.lcm.Publish(self.publish_channel, data)
-        return time.perf_counter()
+        return sent
 
     def poll(self, timeout_s: float) -> list[tuple[float, bytes]]:
         """Messages received within ``timeout_s`` (0: only those waiting), oldest first."""
