@@ -122,3 +122,30 @@ def test_realtime_late_ticks_then_timeout():
             break
     # 50 periods in a row without a command = the 50 ms command timeout
     assert session.record.late == k == 50 and session.record.fault_kind == "command timeout"
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (("drive", "conveyor_pick_place"), "the pick world over LCM is not supported yet"),
+        (("hardware", "curve_camera"), "measurement: a camera over LCM"),
+        (("hardware", "curve_b075_tf15", "--drop-status", "1.5"), "--drop-status: must be in [0, 1)"),
+        (("drive", "curve_b075_tf15", "--status-timeout", "0"), "--status-timeout: must be > 0"),
+        (
+            (
+                "hardware",
+                "curve_b075_tf15",
+                "--set",
+                "multibody.time_step=0.001",
+                "--set",
+                "controller.control_period=0.002",
+            ),
+            "multibody.time_step: the hardware",
+        ),
+    ],
+)
+def test_bad_input_is_one_line(ptint_here, args, words, tmp_path):
+    """Bad input: exit 2, one line naming the field, nothing written, no LCM traffic."""
+    out = ptint_here(*args, "--out", tmp_path / "out")
+    assert out.returncode == 2 and words in out.stderr, out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1 and not (tmp_path / "out").exists()
