@@ -6,7 +6,7 @@ multicast stays on this machine; no packet can reach the host's own network).
 namespace, ``lo`` up, the multicast route ``224.0.0.0/4 dev lo``).  Tests that need two
 processes call ``require_netns()``, which does not skip silently: without a namespace it warns
 with the reason and skips, and the single-process in-memory tests (``memq://``,
-tests/unit/test_hardware_link.py) still run the same checks.
+tests/unit/test_lcm_checks.py) still run the same checks.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The hardware link's checks in one process over an in-memory LCM (``memq://``): what the
-two-process tests (tests/e2e/test_hardware_link.py) exercise across a private namespace, here
+two-process tests (tests/e2e/test_lcm_two_processes.py) exercise across a private namespace, here
 without any network, so they run wherever a namespace cannot be made."""
 
 from __future__ import annotations

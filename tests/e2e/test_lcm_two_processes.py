@@ -98,7 +98,7 @@ def test_hardware_killed_stops_the_drive(tmp_path):
 @pytest.mark.parametrize("mode, words", [("nan", "non-finite torque")])
 def test_bad_commands_rejected_and_held(tmp_path, mode, words):
     """A NaN torque: rejected, reported, the arm held (over-limit torques and a wrong size:
-    the same path, tests/unit/test_hardware_link.py with memq://; bad_drive.py has them too)."""
+    the same path, tests/unit/test_lcm_checks.py with memq://; bad_drive.py has them too)."""
     out = run_plan(
         [
             {
