@@ -19,12 +19,16 @@ Torques beyond the actuators' effort limits are clipped to them (``limits.satura
 default: where ``ptint run``'s station saturates; the hardware side rejects them as a fault).
 It ends when it has answered the last tick
 (t ≥ duration − 1.5 T), or with ``DriveFault`` (one line): no status within the start-up timeout,
-no status for ``status_timeout`` s, or a status of the wrong size.
+no status for ``status_timeout`` s, a status of the wrong size, or a status whose applied torque
+(``joint_torque_commanded``) is none of the drive's recent commands — the hardware took a second
+sender's command (the drive's check beside the hardware's own, ``command_link``); the drive then
+sends a NaN command, which the hardware's checks reject by holding the arm.
 """
 
 from __future__ import annotations
 
 import copy
+from collections import deque
 import dataclasses
 import time
 from dataclasses import dataclass, field
@@ -43,6 +47,7 @@ from ptint_drake.hardware.link import (
     Endpoint,
     pack_command,
     spread,
+    status_torque,
     unpack_status,
     url_warning,
 )
@@ -53,6 +58,8 @@ from ptint_drake.worlds.registry import objects_of, schedule_of
 # s: after integrating σ to a status's time t, a step this short takes the controller's events at t
 # (a segment's start stores s(t0)) with that status's state, as the one-process run's do
 EVENT_STEP = 1e-9
+STOP_REPEATS = 3  # NaN commands sent to stop a hardware that took a second sender's command
+RECENT = 200  # commands remembered for the check of the applied torque (real time applies late ones)
 
 
 class DriveFault(Exception):
@@ -143,6 +150,10 @@ def run_drive(
     answered: Optional[int] = None
     answer = b""
     last_q = last_v = None
+    # what this drive sent lately (and the zero torque of the start): a status whose applied
+    # torque is none of them shows a second sender's command taken by the hardware
+    recent: deque = deque(maxlen=RECENT)
+    sent_torques = {tuple(np.zeros(n))}
     end = settings.duration - 1.5 * settings.period
     last_seen = time.perf_counter()
     while True:
@@ -184,6 +195,18 @@ def run_drive(
             if answered is not None:
                 record.gaps += max(0, int(round((utime - answered) * 1e-6 / settings.period)) - 1)
             t = utime * 1e-6
+            applied = status_torque(data)
+            if tuple(applied) not in sent_torques:
+                # the hardware obeys someone else: make its checks hold the arm (a command it must
+                # reject, sent a few times: LCM may drop one), then stop
+                stop = pack_command(utime, np.full(n, np.nan))
+                for _ in range(STOP_REPEATS):
+                    endpoint.publish(stop)
+                raise DriveFault(
+                    f"the hardware applied torques this drive did not send, at t = {t:.3f} s "
+                    f"({np.array2string(applied, precision=3)}): a second sender on {COMMAND_CHANNEL}; "
+                    f"sent a NaN command so that the hardware holds the arm, and stopped commanding"
+                )
             if answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
                 state_in.FixValue(context, np.concatenate([q, v]))
                 context.SetTime(t)
@@ -201,6 +224,10 @@ def run_drive(
                 tau = np.clip(tau, -limits, limits)
             last_q, last_v = q, v
             answer = pack_command(utime, tau)
+            if len(recent) == recent.maxlen and recent.count(recent[0]) == 1:
+                sent_torques.discard(recent[0])
+            recent.append(tuple(tau))
+            sent_torques.add(recent[-1])
             sent = endpoint.publish(answer)
             answered = utime
             record.commands += 1

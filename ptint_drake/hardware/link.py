@@ -107,6 +107,12 @@ def unpack_status(data: bytes, n: int) -> tuple[int, np.ndarray, np.ndarray]:
     return m.utime, np.array(m.joint_position_measured), np.array(m.joint_velocity_estimated)
 
 
+def status_torque(data: bytes) -> np.ndarray:
+    """``joint_torque_commanded`` of a (checked) status: the torque the hardware applied over its
+    last step (N·m)."""
+    return np.array(lcmt_iiwa_status.decode(data).joint_torque_commanded, dtype=float)
+
+
 def pack_command(utime: int, tau: np.ndarray) -> bytes:
     """A torque-only ``lcmt_iiwa_command`` answering the status of ``utime``: τ (N·m)."""
     m = lcmt_iiwa_command()

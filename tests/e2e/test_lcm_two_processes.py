@@ -136,17 +136,19 @@ def test_second_sender_detected(tmp_path):
             },
         ]
     )
-    assert out["hw"]["rc"] == 1
-    assert "second sender" in one_line(out["hw"]["stderr"])
+    # found by the hardware (two commands for one status) or, when LCM dropped one of them, by
+    # the drive (a torque applied that it did not send), which then sends a NaN command so that
+    # the hardware's checks hold the arm
+    assert out["hw"]["rc"] == 1 and out["drive"]["rc"] == 1
+    hw_line, drive_line = one_line(out["hw"]["stderr"]), one_line(out["drive"]["stderr"])
+    assert "second sender" in hw_line or "second sender" in drive_line
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     first = int(out["rogue"]["stdout"].split()[1]) * 1e-6  # the stamp of the rogue's first command
-    # detected at the first of the rogue's commands the hardware handles: pydrake's DrakeLcm keeps
-    # Drake's subscription queue (its Python Subscribe returns no handle to deepen it), so of two
-    # commands arriving while the hardware steps its plant one may be discarded by LCM before the
-    # checks see it; 1 to 19 ticks after the rogue's first stamp in 8 runs on a busy 2-core machine
-    assert link["fault_kind"] == "second sender", link["fault"]
+    # pydrake's DrakeLcm keeps Drake's subscription queue (its Python Subscribe returns no handle to
+    # deepen it): of two commands arriving while the hardware steps its plant, LCM may discard one
+    assert link["fault_kind"] in ("second sender", "bad command"), link["fault"]
     assert first - 1e-9 <= link["fault_time"] <= first + 25 * PERIOD
-    assert out["drive"]["rc"] == 1  # the hardware went silent
+    assert link["hold"]["speed_at_end"] < 0.05
 
 
 def test_dropped_status_completes(tmp_path):
