@@ -233,7 +233,7 @@ def cmd_drive(args: argparse.Namespace) -> int:
         url = run_drive(scenario, settings, record, url=args.url, warn=_warn)
     except DriveFault as exc:
         fault = str(exc)
-    summary = drive_summary(record, settings, url or "default") | {"fault": fault}
+    summary = drive_summary(record, settings, record.url or url or "default") | {"fault": fault}
     with staged_output(Path(out)) as stage:
         save_series(stage / "drive_series.npz", drive_series(record))
         write_json_atomic(stage / "drive.json", summary)

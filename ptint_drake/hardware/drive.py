@@ -87,6 +87,7 @@ class DriveRecord:
     commands: int = 0
     compute: list = field(default_factory=list)  # s wall: status received → command sent
     clipped: int = 0  # commands clipped to the actuators' effort limits
+    url: Optional[str] = None  # the LCM URL in use
     first_t: Optional[float] = None
     last_t: Optional[float] = None
     t: list = field(default_factory=list)
@@ -144,6 +145,7 @@ def run_drive(
     context = simulator.get_mutable_context()
     state_in, out = diagram.get_input_port(0), diagram.get_output_port(0)
     endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL)
+    record.url = endpoint.url
     risk = url_warning(endpoint.url)
     if risk:
         warn(risk)
