@@ -24,10 +24,11 @@ def ptint(*args: str) -> list[str]:
     return [sys.executable, "-m", "ptint_drake.cli", *args]
 
 
-def run_plan(plan: list[dict], timeout: float = 120.0) -> dict:
-    """Each process of ``plan`` (``tests/lcm_link/pair.py``) inside one private namespace."""
+def run_plan(plan: list[dict], cwd: Path, timeout: float = 120.0) -> dict:
+    """Each process of ``plan`` (``tests/lcm_link/pair.py``) inside one private namespace, in the
+    folder ``cwd`` (a command's default out/ lands there)."""
     require_netns()
-    done = run_in_netns([sys.executable, str(HERE / "pair.py"), json.dumps(plan)], timeout=timeout)
+    done = run_in_netns([sys.executable, str(HERE / "pair.py"), json.dumps(plan)], timeout=timeout, cwd=cwd)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -49,7 +50,8 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
                 "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
             },
             {"name": "drive", "delay": 1.0, "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))},
-        ]
+        ],
+        tmp_path,
     )
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
@@ -71,7 +73,8 @@ def test_drive_killed_holds_the_arm(tmp_path):
         [
             {"name": "hw", "argv": ptint("hardware", CURVE, "--out", str(tmp_path / "hw"))},
             {"name": "drive", "argv": ptint("drive", CURVE), "kill_when": ["hw", " 30 %"]},
-        ]
+        ],
+        tmp_path,
     )
     assert out["drive"]["killed"] is not None and out["hw"]["rc"] == 1
     assert "command timeout at t" in one_line(out["hw"]["stderr"])
@@ -86,7 +89,8 @@ def test_hardware_killed_stops_the_drive(tmp_path):
         [
             {"name": "hw", "argv": ptint("hardware", CURVE), "kill_when": ["hw", " 30 %"]},
             {"name": "drive", "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))},
-        ]
+        ],
+        tmp_path,
     )
     assert out["hw"]["killed"] is not None and out["drive"]["rc"] == 1
     assert "no status from the hardware for 0.5 s" in one_line(out["drive"]["stderr"])
@@ -110,7 +114,8 @@ def test_bad_commands_rejected_and_held(tmp_path, mode, words):
                 "argv": [sys.executable, str(HERE / "bad_drive.py"), mode, "0.2", "3"],
                 "timeout": 40.0,
             },
-        ]
+        ],
+        tmp_path,
     )
     assert out["hw"]["rc"] == 1
     assert words in one_line(out["hw"]["stderr"])
@@ -134,7 +139,8 @@ def test_second_sender_detected(tmp_path):
                 "argv": [sys.executable, str(HERE / "bad_drive.py"), "rogue", "0.3", "3"],
                 "timeout": 40.0,
             },
-        ]
+        ],
+        tmp_path,
     )
     # found by the hardware (two commands for one status) or, when LCM dropped one of them, by
     # the drive (a torque applied that it did not send), which then sends a NaN command so that
@@ -176,7 +182,8 @@ def test_dropped_status_completes(tmp_path):
                 "name": "drive",
                 "argv": ptint("drive", CURVE, "--set", "duration=1.0", "--set", "interceptions[0].tf=0.8"),
             },
-        ]
+        ],
+        tmp_path,
     )
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
@@ -188,15 +195,16 @@ def test_dropped_status_completes(tmp_path):
     )
 
 
-def test_drive_without_hardware():
+def test_drive_without_hardware(tmp_path):
     """``ptint drive`` with nobody publishing status: one line after its start-up timeout, exit 1."""
     out = run_plan(
         [
             {
                 "name": "drive",
-                "argv": ptint("drive", CURVE, "--startup-timeout", "1", "--out", "/tmp/ptint_lcm_unused"),
+                "argv": ptint("drive", CURVE, "--startup-timeout", "1", "--out", str(tmp_path / "dr")),
             }
-        ]
+        ],
+        tmp_path,
     )
     assert out["drive"]["rc"] == 1
     assert "within the start-up timeout of 1 s" in one_line(out["drive"]["stderr"])
@@ -208,7 +216,8 @@ def test_realtime_run_completes(tmp_path):
         [
             {"name": "hw", "argv": ptint("hardware", CURVE, "--quiet", "--out", str(tmp_path / "hw"))},
             {"name": "drive", "argv": ptint("drive", CURVE)},
-        ]
+        ],
+        tmp_path,
     )
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
