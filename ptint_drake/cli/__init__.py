@@ -9,6 +9,8 @@
     ptint robust NAME_OR_FILE --samples N [--seed S] [--workers W | --dask ADDRESS] [--out DIR]
                                             Monte Carlo
     ptint bench [SCENARIO ...]              speed and accuracy benchmark, JSON on stdout
+    ptint hardware NAME_OR_FILE [--lockstep]  the simulated world as hardware over LCM
+    ptint drive NAME_OR_FILE                the controller alone over LCM (docs/hardware.md)
 
 ``--set key=value`` (repeatable) overrides any scenario field, list items
 included, e.g. ``--set controller.switching=sign --set 'interceptions[0].tf=1.2'``;
@@ -23,6 +25,7 @@ import os
 import sys
 
 from ptint_drake.cli import options as opt
+from ptint_drake.cli.hardware import add_hardware_parsers
 from ptint_drake.cli.runs import cmd_diagram, cmd_list, cmd_paper, cmd_run
 from ptint_drake.cli.studies import cmd_bench, cmd_compare, cmd_robust, cmd_study, cmd_sweep, cmd_tune
 from ptint_drake.controllers import CONTROLLERS, describe
@@ -58,6 +61,7 @@ def make_parser() -> argparse.ArgumentParser:
     _add_design_parsers(sub)
     _add_camera_parsers(sub)
     _add_bench_parser(sub)
+    add_hardware_parsers(sub)
     return parser
 
 

@@ -1,0 +1,253 @@
+"""The hardware path's commands (issue 35, docs/hardware.md): ``ptint hardware`` (the simulated
+world as the hardware, ``hardware.sim_hardware``) and ``ptint drive`` (the controller alone,
+``hardware.drive``), two processes over LCM; their parsers and option types."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Callable
+
+from ptint_drake.cli.options import OptionError, scenario_and_out
+from ptint_drake.cli.runs import progress
+
+SET_HELP = "override a scenario field (repeatable), as for ptint run; use the same on both sides"
+
+
+def seconds(flag: str, allow_zero: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite time in s, > 0 (or >= 0 with ``allow_zero``)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise OptionError(f"{flag}: expected a number of seconds, got {text!r}") from None
+        if not (math.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
+            raise OptionError(f"{flag}: must be {'>= 0' if allow_zero else '> 0'} and finite, got {text}")
+        return value
+
+    return parse
+
+
+def fraction(flag: str, top_open: bool = True) -> Callable[[str], float]:
+    """An argparse type: a number in [0, 1) (``top_open``) or (0, 1]."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise OptionError(f"{flag}: expected a number, got {text!r}") from None
+        ok = 0.0 <= value < 1.0 if top_open else 0.0 < value <= 1.0
+        if not ok:
+            raise OptionError(f"{flag}: must be in {'[0, 1)' if top_open else '(0, 1]'}, got {text}")
+        return value
+
+    return parse
+
+
+def add_hardware_parsers(sub) -> None:
+    """``hardware`` and ``drive``."""
+    hw = sub.add_parser(
+        "hardware",
+        help="the simulated world as hardware over LCM (with `ptint drive`; docs/hardware.md)",
+        description="Run the scenario's world alone as the hardware: a discrete plant at the control period "
+        "publishing the arm's status (lcmt_iiwa_status on IIWA_STATUS) and applying the torque "
+        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive`; a fault "
+        "(no command, a bad command, a second sender) holds the arm and ends the run with its "
+        "reason. Writes metrics.json (the verdict, and a hardware block with the latency) and "
+        "series.npz. Exit 0 ok, 1 missed or a fault, 2 bad input.",
+    )
+    hw.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
+    hw.add_argument(
+        "--lockstep",
+        action="store_true",
+        help="each plant step waits for its command (the accuracy mode); default: real time",
+    )
+    hw.add_argument(
+        "--realtime-rate",
+        type=seconds("--realtime-rate"),
+        default=1.0,
+        help="without --lockstep: simulated s per wall s (below 1 where the machine falls behind)",
+    )
+    hw.add_argument("--url", help="LCM URL (default: LCM_DEFAULT_URL or Drake's, host-only ttl=0)")
+    hw.add_argument(
+        "--command-timeout",
+        type=seconds("--command-timeout"),
+        default=0.25,
+        help="s without a command before the arm is held (default 0.25)",
+    )
+    hw.add_argument(
+        "--startup-timeout",
+        type=seconds("--startup-timeout"),
+        default=10.0,
+        help="s to wait for the first command (default 10)",
+    )
+    hw.add_argument(
+        "--hold-time",
+        type=seconds("--hold-time"),
+        default=0.5,
+        help="simulated s the arm is held after a fault before the run ends (default 0.5)",
+    )
+    hw.add_argument(
+        "--drop-status",
+        type=fraction("--drop-status"),
+        default=0.0,
+        help="a test option: the fraction of status messages not sent (default 0)",
+    )
+    hw.add_argument("--seed", type=int, default=0, help="seed of --drop-status")
+    hw.add_argument("--out", help="output folder (default out/hardware_NAME)")
+    hw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
+    hw.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    hw.set_defaults(func=cmd_hardware)
+
+    dr = sub.add_parser(
+        "drive",
+        help="the controller alone over LCM, driving `ptint hardware` or a robot (docs/hardware.md)",
+        description="Run the scenario's targets and controller alone: answer each lcmt_iiwa_status on "
+        "IIWA_STATUS with a torque-only lcmt_iiwa_command on IIWA_COMMAND. Writes drive.json "
+        "(what was received and sent) and drive_series.npz. Exit 0 when the scenario's end was "
+        "reached, 1 when the status stopped (one line), 2 bad input.",
+    )
+    dr.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
+    dr.add_argument("--url", help="LCM URL (default: LCM_DEFAULT_URL or Drake's, host-only ttl=0)")
+    dr.add_argument(
+        "--status-timeout",
+        type=seconds("--status-timeout"),
+        default=0.5,
+        help="s without a status before the drive stops (default 0.5)",
+    )
+    dr.add_argument(
+        "--startup-timeout",
+        type=seconds("--startup-timeout"),
+        default=10.0,
+        help="s to wait for the first status (default 10)",
+    )
+    dr.add_argument("--out", help="output folder (default out/drive_NAME)")
+    dr.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
+    dr.add_argument("--quiet", action="store_true", help="accepted like the other commands")
+    dr.set_defaults(func=cmd_drive)
+
+
+def _warn(message: str) -> None:
+    print(f"ptint: warning: {message}", file=sys.stderr)
+
+
+def cmd_hardware(args: argparse.Namespace) -> int:
+    """``ptint hardware``: the world as hardware; exit 0 ok, 1 missed or a fault."""
+    from ptint_drake.hardware.command_link import LinkFault, LinkSettings  # noqa: PLC0415
+    from ptint_drake.hardware.sim_hardware import check_link_scenario, link_period, run_hardware  # noqa: PLC0415
+
+    loaded, out = scenario_and_out(args, prefix="hardware_")
+    scenario = loaded.scenario
+    check_link_scenario(scenario)
+    settings = LinkSettings(
+        period=link_period(scenario),
+        duration=scenario.duration,
+        lockstep=args.lockstep,
+        command_timeout=args.command_timeout,
+        startup_timeout=args.startup_timeout,
+        hold_time=args.hold_time,
+        realtime_rate=args.realtime_rate,
+        drop_status=args.drop_status,
+        seed=args.seed,
+    )
+    try:
+        metrics = run_hardware(
+            scenario,
+            settings,
+            out,
+            url=args.url,
+            progress=None if args.quiet else progress(f"hardware {scenario.name}"),
+            warn=_warn,
+        )
+    except LinkFault as exc:
+        print(f"ptint: error: hardware: {exc} (nothing written)", file=sys.stderr)
+        return 1
+    link = metrics["hardware"]
+    rtt, period = link["round_trip_ms"], link["achieved_period_ms"]
+    lines = [f"hardware: {link['mode']}, period {link['period'] * 1e3:g} ms, {link['ticks']} ticks"]
+    if rtt:
+        lines.append(f"round trip {rtt['median']:.3f} ms median, {rtt['p99']:.3f} ms p99")
+    if period:
+        lines.append(f"achieved period {period['median']:.3f} ms median, {period['p99']:.3f} ms p99")
+    lines.append(
+        f"statuses dropped {link['statuses_dropped']}, re-sent {link['status_resends']}, ticks late "
+        f"{link['ticks_late']}"
+    )
+    print("; ".join(lines))
+    for i, seg in enumerate(metrics["segments"]):
+        print(
+            f"{scenario.name} segment {i}: e(tf) = {seg['e_tf_norm'] * 1e3:.4g} mm, hold max = "
+            f"{seg['e_hold_max_norm'] * 1e3:.4g} mm"
+            if seg.get("e_hold_max_norm") is not None
+            else f"{scenario.name} segment {i}: not reached"
+        )
+    if link["fault"]:
+        hold = link.get("hold", {})
+        settled = hold.get("settled_s_after_fault")
+        print(
+            f"ptint: error: hardware: {link['fault']}; the arm was held"
+            + (
+                f" (joint speeds below {hold['settled_below']} rad/s {settled:.3f} s after the fault)"
+                if settled is not None
+                else " (joint speeds did not settle)"
+            )
+            + f"; wrote {out}/",
+            file=sys.stderr,
+        )
+        return 1
+    if metrics["status"] != "ok":
+        print(f"{scenario.name}: {metrics['status'].upper()} ({'; '.join(metrics['reasons'])}); wrote {out}/")
+        return 1
+    print(f"{scenario.name}: ok (every segment meets the criteria); wrote {out}/")
+    return 0
+
+
+def cmd_drive(args: argparse.Namespace) -> int:
+    """``ptint drive``: the controller alone; exit 0 at the scenario's end, 1 when it stopped."""
+    from ptint_drake.hardware.drive import (
+        DriveFault,
+        DriveRecord,
+        DriveSettings,
+        drive_series,  # noqa: PLC0415
+        drive_summary,
+        run_drive,
+    )
+    from ptint_drake.hardware.sim_hardware import check_link_scenario, link_period  # noqa: PLC0415
+    from ptint_drake.outputs import save_series, staged_output, write_json_atomic  # noqa: PLC0415
+
+    loaded, out = scenario_and_out(args, prefix="drive_")
+    scenario = loaded.scenario
+    check_link_scenario(scenario)
+    settings = DriveSettings(
+        period=link_period(scenario),
+        duration=scenario.duration,
+        startup_timeout=args.startup_timeout,
+        status_timeout=args.status_timeout,
+    )
+    record = DriveRecord()
+    fault, url = None, args.url
+    try:
+        url = run_drive(scenario, settings, record, url=args.url, warn=_warn)
+    except DriveFault as exc:
+        fault = str(exc)
+    summary = drive_summary(record, settings, record.url or url or "default") | {"fault": fault}
+    with staged_output(Path(out)) as stage:
+        save_series(stage / "drive_series.npz", drive_series(record))
+        write_json_atomic(stage / "drive.json", summary)
+    if fault:
+        print(f"ptint: error: drive: {fault}", file=sys.stderr)
+        return 1
+    compute = summary["compute_ms"]
+    print(
+        f"drive: answered {record.commands} statuses (t = {record.first_t:.3f} .. {record.last_t:.3f} s), "
+        f"{record.repeats} repeated, {record.gaps} ticks missing; compute "
+        + (f"{compute['median']:.3f} ms median, {compute['p99']:.3f} ms p99" if compute else "n/a")
+        + f"; wrote {out}/"
+    )
+    return 0
+
+
+__all__ = ["add_hardware_parsers", "cmd_drive", "cmd_hardware"]

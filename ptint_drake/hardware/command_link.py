@@ -1,0 +1,324 @@
+"""The hardware side's controller slot: the arm's status out, torque commands in, over LCM, and
+a safe stop on every fault.
+
+``CommandLink`` is a discrete Drake system at the control period T, placed in the world's
+controller slot in place of the controller and its zero-order hold (``ptint hardware`` puts it
+there through the plugin path, ``controllers.plugin``).  At each tick t_k it reads the plant's
+[q; v], publishes them as an ``lcmt_iiwa_status`` stamped t_k, takes the ``lcmt_iiwa_command``
+answering that status (``HardwareSession.exchange``) and holds its torque until the next tick.
+The plant is discrete with step T, and Drake's discrete ``MultibodyPlant`` takes its step before
+the other discrete updates of the same time (measured on Drake 1.51.1 and 1.58: a zero-order hold
+at t_k samples the arm after the plant's step at t_k), so the status of t_k is the arm after that
+step and its command acts over the next one — the same timing as ``ptint run`` with
+``controller.control_period`` = T on a discrete plant (``controllers.hold``).
+
+- **Lockstep** (``lockstep``): each tick waits for its command (re-sending the status every
+  ``resend`` s of wall time, so a lost status costs time, not the run), up to ``command_timeout``
+  of wall time.
+- **Real time**: the simulator paces the ticks; each tick waits at most ``budget`` × T for its
+  command, otherwise the previous torque stays (``late``); ``command_timeout`` / T ticks in a row
+  without a command is the timeout.
+
+Every command passes the checks before it reaches the plant (``HardwareSession._check``): its
+size, finite torques within the actuators' effort limits, and one command per status — LCM
+carries no sender identity, so a second sender shows up as a command for a status nobody asked
+about, two different commands for one status, or a time stamp that goes backwards.  A failed
+check or a timeout is a *fault*: the link stops publishing status, and the arm is held for
+``hold_time`` s (a position hold at the joint angles of the fault with gravity compensation,
+computed from the arm's model — the driver side may use its model; damping alone does not hold
+the RV-M1), then the run ends with ``LinkFault`` naming it.
+
+=============  ======  ================================================
+port           size    meaning
+=============  ======  ================================================
+``state``      nq+nv   input: the plant's [q; v]
+``target``     9       input: unused (the controller slot's protocol)
+``actuation``  nu      output: the torque taken at the last tick (or the hold's)
+=============  ======  ================================================
+"""
+
+from __future__ import annotations
+
+import time
+from contextvars import ContextVar
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from ptint_drake.hardware.link import Endpoint, pack_status, unpack_command, utime_of
+from ptint_drake.robot import actuator_effort_limits
+
+HOLD_OMEGA = 40.0  # rad/s: the hold's natural frequency (critically damped); settles in ~0.15 s
+SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
+
+
+class LinkFault(Exception):
+    """A fault of the link (the message is the one-line reason)."""
+
+
+@dataclass
+class LinkSettings:
+    """The hardware side's timing and checks (``ptint hardware``'s options)."""
+
+    period: float  # s: T, the tick of the link and the plant's step
+    duration: float  # s of simulated time of the scenario
+    lockstep: bool = True
+    command_timeout: float = 0.25  # s of wall time without a command (see the module docstring)
+    startup_timeout: float = 10.0  # s of wall time for the first command
+    resend: float = 0.005  # s: lockstep re-sends an unanswered status after this wall time
+    hold_time: float = 0.5  # s simulated: the hold after a fault before the run ends
+    budget: float = 0.8  # real time: the part of T a tick waits for its command
+    realtime_rate: float = 1.0
+    drop_status: float = 0.0  # a test option: the fraction of status messages not sent
+    seed: int = 0
+
+
+@dataclass
+class LinkRecord:
+    """What the hardware side measured of the link."""
+
+    rtt: list = field(default_factory=list)  # s wall: status published → its command received
+    tick_wall: list = field(default_factory=list)  # perf_counter of each tick's first publish
+    tick_time: list = field(default_factory=list)  # simulated t of each tick
+    statuses: int = 0  # status messages published (re-sends included)
+    dropped: int = 0  # status messages not sent (``drop_status``)
+    resends: int = 0
+    accepted: int = 0
+    duplicates: int = 0  # a command repeated for its status (an answer to a re-sent status)
+    late: int = 0  # real time: ticks whose command did not arrive within the budget
+    late_commands: int = 0  # commands that arrived after their tick
+    fault: Optional[str] = None
+    fault_time: Optional[float] = None
+    fault_kind: Optional[str] = None
+
+
+ACTIVE: ContextVar[Optional["HardwareSession"]] = ContextVar("ptint_hardware_session", default=None)
+
+
+class HardwareSession:
+    """The hardware side of the link: publishes status, takes and checks commands, records the
+    timing (``record``).  ``limits``: the actuators' effort limits (N·m, actuator order)."""
+
+    def __init__(self, endpoint: Endpoint, n: int, limits: np.ndarray, settings: LinkSettings):
+        self.endpoint, self.n, self.limits, self.s = endpoint, n, np.asarray(limits, float), settings
+        self.record = LinkRecord()
+        self._rng = np.random.default_rng(settings.seed)
+        self._answered: Optional[int] = None  # utime of the last status answered
+        self._answered_tau: Optional[np.ndarray] = None
+        self._pending: Optional[int] = None
+        self._sent: dict[int, float] = {}  # utime → wall time of its first publish
+        self._consecutive_late = 0
+        self._after_handshake = False
+
+    # -- the protocol -------------------------------------------------------------------------
+    def _publish(self, data: bytes) -> float:
+        if self.s.drop_status > 0 and self._rng.random() < self.s.drop_status:
+            self.record.dropped += 1
+            return time.perf_counter()
+        self.record.statuses += 1
+        return self.endpoint.publish(data)
+
+    def _fail(self, t: float, kind: str, message: str) -> None:
+        if self.record.fault is None:
+            self.record.fault, self.record.fault_time, self.record.fault_kind = message, t, kind
+
+    def _check(self, t: float, data: bytes, t_recv: float) -> None:
+        """One received command against the checks (module docstring); a fault or its use."""
+        try:
+            utime, tau = unpack_command(data, self.n)
+        except ValueError as exc:
+            return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {exc}")
+        if not np.all(np.isfinite(tau)):
+            return self._fail(
+                t,
+                "bad command",
+                f"command rejected at t = {t:.3f} s: a non-finite torque {np.array2string(tau, precision=3)}",
+            )
+        over = np.abs(tau) > self.limits * (1 + 1e-9)
+        if np.any(over):
+            j = int(np.argmax(over))
+            return self._fail(
+                t,
+                "bad command",
+                f"command rejected at t = {t:.3f} s: joint {j} torque "
+                f"{tau[j]:.3g} N·m beyond its limit {self.limits[j]:.3g} N·m",
+            )
+        if utime == self._answered:
+            if np.array_equal(tau, self._answered_tau):
+                self.record.duplicates += 1
+                return None
+            return self._fail(
+                t,
+                "second sender",
+                f"two different commands for the status of t = "
+                f"{utime * 1e-6:.3f} s at t = {t:.3f} s: a second sender "
+                f"on {self.endpoint.listen}",
+            )
+        if utime == self._pending:
+            self._answered, self._answered_tau = utime, tau
+            self.record.accepted += 1
+            self.record.rtt.append(t_recv - self._sent[utime])
+            return None
+        if self._answered is not None and utime < self._answered:
+            return self._fail(
+                t,
+                "second sender",
+                f"command time stamps went backwards at t = {t:.3f} s "
+                f"({utime * 1e-6:.3f} s after {self._answered * 1e-6:.3f} s):"
+                f" a second sender on {self.endpoint.listen} or a "
+                f"restarted controller",
+            )
+        if utime in self._sent and (self._pending is None or utime < self._pending):
+            self.record.late_commands += 1  # real time: an answer after its tick
+            return None
+        return self._fail(
+            t,
+            "second sender",
+            f"a command for t = {utime * 1e-6:.6g} s that no status asked "
+            f"for, at t = {t:.3f} s: a second sender on {self.endpoint.listen}",
+        )
+
+    def _wait(self, t: float, utime: int, wait: float, data: bytes, resend: bool) -> bool:
+        """Wait up to ``wait`` s (wall) for the command of ``utime``; True when it came."""
+        deadline = time.perf_counter() + wait
+        last_sent = time.perf_counter()
+        while True:
+            now = time.perf_counter()
+            step = min(deadline - now, self.s.resend) if resend else deadline - now
+            for t_recv, message in self.endpoint.poll(max(step, 0.0)):
+                self._check(t, message, t_recv)
+            if self.record.fault is not None:
+                return False
+            if self._answered == utime:
+                return True
+            now = time.perf_counter()
+            if now >= deadline:
+                return False
+            if resend and now - last_sent >= self.s.resend:
+                self.record.resends += 1
+                last_sent = self._publish(data)
+
+    def handshake(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
+        """Before the simulation starts: the status of the start pose at t = 0 until its command
+        comes (a ``LinkFault`` after ``startup_timeout``), so that the controller may start
+        second and starts from the arm's pose; the first tick then sends the status of t = 0
+        after the plant's first step (a second sample of t = 0, answered anew)."""
+        data = pack_status(0.0, q, v, tau)
+        self._pending = 0
+        self._sent[0] = self._publish(data)
+        if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True):
+            if self.record.fault is not None:
+                raise LinkFault(self.record.fault)
+            raise LinkFault(
+                f"no command within the start-up timeout of {self.s.startup_timeout:g} s on "
+                f"{self.endpoint.url} (channel {self.endpoint.listen}): is `ptint drive` running?"
+            )
+        self.record.rtt.clear()  # the start-up wait is no round trip
+        self.record.accepted = 0
+        # the tick at t = 0 samples the arm after the plant's first step: a new status of t = 0
+        self._answered, self._answered_tau, self._after_handshake = None, None, True
+
+    def exchange(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> Optional[np.ndarray]:
+        """The tick at ``t``: publish the status, take its command (None: none, keep the last
+        torque; ``record.fault`` says when that is a fault)."""
+        utime = utime_of(t)
+        self.record.tick_time.append(t)
+        self.record.tick_wall.append(time.perf_counter())
+        if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
+            self._after_handshake = False
+            self.record.duplicates += len(self.endpoint.poll(0.0))
+        data = pack_status(t, q, v, tau)
+        self._pending = utime
+        self._sent[utime] = self._publish(data)
+        if len(self._sent) > 4096:
+            for key in sorted(self._sent)[:2048]:
+                del self._sent[key]
+        if self.s.lockstep:
+            if self._wait(t, utime, self.s.command_timeout, data, resend=True):
+                return self._answered_tau
+            self._fail(
+                t,
+                "command timeout",
+                f"command timeout at t = {t:.3f} s (no command for {self.s.command_timeout * 1e3:.0f} ms)",
+            )
+            return None
+        if self._wait(t, utime, self.s.budget * self.s.period / self.s.realtime_rate, data, resend=False):
+            self._consecutive_late = 0
+            return self._answered_tau
+        if self.record.fault is None:
+            self.record.late += 1
+            self._consecutive_late += 1
+            if self._consecutive_late * self.s.period / self.s.realtime_rate >= self.s.command_timeout:
+                self._fail(
+                    t,
+                    "command timeout",
+                    f"command timeout at t = {t:.3f} s (no command for {self._consecutive_late} periods)",
+                )
+        return None
+
+
+class CommandLink(LeafSystem):
+    """The hardware side's controller slot (module docstring), constructed by the plugin path
+    inside ``ptint hardware`` (the active ``HardwareSession``, ``ACTIVE``).  ``plant``: the arm's
+    model, for the hold's gravity compensation and its gains."""
+
+    def __init__(self, plant, end_effector: str, params: dict):
+        super().__init__()
+        session = ACTIVE.get()
+        if session is None:
+            raise RuntimeError("CommandLink runs inside `ptint hardware` only (no LCM session)")
+        self._session = session
+        self._plant = plant
+        self._scratch = plant.CreateDefaultContext()  # a work area for the model's terms, no state
+        nq, nv, nu = plant.num_positions(), plant.num_velocities(), plant.num_actuators()
+        self._nq, self._nv, self._nu = nq, nv, nu
+        self._B = plant.MakeActuationMatrix()
+        self._limits = actuator_effort_limits(plant)
+        self._state = self.DeclareVectorInputPort("state", nq + nv)
+        self.DeclareVectorInputPort("target", 9)
+        # discrete state: [τ (nu), mode (0 commanded, 1 held), t_fault, q_hold (nq)]
+        self._xd = self.DeclareDiscreteState(nu + 2 + nq)
+        self.DeclarePeriodicDiscreteUpdateEvent(session.s.period, 0.0, self._update)
+        self.DeclareVectorOutputPort(
+            "actuation",
+            nu,
+            self._calc_actuation,
+            prerequisites_of_calc={self.discrete_state_ticket(self._xd)},
+        )
+
+    def _calc_actuation(self, context, output) -> None:
+        output.SetFromVector(context.get_discrete_state(self._xd).value()[: self._nu])
+
+    def hold_torque(self, q: np.ndarray, v: np.ndarray, q_hold: np.ndarray) -> np.ndarray:
+        """Gravity compensation plus a critically damped position hold at ``q_hold`` (gains
+        from the model's mass matrix diagonal, ``HOLD_OMEGA``), in actuator order, clipped."""
+        plant, ctx = self._plant, self._scratch
+        plant.SetPositions(ctx, q)
+        plant.SetVelocities(ctx, np.zeros(self._nv))
+        m = np.diag(plant.CalcMassMatrix(ctx))
+        tau = -plant.CalcGravityGeneralizedForces(ctx) + m * (
+            HOLD_OMEGA**2 * (q_hold - q) - 2.0 * HOLD_OMEGA * v
+        )
+        return np.clip(self._B.T @ tau, -self._limits, self._limits)
+
+    def _update(self, context, discrete_state) -> None:
+        session, nu, nq = self._session, self._nu, self._nq
+        t = context.get_time()
+        x = self._state.Eval(context)
+        q, v = x[:nq], x[nq:]
+        xd = context.get_discrete_state(self._xd).value().copy()
+        tau, mode = xd[:nu], xd[nu]
+        if mode == 0.0 and t < session.s.duration - 0.5 * session.s.period:
+            command = session.exchange(t, q, v, tau)
+            if session.record.fault is not None:
+                mode, xd[nu + 1], xd[nu + 2 :] = 1.0, t, q
+            elif command is not None:
+                xd[:nu] = command
+        if mode == 1.0:
+            xd[nu] = 1.0
+            if t - xd[nu + 1] >= session.s.hold_time - 1e-9:
+                raise LinkFault(session.record.fault)
+            xd[:nu] = self.hold_torque(q, v, xd[nu + 2 :])
+        discrete_state.get_mutable_vector(self._xd).SetFromVector(xd)

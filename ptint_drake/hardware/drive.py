@@ -1,0 +1,273 @@
+"""``ptint drive``: the controller side alone — the scenario's targets and controller, answering
+each status of the arm with a torque command over LCM.
+
+``DriveDiagram`` is the scenario's controller in its slot (``controllers.AddControllerTo``, the
+same code path as ``ptint run``) between an exported input ``state`` (the arm's [q; v] from the
+last status) and an exported output ``actuation``, with the analytic targets (``TargetView``), no
+plant: the controller's kinematics come from the arm's model as written (``robot.nominal_plant``).
+The drive adds no hold: the hardware side samples and holds (``command_link``).
+
+``run_drive`` answers each status stamped t_k: the controller's own state (σ) is advanced to t_k
+with the previous status's [q; v] (``Simulator.AdvanceTo``, then ``EVENT_STEP`` further for the
+controller's events at t_k), as the one-process run's controller sees a discrete plant's state
+between two steps; then the state input is set to this status's [q; v] (initialized at the
+first status, so that the controller's start is the arm's), and the command
+stamped with the status's ``utime`` carries its output.  A status repeated (the hardware re-sends
+an unanswered one) gets the same command again; a second status of the same time with another
+state (the first tick after the hand-shake: the arm after the plant's first step) a new one.
+Torques beyond the actuators' effort limits are clipped to them (``limits.saturate``, the
+default: where ``ptint run``'s station saturates; the hardware side rejects them as a fault).
+It ends when it has answered the last tick
+(t ≥ duration − 1.5 T), or with ``DriveFault`` (one line): no status within the start-up timeout,
+no status for ``status_timeout`` s, a status of the wrong size, or a status whose applied torque
+(``joint_torque_commanded``) is none of the drive's recent commands — the hardware took a second
+sender's command (the drive's check beside the hardware's own, ``command_link``); the drive then
+sends a NaN command, which the hardware's checks reject by holding the arm.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections import deque
+import dataclasses
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import PassThrough
+
+from ptint_drake.config.schema import Scenario
+from ptint_drake.controllers import AddControllerTo, TargetView
+from ptint_drake.hardware.link import (
+    COMMAND_CHANNEL,
+    STATUS_CHANNEL,
+    Endpoint,
+    pack_command,
+    spread,
+    status_torque,
+    unpack_status,
+    url_warning,
+)
+from ptint_drake.robot import actuator_effort_limits, nominal_plant
+from ptint_drake.worlds.registry import objects_of, schedule_of
+
+
+# s: after integrating σ to a status's time t, a step this short takes the controller's events at t
+# (a segment's start stores s(t0)) with that status's state, as the one-process run's do
+EVENT_STEP = 1e-9
+STOP_REPEATS = 3  # NaN commands sent to stop a hardware that took a second sender's command
+RECENT = 200  # commands remembered for the check of the applied torque (real time applies late ones)
+
+
+class DriveFault(Exception):
+    """The drive stopped commanding (the message is the one-line reason)."""
+
+
+@dataclass
+class DriveSettings:
+    """The drive side's timeouts (``ptint drive``'s options)."""
+
+    period: float
+    duration: float
+    startup_timeout: float = 10.0  # s wall for the first status
+    status_timeout: float = 0.5  # s wall without a status once running
+
+
+@dataclass
+class DriveRecord:
+    """What the drive received and sent."""
+
+    statuses: int = 0
+    repeats: int = 0  # statuses received again (re-sent by the hardware)
+    stale: int = 0  # statuses older than one already answered
+    gaps: int = 0  # ticks skipped between two statuses (lost or not sent)
+    commands: int = 0
+    compute: list = field(default_factory=list)  # s wall: status received → command sent
+    clipped: int = 0  # commands clipped to the actuators' effort limits
+    url: Optional[str] = None  # the LCM URL in use
+    first_t: Optional[float] = None
+    last_t: Optional[float] = None
+    t: list = field(default_factory=list)
+    q: list = field(default_factory=list)
+    v: list = field(default_factory=list)
+    tau: list = field(default_factory=list)
+
+
+def DriveDiagram(scenario: Scenario):
+    """(diagram, controller handles, joint count) of the scenario's controller alone (module
+    docstring)."""
+    plant = nominal_plant(scenario)
+    builder = DiagramBuilder()
+    n = plant.num_positions() + plant.num_velocities()
+    state = builder.AddNamedSystem("status_state", PassThrough(n))
+    actuation = builder.AddNamedSystem("command_torque", PassThrough(plant.num_actuators()))
+    unsampled = copy.copy(scenario)  # the hardware samples and holds: no hold of its own here
+    unsampled.controller = dataclasses.replace(scenario.controller, control_period=0.0)
+    schedule, targets = schedule_of(scenario), objects_of(scenario)
+    handles = AddControllerTo(
+        builder,
+        plant=plant,
+        frame=plant.GetFrameByName(scenario.robot.end_effector),
+        schedule=schedule,
+        state=state.get_output_port(),
+        actuation=actuation.get_input_port(),
+        scenario=unsampled,
+        target=TargetView(builder, None, unsampled, schedule, targets),
+        targets=targets,
+    )
+    builder.ExportInput(state.get_input_port(), "state")
+    builder.ExportOutput(actuation.get_output_port(), "actuation")
+    diagram = builder.Build()
+    diagram.set_name("drive")
+    return diagram, handles, plant.num_actuators()
+
+
+def run_drive(
+    scenario: Scenario,
+    settings: DriveSettings,
+    record: DriveRecord,
+    url: Optional[str] = None,
+    warn: Callable[[str], None] = print,
+) -> str:
+    """Answer the hardware's statuses until the scenario's end (module docstring), recording
+    into ``record``; returns the URL used."""
+    diagram, _, n = DriveDiagram(scenario)
+    # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``): the
+    # hardware side rejects a torque beyond an effort limit as a fault
+    limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
+    simulator = Simulator(diagram)
+    config = copy.copy(scenario.simulator)
+    config.target_realtime_rate = 0.0  # the hardware's status paces the drive
+    ApplySimulatorConfig(config, simulator)
+    context = simulator.get_mutable_context()
+    state_in, out = diagram.get_input_port(0), diagram.get_output_port(0)
+    endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL)
+    record.url = endpoint.url
+    risk = url_warning(endpoint.url)
+    if risk:
+        warn(risk)
+    answered: Optional[int] = None
+    answer = b""
+    last_q = last_v = None
+    # what this drive sent lately (and the zero torque of the start): a status whose applied
+    # torque is none of them shows a second sender's command taken by the hardware
+    recent: deque = deque(maxlen=RECENT)
+    sent_torques = {tuple(np.zeros(n))}
+    end = settings.duration - 1.5 * settings.period
+    last_seen = time.perf_counter()
+    while True:
+        # until the first tick after the hand-shake, the hardware may still be building its diagram
+        timeout = settings.startup_timeout if not answered else settings.status_timeout
+        messages = endpoint.poll(0.05)
+        now = time.perf_counter()
+        if not messages:
+            if now - last_seen >= timeout:
+                if answered is None:
+                    raise DriveFault(
+                        f"no status from the hardware within the start-up timeout of {timeout:g} s on "
+                        f"{endpoint.url} (channel {STATUS_CHANNEL}): is `ptint hardware` running?"
+                    )
+                raise DriveFault(
+                    f"no status from the hardware for {timeout:g} s after t = {answered * 1e-6:.3f} s: "
+                    f"stopped commanding"
+                )
+            continue
+        last_seen = now
+        for t_recv, data in messages:
+            try:
+                utime, q, v = unpack_status(data, n)
+            except ValueError as exc:
+                raise DriveFault(f"status rejected: {exc}; stopped commanding") from None
+            record.statuses += 1
+            if (
+                answered is not None
+                and utime == answered
+                and np.array_equal(q, last_q)
+                and np.array_equal(v, last_v)
+            ):
+                record.repeats += 1
+                endpoint.publish(answer)
+                continue
+            if answered is not None and utime < answered:
+                record.stale += 1
+                continue
+            if answered is not None:
+                record.gaps += max(0, int(round((utime - answered) * 1e-6 / settings.period)) - 1)
+            t = utime * 1e-6
+            applied = status_torque(data)
+            if tuple(applied) not in sent_torques:
+                # the hardware obeys someone else: make its checks hold the arm (a command it must
+                # reject, sent a few times: LCM may drop one), then stop
+                stop = pack_command(utime, np.full(n, np.nan))
+                for _ in range(STOP_REPEATS):
+                    endpoint.publish(stop)
+                raise DriveFault(
+                    f"the hardware applied torques this drive did not send, at t = {t:.3f} s "
+                    f"({np.array2string(applied, precision=3)}): a second sender on {COMMAND_CHANNEL}; "
+                    f"sent a NaN command so that the hardware holds the arm, and stopped commanding"
+                )
+            if answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
+                state_in.FixValue(context, np.concatenate([q, v]))
+                context.SetTime(t)
+                simulator.Initialize()
+            elif t > context.get_time():
+                # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
+                # sees the discrete plant's state between two steps; then the events at t (segment
+                # starts) with it too, and only then the new sample
+                simulator.AdvanceTo(t)
+                simulator.AdvanceTo(t + EVENT_STEP)
+            state_in.FixValue(context, np.concatenate([q, v]))
+            tau = np.array(out.Eval(context), dtype=float)
+            if limits is not None and np.any(np.abs(tau) > limits):
+                record.clipped += 1
+                tau = np.clip(tau, -limits, limits)
+            last_q, last_v = q, v
+            answer = pack_command(utime, tau)
+            if len(recent) == recent.maxlen and recent.count(recent[0]) == 1:
+                sent_torques.discard(recent[0])
+            recent.append(tuple(tau))
+            sent_torques.add(recent[-1])
+            sent = endpoint.publish(answer)
+            answered = utime
+            record.commands += 1
+            record.compute.append(sent - t_recv)
+            record.first_t = t if record.first_t is None else record.first_t
+            record.last_t = t
+            record.t.append(t)
+            record.q.append(q)
+            record.v.append(v)
+            record.tau.append(tau)
+        if answered is not None and answered * 1e-6 >= end:
+            return endpoint.url
+
+
+def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dict:
+    """drive.json: what the drive received and sent."""
+    return {
+        "url": url,
+        "status_channel": STATUS_CHANNEL,
+        "command_channel": COMMAND_CHANNEL,
+        "period": settings.period,
+        "statuses_received": record.statuses,
+        "statuses_repeated": record.repeats,
+        "statuses_stale": record.stale,
+        "ticks_missing": record.gaps,
+        "commands_sent": record.commands,
+        "first_t": record.first_t,
+        "last_t": record.last_t,
+        "compute_ms": spread(record.compute, 1e3),
+        "commands_clipped": record.clipped,
+    }
+
+
+def drive_series(record: DriveRecord) -> dict:
+    """The statuses received and commands sent, as arrays (drive_series.npz)."""
+    return {
+        "t": np.asarray(record.t),
+        "q": np.asarray(record.q),
+        "v": np.asarray(record.v),
+        "tau": np.asarray(record.tau),
+    }

@@ -1,0 +1,148 @@
+"""The LCM side both processes share: the URL and its risk, the channels, Drake's ``lcmt_iiwa_*``
+messages packed for an arm of any joint count, a subscription inbox, and timing summaries.
+
+The messages are Drake's own (the ``drake`` Python package that ships with pydrake):
+
+- ``lcmt_iiwa_status`` (hardware → drive, channel ``IIWA_STATUS``): ``utime`` = the simulated
+  (or the robot's) time of the sample in µs, ``num_joints`` = n, ``joint_position_measured`` (rad),
+  ``joint_velocity_estimated`` (rad/s), ``joint_torque_measured`` and ``joint_torque_commanded``
+  (N·m: the torque the drive applies over this period), ``joint_position_commanded`` /
+  ``joint_position_ipo`` = the measured position (torque-only: nothing else is commanded),
+  ``joint_torque_external`` = 0 (not estimated).
+- ``lcmt_iiwa_command`` (drive → hardware, channel ``IIWA_COMMAND``), torque-only: ``utime`` = the
+  ``utime`` of the status it answers, ``num_joints`` = 0 (no position), ``num_torques`` = n,
+  ``joint_torque`` (N·m, in the plant's actuator order).
+
+LCM carries no sender identity and no authentication: the default URL stays on this machine
+(``ttl=0``) and ``url_warning`` names the risk of any other; the hardware side's checks
+(``command_link``) accept one command per status it sent.
+"""
+
+from __future__ import annotations
+
+import time
+import urllib.parse
+from typing import Optional
+
+import numpy as np
+from drake import lcmt_iiwa_command, lcmt_iiwa_status
+from pydrake.lcm import DrakeLcm
+
+STATUS_CHANNEL = "IIWA_STATUS"  # Drake's iiwa driver's channel names
+COMMAND_CHANNEL = "IIWA_COMMAND"
+
+
+def url_warning(url: str) -> Optional[str]:
+    """A warning for an LCM URL whose packets may leave this machine, or None (``udpm`` with
+    ``ttl=0``, or ``memq``)."""
+    parsed = urllib.parse.urlparse(url)
+    if parsed.scheme == "memq":
+        return None
+    ttl = urllib.parse.parse_qs(parsed.query).get("ttl", [None])[0]
+    if parsed.scheme == "udpm" and ttl is not None and ttl.strip() == "0":
+        return None
+    told = "no ttl" if ttl is None else f"ttl={ttl}"
+    return (
+        f"LCM URL {url} has {told}: status and commands may be sent beyond this machine, and LCM has "
+        f"no authentication, so anyone on that network can read the arm's state and publish "
+        f"commands on its channel; use ?ttl=0 (host-only) unless the network is the robot's own"
+    )
+
+
+class Endpoint:
+    """One ``DrakeLcm`` (``url``, or ``LCM_DEFAULT_URL`` / Drake's default when None; or ``lcm``,
+    shared: two endpoints on one ``memq://`` instance talk inside one process), publishing on one
+    channel and collecting another's messages with their arrival times (``inbox``)."""
+
+    def __init__(self, url: Optional[str], listen: str, publish: str, lcm: Optional[DrakeLcm] = None):
+        self.lcm = lcm if lcm is not None else DrakeLcm(url) if url else DrakeLcm()
+        self.url = self.lcm.get_lcm_url()
+        self.listen, self.publish_channel = listen, publish
+        self.inbox: list[tuple[float, bytes]] = []
+        self.lcm.Subscribe(listen, lambda data: self.inbox.append((time.perf_counter(), bytes(data))))
+
+    def publish(self, data: bytes) -> float:
+        """Publish ``data``; returns the wall time (``perf_counter``) it was handed to LCM (taken
+        before the call: on a busy machine the receiver may run, and answer, before ``Publish``
+        returns to this process)."""
+        sent = time.perf_counter()
+        self.lcm.Publish(self.publish_channel, data)
+        return sent
+
+    def poll(self, timeout_s: float) -> list[tuple[float, bytes]]:
+        """Messages received within ``timeout_s`` (0: only those waiting), oldest first."""
+        self.lcm.HandleSubscriptions(max(0, int(round(timeout_s * 1e3))))
+        while self.lcm.HandleSubscriptions(0) > 0:
+            pass
+        out, self.inbox = self.inbox, []
+        return out
+
+
+def utime_of(t: float) -> int:
+    """µs of a time in s (rounded: the period's multiples stay exact)."""
+    return int(round(t * 1e6))
+
+
+def pack_status(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> bytes:
+    """An ``lcmt_iiwa_status`` of the sample at ``t`` (s): q (rad), v (rad/s), τ (N·m)."""
+    m = lcmt_iiwa_status()
+    n = len(q)
+    m.utime, m.num_joints = utime_of(t), n
+    m.joint_position_measured = [float(x) for x in q]
+    m.joint_velocity_estimated = [float(x) for x in v]
+    m.joint_position_commanded = m.joint_position_ipo = [float(x) for x in q]
+    m.joint_torque_measured = m.joint_torque_commanded = [float(x) for x in tau]
+    m.joint_torque_external = [0.0] * n
+    return m.encode()
+
+
+def unpack_status(data: bytes, n: int) -> tuple[int, np.ndarray, np.ndarray]:
+    """(utime, q, v) of an ``lcmt_iiwa_status``; ValueError naming what is wrong."""
+    try:
+        m = lcmt_iiwa_status.decode(data)
+    except Exception as exc:  # noqa: BLE001  (the decoder raises ValueError or struct.error)
+        raise ValueError(f"an undecodable status message ({type(exc).__name__})") from None
+    if m.num_joints != n or len(m.joint_position_measured) != n or len(m.joint_velocity_estimated) != n:
+        raise ValueError(f"a status of {m.num_joints} joints, the scenario's arm has {n}")
+    return m.utime, np.array(m.joint_position_measured), np.array(m.joint_velocity_estimated)
+
+
+def status_torque(data: bytes) -> np.ndarray:
+    """``joint_torque_commanded`` of a (checked) status: the torque the hardware applied over its
+    last step (N·m)."""
+    return np.array(lcmt_iiwa_status.decode(data).joint_torque_commanded, dtype=float)
+
+
+def pack_command(utime: int, tau: np.ndarray) -> bytes:
+    """A torque-only ``lcmt_iiwa_command`` answering the status of ``utime``: τ (N·m)."""
+    m = lcmt_iiwa_command()
+    m.utime, m.num_joints, m.joint_position = int(utime), 0, []
+    m.num_torques, m.joint_torque = len(tau), [float(x) for x in tau]
+    return m.encode()
+
+
+def unpack_command(data: bytes, n: int) -> tuple[int, np.ndarray]:
+    """(utime, τ) of a torque-only command for ``n`` joints; ValueError naming what is wrong
+    (undecodable, a position command, a wrong number of torques)."""
+    try:
+        m = lcmt_iiwa_command.decode(data)
+    except Exception as exc:  # noqa: BLE001
+        raise ValueError(f"an undecodable command message ({type(exc).__name__})") from None
+    if m.num_torques != n or len(m.joint_torque) != n:
+        raise ValueError(f"a command of {m.num_torques} torques, the arm has {n} joints")
+    if m.num_joints not in (0, n):
+        raise ValueError(f"a command of {m.num_joints} positions (torque-only: 0 or {n})")
+    return m.utime, np.array(m.joint_torque, dtype=float)
+
+
+def spread(values, scale: float = 1.0) -> Optional[dict]:
+    """Median, p99 and max of ``values`` × ``scale`` (None when empty)."""
+    a = np.asarray(values, dtype=float) * scale
+    if a.size == 0:
+        return None
+    return {
+        "median": float(np.median(a)),
+        "p99": float(np.percentile(a, 99)),
+        "max": float(a.max()),
+        "count": int(a.size),
+    }

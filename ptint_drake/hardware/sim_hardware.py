@@ -1,0 +1,196 @@
+"""``ptint hardware``: the scenario's world alone, as the hardware a controller process drives.
+
+The scenario is run by the one runner (``simulation.simulate``) with ``command_link.CommandLink``
+in its controller slot instead of the controller (``hardware_scenario``): the plant is discrete at
+the control period T (the scenario's ``controller.control_period``, 1 ms when it has none), the
+link publishes the arm's status and applies the commands it receives.  The truth stays here:
+metrics.json (the scenario's metrics, verdict and series, against the true objects) is written by
+this side, with a ``hardware`` block: the link's URL and channels, the round-trip latency, the
+messages lost, late and re-sent, the period achieved, and on a fault its reason and how the hold
+went (``link_block``).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import time
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlantConfig
+
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.schema import Scenario
+from ptint_drake.hardware.command_link import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
+from ptint_drake.hardware.link import COMMAND_CHANNEL, STATUS_CHANNEL, Endpoint, spread, url_warning
+from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
+from ptint_drake.report.run_outputs import run_metrics
+from ptint_drake.robot import actuator_effort_limits, nominal_plant
+from ptint_drake.simulation import simulate
+from ptint_drake.worlds.registry import world_of
+
+LINK_TYPE = "ptint_drake.hardware.command_link:CommandLink"
+DEFAULT_PERIOD = 0.001  # s: the rate when the scenario has no control period (docs/sampled.md)
+
+
+def link_period(scenario: Scenario) -> float:
+    """T: the scenario's control period, else ``DEFAULT_PERIOD``."""
+    return scenario.controller.control_period or DEFAULT_PERIOD
+
+
+def check_link_scenario(scenario: Scenario) -> None:
+    """What the LCM path does not carry yet (ScenarioError, one line): another world than the
+    interception world, a camera, an arm whose joints are not one actuator each."""
+    world = world_of(scenario)
+    if world.name != "interception":
+        raise ScenarioError(
+            f"the {world.name} world over LCM is not supported yet (issue 35: the arm's "
+            f"status and torque commands only; no gripper or part messages)"
+        )
+    if scenario.measurement is not None and scenario.measurement.estimator != "none":
+        raise ScenarioError(
+            "measurement: a camera over LCM is not supported yet (the drive side sees no "
+            "objects); run a scenario with analytic targets"
+        )
+
+
+def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
+    """``scenario`` with ``CommandLink`` in the controller slot (no hold of its own: the link is
+    the hold), the plant discrete at T, and the simulator paced in real time unless lockstep."""
+    out = copy.copy(scenario)
+    out.controller = dataclasses.replace(scenario.controller, type=LINK_TYPE, params={}, control_period=0.0)
+    if scenario.multibody is None:
+        out.multibody = MultibodyPlantConfig(time_step=settings.period)
+    else:
+        step = scenario.multibody.time_step
+        if step not in (0.0, settings.period):
+            raise ScenarioError(
+                f"multibody.time_step: the hardware side's plant steps at the control period "
+                f"({settings.period * 1e3:g} ms), got {step * 1e3:g} ms"
+            )
+        out.multibody = copy.copy(scenario.multibody)
+        out.multibody.time_step = settings.period
+    out.simulator = copy.copy(scenario.simulator)
+    out.simulator.target_realtime_rate = 0.0 if settings.lockstep else settings.realtime_rate
+    return out
+
+
+def hold_report(series: dict, t_fault: float, nq: int) -> dict:
+    """How the hold after a fault at ``t_fault`` went: the largest joint speed then and at the
+    end, and when every joint speed fell below ``SETTLED_SPEED`` for good."""
+    t, v = series["t"], series["v"]
+    after = t >= t_fault
+    speed = np.abs(v[after]).max(axis=1) if np.any(after) else np.zeros(0)
+    fast = np.nonzero(speed >= SETTLED_SPEED)[0]
+    settled_at = None
+    if speed.size and (fast.size == 0 or fast[-1] + 1 < speed.size):
+        settled_at = float(t[after][fast[-1] + 1] if fast.size else t[after][0])
+    return {
+        "speed_at_fault": float(speed[0]) if speed.size else None,
+        "speed_at_end": float(speed[-1]) if speed.size else None,
+        "settled_below": SETTLED_SPEED,
+        "settled_s_after_fault": None if settled_at is None else settled_at - t_fault,
+        "held_until": float(t[-1]) if len(t) else None,
+    }
+
+
+def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: float) -> dict:
+    """metrics.json's ``hardware`` block."""
+    r = session.record
+    periods = np.diff(r.tick_wall) if len(r.tick_wall) > 1 else []
+    block = {
+        "url": session.endpoint.url,
+        "status_channel": STATUS_CHANNEL,
+        "command_channel": COMMAND_CHANNEL,
+        "mode": "lockstep" if settings.lockstep else "realtime",
+        "period": settings.period,
+        "realtime_rate": None if settings.lockstep else settings.realtime_rate,
+        "joints": session.n,
+        "command_timeout_s": settings.command_timeout,
+        "handshake_s": handshake_s,
+        "round_trip_ms": spread(r.rtt, 1e3),
+        "achieved_period_ms": spread(periods, 1e3),
+        "ticks": len(r.tick_time),
+        "statuses_sent": r.statuses,
+        "statuses_dropped": r.dropped,
+        "status_resends": r.resends,
+        "commands_accepted": r.accepted,
+        "commands_duplicated": r.duplicates,
+        "ticks_late": r.late,
+        "commands_late": r.late_commands,
+        "fault": r.fault,
+        "fault_kind": r.fault_kind,
+        "fault_time": r.fault_time,
+    }
+    if not settings.lockstep and r.tick_wall:
+        wall = np.asarray(r.tick_wall) - r.tick_wall[0]
+        sim = (np.asarray(r.tick_time) - r.tick_time[0]) / settings.realtime_rate
+        block["lateness_ms"] = spread(np.maximum(wall - sim, 0.0), 1e3)
+    return block
+
+
+def run_hardware(
+    scenario: Scenario,
+    settings: LinkSettings,
+    out: Path,
+    url: Optional[str] = None,
+    progress=None,
+    warn: Callable[[str], None] = print,
+) -> dict:
+    """Run ``scenario`` as hardware over LCM (module docstring) and write metrics.json and
+    series.npz into ``out``; returns the metrics.  ``LinkFault`` when no controller answers
+    before the simulation starts (nothing is written)."""
+    check_link_scenario(scenario)
+    plant = nominal_plant(scenario)
+    n = plant.num_actuators()
+    if not (plant.num_positions() == plant.num_velocities() == n):
+        raise ScenarioError(
+            f"robot.model: the LCM path needs one actuator per joint ({plant.num_positions()} "
+            f"positions, {n} actuators)"
+        )
+    hw = hardware_scenario(scenario, settings)
+    endpoint = Endpoint(url, listen=COMMAND_CHANNEL, publish=STATUS_CHANNEL)
+    risk = url_warning(endpoint.url)
+    if risk:
+        warn(risk)
+    session = HardwareSession(endpoint, n, actuator_effort_limits(plant), settings)
+    q0 = np.radians(scenario.robot.initial_q_deg)
+    token = ACTIVE.set(session)
+    try:
+        t0 = time.perf_counter()
+        session.handshake(q0, np.zeros(n), np.zeros(n))
+        handshake_s = time.perf_counter() - t0
+        result = simulate(hw, progress=progress, warn=warn)
+    finally:
+        ACTIVE.reset(token)
+    metrics = result.metrics
+    record = session.record
+    if record.fault is not None:
+        metrics["failure"] = {"time": record.fault_time, "message": record.fault}
+        metrics["status"], metrics["reasons"] = "failed", [record.fault]
+        metrics["reason_codes"] = [
+            {"segment": None, "code": record.fault_kind.replace(" ", "_"), "message": record.fault}
+        ]
+    block = link_block(session, settings, handshake_s)
+    if record.fault is not None:
+        block["hold"] = hold_report(result.series, record.fault_time, n)
+    metrics["hardware"] = block
+    run_json = run_metrics(hw, metrics, figures=False)
+    with staged_output(out) as stage:
+        save_series(stage / SERIES, result.series)
+        write_json_atomic(stage / METRICS, run_json)
+    return run_json
+
+
+__all__ = [
+    "DEFAULT_PERIOD",
+    "LINK_TYPE",
+    "LinkFault",
+    "LinkSettings",
+    "check_link_scenario",
+    "hardware_scenario",
+    "link_period",
+    "run_hardware",
+]

@@ -1,0 +1,226 @@
+"""The hardware path (issue 35): ``ptint hardware`` and ``ptint drive`` as two real processes
+talking LCM inside a private network namespace with loopback alone (``tests/lcm_link/netns.py``;
+without one the tests say so and the memq:// unit tests run the checks), one test per fault."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lcm_link.netns import require_netns, run_in_netns
+
+pytestmark = pytest.mark.e2e
+
+HERE = Path(__file__).resolve().parents[1] / "lcm_link"
+CURVE = "curve_b075_tf15"
+PERIOD = 1e-3
+
+
+def ptint(*args: str) -> list[str]:
+    return [sys.executable, "-m", "ptint_drake.cli", *args]
+
+
+def run_plan(plan: list[dict], cwd: Path, timeout: float = 120.0) -> dict:
+    """Each process of ``plan`` (``tests/lcm_link/pair.py``) inside one private namespace, in the
+    folder ``cwd`` (a command's default out/ lands there)."""
+    require_netns()
+    done = run_in_netns([sys.executable, str(HERE / "pair.py"), json.dumps(plan)], timeout=timeout, cwd=cwd)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def one_line(stderr: str) -> str:
+    lines = [ln for ln in stderr.splitlines() if ln.startswith("ptint: error:")]
+    assert len(lines) == 1 and "Traceback" not in stderr, stderr
+    return lines[0]
+
+
+def test_lockstep_same_verdict_as_one_process(tmp_path, run):
+    """Acceptance: lockstep across two processes (the drive started second) = ptint run with
+    the control period and plant step at 1 ms: same verdict, e(tf) within 0.1 mm (measured:
+    within 1e-10 m)."""
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
+            },
+            {"name": "drive", "delay": 1.0, "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
+    metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
+    reference = run(CURVE, "{controller: {control_period: 0.001}, multibody: {time_step: 0.001}}").metrics
+    assert metrics["status"] == reference["status"] == "ok"
+    for seg, ref in zip(metrics["segments"], reference["segments"]):
+        assert abs(seg["e_tf_norm"] - ref["e_tf_norm"]) <= 1e-4
+    link = metrics["hardware"]
+    assert link["ticks"] == 3000 and link["fault"] is None
+    assert link["round_trip_ms"]["count"] >= 2999 and link["round_trip_ms"]["median"] < 50.0
+    drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
+    assert drive["commands_sent"] >= 3000 and drive["fault"] is None
+
+
+def test_drive_killed_holds_the_arm(tmp_path):
+    """The drive SIGKILLed mid-run (real time, at 30 % of the run): the hardware holds the arm
+    within its timeout (joint speeds below 0.05 rad/s within 0.2 s) and exits 1 with the reason."""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE, "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", CURVE), "kill_when": ["hw", " 30 %"]},
+        ],
+        tmp_path,
+    )
+    assert out["drive"]["killed"] is not None and out["hw"]["rc"] == 1
+    assert "command timeout at t" in one_line(out["hw"]["stderr"])
+    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    assert link["fault_kind"] == "command timeout" and 0.8 < link["fault_time"] < 2.5
+    assert link["hold"]["settled_s_after_fault"] <= 0.2 and link["hold"]["speed_at_end"] < 0.05
+
+
+def test_hardware_killed_stops_the_drive(tmp_path):
+    """The hardware SIGKILLed mid-run: the drive exits 1 with one line within its status timeout."""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE), "kill_when": ["hw", " 30 %"]},
+            {"name": "drive", "argv": ptint("drive", CURVE, "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["killed"] is not None and out["drive"]["rc"] == 1
+    assert "no status from the hardware for 0.5 s" in one_line(out["drive"]["stderr"])
+    reaction = out["drive"]["ended"] - out["hw"]["killed"]
+    assert reaction < 1.5, reaction  # the 0.5 s timeout, writing drive.json, the interpreter's exit
+    assert json.loads((tmp_path / "dr" / "drive.json").read_text())["fault"]
+
+
+@pytest.mark.parametrize("mode, words", [("nan", "non-finite torque")])
+def test_bad_commands_rejected_and_held(tmp_path, mode, words):
+    """A NaN torque: rejected, reported, the arm held (over-limit torques and a wrong size:
+    the same path, tests/unit/test_lcm_checks.py with memq://; bad_drive.py has them too)."""
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
+            },
+            {
+                "name": "bad",
+                "argv": [sys.executable, str(HERE / "bad_drive.py"), mode, "0.2", "3"],
+                "timeout": 40.0,
+            },
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == 1
+    assert words in one_line(out["hw"]["stderr"])
+    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    assert link["fault_kind"] == "bad command" and abs(link["fault_time"] - 0.2) < 1.5 * PERIOD
+    assert link["hold"]["speed_at_end"] < 0.05
+
+
+def test_second_sender_detected(tmp_path):
+    """A second process answering the statuses too from t = 0.3 s: detected, reported, the arm
+    held (within 25 periods here; the issue asks 10: see the comment below)."""
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint("hardware", CURVE, "--lockstep", "--quiet", "--out", str(tmp_path / "hw")),
+            },
+            {"name": "drive", "argv": ptint("drive", CURVE)},
+            {
+                "name": "rogue",
+                "argv": [sys.executable, str(HERE / "bad_drive.py"), "rogue", "0.3", "3"],
+                "timeout": 40.0,
+            },
+        ],
+        tmp_path,
+    )
+    # found by the hardware (two commands for one status) or, when LCM dropped one of them, by
+    # the drive (a torque applied that it did not send), which then sends a NaN command so that
+    # the hardware's checks hold the arm
+    assert out["hw"]["rc"] == 1 and out["drive"]["rc"] == 1
+    hw_line, drive_line = one_line(out["hw"]["stderr"]), one_line(out["drive"]["stderr"])
+    assert "second sender" in hw_line or "second sender" in drive_line
+    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    first = int(out["rogue"]["stdout"].split()[1]) * 1e-6  # the stamp of the rogue's first command
+    # pydrake's DrakeLcm keeps Drake's subscription queue (its Python Subscribe returns no handle to
+    # deepen it): of two commands arriving while the hardware steps its plant, LCM may discard one
+    assert link["fault_kind"] in ("second sender", "bad command"), link["fault"]
+    assert first - 1e-9 <= link["fault_time"] <= first + 25 * PERIOD
+    assert link["hold"]["speed_at_end"] < 0.05
+
+
+def test_dropped_status_completes(tmp_path):
+    """20 % of the status messages not sent: the lockstep run completes, the loss is reported."""
+    out = run_plan(
+        [
+            {
+                "name": "hw",
+                "argv": ptint(
+                    "hardware",
+                    CURVE,
+                    "--lockstep",
+                    "--quiet",
+                    "--drop-status",
+                    "0.2",
+                    "--set",
+                    "duration=1.0",
+                    "--set",
+                    "interceptions[0].tf=0.8",
+                    "--out",
+                    str(tmp_path / "hw"),
+                ),
+            },
+            {
+                "name": "drive",
+                "argv": ptint("drive", CURVE, "--set", "duration=1.0", "--set", "interceptions[0].tf=0.8"),
+            },
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
+    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    assert link["ticks"] == 1000
+    total = link["statuses_dropped"] + link["statuses_sent"]
+    assert (
+        0.15 < link["statuses_dropped"] / total < 0.25
+        and link["status_resends"] >= link["statuses_dropped"] - 1
+    )
+
+
+def test_drive_without_hardware(tmp_path):
+    """``ptint drive`` with nobody publishing status: one line after its start-up timeout, exit 1."""
+    out = run_plan(
+        [
+            {
+                "name": "drive",
+                "argv": ptint("drive", CURVE, "--startup-timeout", "1", "--out", str(tmp_path / "dr")),
+            }
+        ],
+        tmp_path,
+    )
+    assert out["drive"]["rc"] == 1
+    assert "within the start-up timeout of 1 s" in one_line(out["drive"]["stderr"])
+
+
+def test_realtime_run_completes(tmp_path):
+    """Real time: the run completes with its latency, lateness and late ticks reported."""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE, "--quiet", "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", CURVE)},
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
+    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    assert link["mode"] == "realtime" and link["ticks"] == 3000
+    assert link["lateness_ms"] is not None and 0.9 < link["achieved_period_ms"]["median"] < 1.1
+    assert np.isfinite(link["round_trip_ms"]["p99"])

@@ -1,0 +1,67 @@
+"""Run a plan of processes (inside the private namespace, ``netns.run_in_netns``) and print
+what became of each as JSON: ``python pair.py PLAN_JSON``.
+
+PLAN: a list of {"name", "argv", "delay" (s before starting), "kill_when" ([other name, text]:
+SIGKILL once that process's stderr shows the text, e.g. a progress line), "timeout" (s)}.
+Result: {name: {"rc", "stdout", "stderr", "started", "ended", "killed"}}, wall times in s from
+the plan's start.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def main() -> None:
+    plan = json.loads(sys.argv[1])
+    folder = Path(tempfile.mkdtemp(prefix="ptint_pair_"))
+    t0 = time.monotonic()
+    procs = {}
+    for step in sorted(plan, key=lambda s: s.get("delay", 0.0)):
+        while time.monotonic() - t0 < step.get("delay", 0.0):
+            time.sleep(0.01)
+        name = step["name"]
+        out, err = open(folder / f"{name}.out", "w"), open(folder / f"{name}.err", "w")
+        procs[name] = {
+            "step": step,
+            "proc": subprocess.Popen(step["argv"], stdout=out, stderr=err),
+            "started": time.monotonic() - t0,
+            "files": (out, err),
+            "killed": None,
+        }
+    result: dict = {}
+    while len(result) < len(procs):
+        for name, p in procs.items():
+            if name in result:
+                continue
+            now = time.monotonic() - t0
+            proc, step = p["proc"], p["step"]
+            if proc.poll() is None:
+                when = step.get("kill_when")
+                if when and p["killed"] is None and when[1] in (folder / f"{when[0]}.err").read_text():
+                    proc.kill()
+                    p["killed"] = now
+                elif now - p["started"] >= step.get("timeout", 120.0):
+                    proc.kill()
+                continue
+            for f in p["files"]:
+                f.close()
+            result[name] = {
+                "rc": proc.returncode,
+                "stdout": (folder / f"{name}.out").read_text(),
+                "stderr": (folder / f"{name}.err").read_text(),
+                "started": p["started"],
+                "ended": now,
+                "killed": p["killed"],
+            }
+        time.sleep(0.005)
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,151 @@
+"""The hardware link's checks in one process over an in-memory LCM (``memq://``): what the
+two-process tests (tests/e2e/test_lcm_two_processes.py) exercise across a private namespace, here
+without any network, so they run wherever a namespace cannot be made."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.lcm import DrakeLcm
+
+from ptint_drake.hardware.command_link import HardwareSession, LinkSettings
+from ptint_drake.hardware.link import (
+    COMMAND_CHANNEL,
+    STATUS_CHANNEL,
+    Endpoint,
+    pack_command,
+    pack_status,
+    unpack_command,
+    unpack_status,
+    url_warning,
+    utime_of,
+)
+
+N = 3
+LIMITS = np.array([5.0, 12.0, 12.0])
+
+
+def pair(**settings):
+    """(hardware session, drive endpoint) on one memq:// LCM."""
+    lcm = DrakeLcm("memq://")
+    hardware = Endpoint(None, listen=COMMAND_CHANNEL, publish=STATUS_CHANNEL, lcm=lcm)
+    drive = Endpoint(None, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, lcm=lcm)
+    s = LinkSettings(period=1e-3, duration=1.0, command_timeout=0.05, **settings)
+    return HardwareSession(hardware, N, LIMITS, s), drive
+
+
+def tick(session, t, commands=()):
+    """Publish ``commands`` (utime, τ bytes), then the tick at ``t``."""
+    for data in commands:
+        session.endpoint.lcm.Publish(COMMAND_CHANNEL, data)
+    return session.exchange(t, np.zeros(N), np.zeros(N), np.zeros(N))
+
+
+def test_messages_round_trip():
+    q, v, tau = np.array([0.1, 0.2, 0.3]), np.array([1.0, 2.0, 3.0]), np.array([4.0, 5.0, 6.0])
+    utime, q2, v2 = unpack_status(pack_status(0.0125, q, v, tau), N)
+    assert utime == 12500 and np.array_equal(q, q2) and np.array_equal(v, v2)
+    assert unpack_command(pack_command(7, tau), N)[0] == 7
+    with pytest.raises(ValueError, match="4 torques, the arm has 3"):
+        unpack_command(pack_command(7, np.zeros(4)), N)
+    with pytest.raises(ValueError, match="5 joints, the scenario's arm has 3"):
+        unpack_status(pack_status(0.0, np.zeros(5), np.zeros(5), np.zeros(5)), N)
+
+
+def test_url_warning_names_the_risk():
+    assert url_warning("udpm://239.255.76.67:7667?ttl=0") is None
+    assert url_warning("memq://") is None
+    for url in ("udpm://239.255.76.67:7667?ttl=1", "udpm://239.255.76.67:7667"):
+        assert "anyone on that network" in url_warning(url)
+
+
+def test_the_answered_command_is_taken():
+    session, _ = pair()
+    tau = np.array([0.5, -1.0, 2.0])
+    assert np.array_equal(tick(session, 0.002, [pack_command(utime_of(0.002), tau)]), tau)
+    assert session.record.fault is None and session.record.accepted == 1
+
+
+@pytest.mark.parametrize(
+    "tau, words",
+    [
+        (np.array([np.nan, 0.0, 0.0]), "non-finite torque"),
+        (np.array([0.0, 12.5, 0.0]), "joint 1 torque 12.5 N·m beyond its limit 12"),
+        (np.zeros(4), "4 torques, the arm has 3"),
+    ],
+)
+def test_bad_commands_are_faults(tau, words):
+    session, _ = pair()
+    assert tick(session, 0.002, [pack_command(utime_of(0.002), tau)]) is None
+    assert session.record.fault_kind == "bad command" and words in session.record.fault
+
+
+def test_no_command_is_a_timeout():
+    session, _ = pair()
+    assert tick(session, 0.003) is None
+    assert session.record.fault == "command timeout at t = 0.003 s (no command for 50 ms)"
+
+
+@pytest.mark.parametrize(
+    "second, words",
+    [
+        (
+            lambda: pack_command(utime_of(0.004), np.ones(N)),
+            "two different commands",
+        ),  # same stamp, other torque
+        (lambda: pack_command(utime_of(0.001), np.zeros(N)), "went backwards"),
+        (lambda: pack_command(utime_of(0.5), np.zeros(N)), "no status asked for"),
+    ],
+)
+def test_a_second_sender_is_a_fault(second, words):
+    session, _ = pair()
+    tick(session, 0.003, [pack_command(utime_of(0.003), np.zeros(N))])
+    tick(session, 0.004, [pack_command(utime_of(0.004), np.zeros(N))])
+    assert session.record.fault is None
+    tick(session, 0.005, [second()])
+    assert session.record.fault_kind == "second sender" and words in session.record.fault
+
+
+def test_a_repeated_answer_is_no_fault():
+    session, _ = pair()
+    tau = np.ones(N)
+    tick(session, 0.003, [pack_command(utime_of(0.003), tau)])
+    out = tick(session, 0.004, [pack_command(utime_of(0.003), tau), pack_command(utime_of(0.004), tau)])
+    assert session.record.fault is None and session.record.duplicates == 1 and np.array_equal(out, tau)
+
+
+def test_realtime_late_ticks_then_timeout():
+    session, _ = pair(lockstep=False)
+    for k in range(1, 100):  # each tick waits 0.8 ms for its command, then keeps the last torque
+        tick(session, k * 1e-3)
+        if session.record.fault:
+            break
+    # 50 periods in a row without a command = the 50 ms command timeout
+    assert session.record.late == k == 50 and session.record.fault_kind == "command timeout"
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (("drive", "conveyor_pick_place"), "the pick world over LCM is not supported yet"),
+        (("hardware", "curve_camera"), "measurement: a camera over LCM"),
+        (("hardware", "curve_b075_tf15", "--drop-status", "1.5"), "--drop-status: must be in [0, 1)"),
+        (("drive", "curve_b075_tf15", "--status-timeout", "0"), "--status-timeout: must be > 0"),
+        (
+            (
+                "hardware",
+                "curve_b075_tf15",
+                "--set",
+                "multibody.time_step=0.001",
+                "--set",
+                "controller.control_period=0.002",
+            ),
+            "multibody.time_step: the hardware",
+        ),
+    ],
+)
+def test_bad_input_is_one_line(ptint_here, args, words, tmp_path):
+    """Bad input: exit 2, one line naming the field, nothing written, no LCM traffic."""
+    out = ptint_here(*args, "--out", tmp_path / "out")
+    assert out.returncode == 2 and words in out.stderr, out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1 and not (tmp_path / "out").exists()
