@@ -21,7 +21,8 @@ Quality per fit: ``inliers`` (top-face points), ``residual`` (m: RMS distance of
 to its plane, and the largest difference between the fitted and the known top-face sides or
 diameter), and a covariance (diagonal: the pixel footprint's quantisation over the top-face
 edge for x, y; the plane scatter over √n for z).  A fit is ``ok`` when its top face has at
-least ``min_points`` points, its sides match the known ones within ``SIZE_TOLERANCE`` and its
+least ``min_points`` points and ``COMPLETE`` of those a whole top face has at the cloud's point
+spacing, its sides match the known ones within ``SIZE_TOLERANCE`` and its
 plane is flat within ``PLANE_TOLERANCE``: an occluded part (a cut top face), the arm in the
 belt's height band or two parts that cannot be separated fail and are dropouts.
 """
@@ -40,7 +41,8 @@ from scipy.spatial import ConvexHull, QhullError, cKDTree
 BELT_BAND = 0.004  # m, points this close to the belt plane are the belt (≈ 10 σ of the depth noise at 0.5 m)
 TOP_BAND = 0.004  # m, the top face: points within this of the cluster's highest
 CLUSTER_RADIUS = 0.006  # m, neighbours closer than this are one cluster (a few pixel footprints)
-SIZE_TOLERANCE = 0.004  # m, fitted vs known top-face side (or diameter)
+SIZE_TOLERANCE = 0.0025  # m, fitted vs known top-face side (or diameter)
+COMPLETE = 0.75  # a top face with fewer points than this share of the expected count is cut
 PLANE_TOLERANCE = 0.002  # m, RMS of the top face about its plane
 MIN_POINTS = 30  # top-face points (after the voxel grid) for a fit to count
 
@@ -174,9 +176,16 @@ def yaw_symmetry(shape: str, size) -> float:
     return 0.5 * math.pi if abs(float(size[0]) - float(size[1])) < 1e-9 else math.pi
 
 
+def expected_top_points(shape: str, size, spacing: float) -> float:
+    """Top-face points of a whole, unoccluded part sampled every ``spacing`` m."""
+    a, b = _top_sides(shape, size)
+    return (a * b if shape == "box" else math.pi * a * a / 4.0) / spacing ** 2
+
+
 def fit_part(points: np.ndarray, belt_index: int, shape: str, size, *, min_points: int = MIN_POINTS,
-             footprint: float = 0.001) -> PartFit:
-    """The part's pose from its cluster (step 3); ``footprint``: m per pixel at the part."""
+             footprint: float = 0.001, spacing: float = 0.0) -> PartFit:
+    """The part's pose from its cluster (step 3); ``footprint``: m per pixel at the part;
+    ``spacing``: m between the cloud's points (the voxel grid; 0: no check of completeness)."""
     top = _top_face(points)
     n = len(top)
     nothing = PartFit(belt_index, np.full(3, np.nan), 0.0, yaw_symmetry(shape, size), n, math.inf,
@@ -213,7 +222,10 @@ def fit_part(points: np.ndarray, belt_index: int, shape: str, size, *, min_point
     var_z = flat ** 2 + footprint ** 2 / 12.0 / n
     fit = PartFit(belt_index, position, fold_yaw(yaw, symmetry), symmetry, n, max(flat, size_error),
                   np.diag([var_xy, var_xy, var_z]), True, "", axis)
-    if size_error > SIZE_TOLERANCE:
+    expected = expected_top_points(shape, size, spacing) if spacing > 0.0 else 0.0
+    if n < COMPLETE * expected:
+        fit.ok, fit.reason = False, f"top face cut ({n} of ~{expected:.0f} points: occluded?)"
+    elif size_error > SIZE_TOLERANCE:
         fit.ok, fit.reason = False, f"top face {1000 * size_error:.1f} mm off the known size"
     elif flat > PLANE_TOLERANCE:
         fit.ok, fit.reason = False, f"top face not flat ({1000 * flat:.1f} mm RMS)"
@@ -238,7 +250,7 @@ def _split(cluster: np.ndarray, shape: str, size) -> list[np.ndarray]:
 
 
 def fit_parts(points: np.ndarray, belts: list[BeltRegion], shape: str, size, *,
-              min_points: int = MIN_POINTS, footprint: float = 0.001) -> list[PartFit]:
+              min_points: int = MIN_POINTS, footprint: float = 0.001, spacing: float = 0.0) -> list[PartFit]:
     """Every part seen on ``belts`` (see the module docstring); failed fits included (``ok``
     False, with their ``reason``) so a caller can name why a part was not seen."""
     fits = []
@@ -247,5 +259,6 @@ def fit_parts(points: np.ndarray, belts: list[BeltRegion], shape: str, size, *,
             if len(cluster) < min_points // 2:
                 continue  # specks: noise, an edge of something
             for part in _split(cluster, shape, size):
-                fits.append(fit_part(part, i, shape, size, min_points=min_points, footprint=footprint))
+                fits.append(fit_part(part, i, shape, size, min_points=min_points, footprint=footprint,
+                                     spacing=spacing))
     return fits

@@ -12,7 +12,8 @@ Data association (no truth): object i is looked for on belt ``object_belts[i]``;
 good fits there it takes the one nearest its last accepted position (within ``GATE``), or —
 never seen yet — the one farthest downstream.  Its yaw is unwrapped: the fit's yaw is known
 only up to the part's symmetry, and the sample reports the symmetric yaw nearest the last one.
-A frame where object i has no good fit (not in view, occluded, a poor fit) is a dropout for it.
+A frame where object i has no good fit (not in view, occluded, a poor fit) is a dropout for it:
+its output keeps the last sample (same stamp), as the pose camera's does.
 
 Timing (the pose camera's, ``systems.camera``): the sample taken at t_k becomes visible at
 t_k + latency (latency > 0: the frame is processed after it is taken).  The discrete state is a
@@ -40,8 +41,12 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Outpu
 from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
 from ptint_drake.systems.perception.part_fit import BeltRegion, belt_points, fit_parts, part_height
 
+# m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
+# position error of a 30 mm cube's fit at 0.5 m is 0.2-0.7 mm (tests/unit/test_perception.py)
+FIT_NOISE_STD = 0.0005
 VOXEL = 0.0015  # m, the voxel grid of the cloud (≈ 2 pixel footprints at 0.5 m)
 GATE = 0.05  # m, farthest a part moves between two accepted fits
 TIME_TOL = 1.0e-9
@@ -133,7 +138,7 @@ class PartPoseEstimator(LeafSystem):
 
     def fit_frame(self, cloud: PointCloud) -> list:
         return fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size,
-                         footprint=self._footprint)
+                         footprint=self._footprint, spacing=max(VOXEL, 1.2 * self._footprint))
 
     def _associate(self, fits: list, memory: np.ndarray) -> list:
         """Per object: its fit (or None) and the new memory row."""
@@ -161,7 +166,8 @@ class PartPoseEstimator(LeafSystem):
         done = time.perf_counter()
         memory = context.get_discrete_state(self._memory).value().reshape(self._n, 5).copy()
         chosen = self._associate(fits, memory)
-        slot = np.zeros((self._n, _WIDTH))
+        old = context.get_discrete_state(self._buffer).value()
+        slot = old[:self._n * _WIDTH].reshape(self._n, _WIDTH).copy()  # a dropout holds the last sample
         for i, fit in enumerate(chosen):
             if fit is None:
                 continue
@@ -173,7 +179,6 @@ class PartPoseEstimator(LeafSystem):
             c, s = math.cos(yaw), math.sin(yaw)
             R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
             slot[i] = [t, *fit.position, 1.0, *R.ravel()]
-        old = context.get_discrete_state(self._buffer).value()
         new = np.concatenate([slot.ravel(), old[:-self._n * _WIDTH]])
         state.get_mutable_discrete_state(self._buffer).SetFromVector(new)
         state.get_mutable_discrete_state(self._memory).SetFromVector(memory.ravel())
@@ -254,3 +259,67 @@ def belt_regions(configs) -> list[BeltRegion]:
                        float(b.width)) for b in configs]
 
 
+
+
+BELT_MARGIN = 0.03  # m, a derived belt's extra width beside its part (each side) and length
+
+
+def belts_under_paths(targets, duration: float, shape: str, size) -> tuple[list[BeltRegion], list[int]]:
+    """A belt under each object's straight horizontal path over [0, duration] (the conveyor the
+    scenario's ``linear`` target describes: its top surface half the part's height below the
+    centre), and the belt of each object; ``ValueError`` naming the object otherwise."""
+    belts, of = [], []
+    half = 0.5 * part_height(shape, size)
+    for i, target in enumerate(targets):
+        start, velocity = getattr(target, "start", None), getattr(target, "velocity", None)
+        if start is None or velocity is None or getattr(target, "compiled", None) is None:
+            raise ValueError(f"interceptions[{i}].target: an rgbd camera sees parts on conveyors: "
+                             "the target must be linear")
+        speed = float(np.linalg.norm(velocity[0:2]))
+        if abs(float(velocity[2])) > 1e-12 or speed <= 0.0:
+            raise ValueError(f"interceptions[{i}].target.linear.velocity: an rgbd camera sees parts on "
+                             f"conveyors: the motion must be horizontal and non-zero, got {list(velocity)}")
+        end = start + velocity * duration
+        centre = 0.5 * (start + end) - [0.0, 0.0, half]
+        diagonal = float(np.hypot(*np.asarray(size, float)[:2])) if shape == "box" else float(size[0])
+        belts.append(BeltRegion(centre, velocity / np.linalg.norm(velocity), speed * duration + diagonal
+                                + 2 * BELT_MARGIN, diagonal + 2 * BELT_MARGIN))
+        of.append(i)
+    return belts, of
+
+
+def perception_belts(measurement, targets, duration: float) -> tuple[list[BeltRegion], list[int]]:
+    """The belts the perception knows (``measurement.camera.belts``, or one under each object's
+    path: ``belts_under_paths``) and the belt of each object (configured belts: the one whose
+    centre line passes nearest the object's start, below it)."""
+    c = measurement.camera
+    if not c.belts:
+        return belts_under_paths(targets, duration, c.part_shape, c.part_size)
+    belts = belt_regions(c.belts)
+    of = []
+    for target in targets:
+        start = np.asarray(target.evaluate(0.0), float)[0:3]
+        distances = []
+        for b in belts:
+            u, v = b.frame()
+            d = start - b.center
+            distances.append(abs(d @ v) + max(abs(d @ u) - 0.5 * b.length, 0.0) + abs(d[2]))
+        of.append(int(np.argmin(distances)))
+    return belts, of
+
+
+def AddRgbdPerception(builder: DiagramBuilder, depth_image: OutputPort, measurement, targets,
+                      duration: float) -> tuple[list[SeenObject], PartPoseEstimator]:
+    """The perception of ``measurement`` (sensor rgbd) reading ``depth_image``; one
+    ``SeenObject`` per object of ``targets`` (whose motions give only the belts when none are
+    configured: ``perception_belts``)."""
+    c = measurement.camera
+    belts, of = perception_belts(measurement, targets, duration)
+    config = PerceptionConfig(camera_info(c), camera_pose(c), belts, c.part_shape, list(c.part_size), of,
+                              float(measurement.rate_hz), float(measurement.latency))
+    diagram, estimator = MakeRgbdPerception(config)
+    builder.AddNamedSystem("rgbd_perception", diagram)
+    builder.Connect(depth_image, diagram.get_input_port())
+    seen = [SeenObject(diagram.GetOutputPort(f"measurement_{i}"),
+                       diagram.GetOutputPort(f"measured_rotation_{i}")) for i in range(len(of))]
+    return seen, estimator
