@@ -134,4 +134,5 @@ def pixel_footprint(info: CameraInfo, z: float) -> float:
 
 
 def vertical_fov(info: CameraInfo) -> float:
+    """rad: the camera's vertical field of view."""
     return 2.0 * math.atan(0.5 * info.height() / info.focal_y())

@@ -42,7 +42,8 @@ BELT_BAND = 0.004  # m, points this close to the belt plane are the belt (≈ 10
 TOP_BAND = 0.004  # m, the top face: points within this of the cluster's highest
 CLUSTER_RADIUS = 0.006  # m, neighbours closer than this are one cluster (a few pixel footprints)
 SIZE_TOLERANCE = 0.0025  # m, fitted vs known top-face side (or diameter)
-COMPLETE = 0.75  # a top face with fewer points than this share of the expected count is cut
+COMPLETE = 0.85  # a top face with fewer points than this share of the expected count is cut
+PLANE_BAND = 0.0015  # m, the top face's plane is fitted to the points this close to its median height
 PLANE_TOLERANCE = 0.002  # m, RMS of the top face about its plane
 MIN_POINTS = 30  # top-face points (after the voxel grid) for a fit to count
 
@@ -87,6 +88,7 @@ class PartFit:
 
 
 def part_height(shape: str, size) -> float:
+    """m: a box's z size or a cylinder's height."""
     return float(size[2] if shape == "box" else size[1])
 
 
@@ -193,10 +195,13 @@ def fit_part(points: np.ndarray, belt_index: int, shape: str, size, *, min_point
     if n < min_points:
         nothing.reason = f"{n} top-face points (< {min_points})"
         return nothing
-    centroid = top.mean(axis=0)
-    _, sv, vt = np.linalg.svd(top - centroid, full_matrices=False)
+    # the plane from the points near the face's median height (not the rim of the side walls)
+    flat_face = top[np.abs(top[:, 2] - np.median(top[:, 2])) <= PLANE_BAND]
+    flat_face = flat_face if len(flat_face) >= 3 else top
+    centroid = flat_face.mean(axis=0)
+    _, sv, vt = np.linalg.svd(flat_face - centroid, full_matrices=False)
     axis = vt[2] if vt[2][2] > 0.0 else -vt[2]
-    flat = float(sv[2] / math.sqrt(n))
+    flat = float(sv[2] / math.sqrt(len(flat_face)))
     xy = top[:, 0:2]
     sides = _top_sides(shape, size)
     if shape == "box":

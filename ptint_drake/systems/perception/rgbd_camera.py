@@ -93,6 +93,7 @@ def camera_pose(c: RgbdCameraConfig) -> RigidTransform:
 
 
 def camera_info(c: RgbdCameraConfig) -> CameraInfo:
+    """The configured intrinsics (width, height, vertical field of view)."""
     return CameraInfo(c.width, c.height, math.radians(c.fov_y_deg))
 
 

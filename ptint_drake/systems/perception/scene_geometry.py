@@ -29,7 +29,8 @@ BELT_COLOR = Rgba(0.2, 0.2, 0.22, 1.0)
 BELT_THICKNESS = 0.02  # m, of a drawn belt slab
 
 
-def _instance(X, shape, name: str, color: Rgba) -> GeometryInstance:
+def visual_instance(X, shape, name: str, color: Rgba) -> GeometryInstance:
+    """A geometry drawn for illustration and perception (diffuse ``color``)."""
     inst = GeometryInstance(X, shape, name)
     illustration = IllustrationProperties()
     illustration.AddProperty("phong", "diffuse", color)
@@ -42,6 +43,7 @@ def _instance(X, shape, name: str, color: Rgba) -> GeometryInstance:
 
 
 def part_shape(shape: str, size):
+    """The Drake shape of a box [x, y, z] or an upright cylinder [diameter, height]."""
     if shape == "box":
         return Box(*[float(v) for v in size])
     return Cylinder(0.5 * float(size[0]), float(size[1]))
@@ -56,14 +58,14 @@ class PartGeometry(LeafSystem):
         self._frames = []
         for k in range(count):
             frame = scene_graph.RegisterFrame(self._source, GeometryFrame(f"part_{k}"))
-            scene_graph.RegisterGeometry(self._source, frame, _instance(
+            scene_graph.RegisterGeometry(self._source, frame, visual_instance(
                 RigidTransform(), part_shape(shape, size), f"part_{k}", PART_COLOR))
             self._frames.append(frame)
         for i, belt in enumerate(belts):
             u, v = belt.frame()
             R = RotationMatrix(np.column_stack([u, v, [0.0, 0.0, 1.0]]))
             X = RigidTransform(R, np.asarray(belt.center, float) - [0.0, 0.0, 0.5 * BELT_THICKNESS])
-            scene_graph.RegisterAnchoredGeometry(self._source, _instance(
+            scene_graph.RegisterAnchoredGeometry(self._source, visual_instance(
                 X, Box(belt.length, belt.width, BELT_THICKNESS), f"belt_{i}", BELT_COLOR))
         self._positions = self.DeclareVectorInputPort("positions", 3 * count)
         self._rotations = self.DeclareVectorInputPort("rotations", 9 * count)
@@ -87,6 +89,7 @@ class PartGeometry(LeafSystem):
 def AddPartGeometry(builder: DiagramBuilder, scene_graph: SceneGraph, *, positions: OutputPort,
                     rotations: OutputPort, count: int, shape: str, size, belts: list[BeltRegion]
                     ) -> PartGeometry:
+    """``PartGeometry`` added and wired: posed from ``positions`` and ``rotations``."""
     parts = builder.AddNamedSystem("part_geometry", PartGeometry(
         scene_graph, count=count, shape=shape, size=size, belts=belts))
     builder.Connect(positions, parts.GetInputPort("positions"))

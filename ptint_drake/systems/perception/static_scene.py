@@ -8,7 +8,8 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from pydrake.geometry import SceneGraph
+from pydrake.geometry import Box, Rgba, SceneGraph
+from pydrake.math import RigidTransform
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
@@ -16,7 +17,7 @@ from ptint_drake.config.measurement import RgbdCameraConfig
 from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PerceptionConfig,
                                                                  belt_regions)
 from ptint_drake.systems.perception.rgbd_camera import AddRgbdCamera
-from ptint_drake.systems.perception.scene_geometry import AddPartGeometry
+from ptint_drake.systems.perception.scene_geometry import AddPartGeometry, visual_instance
 
 
 class StaticScene:
@@ -25,7 +26,7 @@ class StaticScene:
     object rides (default: one object per part, on belt 0)."""
 
     def __init__(self, camera: RgbdCameraConfig, poses, *, rate_hz: float = 30.0, latency: float = 0.033,
-                 seed: int = 0, object_belts=None, perceive: bool = True):
+                 seed: int = 0, object_belts=None, perceive: bool = True, occluders=()):
         builder = DiagramBuilder()
         scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
         belts = belt_regions(camera.belts)
@@ -40,6 +41,12 @@ class StaticScene:
         AddPartGeometry(builder, scene_graph, positions=pos.get_output_port(),
                         rotations=rot.get_output_port(), count=n, shape=camera.part_shape,
                         size=camera.part_size, belts=belts)
+        if occluders:
+            source = scene_graph.RegisterSource("occluders")
+            for j, (box, centre) in enumerate(occluders):
+                scene_graph.RegisterAnchoredGeometry(source, visual_instance(
+                    RigidTransform(np.asarray(centre, float)), Box(*box), f"occluder_{j}",
+                    Rgba(0.6, 0.6, 0.6, 1)))
         self.camera = AddRgbdCamera(builder, scene_graph, camera, rate_hz=rate_hz, seed=seed)
         self.perception = self.estimator = None
         if perceive:
