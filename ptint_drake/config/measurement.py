@@ -29,10 +29,10 @@ class RgbdCameraConfig:
     width: int = 640  # pixels
     height: int = 480  # pixels
     fov_y_deg: float = 45.0  # deg, vertical field of view
-    xyz: Optional[List[float]] = None  # m, camera origin in world
-    rpy_deg: Optional[List[float]] = None  # deg, camera frame's roll-pitch-yaw in world
-    look_at: Optional[List[float]] = None  # m, a world point on the optical axis
-    look_from: Optional[List[float]] = None  # m, the camera origin (with look_at)
+    xyz: Optional[list[float]] = None  # m, camera origin in world
+    rpy_deg: Optional[list[float]] = None  # deg, camera frame's roll-pitch-yaw in world
+    look_at: Optional[list[float]] = None  # m, a world point on the optical axis
+    look_from: Optional[list[float]] = None  # m, the camera origin (with look_at)
     # × the RealSense D415-style depth noise (systems.perception.depth_noise); 0: noiseless
     depth_noise_scale: float = 1.0
     part_shape: str = "box"  # the parts' known shape: "box" or "cylinder" (axis vertical)
