@@ -81,11 +81,12 @@ def noisy_depth(depth: np.ndarray, info: CameraInfo, rng: np.random.Generator, s
     nx, ny, nz = duy * dvz - duz * dvy, duz * dvx - dux * dvz, dux * dvy - duy * dvx
     with np.errstate(invalid="ignore", divide="ignore"):
         cos2 = (nx * x + ny * y + nz * zz) ** 2 / ((nx * nx + ny * ny + nz * nz) * (x * x + y * y + zz * zz))
-    cos2 = np.nan_to_num(cos2, nan=1.0)
     cos_from, cos_to = math.cos(math.radians(GRAZING_FROM_DEG)), math.cos(math.radians(GRAZING_TO_DEG))
-    # probability linear in the angle between the two limits
-    angle = np.degrees(np.arccos(np.sqrt(np.clip(cos2, cos_to ** 2, cos_from ** 2))))
-    p_grazing = (angle - GRAZING_FROM_DEG) / (GRAZING_TO_DEG - GRAZING_FROM_DEG)
+    # probability linear in the angle between the two limits (computed where it is not 0)
+    grazing = np.flatnonzero(cos2 < cos_from ** 2)  # NaN (no neighbours): not grazing
+    p_grazing = np.zeros(zz.shape, dtype=np.float32)
+    angle = np.degrees(np.arccos(np.sqrt(np.clip(cos2.flat[grazing], cos_to ** 2, cos_from ** 2))))
+    p_grazing.flat[grazing] = (angle - GRAZING_FROM_DEG) / (GRAZING_TO_DEG - GRAZING_FROM_DEG)
     jump = np.zeros(zz.shape, dtype=bool)
     dz_u = np.abs(np.diff(zz, axis=1)) > EDGE_JUMP
     dz_v = np.abs(np.diff(zz, axis=0)) > EDGE_JUMP
