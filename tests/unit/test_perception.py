@@ -5,14 +5,20 @@ import math
 
 import numpy as np
 import pytest
+from pydrake.common.value import AbstractValue
+from pydrake.perception import BaseField, DepthImageToPointCloud
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.sensors import PixelType
 
 from ptint_drake.config.measurement import BeltRegionConfig, MeasurementConfig, RgbdCameraConfig
 from ptint_drake.systems.camera import validate_measurement
-from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PerceptionConfig,
-                                                                 belt_regions)
+from ptint_drake.systems.perception.part_fit import fit_parts
+from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PartPoseEstimator,
+                                                                 PerceptionConfig, belt_regions,
+                                                                 belts_under_paths)
 from ptint_drake.systems.perception.static_scene import StaticScene
+from ptint_drake.systems.targets import LinearTarget
 
 BELT = BeltRegionConfig(center=[0.3, 0.0, 0.1], direction=[0.0, 1.0, 0.0], length=0.4, width=0.08)
 TILT = math.radians(30.0)  # from vertical, 0.5 m from the belt
@@ -119,3 +125,30 @@ def test_rgbd_measurement_fields_are_checked():
     for config, field in cases:
         with pytest.raises(ValueError, match=field.replace(".", r"\.")):
             validate_measurement(config)
+
+
+def test_derived_belts_of_parallel_paths_keep_their_own_parts():
+    """conveyor_yaw's first and third objects ride parallel paths 50 mm apart at one height: the
+    belts derived under them must each see only their own part."""
+
+    targets = [LinearTarget([0.30, -0.05, 0.115], [0.0, 0.1, 0.0]), LinearTarget([0.25, -0.05, 0.115],
+                                                                                 [0.0, 0.1, 0.0])]
+    belts, of = belts_under_paths(targets, 1.0, "box", [0.03, 0.03, 0.03])
+    assert of == [0, 1]
+    c = camera()
+    scene = StaticScene(c, [(np.array([0.30, 0.0, 0.115]), 0.0), (np.array([0.25, 0.02, 0.115]), 0.0)],
+                        perceive=False)
+    estimator = PartPoseEstimator(PerceptionConfig(scene.camera.info, scene.camera.X_WC, belts, "box",
+                                                   [0.03] * 3, of, 30.0, 0.033))
+    builder = DiagramBuilder()
+    to_cloud = builder.AddSystem(DepthImageToPointCloud(scene.camera.info, PixelType.kDepth32F, 1.0,
+                                                        BaseField.kXYZs))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    depth = scene.camera.noise.get_output_port().Eval(scene.camera.noise.GetMyContextFromRoot(scene.context))
+    to_cloud.depth_image_input_port().FixValue(to_cloud.GetMyMutableContextFromRoot(context), depth)
+    to_cloud.camera_pose_input_port().FixValue(to_cloud.GetMyMutableContextFromRoot(context),
+                                               AbstractValue.Make(scene.camera.X_WC))
+    cloud = to_cloud.point_cloud_output_port().Eval(to_cloud.GetMyContextFromRoot(context))
+    fits = good(fit_parts(estimator.frame_points(cloud), belts, "box", [0.03] * 3))
+    assert sorted((f.belt, round(f.position[0], 2)) for f in fits) == [(0, 0.30), (1, 0.25)]

@@ -3,9 +3,10 @@
 ``fit_parts(points, belts, shape, size)`` does, per configured belt (``BeltRegion``: a
 horizontal rectangle, the conveyor's top surface):
 
-1. background removal: keep the points above the belt's rectangle (a part may overhang by half
-   its diagonal) whose height over the belt plane is in (``BELT_BAND``, part height + ``TOP_BAND``]
-   — the belt itself, anything beside it and anything well above a part are dropped;
+1. background removal: keep the points above the belt's rectangle (a part may overhang its ends
+   by half its diagonal; across, the belt's width must hold the part) whose height over the belt
+   plane is in (``BELT_BAND``, part height + ``TOP_BAND``] — the belt itself, anything beside
+   it and anything well above a part are dropped;
 2. clustering: points closer than ``CLUSTER_RADIUS`` are connected (scipy ``cKDTree`` pairs,
    ``connected_components``); a cluster whose top face is k ≥ 2 parts' area (parts touching) is
    split by k-means on its top-face points (scipy ``kmeans2``, fixed seed);
@@ -102,7 +103,7 @@ def belt_points(points: np.ndarray, belt: BeltRegion, shape: str, size) -> np.nd
     d = points - belt.center
     along, across, up = d @ u, d @ v, d[:, 2]
     reach = 0.5 * math.hypot(*_top_sides(shape, size))
-    keep = ((np.abs(along) <= 0.5 * belt.length + reach) & (np.abs(across) <= 0.5 * belt.width + reach)
+    keep = ((np.abs(along) <= 0.5 * belt.length + reach) & (np.abs(across) <= 0.5 * belt.width)
             & (up > BELT_BAND) & (up <= part_height(shape, size) + TOP_BAND))
     return points[keep]
 

@@ -262,7 +262,10 @@ def belt_regions(configs) -> list[BeltRegion]:
 
 
 
-BELT_MARGIN = 0.03  # m, a derived belt's extra width beside its part (each side) and length
+# m, a derived belt's extra width beside its part's footprint (each side; narrow, so that the belts
+# of two objects on parallel paths do not take each other's parts) and length (each end)
+BELT_MARGIN = 0.005
+BELT_END_MARGIN = 0.03
 
 
 def belts_under_paths(targets, duration: float, shape: str, size) -> tuple[list[BeltRegion], list[int]]:
@@ -272,6 +275,7 @@ def belts_under_paths(targets, duration: float, shape: str, size) -> tuple[list[
     belts, of = [], []
     half = 0.5 * part_height(shape, size)
     for i, target in enumerate(targets):
+        target = getattr(target, "position", target)  # an oriented target: its motion
         start, velocity = getattr(target, "start", None), getattr(target, "velocity", None)
         if start is None or velocity is None or getattr(target, "compiled", None) is None:
             raise ValueError(f"interceptions[{i}].target: an rgbd camera sees parts on conveyors: "
@@ -284,7 +288,7 @@ def belts_under_paths(targets, duration: float, shape: str, size) -> tuple[list[
         centre = 0.5 * (start + end) - [0.0, 0.0, half]
         diagonal = float(np.hypot(*np.asarray(size, float)[:2])) if shape == "box" else float(size[0])
         belts.append(BeltRegion(centre, velocity / np.linalg.norm(velocity), speed * duration + diagonal
-                                + 2 * BELT_MARGIN, diagonal + 2 * BELT_MARGIN))
+                                + 2 * BELT_END_MARGIN, diagonal + 2 * BELT_MARGIN))
         of.append(i)
     return belts, of
 
