@@ -152,3 +152,25 @@ def test_derived_belts_of_parallel_paths_keep_their_own_parts():
     cloud = to_cloud.point_cloud_output_port().Eval(to_cloud.GetMyContextFromRoot(context))
     fits = good(fit_parts(estimator.frame_points(cloud), belts, "box", [0.03] * 3))
     assert sorted((f.belt, round(f.position[0], 2)) for f in fits) == [(0, 0.30), (1, 0.25)]
+
+
+def test_depth_noise_grows_with_depth_squared_and_drops_grazing_pixels():
+    from pydrake.systems.sensors import CameraInfo
+
+    from ptint_drake.systems.perception.depth_noise import NOISE_PER_Z2, noisy_depth
+
+    info = CameraInfo(320, 240, math.radians(45.0))
+    for z in (0.5, 1.0):
+        flat = np.full((240, 320), z, np.float32)  # a wall facing the camera
+        noisy = noisy_depth(flat, info, np.random.default_rng(1))
+        inner = noisy[20:-20, 20:-20]
+        assert np.std(inner - z) == pytest.approx(NOISE_PER_Z2 * z * z, rel=0.05)
+        assert np.mean(inner == 0.0) < 0.01
+    # a surface seen at ~80° incidence (depth × (1 + tan 80° / f) per row; steps < the 10 mm of
+    # an edge): missing with probability ~(80 - 65) / 20
+    rows = (1.0 + math.tan(math.radians(80.0)) / info.focal_y()) ** np.arange(24, dtype=np.float64)
+    grazing = np.full((240, 320), np.inf, np.float32)
+    grazing[0:24] = 0.3 * rows[:, None]
+    noisy = noisy_depth(grazing, info, np.random.default_rng(2))
+    assert 0.5 < np.mean(noisy[2:22, 20:-20] == 0.0) < 0.95
+    assert np.array_equal(noisy_depth(flat, info, np.random.default_rng(1), scale=0.0), flat)
