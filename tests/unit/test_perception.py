@@ -110,6 +110,9 @@ def test_perception_reads_only_the_depth_image():
     z = port.Eval(perception.GetMyContextFromRoot(context))
     assert z[0] == 0.0 and z[4] == 1.0
     assert np.linalg.norm(z[1:4] - centre) < 1e-3
+    quality = perception.GetOutputPort("quality_0").Eval(perception.GetMyContextFromRoot(context))
+    assert quality[0] == 0.0 and quality[6] == 1.0 and quality[1] > 200 and 0.0 < quality[2] < 2e-3
+    assert np.all(quality[3:6] > 0.0) and np.all(np.sqrt(quality[3:6]) < 1e-3)
 
 
 def test_rgbd_measurement_fields_are_checked():

@@ -22,9 +22,10 @@ and the association's memory; an abstract state holds the newest frame's fits (`
 
 Outputs: ``measurement_i`` (5: [stamp, x, y, z, valid]) and ``measured_rotation_i`` (11:
 [stamp, R row-major, valid]) per object — the ports ``kalman.AddCameraEstimators`` and
-``rotation_estimator.AddRotationEstimators`` read — and ``fits`` (list of ``PartFit`` of the
-newest processed frame, failed fits included, with their quality and covariance: what a pick
-world's part-pose source would read).
+``rotation_estimator.AddRotationEstimators`` read — ``quality_i`` (7: [stamp, inliers, residual
+(m), the position covariance's diagonal (m²), valid]) of the same sample, and ``fits`` (list of
+``PartFit`` of the newest processed frame, failed fits included, with their quality and
+covariance: what a pick world's part-pose source would read).
 """
 
 from __future__ import annotations
@@ -50,7 +51,9 @@ FIT_NOISE_STD = 0.0005
 VOXEL = 0.0015  # m, the voxel grid of the cloud (≈ 2 pixel footprints at 0.5 m)
 GATE = 0.05  # m, farthest a part moves between two accepted fits
 TIME_TOL = 1.0e-9
-_WIDTH = 14  # [stamp, x, y, z, valid, R] per object and slot
+# per object and slot: [stamp, x, y, z, valid, R (9), inliers, residual, covariance diagonal (3)]
+_WIDTH = 19
+QUALITY_SIZE = 7  # [stamp, inliers, residual (m), var x, var y, var z (m²), valid]
 
 
 @dataclass
@@ -99,6 +102,8 @@ class PartPoseEstimator(LeafSystem):
                 f"measurement_{i}", 5, self._measurement_calc(i), prerequisites_of_calc=prerequisites))
             self.rotation_ports.append(self.DeclareVectorOutputPort(
                 f"measured_rotation_{i}", 11, self._rotation_calc(i), prerequisites_of_calc=prerequisites))
+            self.DeclareVectorOutputPort(f"quality_{i}", QUALITY_SIZE, self._quality_calc(i),
+                                         prerequisites_of_calc=prerequisites)
         self.DeclareAbstractOutputPort("fits", lambda: AbstractValue.Make([]), self._fits_calc,
                                        prerequisites_of_calc={self.abstract_state_ticket(self._fits)})
 
@@ -179,7 +184,8 @@ class PartPoseEstimator(LeafSystem):
             memory[i] = [1.0, *fit.position, yaw]
             c, s = math.cos(yaw), math.sin(yaw)
             R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-            slot[i] = [t, *fit.position, 1.0, *R.ravel()]
+            slot[i] = [t, *fit.position, 1.0, *R.ravel(), fit.inliers, fit.residual,
+                       *np.diag(fit.covariance)]
         new = np.concatenate([slot.ravel(), old[:-self._n * _WIDTH]])
         state.get_mutable_discrete_state(self._buffer).SetFromVector(new)
         state.get_mutable_discrete_state(self._memory).SetFromVector(memory.ravel())
@@ -205,6 +211,12 @@ class PartPoseEstimator(LeafSystem):
             output.SetFromVector(np.concatenate([row[0:1], row[5:14], row[4:5]]))
         return calc
 
+    def _quality_calc(self, i: int):
+        def calc(context, output):
+            row = self._visible(context, i)
+            output.SetFromVector(np.concatenate([row[0:1], row[14:19], row[4:5]]))
+        return calc
+
     def timing(self, context) -> dict:
         """{t, cloud_s, fit_s} of the newest frame (seconds of wall time: the render and the
         cloud — pulled by the cloud's evaluation — and the fit)."""
@@ -225,6 +237,7 @@ def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstim
     for i in range(len(config.object_belts)):
         builder.ExportOutput(estimator.GetOutputPort(f"measurement_{i}"), f"measurement_{i}")
         builder.ExportOutput(estimator.GetOutputPort(f"measured_rotation_{i}"), f"measured_rotation_{i}")
+        builder.ExportOutput(estimator.GetOutputPort(f"quality_{i}"), f"quality_{i}")
     builder.ExportOutput(estimator.GetOutputPort("fits"), "fits")
     diagram = builder.Build()
     diagram.set_name("rgbd_perception")
