@@ -23,6 +23,8 @@ least ``tau``), lines for the run's output, and whether the controller used the 
 
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Callable, Optional
 
@@ -33,6 +35,7 @@ from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
 
 from ptint_drake.robot import nominal_plant
 from ptint_drake.systems.kalman import AddCameraEstimators, CameraEstimators
+from ptint_drake.systems.perception.part_pose_estimator import FIT_NOISE_STD, AddRgbdPerception
 from ptint_drake.systems.orientation import has_orientation
 from ptint_drake.systems.rotation_estimator import AddRotationEstimators
 from ptint_drake.systems.schedule import Schedule
@@ -151,7 +154,16 @@ def camera_estimators(builder: DiagramBuilder, station_system, scenario: "Scenar
                       targets: list) -> CameraEstimators:
     """One camera + position estimator per object fed by the station's true object positions
     (and orientations when ``measures_orientation``), in view before t = 0 (``targets``: the
-    objects' motions before t = 0)."""
+    objects' motions before t = 0).  With ``measurement.sensor: rgbd`` the samples are the part
+    poses fitted to the station's ``depth_image`` (``perception.AddRgbdPerception``; the motions
+    give only the belts when none are configured)."""
+    if scenario.measurement.sensor == "rgbd":
+        seen, _ = AddRgbdPerception(builder, station_system.GetOutputPort("depth_image"),
+                                    scenario.measurement, targets, scenario.duration)
+        config = scenario.measurement
+        if not config.noise_std:  # the fits' own noise, not the pose sensor's formula
+            config = dataclasses.replace(config, noise_std=FIT_NOISE_STD)
+        return AddCameraEstimators(builder, schedule=schedule, config=config, cameras=seen)
     rotations = (station_system.GetOutputPort("object_rotations") if measures_orientation(scenario, targets)
                  else None)
     return AddCameraEstimators(builder, objects_port=station_system.GetOutputPort("objects"),

@@ -63,7 +63,8 @@ import math
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from ptint_drake.config.measurement import MeasurementConfig
+from ptint_drake.config.measurement import SENSORS, MeasurementConfig
+from ptint_drake.systems.perception.rgbd_camera import validate_camera
 from ptint_drake.systems.orientation import rotation_from_vector
 
 ESTIMATORS = ("auto", "kalman_cv", "kalman_ca", "none")
@@ -99,6 +100,7 @@ def validate_measurement(m: MeasurementConfig) -> None:
         if not (math.isfinite(value) and value >= 0.0):
             raise _field_error(name, f"must be >= 0 and finite, got {getattr(m, name)}")
     _check_estimator(m)
+    _check_sensor(m)
     if isinstance(m.seed, bool) or not isinstance(m.seed, int) or m.seed < 0:
         raise _field_error("seed", f"must be an integer >= 0, got {m.seed!r}")
     windows = []
@@ -121,6 +123,25 @@ def validate_measurement(m: MeasurementConfig) -> None:
             first, second = sorted((i0, i1))
             raise _field_error(f"dropouts[{second}]", f"overlaps dropouts[{first}] "
                                f"([{lo1}, {hi1}] and [{lo0}, {hi0}])")
+
+
+def _check_sensor(m: MeasurementConfig) -> None:
+    """``sensor`` and, for ``rgbd``, its camera (``perception.rgbd_camera.validate_camera``)."""
+    if m.sensor not in SENSORS:
+        raise _field_error("sensor", f"must be one of {', '.join(SENSORS)}, got {m.sensor!r}")
+    if m.sensor == "pose":
+        if m.camera is not None:
+            raise _field_error("camera", "only with sensor: rgbd (the pose sensor is a formula, no image)")
+        return
+    if m.camera is None:
+        raise _field_error("camera", "sensor: rgbd needs a camera (its pose: xyz + rpy_deg or "
+                           "look_at + look_from)")
+    if m.estimator == "none":
+        raise _field_error("estimator", "sensor: rgbd needs an estimator (auto, kalman_cv or kalman_ca)")
+    if not m.latency > TIME_TOL:
+        raise _field_error("latency", "an rgbd camera needs a latency > 0 (its frame is processed after "
+                           "it is taken; e.g. 0.033 at 30 Hz)")
+    validate_camera(m.camera)
 
 
 def _check_estimator(m: MeasurementConfig) -> None:

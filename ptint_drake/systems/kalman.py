@@ -260,7 +260,8 @@ class CameraEstimators:
 def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | None = None,
                         objects_port: OutputPort | None = None, schedule: Schedule,
                         config: MeasurementConfig, histories=None,
-                        rotations_port: OutputPort | None = None) -> CameraEstimators:
+                        rotations_port: OutputPort | None = None, cameras: list | None = None
+                        ) -> CameraEstimators:
     """Add, per object i, ``camera_i`` (seed_offset i) observing ``true_position_ports[i]``
     and ``target_filter_i``; and ``target_selector`` choosing the active one.  The handles
     returned hold every camera and filter (index i: object i).
@@ -273,11 +274,16 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
     ``config.estimator``: ``auto`` (an ``imm.AdaptiveTargetEstimator`` per object, selected in C++
     by a polynomial ``ActiveTargetSelector``), or ``kalman_cv`` / ``kalman_ca`` (a ``TargetKalmanFilter``).
     ``rotations_port`` (9 per object, e.g. the station's ``object_rotations``): measured too.
+    ``cameras`` (one per object, already in the diagram: e.g. ``perception.SeenObject``s of an
+    RGB-D camera's fits): the samples come from them instead (no pose camera is added; pass
+    ``true_position_ports`` as None and no ``objects_port``).
     """
     validate_measurement(config)
     if config.estimator not in ("auto", "kalman_cv", "kalman_ca"):
         raise ValueError("measurement.estimator: AddCameraEstimators needs auto, kalman_cv or "
                          f"kalman_ca, got {config.estimator!r}")
+    if cameras is not None:
+        return _estimators_of(builder, cameras, schedule, config)
     if (true_position_ports is None) == (objects_port is None):
         raise ValueError("AddCameraEstimators: give true_position_ports or objects_port, not both")
     if objects_port is not None:
@@ -309,3 +315,19 @@ def AddCameraEstimators(builder: DiagramBuilder, *, true_position_ports: list | 
         cameras.append(camera)
         filters.append(kf)
     return CameraEstimators(selector.get_target_output_port(), cameras, filters, selector)
+
+
+def _estimators_of(builder: DiagramBuilder, cameras: list, schedule: Schedule,
+                   config: MeasurementConfig) -> CameraEstimators:
+    """A filter per given camera (``AddCameraEstimators``' ``cameras``) and the selector."""
+    polynomial = config.estimator == "auto"
+    selector = builder.AddNamedSystem("target_selector", ActiveTargetSelector(
+        schedule=schedule, count=len(cameras), polynomial=polynomial))
+    filters = []
+    for i, camera in enumerate(cameras):
+        kf = builder.AddNamedSystem(f"target_filter_{i}", _estimator(config, camera.pre_run_samples()))
+        builder.Connect(camera.get_measurement_output_port(), kf.get_measurement_input_port())
+        get = kf.get_polynomial_output_port if polynomial else kf.get_target_output_port
+        builder.Connect(get(), selector.get_input_port(i))
+        filters.append(kf)
+    return CameraEstimators(selector.get_target_output_port(), list(cameras), filters, selector)

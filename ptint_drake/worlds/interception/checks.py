@@ -4,9 +4,13 @@ thrown object above the floor at tf, orientation noise only where an orientation
 
 import math
 
+import numpy as np
+
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.fields import positive, vector3
 from ptint_drake.systems.orientation import has_orientation
+from ptint_drake.systems.perception.part_pose_estimator import perception_belts
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, describe_pose, in_view
 from ptint_drake.systems.targets import WaypointTarget
 from ptint_drake.worlds.interception.objects import interception_targets
 
@@ -23,6 +27,30 @@ def check_interceptions(s) -> None:
         if ic.target.ballistic is not None:
             _validate_throw(ic, f"interceptions[{i}]")
     _validate_rotation_noise(s)
+    _validate_rgbd_view(s)
+
+
+def _validate_rgbd_view(s) -> None:
+    """With ``measurement.sensor: rgbd``: every object rides a conveyor (a horizontal linear
+    motion) and is in the camera's view at its segment's start and at its interception time
+    (else nothing would be seen: rejected before the run, naming the camera's pose)."""
+    m = s.measurement
+    if m is None or m.sensor != "rgbd" or m.camera is None:
+        return
+    targets = interception_targets(s)
+    try:
+        perception_belts(m, targets, s.duration)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+    X_WC, info = camera_pose(m.camera), camera_info(m.camera)
+    for i, (ic, target) in enumerate(zip(s.interceptions, targets)):
+        times = (ic.start, ic.start + ic.tf)
+        points = np.array([target.evaluate(t)[0:3] for t in times])
+        seen = in_view(X_WC, info, points)
+        if not np.all(seen):
+            when = times[int(np.argmin(seen))]
+            raise ScenarioError(f"measurement.camera: interceptions[{i}]'s object is not in view at "
+                                f"t = {when:g} s of the camera at {describe_pose(m.camera)} (nothing to see)")
 
 
 def _validate_interception(s, i: int, ic) -> None:

@@ -22,7 +22,16 @@ port                   size    meaning
 ``objects``            3·n     output: true position of every object
 ``object_rotations``   9·n     output: true orientation of every object (row-major;
                                an unturned frame for an object without one)
+``color_image``        —       output (``measurement.sensor: rgbd`` only): the RGB-D
+                               camera's colour image (ImageRgba8U)
+``depth_image``        —       output (rgbd only): its depth image with the sensor's
+                               noise (ImageDepth32F, m; 0 where missing)
 =====================  ======  ================================================
+
+With an RGB-D camera the station also holds a ``SceneGraph`` drawing the arm's visual
+geometry where the plant is (a never-simulated copy of the model posed from ``state``: the
+arm occludes), the objects (the camera's ``part_shape`` and ``part_size``) posed by their
+motion, and the belts the perception knows (``perception.perception_belts``).
 
 The station may use the model (it *is* the model); the model-free controllers
 only see ``state`` (through the kinematics) and a target.
@@ -37,11 +46,16 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import Saturation
 
-from ptint_drake.robot import actuator_effort_limits, effort_limits, make_plant
+from pydrake.geometry import SceneGraph
+
+from ptint_drake.robot import actuator_effort_limits, effort_limits, make_plant, resolve_model
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.disturbance import JointDisturbance
 from ptint_drake.systems.orientation import ObjectRotations
+from ptint_drake.systems.perception.part_pose_estimator import perception_belts
+from ptint_drake.systems.perception.rgbd_camera import AddRgbdCamera
+from ptint_drake.systems.perception.scene_geometry import AddArmVisuals, AddPartGeometry
 from ptint_drake.systems.targets import TargetSource
 from ptint_drake.worlds.interception.objects import interception_schedule, interception_targets
 
@@ -86,6 +100,28 @@ def MakeStation(scenario: Scenario) -> Station:
     builder.ExportOutput(truth.GetOutputPort("objects"), "objects")
     rotations = builder.AddNamedSystem("object_rotations", ObjectRotations(targets))
     builder.ExportOutput(rotations.get_output_port(), "object_rotations")
+    m = scenario.measurement
+    if m is not None and m.sensor == "rgbd":
+        _add_camera(builder, scenario, plant_state=plant.get_state_output_port(),
+                    positions=truth.GetOutputPort("objects"), rotations=rotations.get_output_port(),
+                    targets=targets)
     diagram = builder.Build()
     diagram.set_name("station")
     return Station(diagram, plant, targets, effort_limits(plant), scenario.limits.saturate)
+
+
+def _add_camera(builder: DiagramBuilder, scenario: Scenario, *, plant_state, positions, rotations,
+                targets) -> None:
+    """The scene graph (arm visuals, objects, belts), the RGB-D camera, and its exported images."""
+    m = scenario.measurement
+    try:
+        belts, _ = perception_belts(m, targets, scenario.duration)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+    scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+    AddArmVisuals(builder, scene_graph, str(resolve_model(scenario.robot.model)), plant_state)
+    AddPartGeometry(builder, scene_graph, positions=positions, rotations=rotations, count=len(targets),
+                    shape=m.camera.part_shape, size=m.camera.part_size, belts=belts)
+    camera = AddRgbdCamera(builder, scene_graph, m.camera, rate_hz=m.rate_hz, seed=m.seed)
+    builder.ExportOutput(camera.color_image, "color_image")
+    builder.ExportOutput(camera.depth_image, "depth_image")

@@ -7,7 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pydrake.common.yaml import yaml_load_typed
+
 from ptint_drake.config.schema import Scenario
+from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.robot import resolve_model
 from ptint_drake.systems.orientation import target_rotation_values
 
@@ -55,13 +58,22 @@ def view_tasks(scenario: Scenario, targets: list, series: dict, metrics: dict, s
                    object_rotations(scenario, targets, series) if replay else None)
     stems = run_figure_stems(scenario.controller.task)
     names = [n for n in VIEW_ORDER if (n == "replay" and replay) or (n in stems and figures)]
-    return [(n, series, metrics, stage, scenario.name, replay_args if n == "replay" else (formats,))
-            for n in names]
+    tasks = [(n, series, metrics, stage, scenario.name, replay_args if n == "replay" else (formats,))
+             for n in names]
+    if figures and scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
+        # the scenario as YAML text: a worker process draws each view (pickled arguments)
+        tasks.append(("camera_frames", series, metrics, stage, scenario.name, (dump_yaml(scenario),)))
+    return tasks
 
 
 def draw_view(name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:
     """One figure (``name`` in ``figures.RUN_FIGURES``, ``args`` = (formats,)) or the replay
     (``name == "replay"``, ``args`` = (model file, belts, end effector, ``object_rotations``))."""
+    if name == "camera_frames":  # the RGB-D camera's frames (measurement.sensor: rgbd)
+        from ptint_drake.worlds.interception.camera_frames import write_camera_frames  # noqa: PLC0415
+
+        write_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, stage)
+        return name
     if name == "replay":
         from ptint_drake.replay import write_replay  # noqa: PLC0415
 

@@ -1,0 +1,343 @@
+"""``PartPoseEstimator`` — per frame, the parts' poses fitted to the camera's point cloud, in
+the shape of the pose camera's samples; ``MakeRgbdPerception`` — the pipeline from a depth
+image to those samples as one diagram whose only input is the image.
+
+Pipeline per frame (period 1 / ``rate_hz``, frame k at t_k = k / rate): Drake's
+``DepthImageToPointCloud`` (the configured camera pose X_WC on its ``camera_pose`` port, so the
+cloud is in the world frame; missing pixels become NaN), ``PointCloud.Crop`` to the box around
+the configured belts, ``PointCloud.VoxelizedDownSample`` (``VOXEL``), then ``part_fit.fit_parts``
+(background removal from the belts, clustering, the shape fit, quality).
+
+Data association (no truth): object i is looked for on belt ``object_belts[i]``; among the
+good fits there it takes the one nearest its last accepted position (within ``GATE``), or —
+never seen yet — the one farthest downstream.  Its yaw is unwrapped: the fit's yaw is known
+only up to the part's symmetry, and the sample reports the symmetric yaw nearest the last one.
+A frame where object i has no good fit (not in view, occluded, a poor fit) is a dropout for it:
+its output keeps the last sample (same stamp), as the pose camera's does.
+
+Timing (the pose camera's, ``systems.camera``): the sample taken at t_k becomes visible at
+t_k + latency (latency > 0: the frame is processed after it is taken).  The discrete state is a
+delay buffer of the last N frames, newest first, each [stamp, x, y, z, valid, R (9)] per object,
+and the association's memory; an abstract state holds the newest frame's fits (``fits``).
+
+Outputs: ``measurement_i`` (5: [stamp, x, y, z, valid]) and ``measured_rotation_i`` (11:
+[stamp, R row-major, valid]) per object — the ports ``kalman.AddCameraEstimators`` and
+``rotation_estimator.AddRotationEstimators`` read — ``quality_i`` (7: [stamp, inliers, residual
+(m), the position covariance's diagonal (m²), valid]) of the same sample, and ``fits`` (list of
+``PartFit`` of the newest processed frame, failed fits included, with their quality and
+covariance: what a pick world's part-pose source would read).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.perception import BaseField, DepthImageToPointCloud, PointCloud
+from pydrake.math import RigidTransform
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.primitives import ConstantValueSource
+from pydrake.systems.sensors import CameraInfo, PixelType
+
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
+from ptint_drake.systems.perception.part_fit import BeltRegion, belt_points, fit_parts, part_height
+
+# m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
+# position error of a 30 mm cube's fit at 0.5 m is 0.2-0.7 mm (tests/unit/test_perception.py)
+FIT_NOISE_STD = 0.0005
+VOXEL = 0.0015  # m, the voxel grid of the cloud (≈ 2 pixel footprints at 0.5 m)
+GATE = 0.05  # m, farthest a part moves between two accepted fits
+TIME_TOL = 1.0e-9
+# per object and slot: [stamp, x, y, z, valid, R (9), inliers, residual, covariance diagonal (3)]
+_WIDTH = 19
+QUALITY_SIZE = 7  # [stamp, inliers, residual (m), var x, var y, var z (m²), valid]
+
+
+@dataclass
+class PerceptionConfig:
+    """What the perception knows: the camera (intrinsics, pose), the belts, the parts' shape,
+    which belt each tracked object rides, and the frame timing."""
+
+    info: CameraInfo
+    X_WC: RigidTransform
+    belts: list
+    shape: str
+    size: list
+    object_belts: list
+    rate_hz: float
+    latency: float
+
+
+class PartPoseEstimator(LeafSystem):
+    """Input ``point_cloud`` (world frame); outputs of the module docstring."""
+
+    def __init__(self, config: PerceptionConfig):
+        super().__init__()
+        if not config.latency > TIME_TOL:
+            raise ValueError("measurement.latency: an rgbd camera needs a latency > 0 (its frame is "
+                             "processed after it is taken; e.g. 0.033 at 30 Hz)")
+        self._c = config
+        self._n = len(config.object_belts)
+        self._period = 1.0 / config.rate_hz
+        self._slots = math.ceil(config.latency * config.rate_hz - TIME_TOL) + 2
+        self._lo, self._hi = self._crop_box()
+        distance = min(float(np.linalg.norm(np.asarray(b.center) - config.X_WC.translation()))
+                       for b in config.belts) if config.belts else 0.5
+        self._footprint = distance / config.info.focal_y()
+        self._cloud_in = self.DeclareAbstractInputPort("point_cloud", AbstractValue.Make(PointCloud()))
+        self._buffer = self.DeclareDiscreteState(np.zeros(self._slots * self._n * _WIDTH))
+        # per object: [seen, x, y, z, yaw]
+        self._memory = self.DeclareDiscreteState(np.zeros(self._n * 5))
+        self._fits = self.DeclareAbstractState(AbstractValue.Make([]))
+        self._timing = self.DeclareAbstractState(AbstractValue.Make({}))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(self._period, 0.0, self._update)
+        self.DeclarePeriodicPublishEvent(self._period, config.latency, lambda context: None)
+        prerequisites = {self.time_ticket(), self.xd_ticket()}
+        self.measurement_ports, self.rotation_ports = [], []
+        for i in range(self._n):
+            self.measurement_ports.append(self.DeclareVectorOutputPort(
+                f"measurement_{i}", 5, self._measurement_calc(i), prerequisites_of_calc=prerequisites))
+            self.rotation_ports.append(self.DeclareVectorOutputPort(
+                f"measured_rotation_{i}", 11, self._rotation_calc(i), prerequisites_of_calc=prerequisites))
+            self.DeclareVectorOutputPort(f"quality_{i}", QUALITY_SIZE, self._quality_calc(i),
+                                         prerequisites_of_calc=prerequisites)
+        self.DeclareAbstractOutputPort("fits", lambda: AbstractValue.Make([]), self._fits_calc,
+                                       prerequisites_of_calc={self.abstract_state_ticket(self._fits)})
+
+    def _fits_calc(self, context, output) -> None:
+        output.set_value(list(context.get_abstract_state(self._fits).get_value()))
+
+    def _crop_box(self) -> tuple[np.ndarray, np.ndarray]:
+        if not self._c.belts:
+            return np.zeros(3), np.zeros(3)
+        corners = []
+        reach = 0.5 * math.hypot(*np.asarray(self._c.size, float)[:2])
+        top = part_height(self._c.shape, self._c.size) + 0.01
+        for b in self._c.belts:
+            u, v = b.frame()
+            for su in (-1, 1):
+                for sv in (-1, 1):
+                    for h in (0.0, top):
+                        corners.append(np.asarray(b.center, float) + su * (0.5 * b.length + reach) * u
+                                       + sv * (0.5 * b.width + reach) * v + [0.0, 0.0, h])
+        corners = np.array(corners)
+        return corners.min(axis=0), corners.max(axis=0)
+
+    def frame_points(self, cloud: PointCloud) -> np.ndarray:
+        """The cloud cropped to the belts' part bands (the box around them, then each belt's
+        rectangle and height band: ``part_fit.belt_points``) and downsampled (N × 3)."""
+        xyz = cloud.xyzs()
+        with np.errstate(invalid="ignore"):  # the height first: it leaves few points (NaN: out)
+            z = xyz[2]
+            boxed = xyz[:, np.flatnonzero((z >= self._lo[2]) & (z <= self._hi[2]))].T
+            boxed = boxed[np.all((boxed >= self._lo) & (boxed <= self._hi), axis=1)]
+        bands = [belt_points(boxed, b, self._c.shape, self._c.size) for b in self._c.belts]
+        points = np.concatenate(bands) if bands else np.zeros((0, 3))
+        if len(points) == 0:
+            return points
+        kept = PointCloud(len(points))
+        kept.mutable_xyzs()[:] = points.T
+        return kept.VoxelizedDownSample(VOXEL).xyzs().T
+
+    def fit_frame(self, cloud: PointCloud) -> list:
+        return fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size,
+                         footprint=self._footprint, spacing=max(VOXEL, 1.2 * self._footprint))
+
+    def _associate(self, fits: list, memory: np.ndarray) -> list:
+        """Per object: its fit (or None) and the new memory row."""
+        chosen = []
+        for i, belt in enumerate(self._c.object_belts):
+            candidates = [f for f in fits if f.ok and f.belt == belt]
+            seen, last = memory[i, 0] > 0.5, memory[i, 1:4]
+            fit = None
+            if candidates and seen:
+                fit = min(candidates, key=lambda f: np.linalg.norm(f.position - last))
+                if np.linalg.norm(fit.position - last) > GATE:
+                    fit = None
+            elif candidates:
+                u, _ = self._c.belts[belt].frame()
+                fit = max(candidates, key=lambda f: f.position @ u)
+            chosen.append(fit)
+        return chosen
+
+    def _update(self, context, state) -> None:
+        t = context.get_time()
+        start = time.perf_counter()
+        cloud = self._cloud_in.Eval(context)
+        rendered = time.perf_counter()
+        fits = self.fit_frame(cloud)
+        done = time.perf_counter()
+        memory = context.get_discrete_state(self._memory).value().reshape(self._n, 5).copy()
+        chosen = self._associate(fits, memory)
+        old = context.get_discrete_state(self._buffer).value()
+        slot = old[:self._n * _WIDTH].reshape(self._n, _WIDTH).copy()  # a dropout holds the last sample
+        for i, fit in enumerate(chosen):
+            if fit is None:
+                continue
+            yaw = fit.yaw
+            if memory[i, 0] > 0.5 and fit.symmetry > 0.0:
+                step = fit.symmetry
+                yaw = memory[i, 4] + ((fit.yaw - memory[i, 4] + 0.5 * step) % step - 0.5 * step)
+            memory[i] = [1.0, *fit.position, yaw]
+            c, s = math.cos(yaw), math.sin(yaw)
+            R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+            slot[i] = [t, *fit.position, 1.0, *R.ravel(), fit.inliers, fit.residual,
+                       *np.diag(fit.covariance)]
+        new = np.concatenate([slot.ravel(), old[:-self._n * _WIDTH]])
+        state.get_mutable_discrete_state(self._buffer).SetFromVector(new)
+        state.get_mutable_discrete_state(self._memory).SetFromVector(memory.ravel())
+        state.get_mutable_abstract_state(self._fits).set_value(fits)
+        state.get_mutable_abstract_state(self._timing).set_value(
+            {"t": t, "cloud_s": rendered - start, "fit_s": done - rendered})
+
+    def _visible(self, context, i: int) -> np.ndarray:
+        t = context.get_time()
+        slots = context.get_discrete_state(self._buffer).value().reshape(self._slots, self._n, _WIDTH)
+        for slot in slots:
+            row = slot[i]
+            if row[4] > 0.5 and row[0] + self._c.latency <= t + TIME_TOL:
+                return row
+        return np.zeros(_WIDTH)
+
+    def _measurement_calc(self, i: int):
+        return lambda context, output: output.SetFromVector(self._visible(context, i)[0:5])
+
+    def _rotation_calc(self, i: int):
+        def calc(context, output):
+            row = self._visible(context, i)
+            output.SetFromVector(np.concatenate([row[0:1], row[5:14], row[4:5]]))
+        return calc
+
+    def _quality_calc(self, i: int):
+        def calc(context, output):
+            row = self._visible(context, i)
+            output.SetFromVector(np.concatenate([row[0:1], row[14:19], row[4:5]]))
+        return calc
+
+    def timing(self, context) -> dict:
+        """{t, cloud_s, fit_s} of the newest frame (seconds of wall time: the render and the
+        cloud — pulled by the cloud's evaluation — and the fit)."""
+        return dict(context.get_abstract_state(self._timing).get_value())
+
+
+def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstimator]:
+    """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of
+    ``PartPoseEstimator`` (``measurement_i``, ``measured_rotation_i``, ``fits``)."""
+    builder = DiagramBuilder()
+    cloud = builder.AddNamedSystem("depth_to_cloud", DepthImageToPointCloud(
+        config.info, PixelType.kDepth32F, 1.0, BaseField.kXYZs))
+    pose = builder.AddNamedSystem("camera_pose", ConstantValueSource(AbstractValue.Make(config.X_WC)))
+    builder.Connect(pose.get_output_port(), cloud.camera_pose_input_port())
+    estimator = builder.AddNamedSystem("part_poses", PartPoseEstimator(config))
+    builder.Connect(cloud.point_cloud_output_port(), estimator.GetInputPort("point_cloud"))
+    builder.ExportInput(cloud.depth_image_input_port(), "depth_image")
+    for i in range(len(config.object_belts)):
+        builder.ExportOutput(estimator.GetOutputPort(f"measurement_{i}"), f"measurement_{i}")
+        builder.ExportOutput(estimator.GetOutputPort(f"measured_rotation_{i}"), f"measured_rotation_{i}")
+        builder.ExportOutput(estimator.GetOutputPort(f"quality_{i}"), f"quality_{i}")
+    builder.ExportOutput(estimator.GetOutputPort("fits"), "fits")
+    diagram = builder.Build()
+    diagram.set_name("rgbd_perception")
+    return diagram, estimator
+
+
+@dataclass
+class SeenObject:
+    """Object i as the estimators see it through the perception (the ``Camera`` interface that
+    ``kalman.AddCameraEstimators`` and ``rotation_estimator.AddRotationEstimators`` read): its
+    measurement ports; no pre-run samples (the camera starts seeing at t = 0)."""
+
+    measurement: OutputPort
+    rotation: OutputPort
+    measures_rotation: bool = True
+
+    def get_measurement_output_port(self) -> OutputPort:
+        return self.measurement
+
+    def get_measured_rotation_output_port(self) -> OutputPort:
+        return self.rotation
+
+    def pre_run_samples(self, visible_by: float = 0.0) -> list:
+        return []
+
+    def pre_run_rotations(self, visible_by: float = 0.0) -> list:
+        return []
+
+
+def belt_regions(configs) -> list[BeltRegion]:
+    """``BeltRegion``s of ``measurement.camera.belts`` entries."""
+    return [BeltRegion(np.asarray(b.center, float), np.asarray(b.direction, float), float(b.length),
+                       float(b.width)) for b in configs]
+
+
+
+
+# m, a derived belt's extra width beside its part's footprint (each side; narrow, so that the belts
+# of two objects on parallel paths do not take each other's parts) and length (each end)
+BELT_MARGIN = 0.005
+BELT_END_MARGIN = 0.03
+
+
+def belts_under_paths(targets, duration: float, shape: str, size) -> tuple[list[BeltRegion], list[int]]:
+    """A belt under each object's straight horizontal path over [0, duration] (the conveyor the
+    scenario's ``linear`` target describes: its top surface half the part's height below the
+    centre), and the belt of each object; ``ValueError`` naming the object otherwise."""
+    belts, of = [], []
+    half = 0.5 * part_height(shape, size)
+    for i, target in enumerate(targets):
+        target = getattr(target, "position", target)  # an oriented target: its motion
+        start, velocity = getattr(target, "start", None), getattr(target, "velocity", None)
+        if start is None or velocity is None or getattr(target, "compiled", None) is None:
+            raise ValueError(f"interceptions[{i}].target: an rgbd camera sees parts on conveyors: "
+                             "the target must be linear")
+        speed = float(np.linalg.norm(velocity[0:2]))
+        if abs(float(velocity[2])) > 1e-12 or speed <= 0.0:
+            raise ValueError(f"interceptions[{i}].target.linear.velocity: an rgbd camera sees parts on "
+                             f"conveyors: the motion must be horizontal and non-zero, got {list(velocity)}")
+        end = start + velocity * duration
+        centre = 0.5 * (start + end) - [0.0, 0.0, half]
+        diagonal = float(np.hypot(*np.asarray(size, float)[:2])) if shape == "box" else float(size[0])
+        belts.append(BeltRegion(centre, velocity / np.linalg.norm(velocity), speed * duration + diagonal
+                                + 2 * BELT_END_MARGIN, diagonal + 2 * BELT_MARGIN))
+        of.append(i)
+    return belts, of
+
+
+def perception_belts(measurement, targets, duration: float) -> tuple[list[BeltRegion], list[int]]:
+    """The belts the perception knows (``measurement.camera.belts``, or one under each object's
+    path: ``belts_under_paths``) and the belt of each object (configured belts: the one whose
+    centre line passes nearest the object's start, below it)."""
+    c = measurement.camera
+    if not c.belts:
+        return belts_under_paths(targets, duration, c.part_shape, c.part_size)
+    belts = belt_regions(c.belts)
+    of = []
+    for target in targets:
+        start = np.asarray(target.evaluate(0.0), float)[0:3]
+        distances = []
+        for b in belts:
+            u, v = b.frame()
+            d = start - b.center
+            distances.append(abs(d @ v) + max(abs(d @ u) - 0.5 * b.length, 0.0) + abs(d[2]))
+        of.append(int(np.argmin(distances)))
+    return belts, of
+
+
+def AddRgbdPerception(builder: DiagramBuilder, depth_image: OutputPort, measurement, targets,
+                      duration: float) -> tuple[list[SeenObject], PartPoseEstimator]:
+    """The perception of ``measurement`` (sensor rgbd) reading ``depth_image``; one
+    ``SeenObject`` per object of ``targets`` (whose motions give only the belts when none are
+    configured: ``perception_belts``)."""
+    c = measurement.camera
+    belts, of = perception_belts(measurement, targets, duration)
+    config = PerceptionConfig(camera_info(c), camera_pose(c), belts, c.part_shape, list(c.part_size), of,
+                              float(measurement.rate_hz), float(measurement.latency))
+    diagram, estimator = MakeRgbdPerception(config)
+    builder.AddNamedSystem("rgbd_perception", diagram)
+    builder.Connect(depth_image, diagram.get_input_port())
+    seen = [SeenObject(diagram.GetOutputPort(f"measurement_{i}"),
+                       diagram.GetOutputPort(f"measured_rotation_{i}")) for i in range(len(of))]
+    return seen, estimator
