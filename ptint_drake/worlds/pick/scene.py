@@ -13,6 +13,9 @@ tray, added to a not yet finalized MultibodyPlant (``world.MakePickStation`` cal
   whose default pose rests it on its belt.
 - **Tray** (``AddTray``): a welded plate; each slot is a frame ``slot_k`` on its top surface with
   a thin marker visual (the place pose of a part's centre is ``slot_k`` raised by half its height).
+- **Floor** (``AddFloor``): a 4 × 4 × 0.1 m slab welded to the world, its top surface at z = FLOOR_Z = 0,
+  the plane the arm's pedestal stands on (models/README.md): a part that leaves the hand or falls
+  off a belt comes to rest there, so its place error stays finite.
 
 Contact: every collision geometry carries point-contact properties (friction, stiffness,
 Hunt–Crossley dissipation) and hydroelastic ones — the parts compliant (modulus HYDRO_MODULUS),
@@ -28,7 +31,8 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial,
-                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties, Sphere)
+                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties,
+                              Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
@@ -48,6 +52,9 @@ NUB_RADIUS = 0.001  # m: the point-contact spheres at part and pad corners (``Ad
 FINGER_JOINTS = ("left_finger_joint", "right_finger_joint")
 PAD_EDGE = 0.01 - NUB_RADIUS  # m: pad nubs from the pad centre (models/rvm1_gripper.sdf: 20 mm pads)
 PAD_FRICTION = 1.0  # 1: the pads' friction (models/rvm1_gripper.sdf)
+FLOOR_Z = 0.0  # m: the floor's surface, the plane the arm's pedestal stands on (models/README.md)
+FLOOR_FRICTION = 0.8  # 1: the floor's Coulomb friction (assumption)
+FLOOR_SIZE = (4.0, 4.0, 0.1)  # m: the floor slab (a box: Drake warns about rigid half-spaces)
 
 
 def contact_properties(friction: float, resolution: float = 0.0) -> ProximityProperties:
@@ -216,6 +223,14 @@ def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
         plant.RegisterVisualGeometry(body, X_TS.multiply(RigidTransform([0.0, 0.0, 0.0005])),
                                      Box(0.03, 0.004, 0.001), f"slot_{k}", [0.1, 0.7, 0.2, 1.0])
     return slots
+
+
+def AddFloor(plant: MultibodyPlant):
+    """The floor: a FLOOR_SIZE slab welded to the world, centred under the arm's base, its top
+    surface at z = FLOOR_Z; returns its GeometryId."""
+    X_WF = RigidTransform([0.0, 0.0, FLOOR_Z - FLOOR_SIZE[2] / 2])
+    return plant.RegisterCollisionGeometry(plant.world_body(), X_WF, Box(*FLOOR_SIZE), "floor",
+                                           contact_properties(FLOOR_FRICTION))
 
 
 def _fixed_frame(plant: MultibodyPlant, name: str, X, parent=None) -> FixedOffsetFrame:
