@@ -21,6 +21,7 @@ from scipy.special import betaincinv
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.grippers import payload_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
@@ -105,3 +106,13 @@ def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float,
         raise ScenarioError(f"{field}: task {k}'s {phase} takes the fingers {depth:.1f} mm "
                             f"into the clearance of belt {belt.name!r} at t = {t[i]:.2f} s (keep them "
                             f"≥ {1e3 * MIN_CLEARANCE:g} mm above it)")
+
+
+def arm_warnings(scenario, built) -> list[str]:
+    """Warnings before a pick run about what the arm carries: the gripper plus a part beyond the
+    arm's rated payload (``grippers.payload_warnings``)."""
+    station = built.station
+    plant = station.plant
+    gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
+    return payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
+                            station.config.parts)
