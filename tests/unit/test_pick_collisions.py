@@ -84,3 +84,12 @@ def test_a_part_too_thin_for_the_pads_is_rejected_before_the_run(tmp_path, capsy
                  str(tmp_path / "o"), "--set", "pick.parts[0].size=[0.03,0.03,0.016]"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and "pick.parts[0].size" in err and "belt" in err, err
+
+
+def test_strict_hydroelastic_reports_the_arm_in_a_belt_instead_of_failing():
+    """Strict hydroelastic contact needs a compliant side in every touching pair: the belts, tray
+    and floor are compliant, the arm's links rigid."""
+    station, context = _station(initial_q_deg=INTO_BELT_DEG, contact_model="hydroelastic")
+    flags = _flags_after_a_step(station, context)
+    touched = collision_bodies(station.obstacles, np.zeros(1), flags.reshape(1, -1), (0.0, 1.0), "part")
+    assert touched == ["belt"], flags.tolist()
