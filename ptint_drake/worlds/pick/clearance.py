@@ -22,6 +22,7 @@ from scipy.special import betaincinv
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grippers import payload_warnings
+from ptint_drake.worlds.pick.singularity import singularity_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
@@ -109,10 +110,10 @@ def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float,
 
 
 def arm_warnings(scenario, built) -> list[str]:
-    """Warnings before a pick run about what the arm carries: the gripper plus a part beyond the
-    arm's rated payload (``grippers.payload_warnings``)."""
+    """Warnings before a pick run about the arm: the gripper plus a part beyond the arm's rated
+    payload (``grippers.payload_warnings``), a path past a singularity (``singularity``)."""
     station = built.station
     plant = station.plant
     gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
-    return payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
-                            station.config.parts)
+    return (payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
+                             station.config.parts) + singularity_warnings(scenario, built))
