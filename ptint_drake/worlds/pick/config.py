@@ -15,6 +15,7 @@ import numpy as np
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.pick import (BeltConfig, GripperConfig, PartConfig, PickWorldConfig, SlotConfig,  # noqa: F401
                                      TrayConfig)
+from ptint_drake.worlds.pick.grippers import check_gripper
 
 
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
@@ -92,6 +93,7 @@ def check_pick_parts(config) -> None:
     g = config.gripper
     if min(g.max_force, g.speed, g.kp) <= 0.0 or g.kd < 0.0:
         raise ScenarioError("pick.gripper: max_force, speed and kp must be positive, kd non-negative")
+    check_gripper(g)  # a bundled datasheet gripper's force and speed ranges
     for k, belt in enumerate(config.belts):
         _check_belt(k, belt)
     belts = {b.name: b for b in config.belts}

@@ -18,10 +18,13 @@ slot), and the tool's angle from the top-down grasp (deg).
   vertical axis counted as the same pose, a cylinder's turn about its axis ignored);
 - ``placed``: grasped, and within ``criteria.place_mm`` and ``criteria.place_deg``;
 - ``collision``: a contact of the arm or the gripper with any part or belt from the task's start
-  until the close command.
+  until the close command, or any in ``collision_with``;
+- ``collision_with``: the obstacles (belts, ``tray``, ``floor``, other parts; the own part touched
+  by anything but the fingers) the arm or the gripper touched in the task's window
+  (``collisions.pick_collisions``).
 
 ``pick_reasons`` — the verdict's reasons, printed ``pick 0: dropped``, ``pick 1: not placed``,
-``pick 2: collision`` and ``pick 0: late grasp`` (t_grasp more than ``LATE_GRASP`` after the
+``pick 2: collision with <body>`` and ``pick 0: late grasp`` (t_grasp more than ``LATE_GRASP`` after the
 prescribed grasp time, the descend's start + tf, or never).
 """
 
@@ -31,6 +34,7 @@ import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
 
+from ptint_drake.worlds.pick.collisions import pick_collisions
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_reference
 
@@ -132,6 +136,8 @@ def pick_metrics(scenario, built, logs: dict, segments: list) -> dict:
     picks = []
     for k, task in enumerate(scenario.pick.tasks):
         pick = _one_pick(built, k, t, probe, grip, task.lift_height)
+        pick["collision_with"] = pick_collisions(built, logs, k)  # arm/gripper vs belts, tray, floor, parts
+        pick["collision"] = bool(pick["collision"] or pick["collision_with"])
         pick["placed"] = bool(pick["grasped"] and pick["place_error_mm"] <= scenario.criteria.place_mm
                               and pick["place_error_deg"] <= scenario.criteria.place_deg)
         picks.append(pick)
@@ -143,7 +149,8 @@ def pick_reasons(picks: list) -> list:
     out = []
     for k, p in enumerate(picks):
         if p["collision"]:
-            out.append((k, "collision"))
+            out.append((k, "collision with " + ", ".join(p["collision_with"]) if p.get("collision_with")
+                        else "collision"))
         if p["t_grasp"] is None or p["t_grasp"] > p["t_grasp_prescribed"] + LATE_GRASP:
             out.append((k, "late grasp"))
         if not p["grasped"]:

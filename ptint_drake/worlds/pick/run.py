@@ -115,6 +115,7 @@ def build_pick(scenario: Scenario) -> PickBuilt:
     loggers = {"probe": LogVectorOutput(probe.get_output_port(), builder, PROBE_PERIOD),
                "grip_force": LogVectorOutput(st.GetOutputPort("grip_force"), builder, PROBE_PERIOD),
                "gripper_state": LogVectorOutput(st.GetOutputPort("gripper_state"), builder, PROBE_PERIOD),
+               "collisions": LogVectorOutput(st.GetOutputPort("collisions"), builder, PROBE_PERIOD),
                "state": LogVectorOutput(st.GetOutputPort("state"), builder, PROBE_PERIOD),
                "target": LogVectorOutput(targets.GetOutputPort("target"), builder, PROBE_PERIOD),
                "plant_state": LogVectorOutput(st.GetOutputPort("plant_state"), builder, REPLAY_PERIOD)}

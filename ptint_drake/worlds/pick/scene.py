@@ -13,11 +13,16 @@ tray, added to a not yet finalized MultibodyPlant (``world.MakePickStation`` cal
   whose default pose rests it on its belt.
 - **Tray** (``AddTray``): a welded plate; each slot is a frame ``slot_k`` on its top surface with
   a thin marker visual (the place pose of a part's centre is ``slot_k`` raised by half its height).
+- **Floor** (``AddFloor``): a 4 × 4 × 0.1 m slab welded to the world, its top surface at z = FLOOR_Z = 0,
+  the plane the arm's pedestal stands on (models/README.md): a part that leaves the hand or falls
+  off a belt comes to rest there, so its place error stays finite.
 
 Contact: every collision geometry carries point-contact properties (friction, stiffness,
 Hunt–Crossley dissipation) and hydroelastic ones — the parts compliant (modulus HYDRO_MODULUS),
-pads, belts and tray rigid, so every hydroelastic pair is rigid–compliant — and both Drake
-contact models work.  With point contact (``contact_model: point``) parts and pads also get small
+the belts, tray and floor compliant (SURFACE_MODULUS), the finger pads compliant (1 MPa rubber,
+models/README.md), the arm's links, palm and finger stems rigid — so every pair that can touch is
+rigid–compliant or compliant–compliant and all three Drake contact models work (strict
+``hydroelastic`` included).  With point contact (``contact_model: point``) parts and pads also get small
 corner spheres (``AddPointContactNubs``).  The friction of a pair is Drake's combination
 2 μ₁μ₂ / (μ₁ + μ₂).
 """
@@ -28,7 +33,8 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial,
-                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties, Sphere)
+                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties,
+                              Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
@@ -43,21 +49,29 @@ BELT_KD = 1e5  # N·s/m: the belt's velocity servo (implicit, so any stiffness i
 BELT_FORCE = 1e4  # N: the belt drive's force limit
 POINT_STIFFNESS = 1e5  # N/m: point-contact stiffness of parts, belts and tray
 DISSIPATION = 5.0  # s/m: Hunt–Crossley dissipation
-HYDRO_MODULUS = 1e7  # Pa: hydroelastic modulus of the parts (compliant; pads, belts, tray are rigid)
+HYDRO_MODULUS = 1e7  # Pa: hydroelastic modulus of the parts (compliant)
+# Pa: hydroelastic modulus of the belts, the tray and the floor (compliant, so that the arm's rigid
+# links touching them is a rigid–compliant pair strict hydroelastic contact can compute; assumption)
+SURFACE_MODULUS = 1e8
+SURFACE_RESOLUTION = 0.02  # m: their mesh resolution hint (a compliant box's mesh does not use it)
 NUB_RADIUS = 0.001  # m: the point-contact spheres at part and pad corners (``AddPointContactNubs``)
 FINGER_JOINTS = ("left_finger_joint", "right_finger_joint")
 PAD_EDGE = 0.01 - NUB_RADIUS  # m: pad nubs from the pad centre (models/rvm1_gripper.sdf: 20 mm pads)
 PAD_FRICTION = 1.0  # 1: the pads' friction (models/rvm1_gripper.sdf)
+FLOOR_Z = 0.0  # m: the floor's surface, the plane the arm's pedestal stands on (models/README.md)
+FLOOR_FRICTION = 0.8  # 1: the floor's Coulomb friction (assumption)
+FLOOR_SIZE = (4.0, 4.0, 0.1)  # m: the floor slab (a box: Drake warns about rigid half-spaces)
 
 
-def contact_properties(friction: float, resolution: float = 0.0) -> ProximityProperties:
+def contact_properties(friction: float, resolution: float = 0.0,
+                       modulus: float = HYDRO_MODULUS) -> ProximityProperties:
     """Point-contact properties with Coulomb friction μ (static = dynamic), and hydroelastic ones:
-    compliant with a mesh of ``resolution`` (m), or rigid when it is 0."""
+    compliant (``modulus``, Pa) with a mesh of ``resolution`` (m), or rigid when it is 0."""
     props = ProximityProperties()
     AddContactMaterial(dissipation=DISSIPATION, point_stiffness=POINT_STIFFNESS,
                        friction=CoulombFriction(friction, friction), properties=props)
     if resolution > 0.0:
-        AddCompliantHydroelasticProperties(resolution, HYDRO_MODULUS, props)
+        AddCompliantHydroelasticProperties(resolution, modulus, props)
     else:
         AddRigidHydroelasticProperties(props)
     return props
@@ -142,7 +156,7 @@ def AddBelt(plant: MultibodyPlant, belt: BeltConfig) -> PrismaticJoint:
     size = [belt.length, belt.width, belt.thickness]
     body = plant.AddRigidBody(belt.name, instance, SpatialInertia.SolidBoxWithMass(belt.mass, *size))
     X_BG = RigidTransform([0.0, 0.0, -belt.thickness / 2])
-    plant.RegisterCollisionGeometry(body, X_BG, Box(*size), "belt", contact_properties(belt.friction))
+    plant.RegisterCollisionGeometry(body, X_BG, Box(*size), "belt", _surface_properties(belt.friction))
     plant.RegisterVisualGeometry(body, X_BG, Box(*size), "belt", [0.15, 0.15, 0.17, 1.0])
     rail = plant.AddFrame(_fixed_frame(plant, f"{belt.name}_rail", belt_frame(belt)))
     joint = plant.AddJoint(PrismaticJoint(f"{belt.name}_drive", rail, body.body_frame(), [1.0, 0.0, 0.0]))
@@ -205,7 +219,7 @@ def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
     instance = plant.AddModelInstance("tray")
     body = plant.AddRigidBody("tray", instance, SpatialInertia.SolidBoxWithMass(1.0, *tray.size))
     X_TG = RigidTransform([0.0, 0.0, -tray.size[2] / 2])
-    plant.RegisterCollisionGeometry(body, X_TG, Box(*tray.size), "tray", contact_properties(tray.friction))
+    plant.RegisterCollisionGeometry(body, X_TG, Box(*tray.size), "tray", _surface_properties(tray.friction))
     plant.RegisterVisualGeometry(body, X_TG, Box(*tray.size), "tray", [0.6, 0.45, 0.25, 1.0])
     plant.WeldFrames(plant.world_frame(), body.body_frame(), tray_pose(tray))
     slots = []
@@ -216,6 +230,19 @@ def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
         plant.RegisterVisualGeometry(body, X_TS.multiply(RigidTransform([0.0, 0.0, 0.0005])),
                                      Box(0.03, 0.004, 0.001), f"slot_{k}", [0.1, 0.7, 0.2, 1.0])
     return slots
+
+
+def AddFloor(plant: MultibodyPlant):
+    """The floor: a FLOOR_SIZE slab welded to the world, centred under the arm's base, its top
+    surface at z = FLOOR_Z; returns its GeometryId."""
+    X_WF = RigidTransform([0.0, 0.0, FLOOR_Z - FLOOR_SIZE[2] / 2])
+    return plant.RegisterCollisionGeometry(plant.world_body(), X_WF, Box(*FLOOR_SIZE), "floor",
+                                           _surface_properties(FLOOR_FRICTION))
+
+
+def _surface_properties(friction: float) -> ProximityProperties:
+    """Contact properties of a belt, the tray or the floor: compliant hydroelastic (SURFACE_MODULUS)."""
+    return contact_properties(friction, SURFACE_RESOLUTION, SURFACE_MODULUS)
 
 
 def _fixed_frame(plant: MultibodyPlant, name: str, X, parent=None) -> FixedOffsetFrame:

@@ -25,6 +25,8 @@ port                size     meaning
 ``grip_force``      2        output: force of each finger's drive (N, + opens, − squeezes), the
                              gripper's net actuation after the force limit
 ``contact_results`` —        output: the plant's ContactResults (finger–part forces for metrics)
+``collisions``      2·n      output: per obstacle (``PickStation.obstacles``: belts, tray, floor,
+                             parts) [finger contact, other robot contact] (``CollisionProbe``)
 ``body_poses``      —        output: the plant's body poses (for logging parts, belts, fingers)
 ``plant_state``     —        output: the whole plant's [q; v] (arm, fingers, belts, parts: a replay)
 ``query_object``    —        output: SceneGraph's QueryObject (Meshcat / replay illustration)
@@ -48,9 +50,10 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
+from ptint_drake.worlds.pick.collisions import CollisionProbe
 from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
 from ptint_drake.worlds.pick.part_pose import PartPoses
-from ptint_drake.worlds.pick.scene import AddBelt, AddGripper, AddPart, AddTray, gripper_stroke
+from ptint_drake.worlds.pick.scene import AddBelt, AddFloor, AddGripper, AddPart, AddTray, gripper_stroke
 from ptint_drake.robot import resolve_model
 from ptint_drake.systems.gripper import GripperDriver
 from ptint_drake.config.errors import ScenarioError
@@ -70,6 +73,7 @@ class PickStation:
     parts: list  # RigidBody per part, config order
     slots: list  # Frame slot_k on the tray
     driver: GripperDriver
+    obstacles: list = None  # names of the ``collisions`` port's obstacles, in its order
 
     def start_running(self, plant_context) -> None:
         """Sets, in ``plant_context``, every belt at its speed and every part moving with its belt."""
@@ -117,9 +121,16 @@ def _add_world(plant: MultibodyPlant, scene_graph: SceneGraph, config: PickWorld
                                 f"fit the gripper's {stroke} m stroke")
         parts.append(AddPart(plant, part, by_name[part.belt], nubs))
     slots = AddTray(plant, config.tray)
+    floor = AddFloor(plant)
     fixed = GeometrySet([g for j in belts for g in plant.GetCollisionGeometriesForBody(j.child_body())]
-                        + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("tray"))))
-    scene_graph.collision_filter_manager().Apply(CollisionFilterDeclaration().ExcludeWithin(fixed))
+                        + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("tray"))) + [floor])
+    # the arm and its gripper do not collide with themselves (no self-collision avoidance is
+    # planned; Drake already filters bodies joined by a joint, this also covers e.g. hand–finger)
+    robot = GeometrySet([g for m in (arm, gripper) for b in plant.GetBodyIndices(m)
+                         for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))])
+    manager = scene_graph.collision_filter_manager()
+    manager.Apply(CollisionFilterDeclaration().ExcludeWithin(fixed))
+    manager.Apply(CollisionFilterDeclaration().ExcludeWithin(robot))
     return arm, gripper, belts, parts, slots
 
 
@@ -157,9 +168,28 @@ def MakePickStation(config: PickWorldConfig) -> PickStation:
     builder.ExportOutput(plant.get_state_output_port(gripper), "gripper_state")
     builder.ExportOutput(plant.get_net_actuation_output_port(gripper), "grip_force")
     builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
+    obstacles, collisions = _collision_probe(plant, scene_graph, config, arm, gripper, belts, parts)
+    builder.AddNamedSystem("collision_probe", collisions)
+    builder.Connect(plant.get_contact_results_output_port(), collisions.get_input_port())
+    builder.ExportOutput(collisions.get_output_port(), "collisions")
     builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     builder.ExportOutput(plant.get_state_output_port(), "plant_state")
     builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
     diagram = builder.Build()
     diagram.set_name("pick_station")
-    return PickStation(diagram, plant, scene_graph, config, arm, gripper, belts, parts, slots, driver)
+    return PickStation(diagram, plant, scene_graph, config, arm, gripper, belts, parts, slots, driver,
+                       obstacles)
+
+
+def _collision_probe(plant, scene_graph, config, arm, gripper, belts, parts) -> tuple:
+    """The obstacles' names (belts, "tray", "floor", parts) and their ``CollisionProbe``."""
+    names = [b.name for b in config.belts] + ["tray", "floor"] + [p.name for p in config.parts]
+    bodies = ([[j.child_body().index()] for j in belts] + [[plant.GetBodyByName("tray").index()],
+                                                           [plant.world_body().index()]]
+              + [[b.index()] for b in parts])
+    robot = [b for m in (arm, gripper) for b in plant.GetBodyIndices(m)]
+    fingers = [plant.GetBodyByName(n, gripper).index() for n in ("left_finger", "right_finger")]
+    inspector = scene_graph.model_inspector()
+    geometry = {g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
+                for g in inspector.GetAllGeometryIds() if plant.GetBodyFromFrameId(inspector.GetFrameId(g))}
+    return names, CollisionProbe(bodies, fingers, robot, geometry)

@@ -94,7 +94,8 @@ def report(scenario, metrics: dict, out) -> int:
               f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
               f"{p['place_error_deg']:.2f}°"
               f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, grip {p['peak_grip_force_N']:.1f} N"
-              + (", COLLISION before the close" if p["collision"] else ""))
+              + (f", COLLISION with {', '.join(p['collision_with'])}" if p.get("collision_with")
+                 else ", COLLISION before the close" if p["collision"] else ""))
     sim = metrics["sim"]
     print(f"realtime factor {sim['realtime_factor']:.2f} end to end ({sim['contact_approximation']}, "
           f"{sim['contact_model']} contact, {1e3 * sim['plant_time_step']:g} ms plant); wrote {out}/")

@@ -21,6 +21,7 @@ from ptint_drake.metrics import Reason, drive_metrics
 from ptint_drake.run_warnings import sampled_control_warnings
 from ptint_drake.worlds.base import World, WorldRun
 from ptint_drake.worlds.pick import studies
+from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
@@ -45,7 +46,8 @@ class PickRun(WorldRun):
 
     def pre_run_warnings(self) -> list[str]:
         check_pick_reachable(self.scenario, self.built)
-        return sampled_control_warnings(self.scenario)
+        check_pick_clearance(self.scenario, self.built)  # the fingers clear of the belts
+        return sampled_control_warnings(self.scenario) + arm_warnings(self.scenario, self.built)
 
     def initialize(self, context) -> None:
         station = self.built.station

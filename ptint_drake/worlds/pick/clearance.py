@@ -1,0 +1,119 @@
+"""Before a pick run: do the fingers keep clear of the belts on the way to each part?
+
+The approach and the descend of a task are prescribed-time interceptions of a moving target: with
+the controller's design error dynamics e(t) = ξ(t) e(t0) (SPEC 2.1, ξ the time base generator
+ξ(τ) = I⁻¹(1−β, 1−β; 1 − τ/tf)), the fingertip centre follows x(t) = p(t) + ξ(t) (x(t0) − p(t0)),
+with p(t) the target riding its belt at the belt's nominal speed.  ``check_pick_clearance``
+samples that path (the approach from the start pose, or from the previous task's retreat, to
+``clearance`` above the part; the descend onto the part's centre) and checks the fingers' vertical
+extent (from the pads' lower edge to the fingers' top, read from the gripper's collision geometry)
+against each belt's slab wherever the open fingers (a disc of half the opening plus the finger's
+thickness) are over it.  A pass into a belt, or less than ``MIN_CLEARANCE`` above it, is a
+one-line ScenarioError naming the field to change (exit 2).  The links above the hand are not
+checked here: their contacts are found during the run (``collisions``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.geometry import Box
+from scipy.special import betaincinv
+
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.grippers import payload_warnings
+from ptint_drake.worlds.pick.singularity import singularity_warnings
+from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
+
+MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
+SAMPLES = 60  # points along each checked segment
+
+
+def finger_extent(station) -> tuple:
+    """(reach, top, thickness) of the fingers in the fingertip-centre frame, from their collision
+    boxes: how far they reach past the fingertip centre along the approach, how far their top is
+    before it (both m, positive), and the finger's thickness outward of the pad's face."""
+    plant, inspector = station.plant, station.scene_graph.model_inspector()
+    reach, top, thickness = 0.0, 0.0, 0.0
+    for name in ("left_finger", "right_finger"):
+        body = plant.GetBodyByName(name, station.gripper)
+        for g in plant.GetCollisionGeometriesForBody(body):
+            shape = inspector.GetShape(g)
+            if not isinstance(shape, Box):
+                continue
+            X = inspector.GetPoseInFrame(g)
+            half = np.array([shape.width(), shape.depth(), shape.height()]) / 2
+            corners = np.array([X.multiply(half * np.array([sx, sy, sz]))
+                                for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+            reach, top = max(reach, corners[:, 2].max()), max(top, -corners[:, 2].min())
+            thickness = max(thickness, np.abs(corners[:, 0]).max())
+    return reach, top, thickness
+
+
+def _xi(tau: np.ndarray, tf: float, beta: float) -> np.ndarray:
+    return betaincinv(1.0 - beta, 1.0 - beta, np.clip(1.0 - tau / tf, 0.0, 1.0))
+
+
+def check_pick_clearance(scenario, built) -> None:
+    """ScenarioError when a task's approach or descend takes the fingers into a belt (module
+    docstring); ``built``: a ``run.PickBuilt``."""
+    station, plan = built.station, built.plan
+    config = station.config
+    belts = {b.name: b for b in config.belts}
+    context = station.plant.CreateDefaultContext()
+    arm_context = built.arm.CreateDefaultContext()
+    built.arm.SetPositions(arm_context, np.radians(scenario.robot.initial_q_deg))
+    x0 = built.arm.GetFrameByName(scenario.robot.end_effector).CalcPoseInWorld(arm_context).translation()
+    reach, top, thickness = finger_extent(station)
+    stroke = sum(station.plant.GetJointByName(n, station.gripper).position_upper_limits()[0]
+                 for n in FINGER_JOINTS)
+    for k, task in enumerate(scenario.pick.tasks):
+        i_part = plan.segments[plan.segment_index(k, "approach")].index
+        part = config.parts[i_part]
+        belt = belts[part.belt]
+        start = station.parts[i_part].EvalPoseInWorld(context).translation()
+        ride = belt.speed * np.asarray(belt.direction, dtype=float)
+        radius = min(grasp_width(part) + task.margin, stroke) / 2 + thickness
+        for phase, field in (("approach", "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"),
+                             ("descend", f"pick.parts[{i_part}].size")):
+            seg = plan.schedule.segments[plan.segment_index(k, phase)]
+            lift = np.array([0.0, 0.0, task.clearance if phase == "approach" else 0.0])
+            tau = np.linspace(0.0, seg.tf, SAMPLES)
+            t = seg.start + tau
+            target = start + np.outer(t, ride) + lift
+            if phase == "descend":
+                x0 = start + seg.start * ride + [0.0, 0.0, task.clearance]
+            path = target + np.outer(_xi(tau, seg.tf, seg.beta), x0 - target[0])
+            for b in config.belts:
+                _check_belt(b, path, t, reach, top, radius, field, k, phase)
+            x0 = path[-1]
+        place = built.targets.places[plan.segment_index(k, "place")]
+        x0 = place + [0.0, 0.0, task.clearance]
+
+
+def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float, radius: float,
+                field: str, k: int, phase: str) -> None:
+    X = belt_frame(belt)
+    R = X.rotation().matrix()
+    slide = np.outer(t, belt.speed * np.asarray(belt.direction, dtype=float))
+    local = (path - X.translation() - slide) @ R  # in the belt's frame (its top-surface centre)
+    over = ((np.abs(local[:, 0]) <= belt.length / 2 + radius)
+            & (np.abs(local[:, 1]) <= belt.width / 2 + radius))
+    low, high = local[:, 2] - reach, local[:, 2] + top  # the fingers' vertical extent
+    hit = over & (low < MIN_CLEARANCE) & (high > -belt.thickness)
+    if np.any(hit):
+        i = int(np.flatnonzero(hit)[np.argmin(low[hit])])  # the deepest point
+        depth = 1e3 * (MIN_CLEARANCE - low[i])
+        raise ScenarioError(f"{field}: task {k}'s {phase} takes the fingers {depth:.1f} mm "
+                            f"into the clearance of belt {belt.name!r} at t = {t[i]:.2f} s (keep them "
+                            f"≥ {1e3 * MIN_CLEARANCE:g} mm above it)")
+
+
+def arm_warnings(scenario, built) -> list[str]:
+    """Warnings before a pick run about the arm: the gripper plus a part beyond the arm's rated
+    payload (``grippers.payload_warnings``), a path past a singularity (``singularity``)."""
+    station = built.station
+    plant = station.plant
+    gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
+    return (payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
+                             station.config.parts) + singularity_warnings(scenario, built))

@@ -1,0 +1,90 @@
+"""``CollisionProbe`` — which obstacle the arm or its gripper touches, read from the plant's
+contact results (the simulation's truth, for the metrics; a controller never sees it).
+
+An *obstacle* is every body the robot must not touch: each belt, the tray, the floor (the world
+body's geometry) and each part — a part only counts when it is not the one being grasped (the
+fingers may touch that one, nothing else of the robot may).  Per obstacle two flags (1 or 0): in
+contact with a finger (pad or stem), in contact with any other body of the arm or the gripper.
+
+==================  ===========  ======================================================
+port                size         meaning
+==================  ===========  ======================================================
+``contact_results`` —            input: the plant's ContactResults
+``collisions``      2 · n        output: per obstacle [finger contact, other robot contact]
+==================  ===========  ======================================================
+
+``collision_bodies`` reads the logged flags for one pick: the obstacles touched within the
+task's window (from its start, or t = 0 for the first task, until the next task starts or the
+run ends), the task's own part excepted from its fingers' contacts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.multibody.plant import ContactResults
+from pydrake.systems.framework import LeafSystem
+
+FINGER, OTHER = 0, 1  # the flags' places in an obstacle's pair
+
+
+class CollisionProbe(LeafSystem):
+    """Contact flags per obstacle (module docstring).  ``obstacles``: the obstacles' body index
+    lists (a belt, the tray, the world body for the floor, a part), in output order;
+    ``fingers``, ``robot``: body indices of the fingers and of every arm and gripper body;
+    ``body_of_geometry``: GeometryId → body index (hydroelastic contacts report geometries)."""
+
+    def __init__(self, obstacles: list, fingers, robot, body_of_geometry: dict):
+        super().__init__()
+        self._obstacle = {int(b): k for k, bodies in enumerate(obstacles) for b in bodies}
+        self._fingers = {int(b) for b in fingers}
+        self._robot = {int(b) for b in robot}
+        self._geometry = body_of_geometry
+        self._contacts = self.DeclareAbstractInputPort("contact_results",
+                                                       AbstractValue.Make(ContactResults()))
+        self.DeclareVectorOutputPort("collisions", 2 * len(obstacles), self._calc)
+
+    def _pairs(self, results):
+        for i in range(results.num_point_pair_contacts()):
+            info = results.point_pair_contact_info(i)
+            yield int(info.bodyA_index()), int(info.bodyB_index())
+        for i in range(results.num_hydroelastic_contacts()):
+            surface = results.hydroelastic_contact_info(i).contact_surface()
+            yield self._geometry[surface.id_M()], self._geometry[surface.id_N()]
+
+    def _calc(self, context, output) -> None:
+        out = np.zeros(output.size())
+        for a, b in self._pairs(self._contacts.Eval(context)):
+            if b in self._robot:
+                a, b = b, a
+            if a in self._robot and b in self._obstacle:
+                out[2 * self._obstacle[b] + (FINGER if a in self._fingers else OTHER)] = 1.0
+        output.SetFromVector(out)
+
+
+def collision_bodies(names: list, t: np.ndarray, flags: np.ndarray, window: tuple, own: str) -> list:
+    """The obstacles (names, output order) touched by the robot for t in ``window`` = (start,
+    end), from the logged ``flags`` (rows: CollisionProbe outputs at times ``t``); the part named
+    ``own`` (the one being picked) only counts when something other than a finger touches it."""
+    inside = (t >= window[0]) & (t < window[1])
+    touched = []
+    for k, name in enumerate(names):
+        columns = [2 * k + OTHER] if name == own else [2 * k + FINGER, 2 * k + OTHER]
+        if np.any(flags[np.ix_(inside, columns)] > 0):
+            touched.append(name)
+    return touched
+
+
+def pick_collisions(built, logs: dict, k: int) -> list:
+    """``collision_bodies`` of task k of a built pick run (``run.PickBuilt``) from its ``logs``
+    (``"collisions"``: the station's port logged): its window runs from its approach's start (0
+    for the first task) to the next task's approach (the run's end for the last)."""
+    if "collisions" not in logs:
+        return []
+    t, flags = logs["collisions"]
+    plan = built.plan
+    starts = [plan.schedule.segments[plan.segment_index(j, "approach")].start
+              for j in range(len(plan.close_times))]
+    window = (0.0 if k == 0 else starts[k], starts[k + 1] if k + 1 < len(starts) else np.inf)
+    own = built.station.config.parts[plan.segments[plan.segment_index(k, "approach")].index].name
+    return collision_bodies(built.station.obstacles, t, flags, window, own)

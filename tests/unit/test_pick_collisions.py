@@ -1,0 +1,95 @@
+"""Issue 33: the arm's collision geometry, the floor, the collision report and the clearance check."""
+
+import numpy as np
+from pydrake.math import RigidTransform
+from pydrake.systems.analysis import Simulator
+
+from ptint_drake.cli import main
+from ptint_drake.scenario import load_scenario
+from ptint_drake.worlds.pick.collisions import collision_bodies
+from ptint_drake.worlds.pick.metrics import pick_reasons
+from ptint_drake.worlds.pick.run import world_config
+from ptint_drake.worlds.pick.station import MakePickStation
+
+# rvm1_5dof with the fingertip centre at (0.30, 0, 0.09), pointing down: the fingers inside the belt
+INTO_BELT_DEG = [0.0, 76.2, -5.9, 17.7, 0.0]
+
+
+def _station(**robot):
+    scenario = load_scenario("conveyor_pick_place")
+    config = world_config(scenario)
+    for key, value in robot.items():
+        setattr(config, key, value)
+    station = MakePickStation(config)
+    context = station.diagram.CreateDefaultContext()
+    station.diagram.GetInputPort("actuation").FixValue(context, np.zeros(5))
+    station.diagram.GetInputPort("gripper_command").FixValue(context, [config.gripper.initial_opening])
+    return station, context
+
+
+def test_every_arm_link_and_finger_stem_has_collision_geometry():
+    station, _ = _station()
+    plant = station.plant
+    for m in (station.arm, station.gripper):
+        for b in plant.GetBodyIndices(m):
+            body = plant.get_body(b)
+            if body.name() != "tool":  # a frame-only link
+                assert plant.GetCollisionGeometriesForBody(body), body.name()
+    inspector = station.scene_graph.model_inspector()
+    finger = plant.GetBodyByName("left_finger")
+    names = {inspector.GetName(g) for g in plant.GetCollisionGeometriesForBody(finger)}
+    assert any("stem" in n for n in names) and any("pad" in n for n in names), names
+
+
+def _flags_after_a_step(station, context):
+    Simulator(station.diagram, context).AdvanceTo(0.002)  # a discrete plant reports its last step's contacts
+    return station.diagram.GetOutputPort("collisions").Eval(context).reshape(-1, 2)
+
+
+def test_the_arm_in_a_belt_is_a_collision_with_that_belt_and_the_start_pose_is_not():
+    flags = _flags_after_a_step(*_station())
+    assert not np.any(flags), flags.tolist()
+    station, context = _station(initial_q_deg=INTO_BELT_DEG)
+    flags = _flags_after_a_step(station, context)
+    touched = collision_bodies(station.obstacles, np.zeros(1), flags.reshape(1, -1), (0.0, 1.0), "part")
+    assert touched == ["belt"], dict(zip(station.obstacles, flags.tolist()))
+    reasons = pick_reasons([{"collision": True, "collision_with": touched, "t_grasp": 1.0,
+                             "t_grasp_prescribed": 1.0, "grasped": True, "placed": True}])
+    assert reasons == [(0, "collision with belt")]
+
+
+def test_a_part_dropped_off_the_belts_lands_on_the_floor():
+    station, context = _station()
+    plant = station.plant
+    pc = plant.GetMyMutableContextFromRoot(context)
+    plant.SetFreeBodyPose(pc, station.parts[0], RigidTransform([-0.4, -0.4, 0.3]))  # behind the arm
+    plant.SetVelocities(pc, station.arm, np.zeros(5))
+    simulator = Simulator(station.diagram, context)
+    simulator.AdvanceTo(0.6)
+    z = station.parts[0].EvalPoseInWorld(pc).translation()[2]
+    assert abs(z - 0.015) < 1e-3, z  # resting on z = 0, half its 30 mm height up
+
+
+def test_a_start_pose_through_the_belt_is_rejected_before_the_run(tmp_path, capsys):
+    code = main(["run", "conveyor_pick_place", "--quiet", "--no-replay", "--no-figures", "--out",
+                 str(tmp_path / "o"), "--set", f"robot.initial_q_deg={INTO_BELT_DEG}"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "robot.initial_q_deg" in err and "belt" in err and len(err.splitlines()) == 1, err
+    assert not (tmp_path / "o" / "metrics.json").exists()
+
+
+def test_a_part_too_thin_for_the_pads_is_rejected_before_the_run(tmp_path, capsys):
+    """A 16 mm part puts the 20 mm pads (centred on the part's centre) 2 mm into its belt."""
+    code = main(["run", "conveyor_pick_place", "--quiet", "--no-replay", "--no-figures", "--out",
+                 str(tmp_path / "o"), "--set", "pick.parts[0].size=[0.03,0.03,0.016]"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "pick.parts[0].size" in err and "belt" in err, err
+
+
+def test_strict_hydroelastic_reports_the_arm_in_a_belt_instead_of_failing():
+    """Strict hydroelastic contact needs a compliant side in every touching pair: the belts, tray
+    and floor are compliant, the arm's links rigid."""
+    station, context = _station(initial_q_deg=INTO_BELT_DEG, contact_model="hydroelastic")
+    flags = _flags_after_a_step(station, context)
+    touched = collision_bodies(station.obstacles, np.zeros(1), flags.reshape(1, -1), (0.0, 1.0), "part")
+    assert touched == ["belt"], flags.tolist()
