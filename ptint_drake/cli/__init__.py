@@ -133,7 +133,11 @@ def _add_grid_parsers(sub) -> None:
     rb.add_argument("--seed", type=int, default=0, help="sample i uses seed + i")
     rb.add_argument("--range", action="append", type=opt.robust_range, metavar="NAME=LOW,HIGH",
                     help="override a parameter range (mass, friction, coulomb, payload, "
-                         "disturbance, noise, latency)")
+                         "disturbance, noise, latency; pick scenarios: part_mass, part_friction, "
+                         "belt_speed, close_jitter, part_lateral)")
+    rb.add_argument("--ranges", choices=("harsh", "mild"), default="harsh",
+                    help="the preset of ranges: harsh (default; pick ranges that reach failures) or "
+                         "mild (the study before them, seed for seed)")
     _study_arguments(rb, "out/robust_NAME", workers_default="1")
     rb.set_defaults(func=cmd_robust)
 

@@ -4,6 +4,7 @@ sample and keeps of it, a ``sweep`` point, why ``tune`` does not search a pick, 
 
 from __future__ import annotations
 
+import re
 import sys
 
 import numpy as np
@@ -17,46 +18,81 @@ def mm_text(value) -> str:
 
 
 def robust_sample(scenario, name: str, seed: int, u):
-    """A pick scenario's sample: link masses, every part's mass and friction, every belt's speed."""
+    """A pick scenario's sample, drawn in this order (so that the ``mild`` preset, whose last two
+    ranges are [0, 0], draws what the study drew before they existed): the arm's link masses; every
+    part's mass and friction; every belt's speed (×); every task's close-command jitter (s, added
+    to the close's time: ``close_delay``); every part's lateral offset on its belt (m, ``lateral``,
+    clipped to the belt's half width)."""
     scenario.plant.mass_scale = float(u("mass"))
     pick = scenario.pick
     for part in pick.parts:
         part.mass, part.friction = float(u("part_mass")), float(u("part_friction"))
     for belt in pick.belts:
         belt.speed *= float(u("belt_speed"))
+    for task in pick.tasks:
+        task.close_delay += float(u("close_jitter"))
+    belts = {b.name: b for b in pick.belts}
+    for part in pick.parts:
+        half = belts[part.belt].width / 2 if part.belt in belts else 0.0
+        part.lateral = float(np.clip(part.lateral + u("part_lateral"), -half, half))
     scenario.name = f"{name}_seed{seed}"
     return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
                       "part_friction": [p.friction for p in pick.parts],
-                      "belt_speed": [b.speed for b in pick.belts]}
+                      "belt_speed": [b.speed for b in pick.belts],
+                      "close_delay": [t.close_delay for t in pick.tasks],
+                      "part_lateral": [p.lateral for p in pick.parts]}
 
 
 def robust_row(seed: int, params: dict, m: dict) -> dict:
     """What a pick sample keeps of its metrics: the picks, the reasons."""
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
+    keys = ("part", "grasped", "placed", "place_error_mm", "place_error_deg", "slip_mm", "t_grasp",
+            "collision")
     return {"seed": seed, "params": params, "ok": m["status"] == "ok", "status": m["status"],
-                "e_tf": e_tf,
-                "e_tf_max": max((v for v in e_tf if v is not None), default=None),
-                "picks": [{k: p[k] for k in ("part", "grasped", "placed", "place_error_mm", "place_error_deg",
-                                             "slip_mm", "t_grasp", "collision")} for p in m["picks"]],
-                "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
-                "warnings": m["warnings"]}
+            "e_tf": e_tf,
+            "e_tf_max": max((v for v in e_tf if v is not None), default=None),
+            "picks": [{k: p.get(k) for k in keys} for p in m["picks"]],
+            "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
+            "warnings": m["warnings"]}
+
+
+_NUMBER = re.compile(r"(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?!\w)")
+
+
+def failure_reason(text: str) -> str:
+    """A verdict's reason or a sample's error as a reason to count: without the pick's index
+    (``pick 2: dropped`` → ``dropped``), list indices as ``[k]``, other numbers as ``#``."""
+    text = re.sub(r"^pick \d+: ", "", text.strip())
+    text = re.sub(r"\[\d+\]", "[k]", text)
+    text = re.sub(r"\[[^\]]*\d[^\]]*\]", "[…]", text)
+    return _NUMBER.sub("#", text)[:160]
+
+
+def picks_ok(row: dict) -> int:
+    """How many of a sample's picks succeeded: placed, with no collision and no reason of the
+    verdict naming the pick (``pick k: late grasp`` fails pick k even if it was placed)."""
+    named = {int(m.group(1)) for text in row.get("reasons") or [] if (m := re.match(r"pick (\d+):", text))}
+    return sum(bool(p.get("placed")) and not p.get("collision") and k not in named
+               for k, p in enumerate(row.get("picks", [])))
 
 
 def robust_summary(rows: list) -> dict:
-    """``pick_success_rate`` (placed parts over all parts; a sample that could not run places none)
-    and ``failures_by_reason`` ({reason code: count}) of a pick study; {} otherwise."""
-    if not any("picks" in r for r in rows):
+    """``pick_success_rate`` (picks that succeeded, ``picks_ok``, over all parts, a sample that
+    could not run placing none) and ``failures_by_reason`` ({reason: count}, ``failure_reason``:
+    each reason of a sample's verdict, each sample's error; most frequent first) of a pick study;
+    {} otherwise."""
+    if not any("picks" in r or "part_mass" in r.get("params", {}) for r in rows):
         return {}
-    per_sample = [len(r["picks"]) for r in rows if "picks" in r]
-    parts = max(per_sample) if per_sample else 0
-    placed = sum(p["placed"] for r in rows for p in r.get("picks", []))
-    reasons = {}
+    parts = sum(len(r["params"]["part_mass"]) for r in rows)
+    ok = sum(picks_ok(r) for r in rows)
+    reasons: dict = {}
     for r in rows:
-        for reason in r.get("reasons", []) or ([f"error: {r['error']}"] if r.get("error") else []):
-            code = reason.split(": ", 1)[-1] if reason.startswith("pick ") else reason
+        texts = r.get("reasons") or ([f"error: {r['error']}"] if r.get("error") else [])
+        for text in texts:
+            code = failure_reason(text)
             reasons[code] = reasons.get(code, 0) + 1
-    return {"pick_success_rate": placed / (parts * len(rows)) if parts else 0.0,
-            "failures_by_reason": reasons}
+    return {"pick_success_rate": ok / parts if parts else 0.0,
+            "failures_by_reason": dict(sorted(reasons.items(), key=lambda kv: (-kv[1], kv[0])))}
 
 
 def sweep_point(row: dict, scenario, beta: float, tf: float, simulate, validate, schedule_end) -> dict:
