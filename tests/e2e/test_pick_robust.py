@@ -111,3 +111,38 @@ def test_lateral_offset_moves_the_part_and_is_checked():
     station = MakePickStation(world_config(scenario))  # the belt runs along +y: across it is -x
     x = station.parts[0].EvalPoseInWorld(station.plant.CreateDefaultContext()).translation()
     assert x[0] == pytest.approx(scenario.pick.belts[0].center[0] - lateral, abs=1e-12)
+
+
+def test_floor_replays_the_runs_arm_trajectory_through_cpp_systems():
+    """``ptint bench --floors``'s pick floor: the station driven by Drake's C++ systems alone
+    (outside the station: no Python system), replaying the run's torques and PD on its [q; v],
+    follows the run's arm within 10 mrad at every step (the grasp's and the release's contact
+    amplify µrad differences for a moment, the PD pulls them back) and within 0.1 mrad over the
+    last 0.25 s (the part placed, the arm retreated)."""
+    from ptint_drake.simulation import make_simulator
+    from ptint_drake.worlds.registry import world_of
+
+    name, text = CONVEYOR
+    scenario = parse_with_overrides(text, "{}", name)
+    replay = world_of(scenario).floor_diagram(scenario, "replay")
+    recording = replay.record()
+    floor = replay.floor(log=True)
+    outside = [s for s in floor.diagram.GetSystems() if s.get_name() != "pick_station"]
+    assert outside and all(type(s).__module__.startswith("pydrake.") for s in outside), \
+        [type(s) for s in outside]
+    simulator = make_simulator(floor)
+    context = simulator.get_mutable_context()
+    floor.initialize(context)
+    simulator.Initialize()
+    for t in floor.stops():
+        simulator.AdvanceTo(t)
+    log = floor.logger.FindLog(context)
+    t_floor, x_floor = log.sample_times(), log.data().T
+    t_run, x_run = recording["t"], recording["state"]
+    index = np.clip(np.searchsorted(t_run, t_floor), 0, len(t_run) - 1)
+    same = np.abs(t_run[index] - t_floor) < 1e-9
+    assert same.sum() > 0.99 * len(t_floor)
+    nq = x_run.shape[1] // 2
+    error = np.abs(x_floor[same, :nq] - x_run[index[same], :nq]).max(axis=1)
+    assert error.max() < 1e-2, error.max()
+    assert error[t_floor[same] > scenario.duration - 0.25].max() < 1e-4
