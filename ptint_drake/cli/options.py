@@ -140,6 +140,16 @@ def robust_range(pair: str) -> tuple[str, tuple[float, float]]:
 
 
 @_option
+def ranges_preset(text: str) -> str:
+    """``--ranges`` of ``robust``: the name of a preset of ranges (``studies.robust.PRESETS``)."""
+    from ptint_drake.studies.robust import PRESETS  # noqa: PLC0415
+
+    if text not in PRESETS:
+        raise ScenarioError(f"--ranges: unknown preset {text!r} (one of {', '.join(PRESETS)})")
+    return text
+
+
+@_option
 def controller_list(text: str) -> list[str]:
     """``--controllers`` of ``compare``: registered controllers and plugins' ``module:Class``."""
     from ptint_drake.controllers import CONTROLLERS, known_type, plugin  # noqa: PLC0415

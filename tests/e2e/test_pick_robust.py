@@ -146,3 +146,22 @@ def test_floor_replays_the_runs_arm_trajectory_through_cpp_systems():
     error = np.abs(x_floor[same, :nq] - x_run[index[same], :nq]).max(axis=1)
     assert error.max() < 1e-2, error.max()
     assert error[t_floor[same] > scenario.duration - 0.25].max() < 1e-4
+
+
+def test_cli_ranges_preset(tmp_path, capsys):
+    """``ptint robust --ranges mild``: robust.json names the preset and its ranges; an unknown
+    preset is one line, exit 2."""
+    import json
+
+    from ptint_drake.cli import main
+
+    assert main(["robust", "conveyor_pick_place", "--ranges", "wild", "--samples", "1"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "--ranges" in err and "harsh, mild" in err, err
+    out = tmp_path / "r"
+    assert main(["robust", "conveyor_pick_place", "--ranges", "mild", "--samples", "1", "--workers", "1",
+                 "--quiet", "--out", str(out)]) == 0
+    result = json.loads((out / "robust.json").read_text())
+    assert result["ranges_preset"] == "mild" and result["ranges"]["part_mass"] == [0.05, 0.3]
+    assert result["pick_success_rate"] == 1.0 and result["failures_by_reason"] == {}
+    assert "pick success rate 100.0 %" in capsys.readouterr().out
