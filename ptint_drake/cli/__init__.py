@@ -137,7 +137,11 @@ def _add_grid_parsers(sub) -> None:
     rb.add_argument("--seed", type=int, default=0, help="sample i uses seed + i")
     rb.add_argument("--range", action="append", type=opt.robust_range, metavar="NAME=LOW,HIGH",
                     help="override a parameter range (mass, friction, coulomb, payload, "
-                         "disturbance, noise, latency)")
+                         "disturbance, noise, latency; pick scenarios: part_mass, part_friction, "
+                         "belt_speed, close_jitter, part_lateral)")
+    rb.add_argument("--ranges", type=opt.ranges_preset, default="harsh", metavar="PRESET",
+                    help="the preset of ranges: harsh (default; pick ranges that reach failures) or "
+                         "mild (the study before them, seed for seed)")
     _study_arguments(rb, "out/robust_NAME", workers_default="1")
     rb.set_defaults(func=cmd_robust)
 
@@ -248,12 +252,14 @@ def _add_bench_parser(sub) -> None:
                        help=f"time two override mappings side by side (interleaved), e.g. '{{}}' '{BEFORE}'")
     bench.add_argument("--repeats", type=opt.count("--repeats"), default=5,
                        help="with --pair: pairs per scenario; with --floors: runs per diagram, at most 3 "
-                            "(default 5)")
+                            "(a pick scenario: alternated pairs, at least 5) (default 5)")
     bench.add_argument("--floors", action="store_true",
                        help="instead: µs per derivative evaluation of the plant with a C++ constant "
                             "actuation, with a do-nothing Python controller, and with the scenario's "
                             "controller (with a camera also the do-nothing controller fed by the "
-                            "camera's estimates)")
+                            "camera's estimates); a pick scenario: CPU s per simulated s of the run "
+                            "and of the same station replaying its arm through Drake's C++ PD, and "
+                            "their ratio")
     bench.set_defaults(func=cmd_bench)
 
 

@@ -125,16 +125,28 @@ def count(flag: str) -> Callable[[str], int]:
 
 @_option
 def robust_range(pair: str) -> tuple[str, tuple[float, float]]:
-    """``--range NAME=LOW,HIGH`` of ``robust``: (NAME, (LOW, HIGH)) with 0 <= LOW <= HIGH."""
-    from ptint_drake.studies.robust import RANGES  # noqa: PLC0415
+    """``--range NAME=LOW,HIGH`` of ``robust``: (NAME, (LOW, HIGH)) with 0 <= LOW <= HIGH (LOW < 0
+    allowed for the signed ranges, close_jitter and part_lateral)."""
+    from ptint_drake.studies.robust import RANGES, SIGNED  # noqa: PLC0415
 
     key, _, value = pair.partition("=")
     if key not in RANGES:
         raise ScenarioError(f"--range: unknown parameter {key!r} (one of {', '.join(RANGES)})")
     lo_hi = floats(value, f"--range {key}")
-    if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or lo_hi[0] < 0:
-        raise ScenarioError(f"--range {key}: expected LOW,HIGH with 0 <= LOW <= HIGH, got {value!r}")
+    if len(lo_hi) != 2 or lo_hi[0] > lo_hi[1] or (lo_hi[0] < 0 and key not in SIGNED):
+        bound = "LOW <= HIGH" if key in SIGNED else "0 <= LOW <= HIGH"
+        raise ScenarioError(f"--range {key}: expected LOW,HIGH with {bound}, got {value!r}")
     return key, (lo_hi[0], lo_hi[1])
+
+
+@_option
+def ranges_preset(text: str) -> str:
+    """``--ranges`` of ``robust``: the name of a preset of ranges (``studies.robust.PRESETS``)."""
+    from ptint_drake.studies.robust import PRESETS  # noqa: PLC0415
+
+    if text not in PRESETS:
+        raise ScenarioError(f"--ranges: unknown preset {text!r} (one of {', '.join(PRESETS)})")
+    return text
 
 
 @_option

@@ -65,10 +65,10 @@ def cmd_robust(args: argparse.Namespace) -> int:
     """The Monte Carlo study: robust.json, samples.json, worst.yaml, a histogram."""
     from ptint_drake.studies import robust  # noqa: PLC0415
 
-    ranges = dict(robust.RANGES) | dict(args.range or [])
+    ranges = dict(robust.PRESETS[args.ranges]) | dict(args.range or [])
     loaded, out = scenario_and_out(args, "robust_")
     result = _dask_errors(lambda: robust.run_robust(
-        loaded, args.samples, args.seed, ranges=ranges,
+        loaded, args.samples, args.seed, ranges=ranges, preset=args.ranges,
         progress=_every_tenth("robust", "samples", args.quiet), **_where(args)))
     robust.write_robust(result, out)  # staged: the folder is created only now
     p = result["e_tf_percentiles"]

@@ -56,6 +56,7 @@ class PartConfig:
     # m, box [x, y, z] (x: across the fingers when grasped) or cylinder [diameter, height]
     size: List[float] = field(default_factory=lambda: [0.03, 0.03, 0.03])
     offset: float = 0.0  # m, along the belt from its centre at t = 0 (negative: upstream)
+    lateral: float = 0.0  # m, across the belt from its centre line at t = 0 (+: left of the travel)
     yaw_deg: float = 0.0  # deg, rotation about the vertical at t = 0
     mass: float = 0.1  # kg
     friction: float = 0.8  # 1, Coulomb friction coefficient of its surface (static = dynamic)
@@ -127,6 +128,7 @@ class PickTaskConfig:
     lift_height: float = 0.05  # m, of the lift and the carry
     dwell: float = 0.15  # s, the grip building up after the close, and the fingers opening
     margin: float = 0.012  # m, the open fingers' clearance around the part (opening − width)
+    close_delay: float = 0.0  # s, added to the close command's time (negative: early; robust's jitter)
 
 
 @dataclass

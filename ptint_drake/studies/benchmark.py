@@ -190,7 +190,7 @@ def _floor_timing(built, scenario, repeats: int) -> dict:
             "steps": int(steps), "wall_s": round(best, 4)}
 
 
-def floors(names=None, repeats: int = 3, progress=None) -> dict:
+def floors(names=None, repeats: int = 3, progress=None, pairs: int = 5) -> dict:
     """What one derivative evaluation of the closed loop costs, taken apart, per scenario.
 
     Three diagrams on the scenario's plant (its station: saturation, friction, objects),
@@ -209,8 +209,10 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
     A scenario with a camera in the loop adds ``python_camera``: the do-nothing controller fed
     by the same cameras, estimators and selectors (their discrete updates, their outputs read
     at every evaluation), and ``controller_over_python_camera``: what the controller adds to
-    what any controller fed by the camera pays.  A world without floor diagrams
-    (``World.floor_diagram``: the pick world) is skipped with a note.
+    what any controller fed by the camera pays.  A world whose floor is a replay of its run (no
+    ``cpp`` floor but a ``World.floor_diagram(scenario, "replay")``: the pick world) gets
+    ``replay_floor`` with ``pairs`` (at least 5) alternated pairs; a world without floor diagrams
+    is skipped with a note.
     """
     names = list(names or bundled_scenarios())
     out = {}
@@ -220,7 +222,12 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
         _, text = scenario_text(name)
         scenario = parse_with_overrides(text, "{}", name)
         world = world_of(scenario)
-        if world.floor_diagram(scenario, "cpp") is None:
+        cpp = world.floor_diagram(scenario, "cpp")
+        replay = world.floor_diagram(scenario, "replay") if cpp is None else None
+        if replay is not None:
+            out[name] = replay_floor(replay, max(pairs, 5))
+            continue
+        if cpp is None:
             out[name] = {"skipped": f"a {world.name} scenario: its world has no floor diagrams"}
             continue
         row = {}
@@ -240,6 +247,51 @@ def floors(names=None, repeats: int = 3, progress=None) -> dict:
         row["kernels_us"] = kernel_cost(scenario)
         out[name] = row
     return out
+
+
+def _cpu_per_simulated_s(run) -> dict:
+    """Process CPU seconds (and wall seconds) of one simulation of ``run`` (a ``WorldRun``) as the
+    runner drives it — ``Initialize`` and ``AdvanceTo`` over its stops, ``at_stop`` after each —
+    per simulated second; the build and the metrics are not counted."""
+    simulator = make_simulator(run)
+    context = simulator.get_mutable_context()
+    run.initialize(context)
+    cpu0, wall0 = time.process_time(), time.perf_counter()
+    simulator.Initialize()
+    for t_stop in run.stops():
+        if t_stop > context.get_time() or run.advance_at_reached_stops:
+            simulator.AdvanceTo(t_stop)
+        run.at_stop(context, t_stop)
+    cpu, wall, t = time.process_time() - cpu0, time.perf_counter() - wall0, context.get_time()
+    return {"cpu_per_s": cpu / t, "wall_per_s": wall / t,
+            "steps": int(simulator.get_integrator().get_num_steps_taken())}
+
+
+def replay_floor(replay, pairs: int = 5) -> dict:
+    """A run beside its floor (``worlds.pick.studies.FloorReplay``: the same station replaying the
+    run's arm torques and [q; v] through Drake's C++ PD and its gripper commands, with the run's
+    integrator): one recording run, one warm-up of each, then ``pairs`` alternated pairs (run
+    first, then floor first, …).  CPU seconds per simulated second of each (median), and
+    ``run_over_floor``: the median over pairs of their ratio, with its range."""
+    import statistics
+
+    replay.record()
+    _cpu_per_simulated_s(replay.run()), _cpu_per_simulated_s(replay.floor())  # warm-up
+    runs, floors_, ratios = [], [], []
+    for i in range(pairs):
+        order = (replay.run, replay.floor) if i % 2 == 0 else (replay.floor, replay.run)
+        first, second = (_cpu_per_simulated_s(make()) for make in order)
+        run, floor = (first, second) if i % 2 == 0 else (second, first)
+        runs.append(run), floors_.append(floor), ratios.append(run["cpu_per_s"] / floor["cpu_per_s"])
+    med = lambda rows, key: round(statistics.median(r[key] for r in rows), 4)  # noqa: E731
+    return {"pairs": pairs, "integrator": replay.scenario_integrator(),
+            "run_cpu_per_simulated_s": med(runs, "cpu_per_s"),
+            "floor_cpu_per_simulated_s": med(floors_, "cpu_per_s"),
+            "run_wall_per_simulated_s": med(runs, "wall_per_s"),
+            "floor_wall_per_simulated_s": med(floors_, "wall_per_s"),
+            "run_over_floor": round(statistics.median(ratios), 3),
+            "run_over_floor_range": [round(min(ratios), 3), round(max(ratios), 3)],
+            "steps": [runs[0]["steps"], floors_[0]["steps"]]}
 
 
 def kernel_cost(scenario, calls: int = 2000) -> "float | None":
@@ -288,7 +340,7 @@ def from_options(args: Namespace, say: "Callable[[str], None] | None" = None) ->
     result = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
                           "cpus": __import__("os").cpu_count(), "drake": drake_version()}}
     if args.floors:
-        result["floors"] = floors(names, min(args.repeats, 3), say)
+        result["floors"] = floors(names, min(args.repeats, 3), say, pairs=max(args.repeats, 5))
     if args.schemes:
         result["schemes"] = scheme_table(names, args.schemes, args.accuracies, args.simulator_extra, say)
     if args.pair:

@@ -5,7 +5,8 @@ Sample ``i`` draws its parameters from ``numpy.random.default_rng(seed + i)`` in
 order, so any sample is reproduced from its seed alone; the worst one is also written
 as a complete scenario file (``worst.yaml``) that ``ptint run`` replays exactly.
 
-Default ranges (uniform; ``--set``-style overrides through ``RANGES`` keys):
+Default ranges (uniform; ``--range NAME=LOW,HIGH`` overrides one; ``--ranges mild`` takes the
+``MILD`` preset instead):
 
 | parameter | range | applied as |
 |---|---|---|
@@ -16,13 +17,23 @@ Default ranges (uniform; ``--set``-style overrides through ``RANGES`` keys):
 | disturbance | [0, 0.5] N·m per joint | sine (0.5–3 Hz, random phase) + a step of ± that at a random t |
 | noise | [0, 1e-4] m | the camera's noise std (``measurement.noise_std``) |
 | latency | [0, 0] s | the camera's latency (compensated by the estimator) |
-| part_mass | [0.05, 0.3] kg | every part's mass (pick scenarios) |
-| part_friction | [0.5, 1.0] | every part's friction coefficient (pick scenarios) |
-| belt_speed | ×[0.8, 1.2] | every belt's speed (pick scenarios; the plan is not told) |
+| part_mass | [0.05, 1.06] kg | every part's mass (pick scenarios): the RV-M1's 1.2 kg payload less its hand |
+| part_friction | [0.05, 1.0] | every part's friction coefficient (pick scenarios) |
+| belt_speed | ×[0.5, 2] | every belt's speed (pick scenarios; the plan is not told) |
+| close_jitter | [−0.06, 0.06] s | added to every close command's time (pick scenarios) |
+| part_lateral | [−0.01, 0.01] m | every part's offset across its belt (pick scenarios) |
 
-A pick scenario (``pick``) draws ``mass`` and the three pick ranges only (its plant takes no
+These pick ranges reach failures: at friction 0.05 a 1 kg part slips out of a 30 N grip, a belt at
+twice its speed brings a part out of reach, a late close grasps late.  ``MILD`` is the study as it
+was before (part mass [0.05, 0.3] kg, friction [0.5, 1.0], belt ×[0.8, 1.2], no jitter, no
+lateral offset): its draws are those of that study, seed for seed.
+
+A pick scenario (``pick``) draws ``mass`` and the five pick ranges only (its plant takes no
 other deviation; the part in the hand is the payload) and is judged by its picks: robust.json
-adds ``pick_success_rate`` (placed parts / all parts) and ``failures_by_reason``.
+adds ``pick_success_rate`` (parts placed with no collision / all parts) and ``failures_by_reason``
+(each failed pick's verdict reason without its index, each sample's error: their counts).  Every
+sample ends with a verdict: a sample that is rejected before its run or raises is an error row,
+counted by its reason.
 
 The target is seen through a camera with ``estimator: auto`` (the scenario's own camera,
 or a 30 Hz one) unless both the noise and the latency ranges are [0, 0] (then the
@@ -51,10 +62,18 @@ RANGES = {
     "disturbance": (0.0, 0.5),
     "noise": (0.0, 1e-4),
     "latency": (0.0, 0.0),
-    "part_mass": (0.05, 0.3),
-    "part_friction": (0.5, 1.0),
-    "belt_speed": (0.8, 1.2),
+    "part_mass": (0.05, 1.06),  # kg: the RV-M1's 1.2 kg payload less models/rvm1_gripper.sdf's 0.14 kg
+    "part_friction": (0.05, 1.0),
+    "belt_speed": (0.5, 2.0),
+    "close_jitter": (-0.06, 0.06),  # s
+    "part_lateral": (-0.01, 0.01),  # m
 }
+RVM1_PAYLOAD_KG = 1.2  # rated, including the hand (models/README.md)
+# The study as it was before the harsh pick ranges (module docstring): the same draws, seed for seed.
+MILD = RANGES | {"part_mass": (0.05, 0.3), "part_friction": (0.5, 1.0), "belt_speed": (0.8, 1.2),
+                 "close_jitter": (0.0, 0.0), "part_lateral": (0.0, 0.0)}
+PRESETS = {"harsh": RANGES, "mild": MILD}
+SIGNED = ("close_jitter", "part_lateral")  # ranges that may go below 0
 
 
 def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
@@ -106,8 +125,12 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
     scenario, params = sample_scenario(text, name, seed, ranges)
     try:
         result = simulate(scenario)
-    except (ScenarioError, RuntimeError) as exc:
-        return {"seed": seed, "params": params, "ok": False, "error": " ".join(str(exc).split())[:300]}
+    except (ScenarioError, RuntimeError) as exc:  # rejected before the run, or the integrator gave up
+        return {"seed": seed, "params": params, "ok": False, "status": "error",
+                "error": " ".join(str(exc).split())[:300]}
+    except Exception as exc:  # noqa: BLE001  (any other: still a verdict, named by its type)
+        return {"seed": seed, "params": params, "ok": False, "status": "error",
+                "error": " ".join(f"{type(exc).__name__}: {exc}".split())[:300]}
     m = result.metrics
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
     own = world_of(scenario).robust_row(seed, params, m)
@@ -137,11 +160,13 @@ def _percentiles(values) -> dict:
 
 
 def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int = None,
-               executor=None, ranges: dict = RANGES, progress=None, dask: str = None) -> dict:
+               executor=None, ranges: dict = RANGES, progress=None, dask: str = None,
+               preset: str = "harsh") -> dict:
     """Run the study on the scenario ``loaded`` (each sample is rebuilt from its text);
     returns the content of robust.json (plus ``rows`` and ``worst_yaml``).
     ``workers`` local processes (default 1), or ``dask`` (a scheduler address), or
-    ``executor`` (used as given, left open).  ``progress(done, total)`` as samples arrive."""
+    ``executor`` (used as given, left open).  ``progress(done, total)`` as samples arrive.
+    ``preset``: the name of the ranges' preset, recorded (``PRESETS``)."""
     t0 = time.perf_counter()
     report = (lambda done, total, index, row: progress(done, total)) if progress else None
     stats = {}
@@ -158,6 +183,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
         "scenario": name,
         "samples": samples,
         "seed": seed,
+        "ranges_preset": preset,
         "ranges": {k: list(v) for k, v in ranges.items()},
         "success_rate": sum(r["ok"] for r in rows) / samples,
         "failures": [{"seed": r["seed"], "status": r.get("status", "error"),

@@ -83,9 +83,11 @@ def test_robust_samples_a_pick_scenario_within_its_ranges():
         part, belt = scenario.pick.parts[0], scenario.pick.belts[0]
         assert RANGES["part_mass"][0] <= part.mass <= RANGES["part_mass"][1]
         assert RANGES["part_friction"][0] <= part.friction <= RANGES["part_friction"][1]
-        assert 0.08 <= belt.speed <= 0.12 and params["belt_speed"] == [belt.speed]
-    rows = [{"picks": [{"placed": True}, {"placed": False}], "reasons": ["pick 1: dropped"]},
-            {"error": "boom", "ok": False}]
+        lo, hi = RANGES["belt_speed"]
+        assert 0.1 * lo <= belt.speed <= 0.1 * hi and params["belt_speed"] == [belt.speed]
+    two = {"part_mass": [0.1, 0.1]}
+    rows = [{"params": two, "picks": [{"placed": True}, {"placed": False}], "reasons": ["pick 1: dropped"]},
+            {"params": two, "error": "boom", "ok": False}]
     summary = robust_summary(rows)
     assert summary["pick_success_rate"] == 0.25
     assert summary["failures_by_reason"] == {"dropped": 1, "error: boom": 1}

@@ -49,6 +49,9 @@ def _check_part(k: int, part: PartConfig, belts: dict) -> None:
     if abs(part.offset) > belts[part.belt].length / 2:
         raise ScenarioError(f"{where}.offset: {part.offset} m starts the part off its belt "
                             f"(length {belts[part.belt].length} m)")
+    if abs(part.lateral) > belts[part.belt].width / 2:
+        raise ScenarioError(f"{where}.lateral: {part.lateral} m puts the part's centre off its belt "
+                            f"(width {belts[part.belt].width} m)")
 
 
 def _check_belt(k: int, belt: BeltConfig) -> None:

@@ -180,10 +180,11 @@ def part_inertia(part: PartConfig) -> SpatialInertia:
 
 
 def part_start_pose(part: PartConfig, belt: BeltConfig) -> RigidTransform:
-    """The part's centre at t = 0: ``offset`` along its belt, resting on it, turned ``yaw_deg``."""
+    """The part's centre at t = 0: ``offset`` along its belt and ``lateral`` across it, resting on
+    it, turned ``yaw_deg``."""
     _, height = part_shape(part)
     X_WB = belt_frame(belt)
-    p = X_WB.multiply(np.array([part.offset, 0.0, height / 2]))
+    p = X_WB.multiply(np.array([part.offset, part.lateral, height / 2]))
     return RigidTransform(RotationMatrix.MakeZRotation(np.radians(part.yaw_deg)), p)
 
 

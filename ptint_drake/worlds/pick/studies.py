@@ -1,14 +1,25 @@
 """The pick world's parts of the studies and of ``ptint run``'s lines: what ``robust`` draws for a
-sample and keeps of it, a ``sweep`` point, why ``tune`` does not search a pick, and the lines
-``ptint run`` prints (each a hook of ``worlds.base.World``)."""
+sample and keeps of it, a ``sweep`` point, why ``tune`` does not search a pick, the lines
+``ptint run`` prints (each a hook of ``worlds.base.World``), and ``ptint bench --floors``'s
+replayed-arm floor (``FloorReplay``)."""
 
 from __future__ import annotations
 
+import copy
+import re
 import sys
 
 import numpy as np
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.controllers import PidController
+from pydrake.systems.framework import DiagramBuilder, EventStatus
+from pydrake.systems.primitives import Adder, LogVectorOutput, Saturation, TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.config.pick import PHASES
+from ptint_drake.mass_scaling import scale_in_context
+from ptint_drake.worlds.pick.run import pick_simulator, world_config
+from ptint_drake.worlds.pick.station import MakePickStation
 
 
 def mm_text(value) -> str:
@@ -17,46 +28,81 @@ def mm_text(value) -> str:
 
 
 def robust_sample(scenario, name: str, seed: int, u):
-    """A pick scenario's sample: link masses, every part's mass and friction, every belt's speed."""
+    """A pick scenario's sample, drawn in this order (so that the ``mild`` preset, whose last two
+    ranges are [0, 0], draws what the study drew before they existed): the arm's link masses; every
+    part's mass and friction; every belt's speed (×); every task's close-command jitter (s, added
+    to the close's time: ``close_delay``); every part's lateral offset on its belt (m, ``lateral``,
+    clipped to the belt's half width)."""
     scenario.plant.mass_scale = float(u("mass"))
     pick = scenario.pick
     for part in pick.parts:
         part.mass, part.friction = float(u("part_mass")), float(u("part_friction"))
     for belt in pick.belts:
         belt.speed *= float(u("belt_speed"))
+    for task in pick.tasks:
+        task.close_delay += float(u("close_jitter"))
+    belts = {b.name: b for b in pick.belts}
+    for part in pick.parts:
+        half = belts[part.belt].width / 2 if part.belt in belts else 0.0
+        part.lateral = float(np.clip(part.lateral + u("part_lateral"), -half, half))
     scenario.name = f"{name}_seed{seed}"
     return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
                       "part_friction": [p.friction for p in pick.parts],
-                      "belt_speed": [b.speed for b in pick.belts]}
+                      "belt_speed": [b.speed for b in pick.belts],
+                      "close_delay": [t.close_delay for t in pick.tasks],
+                      "part_lateral": [p.lateral for p in pick.parts]}
 
 
 def robust_row(seed: int, params: dict, m: dict) -> dict:
     """What a pick sample keeps of its metrics: the picks, the reasons."""
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
+    keys = ("part", "grasped", "placed", "place_error_mm", "place_error_deg", "slip_mm", "t_grasp",
+            "collision")
     return {"seed": seed, "params": params, "ok": m["status"] == "ok", "status": m["status"],
-                "e_tf": e_tf,
-                "e_tf_max": max((v for v in e_tf if v is not None), default=None),
-                "picks": [{k: p[k] for k in ("part", "grasped", "placed", "place_error_mm", "place_error_deg",
-                                             "slip_mm", "t_grasp", "collision")} for p in m["picks"]],
-                "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
-                "warnings": m["warnings"]}
+            "e_tf": e_tf,
+            "e_tf_max": max((v for v in e_tf if v is not None), default=None),
+            "picks": [{k: p.get(k) for k in keys} for p in m["picks"]],
+            "reasons": m["reasons"], "realtime_factor": m["sim"]["realtime_factor"],
+            "warnings": m["warnings"]}
+
+
+_NUMBER = re.compile(r"(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?!\w)")
+
+
+def failure_reason(text: str) -> str:
+    """A verdict's reason or a sample's error as a reason to count: without the pick's index
+    (``pick 2: dropped`` → ``dropped``), list indices as ``[k]``, other numbers as ``#``."""
+    text = re.sub(r"^pick \d+: ", "", text.strip())
+    text = re.sub(r"\[\d+\]", "[k]", text)
+    text = re.sub(r"\[[^\]]*\d[^\]]*\]", "[…]", text)
+    return _NUMBER.sub("#", text)[:160]
+
+
+def picks_ok(row: dict) -> int:
+    """How many of a sample's picks succeeded: placed, with no collision and no reason of the
+    verdict naming the pick (``pick k: late grasp`` fails pick k even if it was placed)."""
+    named = {int(m.group(1)) for text in row.get("reasons") or [] if (m := re.match(r"pick (\d+):", text))}
+    return sum(bool(p.get("placed")) and not p.get("collision") and k not in named
+               for k, p in enumerate(row.get("picks", [])))
 
 
 def robust_summary(rows: list) -> dict:
-    """``pick_success_rate`` (placed parts over all parts; a sample that could not run places none)
-    and ``failures_by_reason`` ({reason code: count}) of a pick study; {} otherwise."""
-    if not any("picks" in r for r in rows):
+    """``pick_success_rate`` (picks that succeeded, ``picks_ok``, over all parts, a sample that
+    could not run placing none) and ``failures_by_reason`` ({reason: count}, ``failure_reason``:
+    each reason of a sample's verdict, each sample's error; most frequent first) of a pick study;
+    {} otherwise."""
+    if not any("picks" in r or "part_mass" in r.get("params", {}) for r in rows):
         return {}
-    per_sample = [len(r["picks"]) for r in rows if "picks" in r]
-    parts = max(per_sample) if per_sample else 0
-    placed = sum(p["placed"] for r in rows for p in r.get("picks", []))
-    reasons = {}
+    parts = sum(len(r["params"]["part_mass"]) for r in rows)
+    ok = sum(picks_ok(r) for r in rows)
+    reasons: dict = {}
     for r in rows:
-        for reason in r.get("reasons", []) or ([f"error: {r['error']}"] if r.get("error") else []):
-            code = reason.split(": ", 1)[-1] if reason.startswith("pick ") else reason
+        texts = r.get("reasons") or ([f"error: {r['error']}"] if r.get("error") else [])
+        for text in texts:
+            code = failure_reason(text)
             reasons[code] = reasons.get(code, 0) + 1
-    return {"pick_success_rate": placed / (parts * len(rows)) if parts else 0.0,
-            "failures_by_reason": reasons}
+    return {"pick_success_rate": ok / parts if parts else 0.0,
+            "failures_by_reason": dict(sorted(reasons.items(), key=lambda kv: (-kv[1], kv[0])))}
 
 
 def sweep_point(row: dict, scenario, beta: float, tf: float, simulate, validate, schedule_end) -> dict:
@@ -107,3 +153,143 @@ def report(scenario, metrics: dict, out) -> int:
         return 1
     print(f"{scenario.name}: ok (every part placed)")
     return 0
+
+
+# ``ptint bench --floors`` on a pick scenario: the run beside its replayed-arm floor.
+
+FLOOR_KP = 100.0  # N·m/rad per joint: the replay's PD on the logged [q; v] (the logged torque fed forward)
+FLOOR_KD = 2.0  # N·m·s/rad per joint
+
+
+def _samples(times, values) -> tuple:
+    """(times, values) with one sample per time, as the plant's discrete update at that time took
+    it: of equal times the first (a later one follows an update, e.g. ``AdvanceTo`` a reached
+    stop), of times within 1 ns the last (the step to a stop a hair before a sample time)."""
+    ts, vs = [], []
+    for t, v in zip(times, values):
+        t = float(t)
+        if ts and t == ts[-1]:
+            continue
+        if ts and t - ts[-1] < 1e-9:
+            ts.pop(), vs.pop()
+        ts.append(t), vs.append(np.atleast_1d(np.asarray(v, dtype=float)))
+    return np.array(ts), np.array(vs)
+
+
+def _hold(times, values, end: float) -> PiecewisePolynomial:
+    """A zero-order hold through the samples (``_samples``), held to ``end`` (and a second on)."""
+    ts, vs = _samples(times, values)
+    ts, vs = np.r_[ts, max(end, ts[-1] + 1.0)], np.vstack([vs, vs[-1:]])
+    return PiecewisePolynomial.ZeroOrderHold(ts, vs.T)
+
+
+class FloorRun:
+    """The pick run's floor (``FloorReplay.floor``): the same station (arm, gripper and its driver,
+    belts, parts, tray, the same plant settings and start) driven by Drake's C++ systems alone —
+    a ``TrajectorySource`` replaying the run's arm torques (a zero-order hold of what the plant
+    received at each step) added to a ``PidController`` (PD, no I) on the run's [q; v] (a
+    first-order hold), through the arm's effort limits (``Saturation``), and a ``TrajectorySource``
+    replaying the gripper's commands — simulated with the run's integrator and stops.  Replaying
+    what the run computed, the arm follows the run's trajectory, the fingers close at the run's
+    times and the contacts are the run's; only the controller, the targets, the probe and the
+    loggers (the run's Python) are gone.  ``log``: log the arm's [q; v] every step."""
+
+    advance_at_reached_stops = True
+
+    def __init__(self, scenario, recording: dict, stops: list, log: bool = False):
+        builder = DiagramBuilder()
+        self.scenario, self._stops = scenario, stops
+        self.station = MakePickStation(world_config(scenario))
+        st = builder.AddNamedSystem("pick_station", self.station.diagram)
+        t, x = _samples(recording["t"], recording["state"])
+        end = scenario.duration
+        nq = x.shape[1] // 2
+        desired = builder.AddNamedSystem("logged_state", TrajectorySource(
+            PiecewisePolynomial.FirstOrderHold(t, x.T)))
+        torque = builder.AddNamedSystem("logged_torque", TrajectorySource(
+            _hold(recording["t"], recording["torque"], end)))
+        pd = builder.AddNamedSystem("pd", PidController(np.full(nq, FLOOR_KP), np.zeros(nq),
+                                                         np.full(nq, FLOOR_KD)))
+        adder = builder.AddNamedSystem("feedforward_plus_pd", Adder(2, nq))
+        limits = recording["limits"]
+        saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
+        command_times, command_values = zip(*recording["commands"])
+        gripper = builder.AddNamedSystem("logged_gripper_command", TrajectorySource(
+            _hold(command_times, command_values, end)))
+        builder.Connect(st.GetOutputPort("state"), pd.get_input_port_estimated_state())
+        builder.Connect(desired.get_output_port(), pd.get_input_port_desired_state())
+        builder.Connect(torque.get_output_port(), adder.get_input_port(0))
+        builder.Connect(pd.get_output_port_control(), adder.get_input_port(1))
+        builder.Connect(adder.get_output_port(), saturation.get_input_port())
+        builder.Connect(saturation.get_output_port(), st.GetInputPort("actuation"))
+        builder.Connect(gripper.get_output_port(), st.GetInputPort("gripper_command"))
+        period = scenario.controller.control_period
+        self.logger = LogVectorOutput(st.GetOutputPort("state"), builder, period) if log else None
+        self.diagram = builder.Build()
+        self.diagram.set_name("pick_floor")
+        self.simulator_config = pick_simulator(scenario)
+
+    def initialize(self, context) -> None:
+        """The run's start (``world.PickRun.initialize``): scaled arm masses, belts and parts moving."""
+        plant = self.station.plant
+        plant_context = plant.GetMyMutableContextFromRoot(context)
+        scale_in_context(plant, plant_context, self.station.arm, self.scenario.plant.mass_scale)
+        self.station.start_running(plant_context)
+
+    def stops(self) -> list:
+        return list(self._stops)
+
+    def at_stop(self, context, t: float) -> None:
+        """Nothing is measured on the floor."""
+
+
+class FloorReplay:
+    """A pick scenario's run and its floor, for ``studies.benchmark``: ``run()`` is a fresh run
+    of the scenario (``make_run(scenario)``, a ``worlds.base.WorldRun``); ``record()`` simulates
+    one run with a monitor that keeps, after every step, the arm's [q; v] and the torque the plant
+    takes at that time (the saturated controller output), and the plan's gripper commands;
+    ``floor(log)`` is the ``FloorRun`` replaying that recording."""
+
+    def __init__(self, scenario, make_run):
+        self.scenario, self._make_run = scenario, make_run
+        self.recording: dict = {}
+
+    def run(self):
+        return self._make_run(copy.deepcopy(self.scenario))
+
+    def record(self) -> dict:
+        run = self.run()
+        built = run.built
+        station = built.diagram.GetSubsystemByName("pick_station")
+        saturation = built.diagram.GetSubsystemByName("saturation")
+        ts, xs, taus = [], [], []
+
+        def keep(context):
+            ts.append(context.get_time())
+            xs.append(station.GetOutputPort("state").Eval(station.GetMyContextFromRoot(context)).copy())
+            taus.append(saturation.get_output_port().Eval(saturation.GetMyContextFromRoot(context)).copy())
+            return EventStatus.Succeeded()
+
+        simulator = Simulator(run.diagram)
+        ApplySimulatorConfig(run.simulator_config, simulator)
+        context = simulator.get_mutable_context()
+        run.initialize(context)
+        simulator.set_monitor(keep)
+        simulator.Initialize()
+        for t_stop in run.stops():
+            simulator.AdvanceTo(t_stop)
+        self.recording = {"t": np.array(ts), "state": np.array(xs), "torque": np.array(taus),
+                          "commands": list(built.plan.commands), "limits": np.asarray(built.limits),
+                          "stops": run.stops()}
+        return self.recording
+
+    def scenario_integrator(self) -> str:
+        """The run's integrator settings, in words."""
+        c = pick_simulator(self.scenario)
+        return (f"{c.integration_scheme}, max step {c.max_step_size:g} s"
+                + (f", accuracy {c.accuracy:g}" if c.use_error_control else ", fixed step"))
+
+    def floor(self, log: bool = False) -> FloorRun:
+        if not self.recording:
+            self.record()
+        return FloorRun(copy.deepcopy(self.scenario), self.recording, self.recording["stops"], log)

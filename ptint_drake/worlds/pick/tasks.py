@@ -98,7 +98,7 @@ def pick_plan(pick: PickConfig) -> PickPlan:
         width = grasp_width(pick.parts[part])
         opening = width + task.margin
         grasp = segs[1].end
-        close = grasp - 0.5 * task.margin / pick.gripper.speed
+        close = grasp - 0.5 * task.margin / pick.gripper.speed + task.close_delay
         commands += [(segs[0].start, opening), (close, 0.0), (segs[4].end, opening)]
         segments += segs
         plans += plan

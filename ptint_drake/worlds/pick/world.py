@@ -142,7 +142,8 @@ class PickWorld(World):
         return name
 
     def floor_diagram(self, scenario: Scenario, kind: str):
-        return None
+        """``"replay"``: the run beside its replayed-arm floor (``studies.FloorReplay``); no other kind."""
+        return studies.FloorReplay(scenario, PickRun) if kind == "replay" else None
 
     def report(self, scenario: Scenario, metrics: dict, out) -> int:
         return studies.report(scenario, metrics, out)
