@@ -5,24 +5,39 @@ start + tf against what it aims at *then* (the part's simulated pose, the latche
 slot), and the tool's angle from the top-down grasp (deg).
 
 ``pick_metrics`` — metrics.json's ``"picks"``, one entry per task, from the probe's log
-(``pick.probe``, every 2 ms) — the plant's truth, never the controller's view:
+(``pick.probe``, every 2 ms: the plant's truth, never the controller's view) and the grasp
+observer's log (``systems.gripper.GraspObserver``: what the gripper sensed):
 
-- ``t_grasp``: the first time both finger pads touch the part (None: never);
-- ``grasped``: at the end of the lift the part is between both pads and off its belt (its centre
-  more than half the lift height above where it was at the prescribed grasp time);
-- ``slip_mm``: the part's largest displacement relative to the tool frame from the lift's start to
-  the place's tf;
-- ``peak_grip_force_N``: the largest mean squeeze of the two finger drives while carried;
+- ``attempts``: approaches and descends made (1 + retries); ``attempt_details``: per attempt its
+  close command, prescribed grasp time, when its grasp state was read (``t_check``) and what it
+  was (``state``), and the largest pad–part grip force until then (``peak_grip_force_N``);
+  ``grasp_confirmed``: the last attempt's state was ``holding``; ``retry_refused``: why no
+  (further) retry was planned ("out of retries", "out of reach …");
+- ``t_grasp``: the first time both finger pads touch the part in the last attempt (None: never);
+  ``t_holding``: the first time the gripper reported ``holding`` then;
+- ``grasped``: the grasp was confirmed, and at the lift's start the part is squeezed between both
+  pads (the grip force ≥ ``GRASP_FORCE``); ``grip_force_N``: the grip force then;
+- grip force: the smaller of the two pads' contact forces on the part along the closing axis
+  (``probe.grip_forces``), what squeezes it; ``peak_grip_force_N``: its largest value from the
+  lift's start to the place's tf;
+- ``held_at_place``: both pads touch the part at the place's tf; ``state_at_place``: the
+  gripper's state then;
+- ``slip_mm``: for a grasped part, its largest displacement relative to the tool frame from the
+  lift's start to the place's tf while both pads touch it (None for a part never grasped);
 - ``place_error_mm`` / ``place_error_deg``: the part's resting pose at the end of the run against
   its place pose (centre; the angle of the rotation between them, a box's half-turn about its
   vertical axis counted as the same pose, a cylinder's turn about its axis ignored);
-- ``placed``: grasped, and within ``criteria.place_mm`` and ``criteria.place_deg``;
-- ``collision``: a contact of the arm or the gripper with any part or belt from the task's start
-  until the close command.
+- ``placed``: grasped, held at the place, and within ``criteria.place_mm`` and
+  ``criteria.place_deg``;
+- ``collision``: a contact of the arm or the gripper with any part or belt during an approach or
+  a descend before its close command.
 
-``pick_reasons`` — the verdict's reasons, printed ``pick 0: dropped``, ``pick 1: not placed``,
-``pick 2: collision`` and ``pick 0: late grasp`` (t_grasp more than ``LATE_GRASP`` after the
-prescribed grasp time, the descend's start + tf, or never).
+``pick_reasons`` — the verdict's reasons: ``pick k: collision``; ``pick k: empty grasp`` (the
+grasp never confirmed, no retry allowed: ``pick.retries: 0``) or ``pick k: missed after retry``
+(retries spent, or the retry out of reach); otherwise ``pick k: late grasp`` (t_grasp more than
+``LATE_GRASP`` after the prescribed grasp time, or never), ``pick k: early grasp`` (more than
+``EARLY_GRASP`` before it), ``pick k: dropped`` (grasped, not in the hand at the place) or
+``pick k: not placed``.
 """
 
 from __future__ import annotations
@@ -127,7 +142,9 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
         before |= (t >= a.start) & (t < a.close)
     collision = bool(np.any(robot_flags[before] > 0))
     i_lift, i_place = _at(t, lift_start), _at(t, place_end)
-    grasped = bool(both[i_lift] and grip[i_lift] >= GRASP_FORCE)
+    checks = outcome["checks"][k]
+    confirmed = bool(checks and checks[-1]["state"] == "holding")
+    grasped = bool(confirmed and both[i_lift] and grip[i_lift] >= GRASP_FORCE)
     held_at_place = bool(both[i_place])
     carried = _window(t, lift_start, place_end) & both
     slip = None
@@ -138,11 +155,11 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
         slip = float(np.max(np.linalg.norm(rel - rel[0], axis=1)))
     in_carry = _window(t, lift_start, place_end)
     holding = np.flatnonzero((states == HOLDING) & _window(t, last.start, place_end))
-    checks = outcome["checks"][k]
     details = []
     for j, a in enumerate(attempts):
-        span = _window(t, a.start, a.check)
-        details.append({"t_close_command": a.close, "t_grasp_prescribed": a.grasp, "t_check": a.check,
+        t_check = checks[j]["t"] if j < len(checks) else a.check  # when the state was read
+        span = _window(t, a.start, t_check)
+        details.append({"t_close_command": a.close, "t_grasp_prescribed": a.grasp, "t_check": t_check,
                         "state": checks[j]["state"] if j < len(checks) else None,
                         "peak_grip_force_N": float(np.max(grip[span])) if np.any(span) else 0.0})
     i_place_seg = plan.segment_index(k, "place")
@@ -151,7 +168,7 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
     return {"part": part.name, "part_index": part_index, "slot": plan.segments[i_place_seg].index,
             "grasped": grasped, "t_grasp": t_grasp, "t_grasp_prescribed": last.grasp,
             "t_close_command": last.close, "attempts": len(attempts), "attempt_details": details,
-            "grasp_confirmed": bool(checks and checks[-1]["state"] == "holding"),
+            "grasp_confirmed": confirmed,
             "retry_refused": outcome["refused"][k],
             "t_holding": float(t[holding[0]]) if len(holding) else None,
             "state_at_place": GRASP_STATES[int(states[i_place])], "held_at_place": held_at_place,
