@@ -99,7 +99,8 @@ def test_a_retry_cuts_the_descend_backs_off_and_shifts_the_later_tasks():
 def test_a_lift_delay_waits_for_the_grasp():
     plan = pick_plan(_pick(), (Replan((), 0.05),))
     lift = plan.schedule.segments[plan.segment_index(0, "lift")]
-    assert lift.start == pytest.approx(1.7 + 0.15 + 0.05) and plan.attempts[0][0].check == pytest.approx(lift.start)
+    assert lift.start == pytest.approx(1.7 + 0.15 + 0.05)
+    assert plan.attempts[0][0].check == pytest.approx(lift.start)
 
 
 def test_the_close_advance_test_option_moves_the_first_close_only():
