@@ -48,8 +48,8 @@ def test_a_retry_out_of_reach_is_missed_after_retry(run):
     """A fast belt: by the retry's grasp time the part has ridden out of the arm's reach."""
     m = run("conveyor_pick_place", "pick: {test_close_advance_s: 0.3, belts: [{name: belt, center: "
             "[0.30, 0.0, 0.135], direction: [0.0, 1.0, 0.0], speed: 0.25, length: 2.0}], "
-            "parts: [{name: part, belt: belt, size: [0.03, 0.03, 0.03], offset: -0.35}], tasks: [{part: part, slot: 0, "
-            "clearance: 0.1, descend: {tf: 0.6}}]}").metrics
+            "parts: [{name: part, belt: belt, size: [0.03, 0.03, 0.03], offset: -0.35}], "
+            "tasks: [{part: part, slot: 0, clearance: 0.1, descend: {tf: 0.6}}]}").metrics
     assert _reasons(m) == ["pick 0: missed after retry"]
     assert m["picks"][0]["retry_refused"].startswith("out of reach")
 
