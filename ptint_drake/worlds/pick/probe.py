@@ -61,17 +61,22 @@ class PickProbe(LeafSystem):
         """(body A, body B) of every contact, with the force on B (world, N) if ``forces``."""
         for i in range(results.num_point_pair_contacts()):
             info = results.point_pair_contact_info(i)
-            yield int(info.bodyA_index()), int(info.bodyB_index()), info.contact_force() if forces else None
+            yield (int(info.bodyA_index()), int(info.bodyB_index()),
+                   np.array(info.contact_force()) if forces else None)
         for i in range(results.num_hydroelastic_contacts()):
             info = results.hydroelastic_contact_info(i)
             surface = info.contact_surface()
-            force = -info.F_Ac_W().translational() if forces else None  # on N's body: −(on M's)
+            force = None
+            if forces:
+                F_Ac_W = info.F_Ac_W()
+                force = -np.array(F_Ac_W.translational())  # on N's body: −(on M's)
             yield self._geometry[surface.id_M()], self._geometry[surface.id_N()], force
 
     def _calc_forces(self, context, output) -> None:
         out = np.zeros(output.size())
         poses = self._poses.Eval(context)
-        x_tool = (poses[self._tool_body] @ self._X_BT).rotation().col(0)
+        X_WT = poses[self._tool_body] @ self._X_BT
+        x_tool = np.array(X_WT.rotation().matrix()[:, 0])  # a copy while X_WT lives (Drake 1.51's views)
         pads = {self._left: 0, self._right: 1}
         for a, b, f in self._pairs(self._contacts.Eval(context), forces=True):
             if a in self._part_slot and b in pads:
