@@ -64,8 +64,20 @@ def test_a_slippery_heavy_part_is_dropped(run):
     assert pick["state_at_place"] == "lost" and not pick["held_at_place"]  # … and gone by the place
 
 
+def test_the_lift_waits_for_holding_and_a_late_close_is_a_late_grasp(run):
+    """The close 0.16 s late: at the lift's planned start (grasp + 0.15 s) the fingers are still
+    closing; the lift waits 50 ms, the gripper reports holding, the part is placed, and the
+    verdict says late grasp."""
+    m = run("conveyor_pick_place", "pick: {test_close_advance_s: -0.16}").metrics
+    assert m["reasons"] == ["pick 0: late grasp"], m["reasons"]
+    pick = m["picks"][0]
+    lift = next(s for s in m["segments"] if s["phase"] == "lift")
+    assert lift["start"] == pytest.approx(1.7 + 0.15 + 0.05)
+    assert pick["t_grasp"] > 1.75 and 1.85 < pick["t_holding"] <= lift["start"] and pick["attempts"] == 1
+    assert pick["place_error_mm"] <= 3.0 and pick["held_at_place"]
+
+
 @pytest.mark.parametrize("override, reason", [
-    ("pick: {test_close_advance_s: -0.1}", "pick 0: late grasp"),  # the close 0.1 s late
     ("pick: {test_close_advance_s: 0.1}", "pick 0: early grasp"),  # on the part 0.1 s early
     ("criteria: {place_mm: 0.01}", "pick 0: not placed"),  # 0.16 mm is outside 0.01 mm
 ])
