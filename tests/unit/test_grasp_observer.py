@@ -124,3 +124,15 @@ def test_widths_follow_the_active_task():
     plan = pick_plan(_pick())
     assert [w for _, w in plan.widths] == [0.03, 0.03]
     assert np.diff([t for t, _ in plan.widths])[0] > 0
+
+
+def test_no_retry_left_backs_off_with_the_fingers_open():
+    pick = _pick()
+    plan = pick_plan(pick, (Replan((), 0.0, abort=1.6),))
+    phases = [s.phase for s in plan.segments if s.task == 0]
+    assert phases == ["approach", "descend", "backoff", "lift", "carry", "place", "retreat"]
+    segs = plan.schedule.segments
+    assert segs[1].end == pytest.approx(1.6) and segs[2].start == pytest.approx(1.6)
+    assert segs[3].start == pytest.approx(segs[2].end)  # the lift right after the backoff
+    assert dict(plan.commands)[1.6] == pytest.approx(0.042)
+    assert plan.attempts[0][0].check == pytest.approx(1.6)

@@ -27,6 +27,7 @@ commands (``pick.targets.GripperSequence``).
 """
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
@@ -54,11 +55,14 @@ class PlanSegment:
 @dataclass(frozen=True)
 class Replan:
     """What a run decided for one task (``worlds.pick.world``): the start of each retry (its
-    backoff, s) and how long the lift of the last attempt waits beyond its planned start for the
-    grasp to be confirmed (s)."""
+    backoff, s), how long the lift of the last attempt waits beyond its planned start for the
+    grasp to be confirmed (s), and ``abort``: when the last attempt, found without a part and
+    with no retry left, backs off (s; None: it did not) — the fingers open and the tool rises
+    ``clearance`` before the task's lift, carry, place and retreat go on with an empty hand."""
 
     retries: tuple = ()
     lift_delay: float = 0.0
+    abort: Optional[float] = None
 
 
 @dataclass(frozen=True)
@@ -118,9 +122,13 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, sta
         approach = t
         t = add("approach", "part", part, _up(task.clearance), 0.0, t, attempt)
         grasp = t + task.descend.tf  # prescribed, even where the descend is cut short
+        last = replan.abort if replan.abort is not None else np.inf
         t = add("descend", "part", part, _up(0.0), 0.0, t, attempt,
-                retries[attempt] if attempt < len(retries) else np.inf)
+                retries[attempt] if attempt < len(retries) else last)
         attempts.append((approach, grasp))
+    if replan.abort is not None:
+        t = add("backoff", "latched", part, _up(task.clearance), 0.0, replan.abort, len(retries))
+        t -= task.dwell  # the lift right after it
     t = add("lift", "latched", part, _up(task.lift_height), 0.0, t + task.dwell + replan.lift_delay)
     t = add("carry", "slot", task.slot, _up(task.lift_height), slot_yaw, t)
     t = add("place", "slot", task.slot, _up(0.0), slot_yaw, t)
@@ -152,6 +160,9 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
                 close -= pick.test_close_advance_s  # a test option (PickConfig)
             commands += [((replan.retries[j - 1] if j else approach), opening), (close, 0.0)]
             check = replan.retries[j] if j < len(replan.retries) else grasp + task.dwell + replan.lift_delay
+            if j == len(replan.retries) and replan.abort is not None:
+                check = replan.abort
+                commands.append((replan.abort, opening))
             task_attempts.append(Attempt(approach, close, grasp, check))
         place = [p.phase for p in plan].index("place")
         commands.append((segs[place].end, opening))

@@ -129,16 +129,15 @@ class PickRun(WorldRun):
         self.checks[k].append({"state": GRASP_STATES[state], "t": t})
         if state == HOLDING:
             return
-        if len(replan.retries) >= pick.retries:
-            self.refused[k] = "out of retries"
-            return
         candidate = self.replans.copy()
         candidate[k] = Replan(replan.retries + (t,), 0.0)
-        plan = pick_plan(pick, tuple(candidate))
-        why = self._unreachable(context, k, plan.attempts[k][-1].grasp, t)
-        if why:
+        if len(replan.retries) >= pick.retries:
+            why = "out of retries"
+        else:
+            why = self._unreachable(context, k, pick_plan(pick, tuple(candidate)).attempts[k][-1].grasp, t)
+        if why:  # no retry: back off with the fingers open, then the rest of the task
             self.refused[k] = why
-            return
+            candidate[k] = Replan(replan.retries, 0.0, abort=t)
         self.replans = candidate
         self._rebuild()
 
