@@ -6,15 +6,17 @@
 the segments and ``picks``) and verdict (``metrics.pick_reasons``), its figure and replay
 (``views``).  The runner (``worlds.runner``) simulates it.
 
-The confirmed grasp: at each task's check (its lift's planned start, prescribed grasp time +
-``dwell``) ``PickRun.at_stop`` reads the ``GraspObserver``'s state (what the gripper senses).
+The confirmed grasp: every ``SENSE_PERIOD`` from a close command (``empty`` or ``lost`` act at
+once) and at each task's check (its lift's planned start, prescribed grasp time + ``dwell``)
+``PickRun.at_stop`` reads the ``GraspObserver``'s state (what the gripper senses).
 ``holding``: the plan goes on.  ``closing`` (still moving): the lift waits, ``GRASP_WAIT`` at a
 time, up to ``pick.grasp_window`` after the prescribed grasp time.  ``empty``, ``lost``, or the
 window over: while ``pick.retries`` allow, a retry is planned from that moment and the part's
 current (simulated) pose — a backoff (up ``clearance``, the fingers opening), a new approach and
 descend, then the task's lift, carry, place and retreat, later tasks shifted — if its grasp and
 lift points (the part's position extrapolated at its current velocity to the new grasp time) are
-reachable from above.  A new plan means a new diagram (the controller's schedule is built into
+reachable from above; otherwise (``refused``) the arm backs off the same way, fingers open,
+and the task goes on with an empty hand (``tasks.Replan.abort``).  A new plan means a new diagram (the controller's schedule is built into
 it): ``replan`` builds it and ``resume`` carries the whole state (time, plant, controller,
 drive, observer, targets) into its context; the runner goes on from there.  If the retries push
 the plan's end later, the run is lengthened by as much (metrics ``duration``).
