@@ -16,9 +16,10 @@ current (simulated) pose — a backoff (up ``clearance``, the fingers opening), 
 descend, then the task's lift, carry, place and retreat, later tasks shifted — if its grasp and
 lift points (the part's position extrapolated at its current velocity to the new grasp time) are
 reachable from above; otherwise (``refused``) the arm backs off the same way, fingers open,
-and the task goes on with an empty hand (``tasks.Replan.abort``).  A new plan means a new diagram (the controller's schedule is built into
-it): ``replan`` builds it and ``resume`` carries the whole state (time, plant, controller,
-drive, observer, targets) into its context; the runner goes on from there.  If the retries push
+and the task goes on with an empty hand (``tasks.Replan.abort``).  A new plan means a new
+diagram (the controller's schedule is built into it): ``replan`` builds it and ``resume``
+carries the numeric state (time, plant, controller, drive, observer, targets) into its
+context; the runner goes on from there.  If the retries push
 the plan's end later, the run is lengthened by as much (metrics ``duration``).
 """
 
