@@ -129,6 +129,9 @@ class PickTaskConfig:
     dwell: float = 0.15  # s, the grip building up after the close, and the fingers opening
     margin: float = 0.012  # m, the open fingers' clearance around the part (opening − width)
     close_delay: float = 0.0  # s, added to the close command's time (negative: early; robust's jitter)
+    # a retry's first segment: the tool rises ``clearance`` above where the part is while the
+    # fingers open (then a new approach and descend, with this task's tf and β)
+    backoff: MoveConfig = field(default_factory=lambda: MoveConfig(0.3))
 
 
 @dataclass
@@ -140,5 +143,13 @@ class PickConfig:
     parts: List[PartConfig] = field(default_factory=list)
     tray: TrayConfig = field(default_factory=TrayConfig)
     tasks: List[PickTaskConfig] = field(default_factory=list)
+    # the confirmed grasp (``systems.gripper.GraspObserver``, docs/pick_place.md "Grasp states"):
+    retries: int = 1  # new approach + descend after an empty grasp or a timeout (0: none)
+    grasp_window: float = 0.3  # s after the prescribed grasp time: the latest the lift waits for ``holding``
+    width_tolerance: float = 0.003  # m, ``holding``: the opening within the part's width ± this
+    # TEST OPTION (leave 0): send the first attempt's close command this much earlier, so that
+    # "closed on nothing" is reproducible (e.g. 0.3: the fingers close above the part; negative:
+    # later, a late grasp)
+    test_close_advance_s: float = 0.0
 
 

@@ -74,3 +74,92 @@ class GripperDriver(LeafSystem):
             step = min(max(goal - qi, -self._step), self._step)
             out[i], out[2 + i] = qi + step, step / self._period
         state.get_mutable_vector(self._reference).SetFromVector(out)
+
+
+# Grasp states (``GraspObserver``'s output ``grasp_state``), in the spirit of the grasping states a
+# Schunk WSG driver reports (IDLE / GRASPING / HOLDING / NO PART FOUND / PART LOST).
+OPEN, CLOSING, HOLDING, EMPTY, LOST = 0, 1, 2, 3, 4
+GRASP_STATES = ("open", "closing", "holding", "empty", "lost")
+
+
+class GraspObserver(LeafSystem):
+    """The grasp state decided from what a real parallel gripper reports — the finger positions
+    and speeds (its encoder) and each finger drive's force (its motor current) — and the grasp
+    command (the wanted opening and the expected part width), never from the plant's contact
+    results, which no real driver can read.  The rule follows the grasping states of a Schunk
+    WSG 50's driver (its command set: grasp a part of a given width with a force, reporting
+    HOLDING, NO PART FOUND or PART LOST); the thresholds below are this package's choices.
+
+    Every ``period`` (default 1 ms, the plant's step), with w = q_left + q_right the opening
+    between the pads, ṡ = max(|v_left|, |v_right|), F = min over the two drives of the squeezing
+    force (−force, N), w_part the expected width and the previous state s:
+
+    - command > 0 (open or opening): ``open``;
+    - else if s is ``holding`` or ``lost`` and w < w_part − ``width_tolerance``: ``lost`` (the
+      width collapsed: the part left the fingers);
+    - else if s is ``holding``: ``holding`` (it stays so while the width does not collapse);
+    - else if s is ``empty``: ``empty`` (until the next open command);
+    - else if w < w_part − ``width_tolerance``: ``empty`` (closed past the part's size: nothing
+      between the fingers);
+    - else if ṡ < ``stop_ratio`` · ``speed`` (the closing speed) and |w − w_part| ≤ ``width_tolerance`` and
+      F ≥ ``force_ratio`` · ``max_force``: ``holding`` (stopped on something of the part's size,
+      squeezing at the set point);
+    - else ``closing`` (moving, or stopped on something not of the part's size).
+
+    Defaults: ``width_tolerance`` 3 mm (a quarter of the pick's default 12 mm opening margin;
+    the pads sink into a 30 mm part by about 1 mm under the RV-M1 hand's 30 N, point contact),
+    ``stop_speed`` 10 % of the closing speed (5 mm/s for the RV-M1 hand's 50 mm/s: measured on
+    conveyor_pick_place, the pads stop from 50 mm/s to 3 mm/s within 10 ms of touching the part,
+    then creep at 2–4 mm/s for 0.15 s as the contact settles), ``force_ratio`` 0.9 (the drive's
+    PD reaches its force limit
+    within a few ms once the pads touch; ``GripperDriver``'s CLOSE_MARGIN puts the reference
+    1.5 force-limit deflections behind the centre).
+
+    =================  ====  ============================================================
+    port               size  meaning
+    =================  ====  ============================================================
+    ``finger_state``   4     input: [q_left, q_right, v_left, v_right] (m, m/s)
+    ``drive_force``    2     input: each finger drive's force (N, + opens, − squeezes)
+    ``command``        1     input: the wanted opening (m); ≤ 0: close (``GripperDriver``)
+    ``part_width``     1     input: the expected width of the part to grasp (m)
+    ``grasp_state``    1     output: the state's code (OPEN … LOST; ``GRASP_STATES`` names)
+    =================  ====  ============================================================
+
+    Discrete state ``grasp`` = [code], updated every ``period``; the output is that state (so a
+    sample at t shows the decision of the update at or before t).
+    """
+
+    def __init__(self, max_force: float, speed: float, width_tolerance: float = 0.003,
+                 stop_ratio: float = 0.1, force_ratio: float = 0.9, period: float = 0.001):
+        super().__init__()
+        self._force = force_ratio * max_force
+        self._tolerance, self._stop_speed = width_tolerance, stop_ratio * speed
+        self._fingers = self.DeclareVectorInputPort("finger_state", 4)
+        self._drive = self.DeclareVectorInputPort("drive_force", 2)
+        self._command = self.DeclareVectorInputPort("command", 1)
+        self._width = self.DeclareVectorInputPort("part_width", 1)
+        self._grasp = self.DeclareDiscreteState(BasicVector([float(OPEN)]))
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        self.DeclareStateOutputPort("grasp_state", self._grasp)
+
+    def decide(self, previous: int, command: float, fingers, drive, part_width: float) -> int:
+        """The next state from the previous one and the inputs (the rule in the class docstring)."""
+        if command > 0.0:
+            return OPEN
+        width = float(fingers[0]) + float(fingers[1])
+        collapsed = width < part_width - self._tolerance
+        if previous in (HOLDING, LOST):
+            return LOST if collapsed else previous
+        if previous == EMPTY or collapsed:
+            return EMPTY
+        stopped = max(abs(float(fingers[2])), abs(float(fingers[3]))) < self._stop_speed
+        squeezing = min(-float(drive[0]), -float(drive[1])) >= self._force
+        if stopped and squeezing and abs(width - part_width) <= self._tolerance:
+            return HOLDING
+        return CLOSING
+
+    def _update(self, context, state) -> None:
+        previous = int(context.get_discrete_state(self._grasp).get_value()[0])
+        code = self.decide(previous, float(self._command.Eval(context)[0]), self._fingers.Eval(context),
+                           self._drive.Eval(context), float(self._width.Eval(context)[0]))
+        state.get_mutable_vector(self._grasp).SetAtIndex(0, float(code))

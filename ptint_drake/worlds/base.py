@@ -9,7 +9,10 @@ owns the ``Simulator`` and its ``AdvanceTo`` loop for all of them.  A world buil
 
 1. ``pre_run_warnings()`` (checks before simulating; a ``ScenarioError`` stops the run);
 2. ``simulator_config``, ``initialize(context)`` and ``monitor(progress)`` (the watchdog);
-3. ``stops()``: the exact times ``AdvanceTo`` lands on; ``at_stop(context, t)`` after each;
+3. ``stops()``: the exact times ``AdvanceTo`` lands on; ``at_stop(context, t)`` after each; then
+   ``replan(context, t)``: True when the world planned anew there (its ``diagram`` is new: the
+   runner makes a new simulator and ``resume(new_context, old_context)`` carries the state), and
+   ``stops()`` is read again;
 4. ``finish(context, integrator)`` → (metrics, series, warnings after the run);
 5. ``reasons(metrics, criteria)``: why it missed (the verdict), and ``sim_info`` extras.
 
@@ -80,6 +83,14 @@ class WorldRun:
 
     def at_stop(self, context, t: float) -> None:
         """Record what is measured at the exact stop ``t``."""
+
+    def replan(self, context, t: float) -> bool:
+        """After ``at_stop``: True if the world replaced its ``diagram`` with a new plan from here."""
+        return False
+
+    def resume(self, new_context, old_context) -> None:
+        """Set the new diagram's ``new_context`` from the replaced one's (after ``replan``)."""
+        raise NotImplementedError
 
     def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
         """(metrics, series, warnings known after the run)."""

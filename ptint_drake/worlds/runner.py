@@ -40,12 +40,19 @@ def _failure(t: float, what: str, exc: BaseException) -> dict:
     return {"time": t, "message": f"{what} at t = {t:.4f} s: {detail}"}
 
 
-def _advance(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: Progress):
-    """Run to every exact stop; returns (failure or None, wall s of ``AdvanceTo``)."""
+def _advance(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: Progress, monitor=None):
+    """Run to every exact stop; returns (failure or None, wall s of ``AdvanceTo``, the simulator
+    of the end, steps taken by the simulators a replan replaced).  ``run.stops()`` is read again
+    after each stop: a world that plans anew at a stop (``WorldRun.replan``) hands over a new
+    diagram, which goes on from the old context's state in a new simulator."""
     context = simulator.get_mutable_context()
-    failure, wall = None, 0.0
+    failure, wall, done, steps_before = None, 0.0, None, 0
     simulator.Initialize()
-    for t_stop in run.stops():
+    while True:
+        upcoming = [t for t in run.stops() if done is None or t > done]
+        if not upcoming:
+            break
+        t_stop = upcoming[0]
         if t_stop > context.get_time() or run.advance_at_reached_stops:
             t0 = time.perf_counter()
             try:
@@ -64,10 +71,21 @@ def _advance(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: 
         if failure is not None:
             break
         run.at_stop(context, t_stop)
+        done = t_stop
+        if run.replan(context, t_stop):
+            steps_before += int(simulator.get_integrator().get_num_steps_taken())
+            t0 = time.perf_counter()
+            simulator = make_simulator(run)
+            run.resume(simulator.get_mutable_context(), context)
+            context = simulator.get_mutable_context()
+            if monitor is not None:
+                simulator.set_monitor(monitor)
+            simulator.Initialize()
+            wall += time.perf_counter() - t0
         if progress is not None:
-            steps = int(simulator.get_integrator().get_num_steps_taken())
+            steps = steps_before + int(simulator.get_integrator().get_num_steps_taken())
             progress(context.get_time(), scenario.duration, steps)
-    return failure, wall
+    return failure, wall, simulator, steps_before
 
 
 def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
@@ -93,10 +111,10 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
     monitor = run.monitor(progress)
     if monitor is not None:
         simulator.set_monitor(monitor)
-    failure, wall = _advance(simulator, run, scenario, progress)
+    failure, wall, simulator, steps_before = _advance(simulator, run, scenario, progress, monitor)
     context, integrator = simulator.get_context(), simulator.get_integrator()
     if progress is not None:
-        progress(context.get_time(), scenario.duration, int(integrator.get_num_steps_taken()))
+        progress(context.get_time(), scenario.duration, steps_before + int(integrator.get_num_steps_taken()))
     metrics, series, after = run.finish(context, integrator)
     warnings = warnings + after
     if failure:
@@ -111,6 +129,7 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
                                "model_based": run.controller.model_based}}
     total = time.perf_counter() - t_start
     metrics["sim"] = _sim_info(scenario, run, integrator, context.get_time(), total, wall)
+    metrics["sim"]["steps"] += steps_before
     return RunResult(scenario, metrics, series)
 
 

@@ -5,27 +5,42 @@ start + tf against what it aims at *then* (the part's simulated pose, the latche
 slot), and the tool's angle from the top-down grasp (deg).
 
 ``pick_metrics`` — metrics.json's ``"picks"``, one entry per task, from the probe's log
-(``pick.probe``, every 2 ms) — the plant's truth, never the controller's view:
+(``pick.probe``, every 2 ms: the plant's truth, never the controller's view) and the grasp
+observer's log (``systems.gripper.GraspObserver``: what the gripper sensed):
 
-- ``t_grasp``: the first time both finger pads touch the part (None: never);
-- ``grasped``: at the end of the lift the part is between both pads and off its belt (its centre
-  more than half the lift height above where it was at the prescribed grasp time);
-- ``slip_mm``: the part's largest displacement relative to the tool frame from the lift's start to
-  the place's tf;
-- ``peak_grip_force_N``: the largest mean squeeze of the two finger drives while carried;
+- ``attempts``: approaches and descends made (1 + retries); ``attempt_details``: per attempt its
+  close command, prescribed grasp time, when its grasp state was read (``t_check``) and what it
+  was (``state``), and the largest pad–part grip force until then (``peak_grip_force_N``);
+  ``grasp_confirmed``: the last attempt's state was ``holding``; ``retry_refused``: why no
+  (further) retry was planned ("out of retries", "out of reach …");
+- ``t_grasp``: the first time both finger pads touch the part in the last attempt (None: never);
+  ``t_holding``: the first time the gripper reported ``holding`` then;
+- ``grasped``: the grasp was confirmed, and at the lift's start the part is squeezed between both
+  pads (the grip force ≥ ``GRASP_FORCE``); ``grip_force_N``: the grip force then;
+- grip force: the smaller of the two pads' contact forces on the part along the closing axis
+  (``probe.grip_forces``), what squeezes it; ``peak_grip_force_N``: its largest value from the
+  lift's start to the place's tf;
+- ``held_at_place``: both pads touch the part at the place's tf; ``state_at_place``: the
+  gripper's state then;
+- ``slip_mm``: for a grasped part, its largest displacement relative to the tool frame from the
+  lift's start to the place's tf while both pads touch it (None for a part never grasped);
 - ``place_error_mm`` / ``place_error_deg``: the part's resting pose at the end of the run against
   its place pose (centre; the angle of the rotation between them, a box's half-turn about its
   vertical axis counted as the same pose, a cylinder's turn about its axis ignored);
-- ``placed``: grasped, and within ``criteria.place_mm`` and ``criteria.place_deg``;
-- ``collision``: a contact of the arm or the gripper with any part or belt from the task's start
-  until the close command, or any in ``collision_with``;
+- ``placed``: grasped, held at the place, and within ``criteria.place_mm`` and
+  ``criteria.place_deg``;
+- ``collision``: a contact of the arm or the gripper with any part or belt during an approach or
+  a descend before its close command, or any in ``collision_with``;
 - ``collision_with``: the obstacles (belts, ``tray``, ``floor``, other parts; the own part touched
   by anything but the fingers) the arm or the gripper touched in the task's window
   (``collisions.pick_collisions``).
 
-``pick_reasons`` — the verdict's reasons, printed ``pick 0: dropped``, ``pick 1: not placed``,
-``pick 2: collision with <body>`` and ``pick 0: late grasp`` (t_grasp more than ``LATE_GRASP`` after the
-prescribed grasp time, the descend's start + tf, or never).
+``pick_reasons`` — the verdict's reasons: ``pick k: collision with <body>`` (or ``collision``);
+``pick k: empty grasp`` (the grasp never confirmed, no retry allowed: ``pick.retries: 0``) or
+``pick k: missed after retry`` (retries spent, or the retry out of reach); otherwise ``pick k:
+late grasp`` (t_grasp more than ``LATE_GRASP`` after the prescribed grasp time, or never),
+``pick k: early grasp`` (more than ``EARLY_GRASP`` before it), ``pick k: dropped`` (grasped, not
+in the hand at the place) or ``pick k: not placed``.
 """
 
 from __future__ import annotations
@@ -39,6 +54,7 @@ from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_reference
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time
+EARLY_GRASP = 0.05  # s before it
 
 
 def rotation_of(wxyz) -> np.ndarray:
@@ -95,65 +111,110 @@ def _first(t: np.ndarray, mask: np.ndarray):
     return float(t[hits[0]]) if len(hits) else None
 
 
-def _one_pick(built, k: int, t: np.ndarray, probe: np.ndarray, grip: np.ndarray, lift: float) -> dict:
+GRASP_FORCE = 1.0  # N: the smaller pad force above which the part counts as squeezed
+
+
+def _window(t: np.ndarray, a: float, b: float) -> np.ndarray:
+    return (t >= a - 1e-9) & (t <= b + 1e-9)
+
+
+def _at(t: np.ndarray, when: float) -> int:
+    """The last sample at or before ``when``."""
+    return min(max(int(np.searchsorted(t, when + 1e-9, side="right")) - 1, 0), len(t) - 1)
+
+
+def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
+    from ptint_drake.systems.gripper import GRASP_STATES, HOLDING  # noqa: PLC0415
+
+    t, probe = logs["probe"]
+    forces, states = logs["grip_forces"][1], logs["grasp_state"][1][:, 0]
     plan = built.plan
-    segs = [(s, p) for s, p in zip(plan.schedule.segments, plan.segments) if p.task == k]
-    part_index = segs[0][1].index
+    attempts = plan.attempts[k]
+    seg = {p: plan.schedule.segments[plan.segment_index(k, p)] for p in ("lift", "place")}
+    part_index = plan.segments[plan.segment_index(k, "approach")].index
     part = built.station.config.parts[part_index]
     block = probe[:, PART_WIDTH * part_index: PART_WIDTH * (part_index + 1)]
-    start, close, lift_end = segs[0][0].start, plan.close_times[k], segs[2][0].end
-    lift_start, place_end = segs[2][0].start, segs[4][0].end
+    grip = np.min(forces[:, 2 * part_index: 2 * part_index + 2], axis=1)  # what squeezes it (N)
+    last = attempts[-1]
+    lift_start, place_end = seg["lift"].start, seg["place"].end
     both = (block[:, LEFT] > 0) & (block[:, RIGHT] > 0)
-    t_grasp = _first(t, both & (t >= start))
+    t_grasp = _first(t, both & (t >= last.start))
     robot_flags = probe[:, [PART_WIDTH * j + c for j in range(len(built.station.parts))
                             for c in (LEFT, RIGHT, OTHER)] + [probe.shape[1] + BELT]]
-    before = (t >= start) & (t < close)
+    before = np.zeros(len(t), dtype=bool)
+    for a in attempts:  # each approach and descend until its close command
+        before |= (t >= a.start) & (t < a.close)
     collision = bool(np.any(robot_flags[before] > 0))
-    i_lift = max(int(np.searchsorted(t, lift_end, side="right")) - 1, 0)
-    i_grasp = min(int(np.searchsorted(t, plan.grasp_times[k])), len(t) - 1)
-    grasped = bool(both[i_lift] and block[i_lift, 2] > block[i_grasp, 2] + 0.5 * lift)
-    carried = (t >= lift_start) & (t <= place_end)
-    tool_p, tool_q = probe[:, -7:-4], probe[:, -4:]
-    rel = np.array([rotation_of(tool_q[j]).T @ (block[j, 0:3] - tool_p[j]) for j in np.flatnonzero(carried)])
-    slip = float(np.max(np.linalg.norm(rel - rel[0], axis=1))) if len(rel) else None
-    squeeze = -np.mean(grip[carried], axis=1) if np.any(carried) else np.zeros(1)
-    place = built.targets.places[plan.segment_index(k, "place")]
-    place_yaw = segs[4][1].yaw
+    i_lift, i_place = _at(t, lift_start), _at(t, place_end)
+    checks = outcome["checks"][k]
+    confirmed = bool(checks and checks[-1]["state"] == "holding")
+    grasped = bool(confirmed and both[i_lift] and grip[i_lift] >= GRASP_FORCE)
+    held_at_place = bool(both[i_place])
+    carried = _window(t, lift_start, place_end) & both
+    slip = None
+    if grasped and np.any(carried):
+        tool_p, tool_q = probe[:, -7:-4], probe[:, -4:]
+        rel = np.array([rotation_of(tool_q[j]).T @ (block[j, 0:3] - tool_p[j])
+                        for j in np.flatnonzero(carried)])
+        slip = float(np.max(np.linalg.norm(rel - rel[0], axis=1)))
+    in_carry = _window(t, lift_start, place_end)
+    holding = np.flatnonzero((states == HOLDING) & _window(t, last.start, place_end))
+    details = []
+    for j, a in enumerate(attempts):
+        t_check = checks[j]["t"] if j < len(checks) else a.check  # when the state was read
+        span = _window(t, a.start, t_check)
+        details.append({"t_close_command": a.close, "t_grasp_prescribed": a.grasp, "t_check": t_check,
+                        "state": checks[j]["state"] if j < len(checks) else None,
+                        "peak_grip_force_N": float(np.max(grip[span])) if np.any(span) else 0.0})
+    i_place_seg = plan.segment_index(k, "place")
+    place, place_yaw = built.targets.places[i_place_seg], plan.segments[i_place_seg].yaw
     R_end = rotation_of(block[-1, 3:7])
-    return {"part": part.name, "part_index": part_index, "slot": segs[4][1].index, "grasped": grasped,
-            "t_grasp": t_grasp, "t_grasp_prescribed": plan.grasp_times[k], "t_close_command": close,
+    return {"part": part.name, "part_index": part_index, "slot": plan.segments[i_place_seg].index,
+            "grasped": grasped, "t_grasp": t_grasp, "t_grasp_prescribed": last.grasp,
+            "t_close_command": last.close, "attempts": len(attempts), "attempt_details": details,
+            "grasp_confirmed": confirmed,
+            "retry_refused": outcome["refused"][k],
+            "t_holding": float(t[holding[0]]) if len(holding) else None,
+            "state_at_place": GRASP_STATES[int(states[i_place])], "held_at_place": held_at_place,
+            "grip_force_N": float(grip[i_lift]),
             "slip_mm": None if slip is None else 1e3 * slip,
-            "peak_grip_force_N": float(np.max(np.abs(squeeze))),
+            "peak_grip_force_N": float(np.max(grip[in_carry])) if np.any(in_carry) else 0.0,
             "place_error_mm": float(1e3 * np.linalg.norm(block[-1, 0:3] - place)),
             "place_error_deg": _place_angle(R_end, place_yaw, part.shape),
             "collision": collision}
 
 
-def pick_metrics(scenario, built, logs: dict, segments: list) -> dict:
-    """metrics.json of a pick scenario: ``segments`` (``segment_rows``) and ``picks``."""
-    t, probe = logs["probe"]
-    _, grip = logs["grip_force"]
+def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> dict:
+    """metrics.json of a pick scenario: ``segments`` (``segment_rows``) and ``picks``; ``outcome``:
+    the run's grasp checks per task and attempt, why a retry was refused, the run's end (s)."""
     picks = []
-    for k, task in enumerate(scenario.pick.tasks):
-        pick = _one_pick(built, k, t, probe, grip, task.lift_height)
+    for k in range(len(scenario.pick.tasks)):
+        pick = _one_pick(built, k, logs, outcome)
         pick["collision_with"] = pick_collisions(built, logs, k)  # arm/gripper vs belts, tray, floor, parts
         pick["collision"] = bool(pick["collision"] or pick["collision_with"])
-        pick["placed"] = bool(pick["grasped"] and pick["place_error_mm"] <= scenario.criteria.place_mm
+        pick["placed"] = bool(pick["grasped"] and pick["held_at_place"]
+                              and pick["place_error_mm"] <= scenario.criteria.place_mm
                               and pick["place_error_deg"] <= scenario.criteria.place_deg)
         picks.append(pick)
-    return {"scenario": scenario.name, "duration": scenario.duration, "segments": segments, "picks": picks}
+    return {"scenario": scenario.name, "duration": outcome["end"], "segments": segments, "picks": picks}
 
 
 def pick_reasons(picks: list) -> list:
-    """(task, code) of every pick that failed: dropped, not placed, collision, late grasp."""
+    """(task, code) of every pick that failed (module docstring)."""
     out = []
     for k, p in enumerate(picks):
         if p["collision"]:
             out.append((k, "collision with " + ", ".join(p["collision_with"]) if p.get("collision_with")
                         else "collision"))
+        if not p["grasp_confirmed"]:
+            alone = p["attempts"] == 1 and p["retry_refused"] == "out of retries"
+            out.append((k, "empty grasp" if alone else "missed after retry"))
+            continue
         if p["t_grasp"] is None or p["t_grasp"] > p["t_grasp_prescribed"] + LATE_GRASP:
             out.append((k, "late grasp"))
-        if not p["grasped"]:
+        elif p["t_grasp"] < p["t_grasp_prescribed"] - EARLY_GRASP:
+            out.append((k, "early grasp"))
+        if p["grasped"] and not p["held_at_place"]:
             out.append((k, "dropped"))
         elif not p["placed"]:
             out.append((k, "not placed"))

@@ -5,8 +5,10 @@ controller in its slot (``controllers.AddControllerTo``: the arm's [q; v] in, it
 through the drive's zero-order hold and the effort limits; the arm's kinematics from a plant of
 the arm's model file alone — the controller knows nothing of the gripper, the parts or the
 payload), ``PickTargets`` (what each segment aims at, from the parts' simulated poses),
-``GripperSequence`` (open, close at the prescribed time, open) and ``PickProbe`` (poses and
-contacts, logged every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it through the one runner
+``GripperSequence`` (open, close at the prescribed time, open), ``GraspObserver`` (the grasp
+state from the fingers' width, speed and drive force: ``systems.gripper``) and ``PickProbe``
+(poses, contacts and pad forces, logged every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it
+through the one runner
 (``worlds.runner``), stopping at every segment's start and end; its metrics carry the segments and
 ``picks`` (``metrics``).
 """
@@ -25,13 +27,14 @@ from ptint_drake.config.schema import Scenario, default_simulator
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
 from ptint_drake.reachability import inverse_kinematics
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
+from ptint_drake.systems.gripper import GraspObserver
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
 from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
 from ptint_drake.worlds.pick.probe import PickProbe
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
-from ptint_drake.worlds.pick.tasks import PickPlan, pick_plan
+from ptint_drake.worlds.pick.tasks import PickPlan, Replan, pick_plan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
@@ -71,6 +74,7 @@ class PickBuilt:
     loggers: dict
     arm: object  # the arm's model alone (continuous, nominal): the controller's kinematics
     limits: np.ndarray  # the arm's effort limits (N·m)
+    observer: GraspObserver = None  # the grasp state (systems.gripper)
 
 
 def place_positions(station: PickStation, plan: PickPlan) -> list:
@@ -88,12 +92,12 @@ def place_positions(station: PickStation, plan: PickPlan) -> list:
     return out
 
 
-def build_pick(scenario: Scenario) -> PickBuilt:
-    """The pick scenario's diagram (module docstring)."""
+def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuilt:
+    """The pick scenario's diagram (module docstring), its plan with the ``replans`` a run decided."""
     builder = DiagramBuilder()
     station = MakePickStation(world_config(scenario))
     st = builder.AddNamedSystem("pick_station", station.diagram)
-    plan = pick_plan(scenario.pick)
+    plan = pick_plan(scenario.pick, replans)
     n = len(station.parts)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, place_positions(station, plan)))
     for k in range(n):
@@ -107,12 +111,21 @@ def build_pick(scenario: Scenario) -> PickBuilt:
     handles = AddControllerTo(builder, plant=arm, frame=arm.GetFrameByName(scenario.robot.end_effector),
                               schedule=plan.schedule, state=st.GetOutputPort("state"),
                               actuation=saturation.get_input_port(), scenario=scenario, target=view)
-    sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands))
-    builder.Connect(sequence.get_output_port(), st.GetInputPort("gripper_command"))
+    sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
+    builder.Connect(sequence.GetOutputPort("command"), st.GetInputPort("gripper_command"))
+    observer = builder.AddNamedSystem("grasp_observer", GraspObserver(
+        scenario.pick.gripper.max_force, scenario.pick.gripper.speed, scenario.pick.width_tolerance,
+        period=station.config.time_step))
+    builder.Connect(st.GetOutputPort("gripper_state"), observer.GetInputPort("finger_state"))
+    builder.Connect(st.GetOutputPort("grip_force"), observer.GetInputPort("drive_force"))
+    builder.Connect(sequence.GetOutputPort("command"), observer.GetInputPort("command"))
+    builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
     probe = builder.AddNamedSystem("pick_probe", _probe(station))
     builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
     builder.Connect(st.GetOutputPort("body_poses"), probe.GetInputPort("body_poses"))
-    loggers = {"probe": LogVectorOutput(probe.get_output_port(), builder, PROBE_PERIOD),
+    loggers = {"probe": LogVectorOutput(probe.GetOutputPort("probe"), builder, PROBE_PERIOD),
+               "grip_forces": LogVectorOutput(probe.GetOutputPort("grip_forces"), builder, PROBE_PERIOD),
+               "grasp_state": LogVectorOutput(observer.GetOutputPort("grasp_state"), builder, PROBE_PERIOD),
                "grip_force": LogVectorOutput(st.GetOutputPort("grip_force"), builder, PROBE_PERIOD),
                "gripper_state": LogVectorOutput(st.GetOutputPort("gripper_state"), builder, PROBE_PERIOD),
                "collisions": LogVectorOutput(st.GetOutputPort("collisions"), builder, PROBE_PERIOD),
@@ -124,7 +137,7 @@ def build_pick(scenario: Scenario) -> PickBuilt:
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
     install_stateless_derivatives(diagram)  # as simulation.build: Drake's nanobind bindings
-    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits)
+    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits, observer)
 
 
 def _probe(station: PickStation) -> PickProbe:
@@ -210,6 +223,7 @@ def pick_series(built: PickBuilt, logs: dict) -> dict:
                "tau_applied": np.clip(series["tau"], -built.limits, built.limits),
                "probe": logs["probe"][1], "grip_force": logs["grip_force"][1],
                "gripper_state": logs["gripper_state"][1], "state": state,
+               "grip_forces": logs["grip_forces"][1], "grasp_state": logs["grasp_state"][1][:, 0],
                "replay_t": logs["plant_state"][0], "plant_state": logs["plant_state"][1]}
     return series
 

@@ -23,7 +23,9 @@ grasp time.  A "slot"
 segment aims at the fixed place pose, turned to the slot's yaw about the vertical.
 
 ``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a
-function of time: the plan's commands, piecewise constant (output ``command``).
+function of time: the plan's commands, piecewise constant (output ``command``), and the width of
+the part the active task grasps (output ``part_width``, m: what a grasp command of a real gripper
+carries, for ``systems.gripper.GraspObserver``).
 """
 
 from __future__ import annotations
@@ -59,12 +61,20 @@ class PickTargets(LeafSystem):
         return max(self._plan.schedule.active(context.get_time()), 0)
 
     def _latch(self, context, state) -> None:
+        value = self.latch_value(context)
+        if value is not None:
+            state.get_mutable_discrete_state(self._latched).SetFromVector(value)
+
+    def latch_value(self, context):
+        """The ``latched`` state a "latched" segment starting now sets (None: not such a segment).
+        A run resumed in a new diagram at such a segment's start (``world.PickRun.resume``) sets
+        it before the first step, so that every system's start-of-segment update reads it."""
         seg = self._plan.segments[self._active(context)]
-        if seg.kind == "latched":
-            position = self._poses[seg.index].Eval(context)[0:3]
-            R = self._rotations[seg.index].Eval(context)[0:9]
-            state.get_mutable_discrete_state(self._latched).SetFromVector(
-                np.r_[position, 0.0, 0.0, 0.0, context.get_time(), R])
+        if seg.kind != "latched":
+            return None
+        position = self._poses[seg.index].Eval(context)[0:3]
+        R = self._rotations[seg.index].Eval(context)[0:9]
+        return np.r_[position, 0.0, 0.0, 0.0, context.get_time(), R]
 
     def _grasp_latch(self, task: int):
         def update(context, state) -> None:
@@ -117,16 +127,28 @@ class PickTargets(LeafSystem):
 class GripperSequence(LeafSystem):
     """The plan's gripper commands as a piecewise-constant signal of time (module docstring)."""
 
-    def __init__(self, commands: Sequence):
+    def __init__(self, commands: Sequence, widths: Sequence = ()):
         super().__init__()
         commands = sorted(commands, key=lambda c: c[0])
         self._times = [float(t) for t, _ in commands]
         self._values = [float(v) for _, v in commands]
+        widths = sorted(widths, key=lambda c: c[0]) or [(0.0, 0.0)]
+        self._width_times = [float(t) for t, _ in widths]
+        self._widths = [float(w) for _, w in widths]
         self.DeclareVectorOutputPort("command", 1, self._calc, prerequisites_of_calc={self.time_ticket()})
+        self.DeclareVectorOutputPort("part_width", 1, self._calc_width,
+                                     prerequisites_of_calc={self.time_ticket()})
 
     def opening(self, t: float) -> float:
         """The commanded opening at time t (m; 0: close)."""
         return self._values[max(bisect.bisect_right(self._times, t) - 1, 0)]
 
+    def part_width(self, t: float) -> float:
+        """The width of the part the active task grasps at time t (m)."""
+        return self._widths[max(bisect.bisect_right(self._width_times, t) - 1, 0)]
+
     def _calc(self, context, output) -> None:
         output.SetAtIndex(0, self.opening(context.get_time()))
+
+    def _calc_width(self, context, output) -> None:
+        output.SetAtIndex(0, self.part_width(context.get_time()))

@@ -27,6 +27,7 @@ commands (``pick.targets.GripperSequence``).
 """
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
@@ -39,7 +40,8 @@ from ptint_drake.config.pick import PHASES, MoveConfig, PickConfig, PickTaskConf
 class PlanSegment:
     """What one segment aims at: ``kind`` "part" (part ``index``'s simulated centre + ``offset``),
     "latched" (where part ``index`` was at the segment's start + ``offset``) or "slot" (slot
-    ``index``'s place pose + ``offset``, yaw ``yaw`` rad); ``task`` and ``phase`` name it."""
+    ``index``'s place pose + ``offset``, yaw ``yaw`` rad); ``task``, ``phase`` and ``attempt``
+    (0: the first approach and descend, 1…: a retry's backoff, approach, descend) name it."""
 
     task: int
     phase: str
@@ -47,12 +49,39 @@ class PlanSegment:
     index: int
     offset: tuple
     yaw: float = 0.0
+    attempt: int = 0
+
+
+@dataclass(frozen=True)
+class Replan:
+    """What a run decided for one task (``worlds.pick.world``): the start of each retry (its
+    backoff, s), how long the lift of the last attempt waits beyond its planned start for the
+    grasp to be confirmed (s), and ``abort``: when the last attempt, found without a part and
+    with no retry left, backs off (s; None: it did not) — the fingers open and the tool rises
+    ``clearance`` before the task's lift, carry, place and retreat go on with an empty hand."""
+
+    retries: tuple = ()
+    lift_delay: float = 0.0
+    abort: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One approach and descend of a task: its approach's start, its close command's time, its
+    prescribed grasp time (the descend's end) and the time its grasp is checked (the lift's
+    planned start: grasp + dwell + the lift's delay, or the next retry's start)."""
+
+    start: float
+    close: float
+    grasp: float
+    check: float
 
 
 @dataclass(frozen=True)
 class PickPlan:
-    """The schedule, one ``PlanSegment`` per segment, the gripper's commands [(t, opening)], and
-    per task the close command's time and the prescribed grasp time (descend's start + tf)."""
+    """The schedule, one ``PlanSegment`` per segment, the gripper's commands [(t, opening)], the
+    expected part widths [(t, m)], and per task the close command's time and the prescribed
+    grasp time of its last attempt, and all its ``attempts``."""
 
     schedule: Schedule
     segments: tuple
@@ -60,51 +89,90 @@ class PickPlan:
     close_times: tuple
     grasp_times: tuple
     end: float
+    widths: tuple = ()
+    attempts: tuple = ()
 
-    def segment_index(self, task: int, phase: str) -> int:
-        """The index in the schedule of task ``task``'s segment ``phase`` (one of PHASES)."""
-        return next(i for i, s in enumerate(self.segments) if s.task == task and s.phase == phase)
+    def segment_index(self, task: int, phase: str, attempt: int = -1) -> int:
+        """The index in the schedule of task ``task``'s segment ``phase`` (one of PHASES, or
+        "backoff"); for an approach or a descend, that of ``attempt`` (-1: the last)."""
+        found = [i for i, s in enumerate(self.segments) if s.task == task and s.phase == phase]
+        return found[attempt if phase in ("approach", "descend", "backoff") else 0]
 
 
-def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float):
-    up = lambda h: (0.0, 0.0, h)  # noqa: E731
-    aims = [("approach", "part", part, up(task.clearance), 0.0), ("descend", "part", part, up(0.0), 0.0),
-            ("lift", "latched", part, up(task.lift_height), 0.0),
-            ("carry", "slot", task.slot, up(task.lift_height), slot_yaw),
-            ("place", "slot", task.slot, up(0.0), slot_yaw),
-            ("retreat", "slot", task.slot, up(task.clearance), slot_yaw)]
-    segments, plans, t = [], [], start
-    for phase, kind, index, offset, yaw in aims:
+def _up(h: float) -> tuple:
+    return (0.0, 0.0, h)
+
+
+def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float, replan: Replan):
+    """The segments of task k, their plan entries, the attempts' (approach start, grasp) and the end."""
+    segments, plans, attempts = [], [], []
+
+    def add(phase, kind, index, offset, yaw, t, attempt=0, until=np.inf):
         move = getattr(task, phase)
-        if phase in ("lift", "retreat"):
-            t += task.dwell
-        segments.append(Segment(t, move.tf, move.beta))
-        plans.append(PlanSegment(k, phase, kind, index, offset, yaw))
-        t += move.tf
-    return segments, plans, t
+        tf = min(move.tf, until - t)  # a descend cut short by its retry (the grasp found empty)
+        segments.append(Segment(t, tf, move.beta))
+        plans.append(PlanSegment(k, phase, kind, index, offset, yaw, attempt))
+        return t + tf
+
+    t = start
+    retries = replan.retries
+    for attempt in range(len(retries) + 1):
+        if attempt:
+            t = add("backoff", "latched", part, _up(task.clearance), 0.0, retries[attempt - 1], attempt)
+        approach = t
+        t = add("approach", "part", part, _up(task.clearance), 0.0, t, attempt)
+        grasp = t + task.descend.tf  # prescribed, even where the descend is cut short
+        last = replan.abort if replan.abort is not None else np.inf
+        t = add("descend", "part", part, _up(0.0), 0.0, t, attempt,
+                retries[attempt] if attempt < len(retries) else last)
+        attempts.append((approach, grasp))
+    if replan.abort is not None:
+        t = add("backoff", "latched", part, _up(task.clearance), 0.0, replan.abort, len(retries))
+        t -= task.dwell  # the lift right after it
+    t = add("lift", "latched", part, _up(task.lift_height), 0.0, t + task.dwell + replan.lift_delay)
+    t = add("carry", "slot", task.slot, _up(task.lift_height), slot_yaw, t)
+    t = add("place", "slot", task.slot, _up(0.0), slot_yaw, t)
+    t = add("retreat", "slot", task.slot, _up(task.clearance), slot_yaw, t + task.dwell)
+    return segments, plans, attempts, t
 
 
-def pick_plan(pick: PickConfig) -> PickPlan:
-    """The plan of the ``pick`` block (``check_tasks`` first for one-line errors)."""
+def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
+    """The plan of the ``pick`` block (``check_tasks`` first for one-line errors), with the
+    retries and lift delays a run decided (``replans``: one ``Replan`` per task, none: the plan
+    before the run)."""
     names = [p.name for p in pick.parts]
-    segments, plans, commands, closes, grasps = [], [], [], [], []
+    segments, plans, commands, closes, grasps, widths, attempts = [], [], [], [], [], [], []
     t = 0.0
     commands.append((0.0, pick.gripper.initial_opening))
     for k, task in enumerate(pick.tasks):
+        replan = replans[k] if k < len(replans) else Replan()
         part = names.index(task.part)
         slot_yaw = np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg)
-        start = task.start if task.start > 0.0 else t
-        segs, plan, t = _task_segments(k, task, part, float(slot_yaw), start)
+        start = max(task.start, t) if task.start > 0.0 else t
+        segs, plan, tries, t = _task_segments(k, task, part, float(slot_yaw), start, replan)
         width = grasp_width(pick.parts[part])
         opening = width + task.margin
-        grasp = segs[1].end
-        close = grasp - 0.5 * task.margin / pick.gripper.speed + task.close_delay
-        commands += [(segs[0].start, opening), (close, 0.0), (segs[4].end, opening)]
+        widths.append((tries[0][0], width))
+        task_attempts = []
+        for j, (approach, grasp) in enumerate(tries):
+            close = grasp - 0.5 * task.margin / pick.gripper.speed + task.close_delay
+            if j == 0:
+                close -= pick.test_close_advance_s  # a test option (PickConfig)
+            commands += [((replan.retries[j - 1] if j else approach), opening), (close, 0.0)]
+            check = replan.retries[j] if j < len(replan.retries) else grasp + task.dwell + replan.lift_delay
+            if j == len(replan.retries) and replan.abort is not None:
+                check = replan.abort
+                commands.append((replan.abort, opening))
+            task_attempts.append(Attempt(approach, close, grasp, check))
+        place = [p.phase for p in plan].index("place")
+        commands.append((segs[place].end, opening))
         segments += segs
         plans += plan
-        closes.append(close)
-        grasps.append(grasp)
-    return PickPlan(Schedule(segments), tuple(plans), tuple(commands), tuple(closes), tuple(grasps), t)
+        closes.append(task_attempts[-1].close)
+        grasps.append(task_attempts[-1].grasp)
+        attempts.append(tuple(task_attempts))
+    return PickPlan(Schedule(segments), tuple(plans), tuple(commands), tuple(closes), tuple(grasps), t,
+                    tuple(widths), tuple(attempts))
 
 
 def check_tasks(pick: PickConfig) -> None:
@@ -114,6 +182,14 @@ def check_tasks(pick: PickConfig) -> None:
         raise ScenarioError("pick.tasks: at least one task is needed")
     if len(set(names)) != len(names):
         raise ScenarioError("pick.parts: part names must be unique")
+    if not (isinstance(pick.retries, int) and 0 <= pick.retries <= 5):
+        raise ScenarioError(f"pick.retries: an integer 0 … 5, got {pick.retries}")
+    for name in ("grasp_window", "width_tolerance"):
+        if not (getattr(pick, name) > 0.0 and np.isfinite(getattr(pick, name))):
+            raise ScenarioError(f"pick.{name}: must be positive, got {getattr(pick, name)}")
+    if not -1.0 <= pick.test_close_advance_s <= 1.0:
+        raise ScenarioError(f"pick.test_close_advance_s: a test option in [-1, 1] s, "
+                            f"got {pick.test_close_advance_s}")
     t = 0.0
     for k, task in enumerate(pick.tasks):
         where = f"pick.tasks[{k}]"
@@ -122,7 +198,7 @@ def check_tasks(pick: PickConfig) -> None:
         if not 0 <= task.slot < len(pick.tray.slots):
             raise ScenarioError(f"{where}.slot: {task.slot} is not a slot of the tray "
                                 f"({len(pick.tray.slots)} slots)")
-        for phase in PHASES:
+        for phase in (*PHASES, "backoff"):
             move = getattr(task, phase)
             if not (move.tf > 0.0 and np.isfinite(move.tf)):
                 raise ScenarioError(f"{where}.{phase}.tf: must be positive, got {move.tf}")

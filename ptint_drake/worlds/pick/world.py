@@ -5,6 +5,22 @@
 (every segment's start and end and every close command), its metrics (``metrics.pick_metrics``:
 the segments and ``picks``) and verdict (``metrics.pick_reasons``), its figure and replay
 (``views``).  The runner (``worlds.runner``) simulates it.
+
+The confirmed grasp: every ``SENSE_PERIOD`` from a close command (``empty`` or ``lost`` act at
+once) and at each task's check (its lift's planned start, prescribed grasp time + ``dwell``)
+``PickRun.at_stop`` reads the ``GraspObserver``'s state (what the gripper senses).
+``holding``: the plan goes on.  ``closing`` (still moving): the lift waits, ``GRASP_WAIT`` at a
+time, up to ``pick.grasp_window`` after the prescribed grasp time.  ``empty``, ``lost``, or the
+window over: while ``pick.retries`` allow, a retry is planned from that moment and the part's
+current (simulated) pose — a backoff (up ``clearance``, the fingers opening), a new approach and
+descend, then the task's lift, carry, place and retreat, later tasks shifted — if its grasp and
+lift points (the part's position extrapolated at its current velocity to the new grasp time) are
+reachable from above; otherwise (``refused``) the arm backs off the same way, fingers open,
+and the task goes on with an empty hand (``tasks.Replan.abort``).  A new plan means a new
+diagram (the controller's schedule is built into it): ``replan`` builds it and ``resume``
+carries the numeric state (time, plant, controller, drive, observer, targets) into its
+context; the runner goes on from there.  If the retries push
+the plan's end later, the run is lengthened by as much (metrics ``duration``).
 """
 
 from __future__ import annotations
@@ -12,6 +28,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from pydrake.common.yaml import yaml_load_typed
+
+import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
@@ -27,7 +45,12 @@ from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLAN
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
                                          pick_simulator, segment_aims)
-from ptint_drake.worlds.pick.tasks import check_tasks, pick_plan
+from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.systems.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST
+from ptint_drake.worlds.pick.tasks import Replan, check_tasks, pick_plan
+
+GRASP_WAIT = 0.05  # s, the lift's wait for ``holding`` while the fingers are still closing
+SENSE_PERIOD = 0.01  # s, between the reads of the grasp state from a close command to its check
 
 
 class PickRun(WorldRun):
@@ -43,6 +66,15 @@ class PickRun(WorldRun):
         self.simulator_config = pick_simulator(scenario)
         self.plant_time_step = self.built.station.config.time_step
         self._aims: dict = {}
+        n = len(scenario.pick.tasks)
+        self.replans = [Replan() for _ in range(n)]
+        # per task, per attempt: {"state": the observer's at the check, "t": the check's time}
+        self.checks: list[list[dict]] = [[] for _ in range(n)]
+        self.refused: list = [None] * n  # why a retry was not planned (out of reach / of retries)
+        self.end = scenario.duration
+        self._tail = scenario.duration - self.built.plan.end  # kept after a lengthened plan
+        self._pieces: list = []  # the logs of the diagrams a replan replaced
+        self._rebuilt = False
 
     def pre_run_warnings(self) -> list[str]:
         check_pick_reachable(self.scenario, self.built)
@@ -55,22 +87,128 @@ class PickRun(WorldRun):
         scale_in_context(station.plant, plant_context, station.arm, self.scenario.plant.mass_scale)
         station.start_running(plant_context)
 
+    def _sense_times(self, k: int) -> list[float]:
+        """The reads of task k's grasp state between its last close command and its check (on the
+        plant's step grid), if that check is still to come."""
+        attempts, dt = self.built.plan.attempts[k], self.plant_time_step
+        if len(self.checks[k]) >= len(attempts):
+            return []
+        a = attempts[-1]
+        n = int((a.check - a.close) / SENSE_PERIOD)
+        return [round((a.close + j * SENSE_PERIOD) / dt) * dt for j in range(1, n + 1)]
+
     def stops(self) -> list[float]:
-        plan, duration = self.built.plan, self.scenario.duration
-        stops = {duration, *plan.close_times}
+        plan, duration = self.built.plan, self.end
+        stops = {duration, *plan.close_times, *(a.check for task in plan.attempts for a in task)}
+        for k in range(len(plan.attempts)):
+            stops.update(self._sense_times(k))
         for seg in plan.schedule.segments:
             stops.update({seg.start, seg.end})
         return sorted(t for t in stops if 0.0 <= t <= duration)
 
     def at_stop(self, context, t: float) -> None:
         self._aims[t] = segment_aims(self.built, context)
+        for k, attempts in enumerate(self.built.plan.attempts):
+            if len(self.checks[k]) >= len(attempts):
+                continue
+            if abs(attempts[-1].check - t) < 1e-9:
+                self._check(context, k, t, self._grasp_state(context))
+            elif any(abs(s - t) < 1e-12 for s in self._sense_times(k)):
+                state = self._grasp_state(context)
+                if state in (EMPTY, LOST):  # nothing between the fingers: no need to wait for the check
+                    self._check(context, k, t, state)
+
+    def _grasp_state(self, context) -> int:
+        observer = self.built.observer
+        return int(observer.GetOutputPort("grasp_state").Eval(observer.GetMyContextFromRoot(context))[0])
+
+    def _check(self, context, k: int, t: float, state: int) -> None:
+        """The grasp check of task k's last attempt (module docstring): may set a new plan."""
+        built, pick = self.built, self.scenario.pick
+        attempt = built.plan.attempts[k][-1]
+        replan = self.replans[k]
+        if state == CLOSING and t + GRASP_WAIT <= attempt.grasp + pick.grasp_window + 1e-9:
+            self.replans[k] = Replan(replan.retries, replan.lift_delay + GRASP_WAIT)
+            self._rebuild()
+            return
+        self.checks[k].append({"state": GRASP_STATES[state], "t": t})
+        if state == HOLDING:
+            return
+        candidate = self.replans.copy()
+        candidate[k] = Replan(replan.retries + (t,), 0.0)
+        if len(replan.retries) >= pick.retries:
+            why = "out of retries"
+        else:
+            why = self._unreachable(context, k, pick_plan(pick, tuple(candidate)).attempts[k][-1].grasp, t)
+        if why:  # no retry: back off with the fingers open, then the rest of the task
+            self.refused[k] = why
+            candidate[k] = Replan(replan.retries, 0.0, abort=t)
+        self.replans = candidate
+        self._rebuild()
+
+    def _unreachable(self, context, k: int, grasp: float, t: float):
+        """Why the retry of task k grasping at ``grasp`` cannot be made, or None."""
+        built, task = self.built, self.scenario.pick.tasks[k]
+        part = [p.name for p in built.station.config.parts].index(task.part)
+        station = built.diagram.GetSubsystemByName("pick_station")
+        sc = station.GetMyContextFromRoot(context)
+        pose = station.GetOutputPort(f"part_{part}_pose").Eval(sc)
+        q = station.GetOutputPort("state").Eval(sc)[:built.arm.num_positions()]
+        x = pose[0:3] + pose[3:6] * (grasp - t)
+        frame = built.arm.GetFrameByName(self.scenario.robot.end_effector)
+        for where in (x, x + [0.0, 0.0, task.lift_height]):
+            if inverse_kinematics(built.arm, frame, np.asarray(where), q, down=True) is None:
+                return f"out of reach ({np.round(where, 3).tolist()} m)"
+        return None
+
+    def _rebuild(self) -> None:
+        self._rebuilt = True
+
+    def replan(self, context, t: float) -> bool:
+        """After ``at_stop``: True when the check planned anew (a new diagram to resume into)."""
+        if not self._rebuilt:
+            return False
+        self._rebuilt = False
+        self._pieces.append(self._logs(context))  # the old diagram's loggers, up to now
+        self.built = build_pick(self.scenario, tuple(self.replans))
+        self.diagram, self.controller = self.built.diagram, self.built.controller
+        self.end = max(self.scenario.duration, self.built.plan.end + self._tail)
+        return True
+
+    def resume(self, new_context, old_context) -> None:
+        """Carry the time, the numeric state (plant, controller, drive, observer, targets: every
+        continuous and discrete state) and set the arm's mass scale as ``initialize`` does.  Not
+        carried: the plant's abstract state (its last step's contact results, holding the old
+        diagram's geometry ids, which its next step computes anew)."""
+        new_context.SetTime(old_context.get_time())
+        new_context.SetContinuousState(old_context.get_continuous_state_vector().CopyToVector())
+        for i in range(old_context.num_discrete_state_groups()):
+            new_context.SetDiscreteState(i, old_context.get_discrete_state(i).value())
+        station = self.built.station
+        scale_in_context(station.plant, station.plant.GetMyMutableContextFromRoot(new_context), station.arm,
+                         self.scenario.plant.mass_scale)
+        targets = self.built.targets
+        tc = targets.GetMyMutableContextFromRoot(new_context)
+        value = targets.latch_value(tc)
+        if value is not None:  # the backoff's latch, before the controller captures its start
+            tc.SetDiscreteState(0, value)
+
+    def _logs(self, context) -> dict:
+        return {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
+                for name, logger in self.built.loggers.items()}
 
     def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
         built = self.built
-        logs = {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
-                for name, logger in built.loggers.items()}
+        logs = self._logs(context)
+        for name in logs:  # the pieces of the replaced diagrams, each up to where the next began
+            t, data = logs[name]
+            for t_piece, data_piece in reversed([piece[name] for piece in self._pieces]):
+                keep = t_piece < (t[0] if len(t) else np.inf)
+                t, data = np.concatenate([t_piece[keep], t]), np.concatenate([data_piece[keep], data])
+            logs[name] = (t, data)
         series = pick_series(built, logs)
-        metrics = pick_metrics(self.scenario, built, logs, segment_rows(built, self._aims))
+        metrics = pick_metrics(self.scenario, built, logs, segment_rows(built, self._aims),
+                               {"checks": self.checks, "refused": self.refused, "end": self.end})
         metrics |= drive_metrics(built.plan.schedule, series["t"], series["tau"], series["tau_applied"],
                                  series["v"], built.limits)
         return metrics, series, []
