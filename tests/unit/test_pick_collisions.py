@@ -54,7 +54,8 @@ def test_the_arm_in_a_belt_is_a_collision_with_that_belt_and_the_start_pose_is_n
     touched = collision_bodies(station.obstacles, np.zeros(1), flags.reshape(1, -1), (0.0, 1.0), "part")
     assert touched == ["belt"], dict(zip(station.obstacles, flags.tolist()))
     reasons = pick_reasons([{"collision": True, "collision_with": touched, "t_grasp": 1.0,
-                             "t_grasp_prescribed": 1.0, "grasped": True, "placed": True}])
+                             "t_grasp_prescribed": 1.0, "grasped": True, "placed": True,
+                             "grasp_confirmed": True, "held_at_place": True}])
     assert reasons == [(0, "collision with belt")]
 
 
