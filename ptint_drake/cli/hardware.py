@@ -49,6 +49,12 @@ def fraction(flag: str, top_open: bool = True) -> Callable[[str], float]:
 
 def add_hardware_parsers(sub) -> None:
     """``hardware`` and ``drive``."""
+    _add_hardware_parser(sub)
+    _add_drive_parser(sub)
+
+
+def _add_hardware_parser(sub) -> None:
+    """``ptint hardware``'s parser."""
     hw = sub.add_parser(
         "hardware",
         help="the simulated world as hardware over LCM (with `ptint drive`; docs/hardware.md)",
@@ -60,6 +66,22 @@ def add_hardware_parsers(sub) -> None:
         "series.npz. Exit 0 ok, 1 missed or a fault, 2 bad input.",
     )
     hw.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
+    _add_hardware_link_options(hw)
+    hw.add_argument(
+        "--drop-status",
+        type=fraction("--drop-status"),
+        default=0.0,
+        help="a test option: the fraction of status messages not sent (default 0)",
+    )
+    hw.add_argument("--seed", type=int, default=0, help="seed of --drop-status")
+    hw.add_argument("--out", help="output folder (default out/hardware_NAME)")
+    hw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
+    hw.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    hw.set_defaults(func=cmd_hardware)
+
+
+def _add_hardware_link_options(hw: argparse.ArgumentParser) -> None:
+    """``ptint hardware``'s pacing, URL and timeout options."""
     hw.add_argument(
         "--lockstep",
         action="store_true",
@@ -90,18 +112,10 @@ def add_hardware_parsers(sub) -> None:
         default=0.5,
         help="simulated s the arm is held after a fault before the run ends (default 0.5)",
     )
-    hw.add_argument(
-        "--drop-status",
-        type=fraction("--drop-status"),
-        default=0.0,
-        help="a test option: the fraction of status messages not sent (default 0)",
-    )
-    hw.add_argument("--seed", type=int, default=0, help="seed of --drop-status")
-    hw.add_argument("--out", help="output folder (default out/hardware_NAME)")
-    hw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
-    hw.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    hw.set_defaults(func=cmd_hardware)
 
+
+def _add_drive_parser(sub) -> None:
+    """``ptint drive``'s parser."""
     dr = sub.add_parser(
         "drive",
         help="the controller alone over LCM, driving `ptint hardware` or a robot (docs/hardware.md)",
@@ -134,15 +148,12 @@ def _warn(message: str) -> None:
     print(f"ptint: warning: {message}", file=sys.stderr)
 
 
-def cmd_hardware(args: argparse.Namespace) -> int:
-    """``ptint hardware``: the world as hardware; exit 0 ok, 1 missed or a fault."""
-    from ptint_drake.hardware.command_link import LinkFault, LinkSettings  # noqa: PLC0415
-    from ptint_drake.hardware.sim_hardware import check_link_scenario, link_period, run_hardware  # noqa: PLC0415
+def _link_settings(args: argparse.Namespace, scenario):
+    """``ptint hardware``'s options as the link's settings."""
+    from ptint_drake.hardware.command_link import LinkSettings  # noqa: PLC0415
+    from ptint_drake.hardware.sim_hardware import link_period  # noqa: PLC0415
 
-    loaded, out = scenario_and_out(args, prefix="hardware_")
-    scenario = loaded.scenario
-    check_link_scenario(scenario)
-    settings = LinkSettings(
+    return LinkSettings(
         period=link_period(scenario),
         duration=scenario.duration,
         lockstep=args.lockstep,
@@ -153,6 +164,59 @@ def cmd_hardware(args: argparse.Namespace) -> int:
         drop_status=args.drop_status,
         seed=args.seed,
     )
+
+
+def _print_link(link: dict) -> None:
+    """One line: the link's mode, period, latency and lost or late messages."""
+    rtt, period = link["round_trip_ms"], link["achieved_period_ms"]
+    lines = [f"hardware: {link['mode']}, period {link['period'] * 1e3:g} ms, {link['ticks']} ticks"]
+    if rtt:
+        lines.append(f"round trip {rtt['median']:.3f} ms median, {rtt['p99']:.3f} ms p99")
+    if period:
+        lines.append(f"achieved period {period['median']:.3f} ms median, {period['p99']:.3f} ms p99")
+    lines.append(
+        f"statuses dropped {link['statuses_dropped']}, re-sent {link['status_resends']}, ticks late "
+        f"{link['ticks_late']}"
+    )
+    print("; ".join(lines))
+
+
+def _print_segments(name: str, segments: list) -> None:
+    """A line per segment: its errors, or that it was not reached."""
+    for i, seg in enumerate(segments):
+        print(
+            f"{name} segment {i}: e(tf) = {seg['e_tf_norm'] * 1e3:.4g} mm, hold max = "
+            f"{seg['e_hold_max_norm'] * 1e3:.4g} mm"
+            if seg.get("e_hold_max_norm") is not None
+            else f"{name} segment {i}: not reached"
+        )
+
+
+def _print_fault(link: dict, out) -> None:
+    """The fault's one-line error on stderr, with how the held arm settled."""
+    hold = link.get("hold", {})
+    settled = hold.get("settled_s_after_fault")
+    print(
+        f"ptint: error: hardware: {link['fault']}; the arm was held"
+        + (
+            f" (joint speeds below {hold['settled_below']} rad/s {settled:.3f} s after the fault)"
+            if settled is not None
+            else " (joint speeds did not settle)"
+        )
+        + f"; wrote {out}/",
+        file=sys.stderr,
+    )
+
+
+def cmd_hardware(args: argparse.Namespace) -> int:
+    """``ptint hardware``: the world as hardware; exit 0 ok, 1 missed or a fault."""
+    from ptint_drake.hardware.command_link import LinkFault  # noqa: PLC0415
+    from ptint_drake.hardware.sim_hardware import check_link_scenario, run_hardware  # noqa: PLC0415
+
+    loaded, out = scenario_and_out(args, prefix="hardware_")
+    scenario = loaded.scenario
+    check_link_scenario(scenario)
+    settings = _link_settings(args, scenario)
     try:
         metrics = run_hardware(
             scenario,
@@ -166,37 +230,10 @@ def cmd_hardware(args: argparse.Namespace) -> int:
         print(f"ptint: error: hardware: {exc} (nothing written)", file=sys.stderr)
         return 1
     link = metrics["hardware"]
-    rtt, period = link["round_trip_ms"], link["achieved_period_ms"]
-    lines = [f"hardware: {link['mode']}, period {link['period'] * 1e3:g} ms, {link['ticks']} ticks"]
-    if rtt:
-        lines.append(f"round trip {rtt['median']:.3f} ms median, {rtt['p99']:.3f} ms p99")
-    if period:
-        lines.append(f"achieved period {period['median']:.3f} ms median, {period['p99']:.3f} ms p99")
-    lines.append(
-        f"statuses dropped {link['statuses_dropped']}, re-sent {link['status_resends']}, ticks late "
-        f"{link['ticks_late']}"
-    )
-    print("; ".join(lines))
-    for i, seg in enumerate(metrics["segments"]):
-        print(
-            f"{scenario.name} segment {i}: e(tf) = {seg['e_tf_norm'] * 1e3:.4g} mm, hold max = "
-            f"{seg['e_hold_max_norm'] * 1e3:.4g} mm"
-            if seg.get("e_hold_max_norm") is not None
-            else f"{scenario.name} segment {i}: not reached"
-        )
+    _print_link(link)
+    _print_segments(scenario.name, metrics["segments"])
     if link["fault"]:
-        hold = link.get("hold", {})
-        settled = hold.get("settled_s_after_fault")
-        print(
-            f"ptint: error: hardware: {link['fault']}; the arm was held"
-            + (
-                f" (joint speeds below {hold['settled_below']} rad/s {settled:.3f} s after the fault)"
-                if settled is not None
-                else " (joint speeds did not settle)"
-            )
-            + f"; wrote {out}/",
-            file=sys.stderr,
-        )
+        _print_fault(link, out)
         return 1
     if metrics["status"] != "ok":
         print(f"{scenario.name}: {metrics['status'].upper()} ({'; '.join(metrics['reasons'])}); wrote {out}/")

@@ -125,6 +125,158 @@ def DriveDiagram(scenario: Scenario):
     return diagram, handles, plant.num_actuators()
 
 
+class _DriveLoop:
+    """``run_drive``'s loop state: the controller's simulator, the LCM endpoint, the last status
+    answered and the commands sent lately; a method per step (wait for statuses, check one,
+    answer it)."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        settings: DriveSettings,
+        record: DriveRecord,
+        url: Optional[str],
+        warn: Callable[[str], None],
+    ) -> None:
+        diagram, _, n = DriveDiagram(scenario)
+        self.n, self.settings, self.record = n, settings, record
+        # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
+        # the hardware side rejects a torque beyond an effort limit as a fault
+        self.limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
+        self.simulator = Simulator(diagram)
+        config = copy.copy(scenario.simulator)
+        config.target_realtime_rate = 0.0  # the hardware's status paces the drive
+        ApplySimulatorConfig(config, self.simulator)
+        self.context = self.simulator.get_mutable_context()
+        self.state_in, self.out = diagram.get_input_port(0), diagram.get_output_port(0)
+        self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL)
+        record.url = self.endpoint.url
+        risk = url_warning(self.endpoint.url)
+        if risk:
+            warn(risk)
+        self.answered: Optional[int] = None
+        self.answer = b""
+        self.last_q = self.last_v = None
+        # what this drive sent lately (and the zero torque of the start): a status whose applied
+        # torque is none of them shows a second sender's command taken by the hardware
+        self.recent: deque = deque(maxlen=RECENT)
+        self.sent_torques = {tuple(np.zeros(n))}
+        self.end = settings.duration - 1.5 * settings.period
+        self.last_seen = time.perf_counter()
+
+    def wait(self) -> list:
+        """The next statuses received (polling until some arrive); ``DriveFault`` after the
+        start-up or status timeout without one."""
+        while True:
+            # until the first tick after the hand-shake, the hardware may still be building its diagram
+            timeout = self.settings.startup_timeout if not self.answered else self.settings.status_timeout
+            messages = self.endpoint.poll(0.05)
+            now = time.perf_counter()
+            if messages:
+                self.last_seen = now
+                return messages
+            if now - self.last_seen >= timeout:
+                if self.answered is None:
+                    raise DriveFault(
+                        f"no status from the hardware within the start-up timeout of {timeout:g} s on "
+                        f"{self.endpoint.url} (channel {STATUS_CHANNEL}): is `ptint hardware` running?"
+                    )
+                raise DriveFault(
+                    f"no status from the hardware for {timeout:g} s after t = {self.answered * 1e-6:.3f} s: "
+                    f"stopped commanding"
+                )
+
+    def take(self, t_recv: float, data: bytes) -> None:
+        """One status received at wall time ``t_recv``: re-send the answer to a repeat, skip a stale
+        one, otherwise check it and answer it."""
+        try:
+            utime, q, v = unpack_status(data, self.n)
+        except ValueError as exc:
+            raise DriveFault(f"status rejected: {exc}; stopped commanding") from None
+        self.record.statuses += 1
+        answered = self.answered
+        if (
+            answered is not None
+            and utime == answered
+            and np.array_equal(q, self.last_q)
+            and np.array_equal(v, self.last_v)
+        ):
+            self.record.repeats += 1
+            self.endpoint.publish(self.answer)
+            return
+        if answered is not None and utime < answered:
+            self.record.stale += 1
+            return
+        if answered is not None:
+            self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
+        self.check_applied(utime, data)
+        self.respond(t_recv, utime, q, v)
+
+    def check_applied(self, utime: int, data: bytes) -> None:
+        """``DriveFault`` (after NaN commands) when the status's applied torque is none of this
+        drive's recent commands."""
+        applied = status_torque(data)
+        if tuple(applied) in self.sent_torques:
+            return
+        # the hardware obeys someone else: make its checks hold the arm (a command it must
+        # reject, sent a few times: LCM may drop one), then stop
+        stop = pack_command(utime, np.full(self.n, np.nan))
+        for _ in range(STOP_REPEATS):
+            self.endpoint.publish(stop)
+        raise DriveFault(
+            f"the hardware applied torques this drive did not send, at t = {utime * 1e-6:.3f} s "
+            f"({np.array2string(applied, precision=3)}): a second sender on {COMMAND_CHANNEL}; "
+            f"sent a NaN command so that the hardware holds the arm, and stopped commanding"
+        )
+
+    def torque(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The controller's torque at the status's time ``t`` for its [q; v] (module docstring),
+        clipped to the effort limits when saturating."""
+        if self.answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
+            self.state_in.FixValue(self.context, np.concatenate([q, v]))
+            self.context.SetTime(t)
+            self.simulator.Initialize()
+        elif t > self.context.get_time():
+            # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
+            # sees the discrete plant's state between two steps; then the events at t (segment
+            # starts) with it too, and only then the new sample
+            self.simulator.AdvanceTo(t)
+            self.simulator.AdvanceTo(t + EVENT_STEP)
+        self.state_in.FixValue(self.context, np.concatenate([q, v]))
+        tau = np.array(self.out.Eval(self.context), dtype=float)
+        if self.limits is not None and np.any(np.abs(tau) > self.limits):
+            self.record.clipped += 1
+            tau = np.clip(tau, -self.limits, self.limits)
+        return tau
+
+    def respond(self, t_recv: float, utime: int, q: np.ndarray, v: np.ndarray) -> None:
+        """Send the command stamped ``utime`` answering a status checked, and record it."""
+        t = utime * 1e-6
+        tau = self.torque(t, q, v)
+        self.last_q, self.last_v = q, v
+        self.answer = pack_command(utime, tau)
+        recent = self.recent
+        if len(recent) == recent.maxlen and recent.count(recent[0]) == 1:
+            self.sent_torques.discard(recent[0])
+        recent.append(tuple(tau))
+        self.sent_torques.add(recent[-1])
+        sent = self.endpoint.publish(self.answer)
+        self.answered = utime
+        record = self.record
+        record.commands += 1
+        record.compute.append(sent - t_recv)
+        record.first_t = t if record.first_t is None else record.first_t
+        record.last_t = t
+        record.t.append(t)
+        record.q.append(q)
+        record.v.append(v)
+        record.tau.append(tau)
+
+    def finished(self) -> bool:
+        """Whether the last tick (t >= duration - 1.5 T) has been answered."""
+        return self.answered is not None and self.answered * 1e-6 >= self.end
+
+
 def run_drive(
     scenario: Scenario,
     settings: DriveSettings,
@@ -134,114 +286,12 @@ def run_drive(
 ) -> str:
     """Answer the hardware's statuses until the scenario's end (module docstring), recording
     into ``record``; returns the URL used."""
-    diagram, _, n = DriveDiagram(scenario)
-    # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``): the
-    # hardware side rejects a torque beyond an effort limit as a fault
-    limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
-    simulator = Simulator(diagram)
-    config = copy.copy(scenario.simulator)
-    config.target_realtime_rate = 0.0  # the hardware's status paces the drive
-    ApplySimulatorConfig(config, simulator)
-    context = simulator.get_mutable_context()
-    state_in, out = diagram.get_input_port(0), diagram.get_output_port(0)
-    endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL)
-    record.url = endpoint.url
-    risk = url_warning(endpoint.url)
-    if risk:
-        warn(risk)
-    answered: Optional[int] = None
-    answer = b""
-    last_q = last_v = None
-    # what this drive sent lately (and the zero torque of the start): a status whose applied
-    # torque is none of them shows a second sender's command taken by the hardware
-    recent: deque = deque(maxlen=RECENT)
-    sent_torques = {tuple(np.zeros(n))}
-    end = settings.duration - 1.5 * settings.period
-    last_seen = time.perf_counter()
+    loop = _DriveLoop(scenario, settings, record, url, warn)
     while True:
-        # until the first tick after the hand-shake, the hardware may still be building its diagram
-        timeout = settings.startup_timeout if not answered else settings.status_timeout
-        messages = endpoint.poll(0.05)
-        now = time.perf_counter()
-        if not messages:
-            if now - last_seen >= timeout:
-                if answered is None:
-                    raise DriveFault(
-                        f"no status from the hardware within the start-up timeout of {timeout:g} s on "
-                        f"{endpoint.url} (channel {STATUS_CHANNEL}): is `ptint hardware` running?"
-                    )
-                raise DriveFault(
-                    f"no status from the hardware for {timeout:g} s after t = {answered * 1e-6:.3f} s: "
-                    f"stopped commanding"
-                )
-            continue
-        last_seen = now
-        for t_recv, data in messages:
-            try:
-                utime, q, v = unpack_status(data, n)
-            except ValueError as exc:
-                raise DriveFault(f"status rejected: {exc}; stopped commanding") from None
-            record.statuses += 1
-            if (
-                answered is not None
-                and utime == answered
-                and np.array_equal(q, last_q)
-                and np.array_equal(v, last_v)
-            ):
-                record.repeats += 1
-                endpoint.publish(answer)
-                continue
-            if answered is not None and utime < answered:
-                record.stale += 1
-                continue
-            if answered is not None:
-                record.gaps += max(0, int(round((utime - answered) * 1e-6 / settings.period)) - 1)
-            t = utime * 1e-6
-            applied = status_torque(data)
-            if tuple(applied) not in sent_torques:
-                # the hardware obeys someone else: make its checks hold the arm (a command it must
-                # reject, sent a few times: LCM may drop one), then stop
-                stop = pack_command(utime, np.full(n, np.nan))
-                for _ in range(STOP_REPEATS):
-                    endpoint.publish(stop)
-                raise DriveFault(
-                    f"the hardware applied torques this drive did not send, at t = {t:.3f} s "
-                    f"({np.array2string(applied, precision=3)}): a second sender on {COMMAND_CHANNEL}; "
-                    f"sent a NaN command so that the hardware holds the arm, and stopped commanding"
-                )
-            if answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
-                state_in.FixValue(context, np.concatenate([q, v]))
-                context.SetTime(t)
-                simulator.Initialize()
-            elif t > context.get_time():
-                # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
-                # sees the discrete plant's state between two steps; then the events at t (segment
-                # starts) with it too, and only then the new sample
-                simulator.AdvanceTo(t)
-                simulator.AdvanceTo(t + EVENT_STEP)
-            state_in.FixValue(context, np.concatenate([q, v]))
-            tau = np.array(out.Eval(context), dtype=float)
-            if limits is not None and np.any(np.abs(tau) > limits):
-                record.clipped += 1
-                tau = np.clip(tau, -limits, limits)
-            last_q, last_v = q, v
-            answer = pack_command(utime, tau)
-            if len(recent) == recent.maxlen and recent.count(recent[0]) == 1:
-                sent_torques.discard(recent[0])
-            recent.append(tuple(tau))
-            sent_torques.add(recent[-1])
-            sent = endpoint.publish(answer)
-            answered = utime
-            record.commands += 1
-            record.compute.append(sent - t_recv)
-            record.first_t = t if record.first_t is None else record.first_t
-            record.last_t = t
-            record.t.append(t)
-            record.q.append(q)
-            record.v.append(v)
-            record.tau.append(tau)
-        if answered is not None and answered * 1e-6 >= end:
-            return endpoint.url
+        for t_recv, data in loop.wait():
+            loop.take(t_recv, data)
+        if loop.finished():
+            return loop.endpoint.url
 
 
 def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dict:
