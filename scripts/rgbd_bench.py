@@ -17,11 +17,9 @@ import time
 
 import numpy as np
 
-from pydrake.systems.framework import DiagramBuilder
-
 from ptint_drake.config.yaml_io import drake_version
 from ptint_drake.scenario import load_scenario
-from ptint_drake.systems.perception.part_pose_estimator import AddRgbdPerception
+from ptint_drake.worlds.interception.camera_frames import build_rgbd_view
 
 
 def main() -> None:
@@ -30,14 +28,8 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=30)
     args = parser.parse_args()
     scenario = load_scenario(args.scenario)
-    from ptint_drake.worlds.interception.station import MakeStation  # noqa: PLC0415 (script)
-    station = MakeStation(scenario)
-    builder = DiagramBuilder()
-    system = builder.AddSystem(station.diagram)
-    _, estimator = AddRgbdPerception(builder, system.GetOutputPort("depth_image"), scenario.measurement,
-                                     station.true_targets, scenario.duration)
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
+    view = build_rgbd_view(scenario)
+    station, estimator, context = view.station, view.estimator, view.context
     sensor = station.diagram.GetSubsystemByName("rgbd_camera")
     noise = station.diagram.GetSubsystemByName("rgbd_camera_depth_noise")
     cloud_port = estimator.GetInputPort("point_cloud")

@@ -11,16 +11,17 @@ Re-rendering after the run costs ~0.3 s for VTK's start-up plus a few ms per fra
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.framework import Context, Diagram, DiagramBuilder, System
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.perception.part_pose_estimator import AddRgbdPerception
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, project
-from ptint_drake.worlds.interception.station import MakeStation
+from ptint_drake.worlds.interception.station import MakeStation, Station
 
 
 def _instants(scenario: Scenario) -> list[tuple[str, float]]:
@@ -40,15 +41,33 @@ def _mark(draw: ImageDraw.ImageDraw, uv, yaw_uv, ok: bool) -> None:
         draw.line([(u, v), tuple(yaw_uv)], fill=color, width=1)
 
 
-def write_camera_frames(scenario: Scenario, series: dict, stage: Path) -> list[str]:
-    """The frames of the module docstring, in ``stage / "frames"``; returns their names."""
+@dataclass
+class RgbdView:
+    """A scenario's station (with its camera) and the perception reading its depth image, in one
+    diagram with a context: what the frames here and ``scripts/rgbd_bench.py`` render and fit."""
+
+    station: Station
+    system: System  # the station's diagram inside ``diagram``
+    estimator: System  # the perception's part-pose estimator (``fit_frame``, ``point_cloud`` input)
+    diagram: Diagram
+    context: Context
+
+
+def build_rgbd_view(scenario: Scenario) -> RgbdView:
+    """The station and its perception of an ``rgbd`` scenario, built with a default context."""
     station = MakeStation(scenario)
     builder = DiagramBuilder()
     system = builder.AddSystem(station.diagram)
     _, estimator = AddRgbdPerception(builder, system.GetOutputPort("depth_image"), scenario.measurement,
                                      station.true_targets, scenario.duration)
     diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
+    return RgbdView(station, system, estimator, diagram, diagram.CreateDefaultContext())
+
+
+def write_camera_frames(scenario: Scenario, series: dict, stage: Path) -> list[str]:
+    """The frames of the module docstring, in ``stage / "frames"``; returns their names."""
+    view = build_rgbd_view(scenario)
+    station, system, estimator, context = view.station, view.system, view.estimator, view.context
     plant_context = station.plant.GetMyMutableContextFromRoot(context)
     station_context = system.GetMyContextFromRoot(context)
     X_WC, info = camera_pose(scenario.measurement.camera), camera_info(scenario.measurement.camera)
