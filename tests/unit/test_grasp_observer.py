@@ -136,3 +136,15 @@ def test_no_retry_left_backs_off_with_the_fingers_open():
     assert segs[3].start == pytest.approx(segs[2].end)  # the lift right after the backoff
     assert dict(plan.commands)[1.6] == pytest.approx(0.042)
     assert plan.attempts[0][0].check == pytest.approx(1.6)
+
+
+def test_pads_sinking_into_a_held_part_after_holding_is_not_lost(observer):
+    """A 40 mm cylinder under the 30 N hand (point contact): holding at 37.5 mm, then the pads
+    sink to 36.7 mm (measured on tests/two_belt_pick.yaml), 3.3 mm below the part's width but
+    within the tolerance of where holding was decided; a collapse from there is lost."""
+    system, context = observer
+    part = 0.04
+    _step(system, context, 0.0, 0.045, 0.05, 0.0, part)
+    assert _step(system, context, 0.0, 0.0375, 0.001, 30.0, part) == HOLDING
+    assert _step(system, context, 0.0, 0.0367, 0.001, 30.0, part) == HOLDING
+    assert _step(system, context, 0.0, 0.0340, 0.05, 30.0, part) == LOST
