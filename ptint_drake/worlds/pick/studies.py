@@ -152,7 +152,10 @@ def report(scenario, metrics: dict, out) -> int:
         print(f"{scenario.name} pick {k} ({p['part']} → slot {p['slot']}): grasped at {grasp}, "
               f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
               f"{p['place_error_deg']:.2f}°"
-              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, grip {p['peak_grip_force_N']:.1f} N"
+              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, "
+              f"contact grip {p['peak_grip_force_N']:.1f} N peak, {p.get('grip_force_N') or 0.0:.1f} N at "
+              f"the lift; {p.get('attempts', 1)} "
+              f"attempt{'s' if p.get('attempts', 1) != 1 else ''}, {p.get('state_at_place')} at the place"
               + (f", COLLISION with {', '.join(p['collision_with'])}" if p.get("collision_with")
                  else ", COLLISION before the close" if p["collision"] else ""))
     sim = metrics["sim"]
