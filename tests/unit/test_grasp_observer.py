@@ -108,6 +108,13 @@ def test_the_close_advance_test_option_moves_the_first_close_only():
     first, second = plan.attempts[0]
     assert first.close == pytest.approx(1.7 - 0.12 - 0.3)
     assert second.close == pytest.approx(second.grasp - 0.12)
+    # the arm holds its pre-grasp pose until the fingers have all but closed past the part's width
+    # ((12 + 3) mm at 2 × 50 mm/s = 0.15 s after the close, less 20 ms): they close on nothing
+    descend = plan.schedule.segments[plan.segment_index(0, "descend", 0)]
+    assert descend.start == pytest.approx(first.close + 0.15 - 0.02)
+    assert first.grasp == pytest.approx(descend.start + 0.5)
+    late = pick_plan(_pick(test_close_advance_s=-0.1)).attempts[0][0]  # later, and no hold
+    assert late.close == pytest.approx(1.7 - 0.12 + 0.1) and late.grasp == pytest.approx(1.7)
 
 
 @pytest.mark.parametrize("change, field", [

@@ -5,7 +5,7 @@ the part (mm, log scale) and its angle from the top-down grasp (deg), the finger
 the grasp state the gripper reported (``systems.gripper.GraspObserver``: open … lost, a step line),
 the grip force (N): the measured contact force squeezing the part (the smaller of the two pads'
 normal forces, as ``peak_grip_force_N``) with the drives' force thin beside it, and the part's
-height (mm); the prescribed grasp time and the close command marked.
+height (mm); each attempt's prescribed grasp time (dashed) and close command (dotted) marked.
 
 ``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
 from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
@@ -58,8 +58,9 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
             if i == 2:
                 ax.plot(t, drive, color="0.6", lw=0.7, label="drives' force")
                 ax.legend(fontsize=7, loc="upper right")
-            ax.axvline(pick["t_grasp_prescribed"], color="k", ls="--", lw=0.8)
-            ax.axvline(pick["t_close_command"], color="tab:red", ls=":", lw=0.8)
+            for attempt in pick.get("attempt_details") or [pick]:  # each attempt's close and grasp
+                ax.axvline(attempt["t_grasp_prescribed"], color="k", ls="--", lw=0.8)
+                ax.axvline(attempt["t_close_command"], color="tab:red", ls=":", lw=0.8)
             ax.set_title(f"pick {row} ({pick['part']}): {label}", fontsize=9)
             ax.set_xlabel("t (s)")
     fig.tight_layout()
