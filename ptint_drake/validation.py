@@ -7,6 +7,7 @@ import math
 
 from pydrake.systems.analysis import GetIntegrationSchemes
 
+from ptint_drake.config.controller import default_pinv_damping
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.fields import nonnegative, positive
 from ptint_drake.controllers import CONTROLLERS, REGISTRY, known_type, plugin
@@ -24,6 +25,8 @@ IMPLEMENTATIONS = ("fused", "blocks")
 def validate(s) -> None:
     """Checks that need no robot model (the model-dependent ones live in ``robot``)."""
     positive(s.duration, "duration")
+    if s.controller.pinv_damping is None:  # left out: one start angle per joint (checked on the model)
+        s.controller.pinv_damping = default_pinv_damping(s.controller.task, len(s.robot.initial_q_deg))
     _validate_controller(s.controller)
     for check, config in ((validate_criteria, s.criteria), (validate_measurement, s.measurement)):
         if config is None:

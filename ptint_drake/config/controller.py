@@ -7,7 +7,7 @@ the two agree.  (No postponed annotations: Drake's ``yaml_load_typed`` reads the
 """
 
 from dataclasses import dataclass, field
-from typing import Dict, List, Union
+from typing import Dict, List, Optional, Union
 
 
 @dataclass
@@ -108,6 +108,24 @@ class CtQuinticConfig:
             raise ValueError(f"ct_quintic.on_ik_failure: use nearest or raise, got {self.on_ik_failure!r}")
 
 
+# Issue 33: the damping a scenario gets when it leaves ``controller.pinv_damping`` out.  A 6-joint arm
+# on the 6-D ``top_down`` task has a square Jacobian: no null space to steer around its wrist
+# singularity (rvm1_6dof's roll-pitch-roll wrist at pitch 0, which a place near the base cannot
+# avoid), and the exact J⁺ answers a small orientation error there with large, opposite roll rates.
+# Measured on rvm1_6dof (docs/pick_place.md "The 6-joint arm"): undamped, assembly_pick_place and
+# the two-belt scenario of tests/two_belt_pick.yaml collide and drop parts; λ = 0.01 m/rad places
+# every part of both and of conveyor_pick_place within 0.4 mm.  Every other case keeps the
+# paper's exact J⁺ (0): a 5-joint arm on top_down (6 × 5, least squares), the position and pose
+# tasks.
+SQUARE_TOP_DOWN_DAMPING = 0.01  # m/rad
+
+
+def default_pinv_damping(task: str, n_joints: int) -> float:
+    """``controller.pinv_damping`` when the scenario leaves it out: ``SQUARE_TOP_DOWN_DAMPING``
+    for ``top_down`` on an arm of 6 or more joints, else 0 (the exact pseudoinverse)."""
+    return SQUARE_TOP_DOWN_DAMPING if task == "top_down" and n_joints >= 6 else 0.0
+
+
 ParamValue = Union[List[float], float, int, str]  # a plugin's setting (the order is Drake YAML's)
 
 
@@ -119,6 +137,9 @@ class ControllerConfig(ControllerGains):
 
     # a plain field rather than a tagged YAML variant, so that ``--set controller.type=pd``
     # works and an untagged mapping stays the paper's controller
+    # None (left out): ``default_pinv_damping`` of the task and the arm's joints, set when the
+    # scenario is validated (``validation.validate``); a number: that λ (m/rad, 0 = exact J⁺)
+    pinv_damping: Optional[float] = None
     type: str = "ptsmc"  # a name of controllers.REGISTRY, or "module:Class"
     implementation: str = "fused"  # ptsmc: "fused" one LeafSystem, or "blocks"
     params: Dict[str, ParamValue] = field(default_factory=dict)  # a plugin's settings

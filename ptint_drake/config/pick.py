@@ -148,8 +148,8 @@ class PickConfig:
     grasp_window: float = 0.3  # s after the prescribed grasp time: the latest the lift waits for ``holding``
     width_tolerance: float = 0.003  # m, ``holding``: the opening within the part's width ± this
     # TEST OPTION (leave 0): send the first attempt's close command this much earlier, so that
-    # "closed on nothing" is reproducible (e.g. 0.3: the fingers close above the part; negative:
-    # later, a late grasp)
+    # "closed on nothing" is reproducible (e.g. 0.3: the arm holds its pre-grasp pose until the
+    # fingers have closed above the part, ``pick.tasks._closed_on_nothing``; negative: later, a late grasp)
     test_close_advance_s: float = 0.0
 
 

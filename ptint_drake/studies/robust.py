@@ -31,7 +31,8 @@ lateral offset): its draws are those of that study, seed for seed.
 A pick scenario (``pick``) draws ``mass`` and the five pick ranges only (its plant takes no
 other deviation; the part in the hand is the payload) and is judged by its picks: robust.json
 adds ``pick_success_rate`` (parts placed with no collision / all parts) and ``failures_by_reason``
-(each failed pick's verdict reason without its index, each sample's error: their counts).  Every
+(each failed pick's verdict reason without its index, each sample's error: their counts; every
+collision under ``collision``) and ``collisions_by_body`` (the bodies those collisions touched).  Every
 sample ends with a verdict: a sample that is rejected before its run or raises is an error row,
 counted by its reason.
 

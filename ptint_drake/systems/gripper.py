@@ -95,8 +95,11 @@ class GraspObserver(LeafSystem):
     force (−force, N), w_part the expected width and the previous state s:
 
     - command > 0 (open or opening): ``open``;
-    - else if s is ``holding`` or ``lost`` and w < w_part − ``width_tolerance``: ``lost`` (the
-      width collapsed: the part left the fingers);
+    - else if s is ``holding`` or ``lost`` and w < w_hold − ``width_tolerance``: ``lost`` (the
+      width collapsed: the part left the fingers), w_hold being the opening when ``holding`` was
+      first decided (the encoder's reading on the part: the pads keep sinking into a part after
+      that, 3.3 mm in all into a 40 mm cylinder under the 30 N hand, point contact, against about
+      1 mm into a 30 mm box, so a width measured from w_part would call a held cylinder lost);
     - else if s is ``holding``: ``holding`` (it stays so while the width does not collapse);
     - else if s is ``empty``: ``empty`` (until the next open command);
     - else if w < w_part − ``width_tolerance``: ``empty`` (closed past the part's size: nothing
@@ -125,8 +128,9 @@ class GraspObserver(LeafSystem):
     ``grasp_state``    1     output: the state's code (OPEN … LOST; ``GRASP_STATES`` names)
     =================  ====  ============================================================
 
-    Discrete state ``grasp`` = [code], updated every ``period``; the output is that state (so a
-    sample at t shows the decision of the update at or before t).
+    Discrete state ``grasp`` = [code] and ``held_width`` = [w_hold] (m; 0 before any ``holding``),
+    updated every ``period``; the output is the code (so a sample at t shows the decision of the
+    update at or before t).
     """
 
     def __init__(self, max_force: float, speed: float, width_tolerance: float = 0.003,
@@ -139,17 +143,21 @@ class GraspObserver(LeafSystem):
         self._command = self.DeclareVectorInputPort("command", 1)
         self._width = self.DeclareVectorInputPort("part_width", 1)
         self._grasp = self.DeclareDiscreteState(BasicVector([float(OPEN)]))
+        self._held = self.DeclareDiscreteState(BasicVector([0.0]))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         self.DeclareStateOutputPort("grasp_state", self._grasp)
 
-    def decide(self, previous: int, command: float, fingers, drive, part_width: float) -> int:
-        """The next state from the previous one and the inputs (the rule in the class docstring)."""
+    def decide(self, previous: int, command: float, fingers, drive, part_width: float,
+               held_width: float | None = None) -> int:
+        """The next state from the previous one and the inputs (the rule in the class docstring);
+        ``held_width``: w_hold, the opening when ``holding`` was decided (None: ``part_width``)."""
         if command > 0.0:
             return OPEN
         width = float(fingers[0]) + float(fingers[1])
-        collapsed = width < part_width - self._tolerance
         if previous in (HOLDING, LOST):
-            return LOST if collapsed else previous
+            held = part_width if held_width is None else held_width
+            return LOST if width < held - self._tolerance else previous
+        collapsed = width < part_width - self._tolerance
         if previous == EMPTY or collapsed:
             return EMPTY
         stopped = max(abs(float(fingers[2])), abs(float(fingers[3]))) < self._stop_speed
@@ -160,6 +168,10 @@ class GraspObserver(LeafSystem):
 
     def _update(self, context, state) -> None:
         previous = int(context.get_discrete_state(self._grasp).get_value()[0])
-        code = self.decide(previous, float(self._command.Eval(context)[0]), self._fingers.Eval(context),
-                           self._drive.Eval(context), float(self._width.Eval(context)[0]))
+        held = float(context.get_discrete_state(self._held).get_value()[0])
+        fingers = self._fingers.Eval(context)
+        code = self.decide(previous, float(self._command.Eval(context)[0]), fingers,
+                           self._drive.Eval(context), float(self._width.Eval(context)[0]), held)
         state.get_mutable_vector(self._grasp).SetAtIndex(0, float(code))
+        if code == HOLDING and previous != HOLDING:  # the encoder's width on the part
+            state.get_mutable_vector(self._held).SetAtIndex(0, float(fingers[0]) + float(fingers[1]))

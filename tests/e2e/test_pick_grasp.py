@@ -7,10 +7,9 @@ import pytest
 
 from ptint_drake.cli import main
 
-# the fingers close 0.3 s early (a test option) while the tool is still 50 mm above its grasp:
-# they close on nothing, above the part
-CLOSE_ON_AIR = ("pick: {test_close_advance_s: 0.3, tasks: [{part: part, slot: 0, clearance: 0.1, "
-                "descend: {tf: 0.6}}]}")
+# the stock scenario with the fingers closing 0.3 s early (a test option): the arm holds its
+# pre-grasp pose, 40 mm above the part, until they have closed: they close on nothing
+CLOSE_ON_AIR = "pick: {test_close_advance_s: 0.3}"
 
 
 def _reasons(m: dict) -> list:
@@ -25,6 +24,7 @@ def test_closed_on_nothing_is_empty_and_the_retry_picks_the_part(run):
     assert pick["attempts"] == 2 and first["state"] == "empty" and second["state"] == "holding"
     # measured between pads and part: nothing was squeezed in the empty attempt
     assert first["peak_grip_force_N"] < 1.0 and second["peak_grip_force_N"] > 25.0
+    assert not pick["collision"] and pick["collision_with"] == []
     # the empty grasp is found while closing, before its prescribed time; the retry's grasp on time
     assert first["t_check"] < first["t_grasp_prescribed"]
     assert abs(pick["t_grasp"] - second["t_grasp_prescribed"]) <= 0.05
@@ -36,8 +36,7 @@ def test_closed_on_nothing_is_empty_and_the_retry_picks_the_part(run):
 def test_without_retries_closed_on_nothing_is_an_empty_grasp_exit_1(tmp_path, capsys):
     out = tmp_path / "o"
     code = main(["run", "conveyor_pick_place", "--quiet", "--no-replay", "--no-figures", "--out", str(out),
-                 "--set", "pick.retries=0", "--set", "pick.test_close_advance_s=0.3",
-                 "--set", "pick.tasks[0].clearance=0.1", "--set", "pick.tasks[0].descend.tf=0.6"])
+                 "--set", "pick.retries=0", "--set", "pick.test_close_advance_s=0.3"])
     m = json.loads((out / "metrics.json").read_text())
     assert code == 1 and m["reasons"] == ["pick 0: empty grasp"], m["reasons"]
     assert m["picks"][0]["attempt_details"][0]["peak_grip_force_N"] < 1.0
@@ -78,7 +77,8 @@ def test_the_lift_waits_for_holding_and_a_late_close_is_a_late_grasp(run):
 
 
 @pytest.mark.parametrize("override, reason", [
-    ("pick: {test_close_advance_s: 0.1}", "pick 0: early grasp"),  # on the part 0.1 s early
+    # the close 0.1 s early, the arm not waiting: the fingers reach the part 0.1 s early
+    ("pick: {tasks: [{part: part, slot: 0, close_delay: -0.1}]}", "pick 0: early grasp"),
     ("criteria: {place_mm: 0.01}", "pick 0: not placed"),  # 0.16 mm is outside 0.01 mm
 ])
 def test_each_pick_reason_fails_the_verdict(run, override, reason):

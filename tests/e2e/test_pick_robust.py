@@ -58,7 +58,8 @@ def test_harsh_ranges_reach_a_named_failure_and_mild_passes():
     assert not failed["ok"] and failed["reasons"] == ["pick 0: late grasp"], failed
     assert passed["ok"] and not passed["reasons"], passed
     summary = robust_summary(rows)
-    assert summary == {"pick_success_rate": 0.5, "failures_by_reason": {"late grasp": 1}}
+    assert summary == {"pick_success_rate": 0.5, "failures_by_reason": {"late grasp": 1},
+                       "collisions_by_body": {}}
     mild = robust.robust_sample(text, name, 0, robust.MILD)
     assert mild["ok"] and all(p["placed"] for p in mild["picks"]), mild
 
@@ -78,7 +79,8 @@ def test_failures_are_counted_by_reason_without_the_pick_index():
     summary = robust_summary(rows)
     assert summary["failures_by_reason"] == {
         "dropped": 2, "error: pick.tasks[k].part: […] m is outside what the arm reaches from above": 2,
-        "collision with conveyor1": 1}
+        "collision": 1}
+    assert summary["collisions_by_body"] == {"conveyor1": 1}
     assert summary["pick_success_rate"] == 1 / 8  # the collided part was placed: it fails all the same
     assert [picks_ok(r) for r in rows] == [0, 1, 0, 0]
     assert failure_reason("integration failed at t = 1.2345 s: step 1e-9") == \
@@ -96,7 +98,7 @@ def test_a_sample_that_raises_ends_with_a_verdict(monkeypatch):
     assert row["ok"] is False and row["status"] == "error"
     assert row["error"] == "ZeroDivisionError: in the middle of a run"
     assert robust_summary([row]) == {"pick_success_rate": 0.0, "failures_by_reason": {
-        "error: ZeroDivisionError: in the middle of a run": 1}}
+        "error: ZeroDivisionError: in the middle of a run": 1}, "collisions_by_body": {}}
 
 
 def test_lateral_offset_moves_the_part_and_is_checked():

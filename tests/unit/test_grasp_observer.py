@@ -108,6 +108,13 @@ def test_the_close_advance_test_option_moves_the_first_close_only():
     first, second = plan.attempts[0]
     assert first.close == pytest.approx(1.7 - 0.12 - 0.3)
     assert second.close == pytest.approx(second.grasp - 0.12)
+    # the arm holds its pre-grasp pose until the fingers have all but closed past the part's width
+    # ((12 + 3) mm at 2 × 50 mm/s = 0.15 s after the close, less 20 ms): they close on nothing
+    descend = plan.schedule.segments[plan.segment_index(0, "descend", 0)]
+    assert descend.start == pytest.approx(first.close + 0.15 - 0.02)
+    assert first.grasp == pytest.approx(descend.start + 0.5)
+    late = pick_plan(_pick(test_close_advance_s=-0.1)).attempts[0][0]  # later, and no hold
+    assert late.close == pytest.approx(1.7 - 0.12 + 0.1) and late.grasp == pytest.approx(1.7)
 
 
 @pytest.mark.parametrize("change, field", [
@@ -136,3 +143,15 @@ def test_no_retry_left_backs_off_with_the_fingers_open():
     assert segs[3].start == pytest.approx(segs[2].end)  # the lift right after the backoff
     assert dict(plan.commands)[1.6] == pytest.approx(0.042)
     assert plan.attempts[0][0].check == pytest.approx(1.6)
+
+
+def test_pads_sinking_into_a_held_part_after_holding_is_not_lost(observer):
+    """A 40 mm cylinder under the 30 N hand (point contact): holding at 37.5 mm, then the pads
+    sink to 36.7 mm (measured on tests/two_belt_pick.yaml), 3.3 mm below the part's width but
+    within the tolerance of where holding was decided; a collapse from there is lost."""
+    system, context = observer
+    part = 0.04
+    _step(system, context, 0.0, 0.045, 0.05, 0.0, part)
+    assert _step(system, context, 0.0, 0.0375, 0.001, 30.0, part) == HOLDING
+    assert _step(system, context, 0.0, 0.0367, 0.001, 30.0, part) == HOLDING
+    assert _step(system, context, 0.0, 0.0340, 0.05, 30.0, part) == LOST

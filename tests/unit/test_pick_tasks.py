@@ -91,3 +91,18 @@ def test_robust_samples_a_pick_scenario_within_its_ranges():
     summary = robust_summary(rows)
     assert summary["pick_success_rate"] == 0.25
     assert summary["failures_by_reason"] == {"dropped": 1, "error: boom": 1}
+
+
+def test_collisions_are_one_reason_with_the_bodies_counted_beneath():
+    """failures_by_reason keys a collision by its kind, whatever bodies it touched (stable keys);
+    collisions_by_body counts how many collisions touched each body."""
+    from ptint_drake.worlds.pick.studies import robust_summary  # noqa: PLC0415
+
+    one = {"part_mass": [0.1]}
+    rows = [{"params": one, "picks": [{"placed": False}],
+             "reasons": ["pick 0: collision with conveyor2, tray, floor, part2", "pick 0: dropped"]},
+            {"params": one, "picks": [{"placed": False}], "reasons": ["pick 0: collision with tray"]},
+            {"params": one, "picks": [{"placed": False}], "reasons": ["pick 0: collision"]}]
+    summary = robust_summary(rows)
+    assert summary["failures_by_reason"] == {"collision": 3, "dropped": 1}
+    assert summary["collisions_by_body"] == {"tray": 2, "conveyor2": 1, "floor": 1, "part2": 1}

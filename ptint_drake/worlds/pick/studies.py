@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import re
 import sys
+from collections import Counter
 
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
@@ -88,21 +89,33 @@ def picks_ok(row: dict) -> int:
 
 def robust_summary(rows: list) -> dict:
     """``pick_success_rate`` (picks that succeeded, ``picks_ok``, over all parts, a sample that
-    could not run placing none) and ``failures_by_reason`` ({reason: count}, ``failure_reason``:
-    each reason of a sample's verdict, each sample's error; most frequent first) of a pick study;
-    {} otherwise."""
+    could not run placing none), ``failures_by_reason`` ({reason: count}, ``failure_reason``:
+    each reason of a sample's verdict, each sample's error; most frequent first; every
+    ``collision with <bodies>`` under the one key ``collision``) and ``collisions_by_body`` ({body:
+    how many of those collisions touched it}) of a pick study; {} otherwise."""
     if not any("picks" in r or "part_mass" in r.get("params", {}) for r in rows):
         return {}
     parts = sum(len(r["params"]["part_mass"]) for r in rows)
     ok = sum(picks_ok(r) for r in rows)
-    reasons: dict = {}
+    reasons, bodies = Counter(), Counter()
     for r in rows:
         texts = r.get("reasons") or ([f"error: {r['error']}"] if r.get("error") else [])
         for text in texts:
             code = failure_reason(text)
-            reasons[code] = reasons.get(code, 0) + 1
+            if code.startswith(COLLISION):  # one key, whatever was touched: the bodies beneath
+                touched = code[len(COLLISION):].removeprefix(" with ")
+                bodies.update(b.strip() for b in touched.split(",") if b.strip())
+                code = COLLISION
+            reasons[code] += 1
     return {"pick_success_rate": ok / parts if parts else 0.0,
-            "failures_by_reason": dict(sorted(reasons.items(), key=lambda kv: (-kv[1], kv[0])))}
+            "failures_by_reason": _most_first(reasons), "collisions_by_body": _most_first(bodies)}
+
+
+COLLISION = "collision"  # failures_by_reason's key of every ``collision with <bodies>``
+
+
+def _most_first(counts: Counter) -> dict:
+    return dict(sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])))
 
 
 def sweep_point(row: dict, scenario, beta: float, tf: float, simulate, validate, schedule_end) -> dict:
@@ -139,7 +152,10 @@ def report(scenario, metrics: dict, out) -> int:
         print(f"{scenario.name} pick {k} ({p['part']} → slot {p['slot']}): grasped at {grasp}, "
               f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
               f"{p['place_error_deg']:.2f}°"
-              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, grip {p['peak_grip_force_N']:.1f} N"
+              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, "
+              f"contact grip {p['peak_grip_force_N']:.1f} N peak, {p.get('grip_force_N') or 0.0:.1f} N at "
+              f"the lift; {p.get('attempts', 1)} "
+              f"attempt{'s' if p.get('attempts', 1) != 1 else ''}, {p.get('state_at_place')} at the place"
               + (f", COLLISION with {', '.join(p['collision_with'])}" if p.get("collision_with")
                  else ", COLLISION before the close" if p["collision"] else ""))
     sim = metrics["sim"]

@@ -103,8 +103,10 @@ def _up(h: float) -> tuple:
     return (0.0, 0.0, h)
 
 
-def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float, replan: Replan):
-    """The segments of task k, their plan entries, the attempts' (approach start, grasp) and the end."""
+def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float, replan: Replan,
+                   hold: float = 0.0):
+    """The segments of task k, their plan entries, the attempts' (approach start, grasp) and the end;
+    ``hold``: how long the first attempt waits at its pre-grasp pose before its descend (s)."""
     segments, plans, attempts = [], [], []
 
     def add(phase, kind, index, offset, yaw, t, attempt=0, until=np.inf):
@@ -121,6 +123,8 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, sta
             t = add("backoff", "latched", part, _up(task.clearance), 0.0, retries[attempt - 1], attempt)
         approach = t
         t = add("approach", "part", part, _up(task.clearance), 0.0, t, attempt)
+        if attempt == 0:
+            t += hold
         grasp = t + task.descend.tf  # prescribed, even where the descend is cut short
         last = replan.abort if replan.abort is not None else np.inf
         t = add("descend", "part", part, _up(0.0), 0.0, t, attempt,
@@ -149,15 +153,16 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
         part = names.index(task.part)
         slot_yaw = np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg)
         start = max(task.start, t) if task.start > 0.0 else t
-        segs, plan, tries, t = _task_segments(k, task, part, float(slot_yaw), start, replan)
         width = grasp_width(pick.parts[part])
         opening = width + task.margin
+        first_close, hold = _closed_on_nothing(pick, task, start)
+        segs, plan, tries, t = _task_segments(k, task, part, float(slot_yaw), start, replan, hold)
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):
             close = grasp - 0.5 * task.margin / pick.gripper.speed + task.close_delay
-            if j == 0:
-                close -= pick.test_close_advance_s  # a test option (PickConfig)
+            if j == 0 and first_close is not None:
+                close = first_close  # the test option (PickConfig.test_close_advance_s)
             commands += [((replan.retries[j - 1] if j else approach), opening), (close, 0.0)]
             check = replan.retries[j] if j < len(replan.retries) else grasp + task.dwell + replan.lift_delay
             if j == len(replan.retries) and replan.abort is not None:
@@ -173,6 +178,35 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
         attempts.append(tuple(task_attempts))
     return PickPlan(Schedule(segments), tuple(plans), tuple(commands), tuple(closes), tuple(grasps), t,
                     tuple(widths), tuple(attempts))
+
+
+SETTLE_BEFORE_DESCEND = 0.02  # s: the held arm descends this long before the fingers close past the part
+
+
+def _closed_on_nothing(pick: PickConfig, task: PickTaskConfig, start: float) -> tuple:
+    """The test option ``pick.test_close_advance_s`` = a on a task's first attempt: (its close
+    command's time, how long the arm holds its pre-grasp pose before the descend); (None, 0) if a = 0.
+
+    a > 0 ("closed on nothing"): the close command comes a earlier than the plan would send it,
+    and the arm waits at its pre-grasp pose, ``clearance`` above the part, until the fingers have
+    all but closed past the part's width (``margin`` + ``width_tolerance`` at twice the jaw speed,
+    less ``SETTLE_BEFORE_DESCEND``), so that they close on nothing above the part whatever the
+    clearance and the descend's tf.  Without the hold, on conveyor_pick_place (clearance 40 mm,
+    descend 0.5 s) a close 0.3 s early finished just as the descending pads met the part's top
+    face, whose friction stopped them 2.6 mm inside the part's width (within the tolerance): the
+    gripper read ``holding`` on the part's top edges (docs/pick_place.md).  a < 0: the close
+    comes |a| later, the arm does not wait (a late grasp).  A close merely early, the fingers still
+    reaching the part, is ``tasks[k].close_delay`` < 0."""
+    advance = pick.test_close_advance_s
+    if advance == 0.0:
+        return None, 0.0
+    approach_end = start + task.approach.tf
+    speed = pick.gripper.speed
+    close = approach_end + task.descend.tf - 0.5 * task.margin / speed + task.close_delay - advance
+    if advance < 0.0:
+        return close, 0.0
+    closed = close + (task.margin + pick.width_tolerance) / (2.0 * speed)
+    return close, max(0.0, closed - SETTLE_BEFORE_DESCEND - approach_end)
 
 
 def check_tasks(pick: PickConfig) -> None:

@@ -1,9 +1,11 @@
 """What ``ptint run`` draws for a pick and place: a figure of the picks and a replay of the world.
 
 ``pick_figure`` — ``picks.png``: per pick (a row), over the task's time: the tool's distance to
-the part (mm, log scale) and its angle from the top-down grasp (deg), the finger opening (mm),
-the grip force (N), and the part's height (mm); the prescribed grasp time and the close command
-marked.
+the part (mm, log scale) and its angle from the top-down grasp (deg), the finger opening (mm) with
+the grasp state the gripper reported (``systems.gripper.GraspObserver``: open … lost, a step line),
+the grip force (N): the measured contact force squeezing the part (the smaller of the two pads'
+normal forces, as ``peak_grip_force_N``) with the drives' force thin beside it, and the part's
+height (mm); each attempt's prescribed grasp time (dashed) and close command (dotted) marked.
 
 ``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
 from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
@@ -39,24 +41,41 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
             -1.0, 1.0))) for j in range(len(t))])
         angle = np.minimum(angle, 180.0 - angle)  # the fingers' axis: a half turn is the same grasp
         opening = 1e3 * (series["gripper_state"][:, 0] + series["gripper_state"][:, 1])
-        force = -np.mean(series["grip_force"], axis=1)
-        panels = [(distance, "tool to part (mm)", True), (opening, "finger opening (mm)", False),
-                  (force, "grip force (N)", False), (1e3 * block[:, 2], "part height (mm)", False)]
-        for ax, (values, label, log) in zip(axes[row], panels):
+        contact = np.min(series["grip_forces"][:, 2 * k: 2 * k + 2], axis=1)  # what squeezes the part
+        drive = -np.mean(series["grip_force"], axis=1)
+        panels = [(distance, "tool to part (mm)", True), (opening, "finger opening, grasp state", False),
+                  (contact, "contact grip force (N)", False), (1e3 * block[:, 2], "part height (mm)", False)]
+        for i, (ax, (values, label, log)) in enumerate(zip(axes[row], panels)):
             ax.plot(t, np.maximum(values, 1e-3) if log else values, lw=1.2)
             if log:
                 ax.set_yscale("log")
                 twin = ax.twinx()
                 twin.plot(t, angle, color="tab:orange", lw=0.8)
                 twin.set_ylabel("angle (deg)", color="tab:orange")
-            ax.axvline(pick["t_grasp_prescribed"], color="k", ls="--", lw=0.8)
-            ax.axvline(pick["t_close_command"], color="tab:red", ls=":", lw=0.8)
+            if i == 1 and "grasp_state" in series:
+                _state_line(ax.twinx(), t, series["grasp_state"])
+                ax.set_ylabel("opening (mm)")
+            if i == 2:
+                ax.plot(t, drive, color="0.6", lw=0.7, label="drives' force")
+                ax.legend(fontsize=7, loc="upper right")
+            for attempt in pick.get("attempt_details") or [pick]:  # each attempt's close and grasp
+                ax.axvline(attempt["t_grasp_prescribed"], color="k", ls="--", lw=0.8)
+                ax.axvline(attempt["t_close_command"], color="tab:red", ls=":", lw=0.8)
             ax.set_title(f"pick {row} ({pick['part']}): {label}", fontsize=9)
             ax.set_xlabel("t (s)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _state_line(ax, t: np.ndarray, codes: np.ndarray) -> None:
+    """The gripper's reported grasp state over time, a step line on its own axis (open … lost)."""
+    from ptint_drake.systems.gripper import GRASP_STATES  # noqa: PLC0415
+
+    ax.step(t, codes, where="post", color="tab:green", lw=0.8)
+    ax.set_yticks(range(len(GRASP_STATES)), GRASP_STATES, fontsize=7, color="tab:green")
+    ax.set_ylim(-0.5, len(GRASP_STATES) - 0.5)
 
 
 def replay_world(scenario):
