@@ -61,6 +61,9 @@ def test_an_unseen_part_gets_no_descend_and_no_close_command():
     ("measurement=null", "pick.parts[0].yaw_deg"),  # random placement needs the camera
     ("measurement.camera.look_at=[0.9, 0.9, 0.65]", "measurement.camera"),  # pointed away
     ("measurement.sensor=pose", "measurement.camera"),
+    ("pick.parts[0].yaw_deg=sideways", "pick.parts[0].yaw_deg"),
+    ("pick.parts[0].lateral=[0.01, -0.01]", "pick.parts[0].lateral"),
+    ("pick.parts[0].offset_jitter=-0.01", "pick.parts[0].offset_jitter"),
 ])
 def test_no_camera_or_one_pointed_away_is_rejected_before_the_run(setting, field, capsys, tmp_path):
     code = cli.main(["run", "conveyor_pick_place_rgbd", "--set", setting, "--out", str(tmp_path / "o")])
@@ -68,3 +71,10 @@ def test_no_camera_or_one_pointed_away_is_rejected_before_the_run(setting, field
     assert code == 2
     assert len(err.splitlines()) == 1 and f"{field}" in err, err
     assert not (tmp_path / "o").exists()
+
+
+def test_parts_of_different_sizes_are_rejected_with_a_camera(capsys, tmp_path):
+    code = cli.main(["run", "assembly_pick_place_rgbd", "--set", "pick.parts[1].size=[0.03, 0.02, 0.03]",
+                     "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "pick.parts[1]" in err, err
