@@ -78,3 +78,17 @@ def test_parts_of_different_sizes_are_rejected_with_a_camera(capsys, tmp_path):
                      "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and "pick.parts[1]" in err, err
+
+
+def test_a_robust_sample_of_an_rgbd_pick_draws_a_new_placement():
+    from ptint_drake.worlds.pick import studies  # noqa: PLC0415
+
+    def draw(seed):
+        scenario, params = studies.robust_sample(load_scenario("conveyor_pick_place_rgbd"), "c", seed,
+                                                 lambda name, n=None: 1.0 if name in ("mass", "part_mass") else
+                                                 0.8 if name == "part_friction" else
+                                                 1.0 if name == "belt_speed" else 0.0)
+        return placed_parts(scenario.pick.parts, scenario.measurement.seed)[0]
+
+    a, b = draw(3), draw(4)
+    assert a.yaw_deg != b.yaw_deg and a.lateral != b.lateral
