@@ -83,11 +83,11 @@ def test_parts_of_different_sizes_are_rejected_with_a_camera(capsys, tmp_path):
 def test_a_robust_sample_of_an_rgbd_pick_draws_a_new_placement():
     from ptint_drake.worlds.pick import studies  # noqa: PLC0415
 
+    middle = {"mass": 1.0, "part_mass": 0.1, "part_friction": 0.8, "belt_speed": 1.0}
+
     def draw(seed):
-        scenario, params = studies.robust_sample(load_scenario("conveyor_pick_place_rgbd"), "c", seed,
-                                                 lambda name, n=None: 1.0 if name in ("mass", "part_mass") else
-                                                 0.8 if name == "part_friction" else
-                                                 1.0 if name == "belt_speed" else 0.0)
+        scenario, _ = studies.robust_sample(load_scenario("conveyor_pick_place_rgbd"), "c", seed,
+                                            lambda name, n=None: middle.get(name, 0.0))
         return placed_parts(scenario.pick.parts, scenario.measurement.seed)[0]
 
     a, b = draw(3), draw(4)

@@ -53,6 +53,10 @@ from ptint_drake.systems.rotation_estimator import RotationEstimator
 from ptint_drake.worlds.pick.placement import nominal_parts
 
 BELT_MARGIN = 0.006  # m, a perceived belt's extra width on each side of the pick belt
+# rad²/s³, the rotation filter's white angular acceleration for a part riding a belt (it does not
+# spin: 1e-4 of the default ``rotation_estimator.Q_SPIN``, so that the yaw rate averages the fits
+# rather than following their jitter over the blind ~0.7 s before a grasp)
+BELT_SPIN_Q = 1.0e-7
 
 
 def camera_of(measurement: MeasurementConfig, pick: PickConfig):
@@ -205,7 +209,8 @@ def AddPartEstimates(builder: DiagramBuilder, depth_image, scenario) -> PartEsti
     belts = belt_regions(camera.belts)
     of = part_belts(pick) if not m.camera.belts else _nearest_belts(belts, pick)
     config = PerceptionConfig(camera_info(camera), camera_pose(camera), belts, camera.part_shape,
-                              list(camera.part_size), of, float(m.rate_hz), float(m.latency))
+                              list(camera.part_size), of, float(m.rate_hz), float(m.latency),
+                              check_above=True)
     perception, estimator = MakeRgbdPerception(config)
     builder.AddNamedSystem("rgbd_perception", perception)
     builder.Connect(depth_image, perception.get_input_port())
@@ -219,7 +224,7 @@ def AddPartEstimates(builder: DiagramBuilder, depth_image, scenario) -> PartEsti
         builder.Connect(perception.GetOutputPort(f"measurement_{k}"), kf.get_measurement_input_port())
         builder.Connect(kf.get_target_output_port(), parts.GetInputPort(f"estimate_{k}"))
         rf = builder.AddNamedSystem(f"part_rotation_filter_{k}",
-                                    RotationEstimator(config=filter_config, prior=[]))
+                                    RotationEstimator(config=filter_config, prior=[], q=BELT_SPIN_Q))
         builder.Connect(perception.GetOutputPort(f"measured_rotation_{k}"),
                         rf.get_measured_rotation_input_port())
         builder.Connect(rf.get_target_rotation_output_port(), parts.GetInputPort(f"rotation_{k}"))
