@@ -10,7 +10,7 @@ task becomes six prescribed-time segments (``worlds.pick.tasks`` has the plan).
 """
 
 from dataclasses import dataclass, field
-from typing import List
+from typing import List, Union
 
 @dataclass
 class GripperConfig:
@@ -56,8 +56,12 @@ class PartConfig:
     # m, box [x, y, z] (x: across the fingers when grasped) or cylinder [diameter, height]
     size: List[float] = field(default_factory=lambda: [0.03, 0.03, 0.03])
     offset: float = 0.0  # m, along the belt from its centre at t = 0 (negative: upstream)
-    lateral: float = 0.0  # m, across the belt from its centre line at t = 0 (+: left of the travel)
-    yaw_deg: float = 0.0  # deg, rotation about the vertical at t = 0
+    # m, across the belt from its centre line at t = 0 (+: left of the travel); or [min, max]:
+    # drawn uniformly from measurement.seed (random placement: needs a camera, worlds.pick.placement)
+    lateral: Union[List[float], float] = 0.0
+    # deg, rotation about the vertical at t = 0; or "random": drawn uniformly in [-180, 180)
+    yaw_deg: Union[float, str] = 0.0
+    offset_jitter: float = 0.0  # m, ± uniform jitter added to ``offset`` (random placement)
     mass: float = 0.1  # kg
     friction: float = 0.8  # 1, Coulomb friction coefficient of its surface (static = dynamic)
 

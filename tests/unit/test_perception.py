@@ -85,6 +85,16 @@ def test_occluded_part_is_a_dropout():
     assert all(f.reason for f in fits)
 
 
+def test_something_above_a_part_makes_its_fit_a_dropout_when_checked():
+    centre = np.array([0.30, 0.0, 0.115])
+    # a 10 mm box 80 mm above the part, beyond it from the camera: the top face stays in view
+    occluder = ([0.01, 0.01, 0.01], [0.33, 0.0, 0.21])
+    seen = StaticScene(camera(), [(centre, 0.0)], occluders=[occluder]).fits(0.0)[0]
+    checked = StaticScene(camera(), [(centre, 0.0)], occluders=[occluder], check_above=True).fits(0.0)[0]
+    assert len(good(seen)) == 1
+    assert checked and not good(checked) and "above it" in checked[0].reason
+
+
 def test_nothing_on_the_belt_gives_no_fit():
     assert StaticScene(camera(), []).fits(0.0)[0] == []
 

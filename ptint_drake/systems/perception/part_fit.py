@@ -231,7 +231,7 @@ def fit_part(points: np.ndarray, belt_index: int, shape: str, size, *, min_point
     expected = expected_top_points(shape, size, spacing) if spacing > 0.0 else 0.0
     if n < COMPLETE * expected:
         fit.ok, fit.reason = False, f"top face cut ({n} of ~{expected:.0f} points: occluded?)"
-    elif size_error > SIZE_TOLERANCE:
+    elif size_error > max(SIZE_TOLERANCE, 2.0 * footprint):  # (an edge is known to ± a pixel)
         fit.ok, fit.reason = False, f"top face {1000 * size_error:.1f} mm off the known size"
     elif flat > PLANE_TOLERANCE:
         fit.ok, fit.reason = False, f"top face not flat ({1000 * flat:.1f} mm RMS)"

@@ -50,6 +50,10 @@ from ptint_drake.systems.perception.part_fit import BeltRegion, belt_points, fit
 FIT_NOISE_STD = 0.0005
 VOXEL = 0.0015  # m, the voxel grid of the cloud (≈ 2 pixel footprints at 0.5 m)
 GATE = 0.05  # m, farthest a part moves between two accepted fits
+OCCLUDER_RADIUS = 0.05  # m, horizontal, around a fit's centre (half a 30 mm cube's diagonal + the
+# 28° tilt's shift of an occluder 40 mm above it)
+OCCLUDER_GAP = 0.008  # m, above the fitted top face
+OCCLUDER_HEIGHT = 0.25  # m, above the fitted top face
 TIME_TOL = 1.0e-9
 # per object and slot: [stamp, x, y, z, valid, R (9), inliers, residual, covariance diagonal (3)]
 _WIDTH = 19
@@ -69,6 +73,10 @@ class PerceptionConfig:
     object_belts: list
     rate_hz: float
     latency: float
+    # a good fit with anything in the cloud above it (within OCCLUDER_RADIUS of its centre, from
+    # OCCLUDER_GAP above its top to OCCLUDER_HEIGHT): a dropout (e.g. the gripper coming down over
+    # it hides part of its top face before the fit fails the completeness check)
+    check_above: bool = False
 
 
 class PartPoseEstimator(LeafSystem):
@@ -143,8 +151,26 @@ class PartPoseEstimator(LeafSystem):
         return kept.VoxelizedDownSample(VOXEL).xyzs().T
 
     def fit_frame(self, cloud: PointCloud) -> list:
-        return fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size,
+        fits = fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size,
                          footprint=self._footprint, spacing=max(VOXEL, 1.2 * self._footprint))
+        if self._c.check_above and any(f.ok for f in fits):
+            self._mark_covered(cloud, fits)
+        return fits
+
+    def _mark_covered(self, cloud: PointCloud, fits: list) -> None:
+        """``check_above``: a good fit with cloud points above it is a dropout."""
+        xyz = cloud.xyzs()
+        top = 0.5 * part_height(self._c.shape, self._c.size)
+        lo = min(f.position[2] for f in fits if f.ok) + top + OCCLUDER_GAP
+        with np.errstate(invalid="ignore"):
+            high = xyz[:, np.flatnonzero((xyz[2] > lo) & (xyz[2] < lo + OCCLUDER_HEIGHT))].T
+        for f in fits:
+            if not f.ok or len(high) == 0:
+                continue
+            above = high[high[:, 2] > f.position[2] + top + OCCLUDER_GAP]
+            near = np.hypot(above[:, 0] - f.position[0], above[:, 1] - f.position[1]) < OCCLUDER_RADIUS
+            if np.count_nonzero(near) >= 3:
+                f.ok, f.reason = False, f"{np.count_nonzero(near)} points above it (occluded?)"
 
     def _associate(self, fits: list, memory: np.ndarray) -> list:
         """Per object: its fit (or None) and the new memory row."""

@@ -26,7 +26,8 @@ class StaticScene:
     object rides (default: one object per part, on belt 0)."""
 
     def __init__(self, camera: RgbdCameraConfig, poses, *, rate_hz: float = 30.0, latency: float = 0.033,
-                 seed: int = 0, object_belts=None, perceive: bool = True, occluders=()):
+                 seed: int = 0, object_belts=None, perceive: bool = True, occluders=(),
+                 check_above: bool = False):
         builder = DiagramBuilder()
         scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
         belts = belt_regions(camera.belts)
@@ -52,7 +53,8 @@ class StaticScene:
         if perceive:
             config = PerceptionConfig(self.camera.info, self.camera.X_WC, belts, camera.part_shape,
                                       list(camera.part_size), list(object_belts if object_belts is not None
-                                                                   else [0] * n), rate_hz, latency)
+                                                                   else [0] * n), rate_hz, latency,
+                                      check_above)
             self.perception, self.estimator = MakeRgbdPerception(config)
             builder.AddSystem(self.perception)
             builder.Connect(self.camera.depth_image, self.perception.get_input_port())

@@ -46,10 +46,11 @@ def _check_part(k: int, part: PartConfig, belts: dict) -> None:
         raise ScenarioError(f"{where}.{'mass' if not part.mass > 0.0 else 'friction'}: must be positive")
     if part.belt not in belts:
         raise ScenarioError(f"{where}.belt: no belt named {part.belt!r}")
-    if abs(part.offset) > belts[part.belt].length / 2:
+    if abs(part.offset) + abs(part.offset_jitter) > belts[part.belt].length / 2:
         raise ScenarioError(f"{where}.offset: {part.offset} m starts the part off its belt "
                             f"(length {belts[part.belt].length} m)")
-    if abs(part.lateral) > belts[part.belt].width / 2:
+    lateral = part.lateral if isinstance(part.lateral, list) else [part.lateral]
+    if max(abs(v) for v in lateral) > belts[part.belt].width / 2:
         raise ScenarioError(f"{where}.lateral: {part.lateral} m puts the part's centre off its belt "
                             f"(width {belts[part.belt].width} m)")
 

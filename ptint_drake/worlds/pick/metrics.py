@@ -99,11 +99,14 @@ def segment_rows(built, aims: dict) -> list:
     return rows
 
 
-def _place_angle(R: np.ndarray, yaw: float, shape: str) -> float:
+def _place_angle(R: np.ndarray, yaw: float, shape: str, size=(1.0, 0.0)) -> float:
+    """deg from the slot's pose, folded by the part's symmetry about the vertical: any turn for a
+    cylinder (the tilt only), 90° for a square-topped box, 180° for another box."""
     if shape == "cylinder":  # its turn about its own axis does not matter: the tilt only
         return float(np.degrees(np.arccos(np.clip(R[2, 2], -1.0, 1.0))))
+    turns = (0.0, np.pi, 0.5 * np.pi, -0.5 * np.pi) if abs(size[0] - size[1]) < 1e-9 else (0.0, np.pi)
     return float(min(np.degrees(rotation_angle(R, RotationMatrix.MakeZRotation(yaw + turn).matrix()))
-                     for turn in (0.0, np.pi)))
+                     for turn in turns))
 
 
 def _first(t: np.ndarray, mask: np.ndarray):
@@ -180,7 +183,7 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
             "slip_mm": None if slip is None else 1e3 * slip,
             "peak_grip_force_N": float(np.max(grip[in_carry])) if np.any(in_carry) else 0.0,
             "place_error_mm": float(1e3 * np.linalg.norm(block[-1, 0:3] - place)),
-            "place_error_deg": _place_angle(R_end, place_yaw, part.shape),
+            "place_error_deg": _place_angle(R_end, place_yaw, part.shape, part.size),
             "collision": collision}
 
 
@@ -206,6 +209,9 @@ def pick_reasons(picks: list) -> list:
         if p["collision"]:
             out.append((k, "collision with " + ", ".join(p["collision_with"]) if p.get("collision_with")
                         else "collision"))
+        if p.get("retry_refused") == "part not seen":  # (an rgbd camera never saw it: no grasp)
+            out.append((k, "part not seen"))
+            continue
         if not p["grasp_confirmed"]:
             alone = p["attempts"] == 1 and p["retry_refused"] == "out of retries"
             out.append((k, "empty grasp" if alone else "missed after retry"))

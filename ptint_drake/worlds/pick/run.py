@@ -30,7 +30,9 @@ from ptint_drake.robot import actuator_effort_limits, nominal_plant
 from ptint_drake.systems.gripper import GraspObserver
 from ptint_drake.systems.kinematics import FrameKinematics
 from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
+from ptint_drake.worlds.pick.camera import AddPartEstimates, PartEstimates
 from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
+from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.worlds.pick.probe import PickProbe
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
@@ -44,9 +46,10 @@ def world_config(scenario: Scenario) -> PickWorldConfig:
     """The pick world of a scenario: its robot, its ``multibody`` plant settings (default: 1 ms,
     point contact, SAP) and its ``pick`` block."""
     mb, p = scenario.multibody, scenario.pick
+    seed = scenario.measurement.seed if scenario.measurement is not None else 0
     config = PickWorldConfig(model=scenario.robot.model, end_effector=scenario.robot.end_effector,
                              initial_q_deg=list(scenario.robot.initial_q_deg), gripper=p.gripper,
-                             belts=p.belts, parts=p.parts, tray=p.tray)
+                             belts=p.belts, parts=placed_parts(p.parts, seed), tray=p.tray)
     if mb is not None:
         config.time_step = mb.time_step
         config.contact_approximation = mb.discrete_contact_approximation or DEFAULT_APPROXIMATION
@@ -75,6 +78,14 @@ class PickBuilt:
     arm: object  # the arm's model alone (continuous, nominal): the controller's kinematics
     limits: np.ndarray  # the arm's effort limits (N·m)
     observer: GraspObserver = None  # the grasp state (systems.gripper)
+    estimates: PartEstimates = None  # with an rgbd camera: what the pick aims at (pick.camera)
+
+    def part_system(self):
+        """The system whose ``part_k_pose`` / ``part_k_rotation`` the targets read: the camera's
+        estimates, or the station's simulated poses."""
+        if self.estimates is not None:
+            return self.estimates.parts
+        return self.diagram.GetSubsystemByName("pick_station")
 
 
 def place_positions(station: PickStation, plan: PickPlan) -> list:
@@ -95,14 +106,18 @@ def place_positions(station: PickStation, plan: PickPlan) -> list:
 def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuilt:
     """The pick scenario's diagram (module docstring), its plan with the ``replans`` a run decided."""
     builder = DiagramBuilder()
-    station = MakePickStation(world_config(scenario))
+    station = MakePickStation(world_config(scenario), scenario.measurement)
     st = builder.AddNamedSystem("pick_station", station.diagram)
     plan = pick_plan(scenario.pick, replans)
     n = len(station.parts)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, place_positions(station, plan)))
+    estimates, parts = None, st
+    if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
+        estimates = AddPartEstimates(builder, st.GetOutputPort("depth_image"), scenario)
+        parts = estimates.parts
     for k in range(n):
-        builder.Connect(st.GetOutputPort(f"part_{k}_pose"), targets.GetInputPort(f"part_{k}_pose"))
-        builder.Connect(st.GetOutputPort(f"part_{k}_rotation"), targets.GetInputPort(f"part_{k}_rotation"))
+        builder.Connect(parts.GetOutputPort(f"part_{k}_pose"), targets.GetInputPort(f"part_{k}_pose"))
+        builder.Connect(parts.GetOutputPort(f"part_{k}_rotation"), targets.GetInputPort(f"part_{k}_rotation"))
     arm = nominal_plant(scenario)
     limits = actuator_effort_limits(arm)
     saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
@@ -137,7 +152,7 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
     install_stateless_derivatives(diagram)  # as simulation.build: Drake's nanobind bindings
-    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits, observer)
+    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits, observer, estimates)
 
 
 def _probe(station: PickStation) -> PickProbe:
@@ -234,12 +249,12 @@ def segment_aims(built: PickBuilt, context) -> dict:
     plant = station.plant
     pc = plant.GetMyContextFromRoot(context)
     tool = plant.GetFrameByName("fingertip_center", station.gripper).CalcPoseInWorld(pc)
-    diagram_station = built.diagram.GetSubsystemByName("pick_station")
-    sc = diagram_station.GetMyContextFromRoot(context)
+    source = built.part_system()  # what the targets read: the estimates with a camera
+    sc = source.GetMyContextFromRoot(context)
     tc = built.targets.GetMyContextFromRoot(context)
     latched = tc.get_discrete_state(0).get_value().copy()
-    parts = [(diagram_station.GetOutputPort(f"part_{k}_pose").Eval(sc).copy(),
-              diagram_station.GetOutputPort(f"part_{k}_rotation").Eval(sc).copy())
+    parts = [(source.GetOutputPort(f"part_{k}_pose").Eval(sc).copy(),
+              source.GetOutputPort(f"part_{k}_rotation").Eval(sc).copy())
              for k in range(len(station.parts))]
     return {"tool": (tool.translation().copy(), tool.rotation().matrix().copy()), "parts": parts,
             "latched": latched}

@@ -30,6 +30,8 @@ port                size     meaning
 ``body_poses``      —        output: the plant's body poses (for logging parts, belts, fingers)
 ``plant_state``     —        output: the whole plant's [q; v] (arm, fingers, belts, parts: a replay)
 ``query_object``    —        output: SceneGraph's QueryObject (Meshcat / replay illustration)
+``color_image``     —        output (``measurement.sensor: rgbd`` only): the camera's colour image
+``depth_image``     —        output (rgbd only): its depth image with the sensor's noise (m)
 ==================  =======  ================================================================
 
 Defaults hold the world: the arm at ``initial_q_deg`` at rest, the fingers at
@@ -50,6 +52,7 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
+from ptint_drake.worlds.pick.camera import AddPickCamera
 from ptint_drake.worlds.pick.collisions import CollisionProbe
 from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
 from ptint_drake.worlds.pick.part_pose import PartPoses
@@ -134,8 +137,10 @@ def _add_world(plant: MultibodyPlant, scene_graph: SceneGraph, config: PickWorld
     return arm, gripper, belts, parts, slots
 
 
-def MakePickStation(config: PickWorldConfig) -> PickStation:
-    """The pick-and-place station of ``config`` (see the module docstring for its ports)."""
+def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
+    """The pick-and-place station of ``config`` (see the module docstring for its ports); with
+    ``measurement`` (``sensor: rgbd``) it also renders its scene graph through the camera
+    (``pick.camera.AddPickCamera``) and exports ``color_image`` and ``depth_image``."""
     check_pick_world(config)
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(
@@ -175,6 +180,10 @@ def MakePickStation(config: PickWorldConfig) -> PickStation:
     builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     builder.ExportOutput(plant.get_state_output_port(), "plant_state")
     builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
+    if measurement is not None and measurement.sensor == "rgbd":
+        camera = AddPickCamera(builder, scene_graph, measurement, config)
+        builder.ExportOutput(camera.color_image, "color_image")
+        builder.ExportOutput(camera.depth_image, "depth_image")
     diagram = builder.Build()
     diagram.set_name("pick_station")
     return PickStation(diagram, plant, scene_graph, config, arm, gripper, belts, parts, slots, driver,

@@ -45,7 +45,11 @@ def robust_sample(scenario, name: str, seed: int, u):
     belts = {b.name: b for b in pick.belts}
     for part in pick.parts:
         half = belts[part.belt].width / 2 if part.belt in belts else 0.0
-        part.lateral = float(np.clip(part.lateral + u("part_lateral"), -half, half))
+        shift = float(u("part_lateral"))
+        if not isinstance(part.lateral, list):  # a [min, max] range is drawn from measurement.seed
+            part.lateral = float(np.clip(part.lateral + shift, -half, half))
+    if scenario.measurement is not None:  # a camera's noise and the random placement: this sample's
+        scenario.measurement.seed = seed
     scenario.name = f"{name}_seed{seed}"
     return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
                       "part_friction": [p.friction for p in pick.parts],

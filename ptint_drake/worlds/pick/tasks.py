@@ -127,8 +127,9 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, sta
             t += hold
         grasp = t + task.descend.tf  # prescribed, even where the descend is cut short
         last = replan.abort if replan.abort is not None else np.inf
-        t = add("descend", "part", part, _up(0.0), 0.0, t, attempt,
-                retries[attempt] if attempt < len(retries) else last)
+        if attempt < len(retries) or last > t + 1e-9:  # an abort at the descend's start: none
+            t = add("descend", "part", part, _up(0.0), 0.0, t, attempt,
+                    retries[attempt] if attempt < len(retries) else last)
         attempts.append((approach, grasp))
     if replan.abort is not None:
         t = add("backoff", "latched", part, _up(task.clearance), 0.0, replan.abort, len(retries))
@@ -163,7 +164,9 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
             close = grasp - 0.5 * task.margin / pick.gripper.speed + task.close_delay
             if j == 0 and first_close is not None:
                 close = first_close  # the test option (PickConfig.test_close_advance_s)
-            commands += [((replan.retries[j - 1] if j else approach), opening), (close, 0.0)]
+            commands.append(((replan.retries[j - 1] if j else approach), opening))
+            if not (j == len(replan.retries) and replan.abort is not None and replan.abort <= close):
+                commands.append((close, 0.0))  # (an abort before the close: no grasp is attempted)
             check = replan.retries[j] if j < len(replan.retries) else grasp + task.dwell + replan.lift_delay
             if j == len(replan.retries) and replan.abort is not None:
                 check = replan.abort

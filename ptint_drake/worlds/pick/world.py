@@ -39,10 +39,12 @@ from ptint_drake.metrics import Reason, drive_metrics
 from ptint_drake.run_warnings import sampled_control_warnings
 from ptint_drake.worlds.base import World, WorldRun
 from ptint_drake.worlds.pick import studies
+from ptint_drake.worlds.pick.camera import check_pick_camera, estimate_metrics
 from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
+from ptint_drake.worlds.pick.placement import check_placement
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
                                          pick_simulator, segment_aims)
 from ptint_drake.reachability import inverse_kinematics
@@ -71,6 +73,7 @@ class PickRun(WorldRun):
         # per task, per attempt: {"state": the observer's at the check, "t": the check's time}
         self.checks: list[list[dict]] = [[] for _ in range(n)]
         self.refused: list = [None] * n  # why a retry was not planned (out of reach / of retries)
+        self.estimates: dict = {}  # with a camera, per task: the estimate at the grasp and the truth
         self.end = scenario.duration
         self._tail = scenario.duration - self.built.plan.end  # kept after a lengthened plan
         self._pieces: list = []  # the logs of the diagrams a replan replaced
@@ -108,8 +111,12 @@ class PickRun(WorldRun):
 
     def at_stop(self, context, t: float) -> None:
         self._aims[t] = segment_aims(self.built, context)
+        if self.built.estimates is not None:
+            self._record_estimate(context, t)
         for k, attempts in enumerate(self.built.plan.attempts):
             if len(self.checks[k]) >= len(attempts):
+                continue
+            if self.built.estimates is not None and self._unseen(context, k, t):
                 continue
             if abs(attempts[-1].check - t) < 1e-9:
                 self._check(context, k, t, self._grasp_state(context))
@@ -117,6 +124,42 @@ class PickRun(WorldRun):
                 state = self._grasp_state(context)
                 if state in (EMPTY, LOST):  # nothing between the fingers: no need to wait for the check
                     self._check(context, k, t, state)
+
+    def _unseen(self, context, k: int, t: float) -> bool:
+        """With a camera, at task k's descend start: record its part's estimate against the truth
+        (``estimates``); if the part was never seen, no grasp: the task backs off at once (no close
+        command) and its check reads ``part not seen``.  True when it did."""
+        plan = self.built.plan
+        i = plan.segment_index(k, "descend")
+        last = plan.segments[i].attempt == len(plan.attempts[k]) - 1
+        if not last or abs(plan.schedule.segments[i].start - t) > 1e-9:
+            return False
+        part = plan.segments[i].index
+        parts = self.built.estimates.parts
+        if parts.GetOutputPort("seen").Eval(parts.GetMyContextFromRoot(context))[part] > 0.5:
+            return False
+        self.checks[k].append({"state": "not seen", "t": t})
+        self.refused[k] = "part not seen"
+        self.replans[k] = Replan(self.replans[k].retries, 0.0, abort=t)
+        self._rebuild()
+        return True
+
+    def _record_estimate(self, context, t: float) -> None:
+        """With a camera, at a task's prescribed grasp: the estimate the grasp latches and the truth."""
+        plan = self.built.plan
+        for k, grasp in enumerate(plan.grasp_times):
+            if abs(grasp - t) > 1e-9:
+                continue
+            part = plan.segments[plan.segment_index(k, "approach")].index
+            station = self.built.diagram.GetSubsystemByName("pick_station")
+            sc = station.GetMyContextFromRoot(context)
+            parts = self.built.estimates.parts
+            pc = parts.GetMyContextFromRoot(context)
+            self.estimates[k] = {name: port.Eval(c)[:size].copy() for name, port, c, size in (
+                ("true", station.GetOutputPort(f"part_{part}_pose"), sc, 3),
+                ("true_R", station.GetOutputPort(f"part_{part}_rotation"), sc, 9),
+                ("estimate", parts.GetOutputPort(f"part_{part}_pose"), pc, 3),
+                ("estimate_R", parts.GetOutputPort(f"part_{part}_rotation"), pc, 9))}
 
     def _grasp_state(self, context) -> int:
         observer = self.built.observer
@@ -152,7 +195,8 @@ class PickRun(WorldRun):
         part = [p.name for p in built.station.config.parts].index(task.part)
         station = built.diagram.GetSubsystemByName("pick_station")
         sc = station.GetMyContextFromRoot(context)
-        pose = station.GetOutputPort(f"part_{part}_pose").Eval(sc)
+        source = built.part_system()  # the estimate with a camera
+        pose = source.GetOutputPort(f"part_{part}_pose").Eval(source.GetMyContextFromRoot(context))
         q = station.GetOutputPort("state").Eval(sc)[:built.arm.num_positions()]
         x = pose[0:3] + pose[3:6] * (grasp - t)
         frame = built.arm.GetFrameByName(self.scenario.robot.end_effector)
@@ -209,6 +253,7 @@ class PickRun(WorldRun):
         series = pick_series(built, logs)
         metrics = pick_metrics(self.scenario, built, logs, segment_rows(built, self._aims),
                                {"checks": self.checks, "refused": self.refused, "end": self.end})
+        estimate_metrics(self.scenario, metrics["picks"], self.estimates)
         metrics |= drive_metrics(built.plan.schedule, series["t"], series["tau"], series["tau_applied"],
                                  series["v"], built.limits)
         return metrics, series, []
@@ -233,9 +278,10 @@ class PickWorld(World):
         if s.interceptions:
             raise ScenarioError("interceptions: a pick scenario's segments come from pick.tasks; leave "
                                 "interceptions out")
-        if s.measurement is not None:
-            raise ScenarioError("measurement: a pick scenario aims at the parts' simulated poses; a camera "
-                                "is not modelled there (leave measurement out)")
+        if s.measurement is not None and s.measurement.sensor != "rgbd":
+            raise ScenarioError("measurement.sensor: a pick scenario sees its parts through an rgbd camera "
+                                "(sensor: rgbd) or aims at their simulated poses (leave measurement out)")
+        check_placement(s.pick, s.measurement)  # random placement needs the camera
         if s.controller.task != "top_down":
             raise ScenarioError(f"controller.task: a pick grasps from above: top_down, "
                                 f"got {s.controller.task!r}")
@@ -248,6 +294,7 @@ class PickWorld(World):
                                  m.contact_model, SCENARIO_PLANT_FIELDS)
         check_pick_parts(s.pick)
         check_tasks(s.pick)
+        check_pick_camera(s)  # the parts in the camera's view (nothing to see: rejected)
         end = pick_plan(s.pick).end
         if s.duration < end:
             raise ScenarioError(f"duration: {s.duration:g} s ends before the pick tasks do ({end:.3g} s)")

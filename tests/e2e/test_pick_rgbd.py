@@ -1,0 +1,45 @@
+"""A pick and place that sees its part through a rendered RGB-D camera (issue 34)."""
+
+import numpy as np
+from conftest import run_cached
+
+from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation import simulate
+from ptint_drake.systems.perception import part_pose_estimator
+
+
+def test_conveyor_pick_place_rgbd_places_a_randomly_placed_part_from_depth_images():
+    result = run_cached("conveyor_pick_place_rgbd")
+    (pick,) = result.metrics["picks"]
+    assert result.ok, result.metrics.get("reasons")
+    assert pick["placed"] and pick["seen"]
+    assert pick["place_error_mm"] <= 3.0 and pick["place_error_deg"] <= 3.0
+    assert pick["estimate_error_mm"] <= 3.0 and pick["estimate_error_deg"] <= 3.0
+
+
+def test_a_part_never_seen_is_not_grasped():
+    # the perception looks for parts on a belt 0.3 m beside the real one: nothing is ever fitted
+    elsewhere = ("measurement: {camera: {belts: [{center: [0.6, 0.0, 0.135], direction: [0.0, 1.0, 0.0], "
+                 "length: 1.2, width: 0.09}]}}")
+    result = run_cached("conveyor_pick_place_rgbd", elsewhere)
+    (pick,) = result.metrics["picks"]
+    assert not result.ok
+    assert not pick["seen"] and not pick["grasped"]
+    assert all(d["peak_grip_force_N"] == 0.0 for d in pick["attempt_details"])
+    assert result.metrics["reasons"] == ["pick 0: part not seen"]
+
+
+def test_a_fit_forced_wrong_makes_the_pick_fail(monkeypatch):
+    real = part_pose_estimator.fit_parts
+
+    def shifted(*args, **kwargs):  # every fit 12 mm off along the pads (the part's y)
+        fits = real(*args, **kwargs)
+        for f in fits:
+            f.position = f.position + np.array([0.012, 0.0, 0.0])
+        return fits
+
+    monkeypatch.setattr(part_pose_estimator, "fit_parts", shifted)
+    result = simulate(load_scenario("conveyor_pick_place_rgbd"))
+    (pick,) = result.metrics["picks"]
+    assert not result.ok and not pick["placed"]
+    assert pick["estimate_error_mm"] > 10.0

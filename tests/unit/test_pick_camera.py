@@ -1,0 +1,94 @@
+"""The pick world with an RGB-D camera (issue 34): random placement, the wiring (the targets read
+the estimates, the perception only the depth image), symmetry, and the rejections before a run."""
+
+import numpy as np
+import pytest
+from pydrake.math import RotationMatrix
+
+from ptint_drake import cli
+from ptint_drake.config.pick import PartConfig
+from ptint_drake.scenario import load_scenario
+from ptint_drake.worlds.pick.metrics import _place_angle
+from ptint_drake.worlds.pick.placement import nominal_parts, placed_parts
+from ptint_drake.worlds.pick.run import build_pick
+from ptint_drake.worlds.pick.tasks import Replan, pick_plan
+
+
+def test_random_placement_is_drawn_from_the_seed_within_its_ranges():
+    parts = [PartConfig(yaw_deg="random", lateral=[-0.015, 0.015], offset=-0.15, offset_jitter=0.02)]
+    draws = [placed_parts(parts, seed)[0] for seed in range(20)]
+    assert all(-0.015 <= p.lateral <= 0.015 and abs(p.offset + 0.15) <= 0.02 for p in draws)
+    assert all(-180.0 <= p.yaw_deg < 180.0 for p in draws)
+    assert len({round(p.yaw_deg, 6) for p in draws}) == 20  # a new yaw per seed
+    assert placed_parts(parts, 3)[0] == placed_parts(parts, 3)[0]
+    nominal = nominal_parts(parts)[0]
+    assert (nominal.yaw_deg, nominal.lateral, nominal.offset) == (0.0, 0.0, -0.15)
+    fixed = [PartConfig(yaw_deg=30.0, lateral=0.01)]
+    assert placed_parts(fixed, 1) is fixed  # nothing random: the same parts
+
+
+def test_the_targets_read_the_estimates_and_the_perception_only_the_image():
+    built = build_pick(load_scenario("conveyor_pick_place_rgbd"))
+    links = built.diagram.connection_map()
+    station = built.diagram.GetSubsystemByName("pick_station")
+    sources = {(s.get_name(), s.get_output_port(p).get_name()) for (d, i), (s, p) in links.items()
+               if d is built.targets}
+    assert sources == {("estimated_parts", "part_0_pose"), ("estimated_parts", "part_0_rotation")}
+    perception = built.diagram.GetSubsystemByName("rgbd_perception")
+    feeds = [(s, s.get_output_port(p).get_name()) for (d, i), (s, p) in links.items() if d is perception]
+    assert feeds == [(station, "depth_image")] and perception.num_input_ports() == 1
+
+
+def test_the_place_angle_folds_by_the_parts_symmetry():
+    R = RotationMatrix.MakeZRotation(np.radians(90.0)).matrix()
+    assert _place_angle(R, 0.0, "box", [0.03, 0.03, 0.03]) == pytest.approx(0.0, abs=1e-9)
+    assert _place_angle(R, 0.0, "box", [0.03, 0.02, 0.03]) == pytest.approx(90.0)
+    assert _place_angle(RotationMatrix.MakeZRotation(2.0).matrix(), 0.0, "cylinder", [0.03, 0.03]) == \
+        pytest.approx(0.0, abs=1e-6)
+
+
+def test_an_unseen_part_gets_no_descend_and_no_close_command():
+    pick = load_scenario("conveyor_pick_place_rgbd").pick
+    plan = pick_plan(pick)
+    descend = plan.schedule.segments[plan.segment_index(0, "descend")].start
+    aborted = pick_plan(pick, (Replan((), 0.0, abort=descend),))
+    assert [s.phase for s in aborted.segments][:2] == ["approach", "backoff"]
+    assert all(opening > 0.0 for _, opening in aborted.commands)  # the fingers never close
+    assert any(opening == 0.0 for _, opening in plan.commands)
+
+
+@pytest.mark.parametrize("setting, field", [
+    ("measurement=null", "pick.parts[0].yaw_deg"),  # random placement needs the camera
+    ("measurement.camera.look_at=[0.9, 0.9, 0.65]", "measurement.camera"),  # pointed away
+    ("measurement.sensor=pose", "measurement.camera"),
+    ("pick.parts[0].yaw_deg=sideways", "pick.parts[0].yaw_deg"),
+    ("pick.parts[0].lateral=[0.01, -0.01]", "pick.parts[0].lateral"),
+    ("pick.parts[0].offset_jitter=-0.01", "pick.parts[0].offset_jitter"),
+])
+def test_no_camera_or_one_pointed_away_is_rejected_before_the_run(setting, field, capsys, tmp_path):
+    code = cli.main(["run", "conveyor_pick_place_rgbd", "--set", setting, "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1 and f"{field}" in err, err
+    assert not (tmp_path / "o").exists()
+
+
+def test_parts_of_different_sizes_are_rejected_with_a_camera(capsys, tmp_path):
+    code = cli.main(["run", "assembly_pick_place_rgbd", "--set", "pick.parts[1].size=[0.03, 0.02, 0.03]",
+                     "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "pick.parts[1]" in err, err
+
+
+def test_a_robust_sample_of_an_rgbd_pick_draws_a_new_placement():
+    from ptint_drake.worlds.pick import studies  # noqa: PLC0415
+
+    middle = {"mass": 1.0, "part_mass": 0.1, "part_friction": 0.8, "belt_speed": 1.0}
+
+    def draw(seed):
+        scenario, _ = studies.robust_sample(load_scenario("conveyor_pick_place_rgbd"), "c", seed,
+                                            lambda name, n=None: middle.get(name, 0.0))
+        return placed_parts(scenario.pick.parts, scenario.measurement.seed)[0]
+
+    a, b = draw(3), draw(4)
+    assert a.yaw_deg != b.yaw_deg and a.lateral != b.lateral
