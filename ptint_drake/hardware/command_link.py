@@ -65,6 +65,7 @@ from ptint_drake.robot import actuator_effort_limits
 
 HOLD_OMEGA = 40.0  # rad/s: the hold's natural frequency (critically damped); settles in ~0.15 s
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
+QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
 
 
 class LinkFault(Exception):
@@ -307,10 +308,28 @@ class HardwareSession:
                 f"{self.endpoint.url} (channel {self.endpoint.listen}): is `ptint drive` running?"
             )
         self.handshake_s = time.perf_counter() - start
+        self._quiet()
         self.record.rtt.clear()  # the start-up wait is no round trip
         self.record.accepted = 0
         # the tick at t = 0 samples the arm after the plant's first step: a new status of t = 0
         self._answered, self._answered_tau, self._after_handshake = None, None, True
+
+    def _quiet(self) -> None:
+        """After the hand-shake: take the drive's answers to the hand-shake's re-sent statuses
+        (stamped t = 0 like the first tick's) until none came for ``QUIET`` s (at most
+        ``QUIET_MAX``), so that none of them is taken for the first tick's answer."""
+        start = last = time.perf_counter()
+        while True:
+            got = self.endpoint.poll(0.01)
+            if self.pick is not None:
+                for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
+                    self._check_gripper(0.0, message)
+            now = time.perf_counter()
+            if got:
+                self.record.duplicates += len(got)
+                last = now
+            if now - last >= QUIET or now - start >= QUIET_MAX:
+                return
 
     def exchange(
         self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
