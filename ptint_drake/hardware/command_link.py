@@ -141,6 +141,10 @@ class HardwareSession:
         self._companions: list = []  # this tick's gripper status and parts messages (pick world)
         self.handshake_s: Optional[float] = None  # wall s the hand-shake took
         self.builds = 0  # CommandLinks built in this session (more than one: a pick replanned)
+        self.watch = (
+            None  # a ``link.SenderWatch`` of the command channels (udpm URLs), set by ``sim_hardware``
+        )
+        self._controller: Optional[tuple] = None  # the source address of the first command (the controller)
 
     # -- the protocol -------------------------------------------------------------------------
     def _publish(self, data: bytes) -> float:
@@ -246,6 +250,24 @@ class HardwareSession:
         got = self._wsg.get(utime)
         return None if got is None else got[0]
 
+    def _check_senders(self, t: float) -> None:
+        """Every packet on the command channels must come from the controller's address (the first
+        command's): another is a second sender (``link.SenderWatch``)."""
+        if self.watch is None:
+            return
+        for channel, source in self.watch.senders():
+            if self._controller is None:
+                self._controller = source
+            elif source != self._controller:
+                self._fail(
+                    t,
+                    "second sender",
+                    f"a command on {channel} from a second sender at t = {t:.3f} s "
+                    f"(from {source[0]}:{source[1]}; the controller sends from "
+                    f"{self._controller[0]}:{self._controller[1]})",
+                )
+                return
+
     def _complete(self, utime: int, wsg: Optional[int]) -> bool:
         """Whether the answer to the status of ``utime`` is in: the arm's command, and in the pick
         world the gripper command for the driver's tick ``wsg``."""
@@ -263,6 +285,7 @@ class HardwareSession:
             step = min(deadline - now, self.s.resend) if resend else deadline - now
             for t_recv, message in self.endpoint.poll(max(step, 0.0)):
                 self._check(t, message, t_recv)
+            self._check_senders(t)
             if self.pick is not None:
                 for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
                     self._check_gripper(t, message)
@@ -321,6 +344,7 @@ class HardwareSession:
         start = last = time.perf_counter()
         while True:
             got = self.endpoint.poll(0.01)
+            self._check_senders(0.0)
             if self.pick is not None:
                 for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
                     self._check_gripper(0.0, message)

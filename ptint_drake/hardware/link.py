@@ -37,6 +37,8 @@ LCM carries no sender identity and no authentication: the default URL stays on t
 
 from __future__ import annotations
 
+import socket
+import struct
 import time
 import urllib.parse
 from typing import Optional
@@ -118,6 +120,67 @@ class Endpoint:
             pass
         out, self.inbox = self.inbox, []
         return out
+
+
+LCM_SHORT, LCM_FRAGMENT = 0x4C433032, 0x4C433033  # "LC02", "LC03": the magic of LCM's UDP packets
+
+
+class SenderWatch:
+    """Who publishes on some channels of a ``udpm://`` LCM group: a plain UDP socket joined to the
+    group beside LCM's own (both bind the port with ``SO_REUSEADDR``: each gets every packet),
+    reading each packet's source address and channel (LCM's packet header: magic, sequence
+    number, then the NUL-terminated channel; a fragmented message names its channel in its first
+    fragment).  Every process's LCM sends from a socket of its own, so two processes publishing
+    on one channel show two source addresses — a sender identity LCM's messages do not carry.
+    Unlike a ``DrakeLcm`` subscription, whose queue holds one message (pydrake's ``Subscribe``
+    returns no handle to deepen it), the kernel's socket buffer keeps every packet until read."""
+
+    def __init__(self, url: str, channels: tuple):
+        parsed = urllib.parse.urlparse(url)
+        group, port = parsed.hostname, parsed.port
+        self.channels = {c.encode() for c in channels}
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        if hasattr(socket, "SO_REUSEPORT"):
+            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        self.sock.bind(("", port))
+        membership = struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("0.0.0.0"))
+        self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
+        self.sock.setblocking(False)
+
+    @staticmethod
+    def for_url(url: str, channels: tuple) -> Optional["SenderWatch"]:
+        """A watch of ``url``'s group, or None where there is none (``memq://``) or the socket
+        cannot join it."""
+        if urllib.parse.urlparse(url).scheme != "udpm":
+            return None
+        try:
+            return SenderWatch(url, channels)
+        except OSError:
+            return None
+
+    def senders(self) -> list[tuple[str, tuple]]:
+        """(channel, source address) of every packet on the watched channels received since the
+        last call, oldest first."""
+        out = []
+        while True:
+            try:
+                data, source = self.sock.recvfrom(65536)
+            except (BlockingIOError, InterruptedError):
+                return out
+            if len(data) < 8:
+                continue
+            magic = struct.unpack(">I", data[:4])[0]
+            start = 8 if magic == LCM_SHORT else 20 if magic == LCM_FRAGMENT else None
+            if start is None or (magic == LCM_FRAGMENT and struct.unpack(">H", data[16:18])[0] != 0):
+                continue  # not LCM, or a later fragment (no channel name)
+            end = data.find(b"\0", start)
+            channel = data[start:end] if end > 0 else b""
+            if channel in self.channels:
+                out.append((channel.decode(), source))
+
+    def close(self) -> None:
+        self.sock.close()
 
 
 def utime_of(t: float) -> int:

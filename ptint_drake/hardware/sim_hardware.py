@@ -37,6 +37,7 @@ from ptint_drake.hardware.link import (
     WSG_COMMAND_CHANNEL,
     WSG_STATUS_CHANNEL,
     Endpoint,
+    SenderWatch,
     spread,
     url_warning,
 )
@@ -130,6 +131,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "realtime_rate": None if settings.lockstep else settings.realtime_rate,
         "joints": session.n,
         "command_timeout_s": settings.command_timeout,
+        "sender_check": "source address" if session.watch is not None else "stamps only",
         "handshake_s": handshake_s,
         "round_trip_ms": spread(r.rtt, 1e3),
         "achieved_period_ms": spread(periods, 1e3),
@@ -190,6 +192,7 @@ def run_hardware(
     if risk:
         warn(risk)
     session = HardwareSession(endpoint, n, actuator_effort_limits(plant), settings)
+    session.watch = SenderWatch.for_url(endpoint.url, (COMMAND_CHANNEL, WSG_COMMAND_CHANNEL))
     if pick is not None:
         session.pick = PickLink(parts=len(pick.parts), max_force=pick.gripper.max_force)
     token = ACTIVE.set(session)
@@ -197,6 +200,8 @@ def run_hardware(
         result = simulate(hw, progress=progress, warn=warn)
     finally:
         ACTIVE.reset(token)
+        if session.watch is not None:
+            session.watch.close()
     handshake_s = session.handshake_s
     metrics = result.metrics
     record = session.record
