@@ -231,10 +231,16 @@ def cmd_hardware(args: argparse.Namespace) -> int:
         return 1
     link = metrics["hardware"]
     _print_link(link)
-    _print_segments(scenario.name, metrics["segments"])
     if link["fault"]:
+        if scenario.pick is None:
+            _print_segments(scenario.name, metrics["segments"])
         _print_fault(link, out)
         return 1
+    if scenario.pick is not None:  # the pick world's lines and verdict, as `ptint run` prints them
+        from ptint_drake.worlds.registry import world_of  # noqa: PLC0415
+
+        return world_of(scenario).report(scenario, metrics, out)
+    _print_segments(scenario.name, metrics["segments"])
     if metrics["status"] != "ok":
         print(f"{scenario.name}: {metrics['status'].upper()} ({'; '.join(metrics['reasons'])}); wrote {out}/")
         return 1

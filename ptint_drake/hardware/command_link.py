@@ -46,12 +46,26 @@ from typing import Optional
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
+from pydrake.systems.primitives import Multiplexer
 
-from ptint_drake.hardware.link import Endpoint, pack_status, unpack_command, utime_of
+from ptint_drake.hardware.link import (
+    PARTS_CHANNEL,
+    WSG_COMMAND_CHANNEL,
+    WSG_STATUS_CHANNEL,
+    PART_SIZE,
+    Endpoint,
+    pack_parts,
+    pack_status,
+    pack_wsg_status,
+    unpack_command,
+    unpack_wsg_command,
+    utime_of,
+)
 from ptint_drake.robot import actuator_effort_limits
 
 HOLD_OMEGA = 40.0  # rad/s: the hold's natural frequency (critically damped); settles in ~0.15 s
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
+QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
 
 
 class LinkFault(Exception):
@@ -76,6 +90,14 @@ class LinkSettings:
 
 
 @dataclass
+class PickLink:
+    """The pick world's part of the link: the parts' count and the gripper's force limit (N)."""
+
+    parts: int
+    max_force: float
+
+
+@dataclass
 class LinkRecord:
     """What the hardware side measured of the link."""
 
@@ -89,6 +111,7 @@ class LinkRecord:
     duplicates: int = 0  # a command repeated for its status (an answer to a re-sent status)
     late: int = 0  # real time: ticks whose command did not arrive within the budget
     late_commands: int = 0  # commands that arrived after their tick
+    gripper_commands: int = 0  # gripper commands taken (pick world)
     fault: Optional[str] = None
     fault_time: Optional[float] = None
     fault_kind: Optional[str] = None
@@ -111,9 +134,22 @@ class HardwareSession:
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
         self._after_handshake = False
+        self.pick: Optional[PickLink] = None  # set for the pick world (``sim_hardware``)
+        self._wsg: dict[
+            int, tuple[float, float]
+        ] = {}  # gripper commands: driver's tick utime → (opening, force)
+        self._companions: list = []  # this tick's gripper status and parts messages (pick world)
+        self.handshake_s: Optional[float] = None  # wall s the hand-shake took
+        self.builds = 0  # CommandLinks built in this session (more than one: a pick replanned)
+        self.watch = (
+            None  # a ``link.SenderWatch`` of the command channels (udpm URLs), set by ``sim_hardware``
+        )
+        self._controller: Optional[tuple] = None  # the source address of the first command (the controller)
 
     # -- the protocol -------------------------------------------------------------------------
     def _publish(self, data: bytes) -> float:
+        for channel, message in self._companions:  # before the arm's status: it completes a tick
+            self.endpoint.publish_on(channel, message)
         if self.s.drop_status > 0 and self._rng.random() < self.s.drop_status:
             self.record.dropped += 1
             return time.perf_counter()
@@ -180,8 +216,68 @@ class HardwareSession:
             f"for, at t = {t:.3f} s: a second sender on {self.endpoint.listen}",
         )
 
-    def _wait(self, t: float, utime: int, wait: float, data: bytes, resend: bool) -> bool:
-        """Wait up to ``wait`` s (wall) for the command of ``utime``; True when it came."""
+    def _check_gripper(self, t: float, data: bytes) -> None:
+        """One received gripper command against the checks: finite, a force within [0, the
+        gripper's limit], one command per driver tick."""
+        try:
+            utime, opening, force = unpack_wsg_command(data)
+        except ValueError as exc:
+            return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: {exc}")
+        if not (np.isfinite(opening) and np.isfinite(force)):
+            return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: not finite")
+        if not 0.0 <= force <= self.pick.max_force * (1 + 1e-9):
+            return self._fail(
+                t,
+                "bad command",
+                f"gripper command rejected at t = {t:.3f} s: force "
+                f"{force:.3g} N outside [0, {self.pick.max_force:g}] N",
+            )
+        if utime in self._wsg and self._wsg[utime] != (opening, force):
+            return self._fail(
+                t,
+                "second sender",
+                f"two different gripper commands for t = {utime * 1e-6:.3f} s "
+                f"at t = {t:.3f} s: a second sender on {WSG_COMMAND_CHANNEL}",
+            )
+        self._wsg[utime] = (opening, force)
+        if len(self._wsg) > 4096:
+            for key in sorted(self._wsg)[:2048]:
+                del self._wsg[key]
+        return None
+
+    def gripper_opening(self, utime: int) -> Optional[float]:
+        """The gripper command (the wanted opening, m) for the driver's tick ``utime``, if received."""
+        got = self._wsg.get(utime)
+        return None if got is None else got[0]
+
+    def _check_senders(self, t: float) -> None:
+        """Every packet on the command channels must come from the controller's address (the first
+        command's): another is a second sender (``link.SenderWatch``)."""
+        if self.watch is None:
+            return
+        for channel, source in self.watch.senders():
+            if self._controller is None:
+                self._controller = source
+            elif source != self._controller:
+                self._fail(
+                    t,
+                    "second sender",
+                    f"a command on {channel} from a second sender at t = {t:.3f} s "
+                    f"(from {source[0]}:{source[1]}; the controller sends from "
+                    f"{self._controller[0]}:{self._controller[1]})",
+                )
+                return
+
+    def _complete(self, utime: int, wsg: Optional[int]) -> bool:
+        """Whether the answer to the status of ``utime`` is in: the arm's command, and in the pick
+        world the gripper command for the driver's tick ``wsg``."""
+        return self._answered == utime and (wsg is None or wsg in self._wsg)
+
+    def _wait(
+        self, t: float, utime: int, wait: float, data: bytes, resend: bool, wsg: Optional[int] = None
+    ) -> bool:
+        """Wait up to ``wait`` s (wall) for the command of ``utime`` (and the gripper command for
+        the driver's tick ``wsg``, when given); True when it came."""
         deadline = time.perf_counter() + wait
         last_sent = time.perf_counter()
         while True:
@@ -189,9 +285,13 @@ class HardwareSession:
             step = min(deadline - now, self.s.resend) if resend else deadline - now
             for t_recv, message in self.endpoint.poll(max(step, 0.0)):
                 self._check(t, message, t_recv)
+            self._check_senders(t)
+            if self.pick is not None:
+                for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
+                    self._check_gripper(t, message)
             if self.record.fault is not None:
                 return False
-            if self._answered == utime:
+            if self._complete(utime, wsg):
                 return True
             now = time.perf_counter()
             if now >= deadline:
@@ -200,43 +300,84 @@ class HardwareSession:
                 self.record.resends += 1
                 last_sent = self._publish(data)
 
-    def handshake(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
+    def _set_companions(self, t: float, extras) -> None:
+        """The pick world's messages of the tick at ``t`` (``extras`` = fingers, drive forces, the
+        parts' motion; None: the arm alone)."""
+        if extras is None or self.pick is None:
+            self._companions = []
+            return
+        fingers, force, parts = extras
+        self._companions = [
+            (WSG_STATUS_CHANNEL, pack_wsg_status(t, fingers, force)),
+            (PARTS_CHANNEL, pack_parts(t, parts)),
+        ]
+
+    def handshake(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None) -> None:
         """Before the simulation starts: the status of the start pose at t = 0 until its command
         comes (a ``LinkFault`` after ``startup_timeout``), so that the controller may start
         second and starts from the arm's pose; the first tick then sends the status of t = 0
         after the plant's first step (a second sample of t = 0, answered anew)."""
+        start = time.perf_counter()
         data = pack_status(0.0, q, v, tau)
+        self._set_companions(0.0, extras)
         self._pending = 0
         self._sent[0] = self._publish(data)
-        if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True):
+        wsg = 0 if self.pick is not None else None  # the gripper command the driver takes at t = 0
+        if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True, wsg=wsg):
             if self.record.fault is not None:
                 raise LinkFault(self.record.fault)
             raise LinkFault(
                 f"no command within the start-up timeout of {self.s.startup_timeout:g} s on "
                 f"{self.endpoint.url} (channel {self.endpoint.listen}): is `ptint drive` running?"
             )
+        self.handshake_s = time.perf_counter() - start
+        self._quiet()
         self.record.rtt.clear()  # the start-up wait is no round trip
         self.record.accepted = 0
         # the tick at t = 0 samples the arm after the plant's first step: a new status of t = 0
         self._answered, self._answered_tau, self._after_handshake = None, None, True
 
-    def exchange(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> Optional[np.ndarray]:
-        """The tick at ``t``: publish the status, take its command (None: none, keep the last
-        torque; ``record.fault`` says when that is a fault)."""
+    def _quiet(self) -> None:
+        """After the hand-shake: take the drive's answers to the hand-shake's re-sent statuses
+        (stamped t = 0 like the first tick's) until none came for ``QUIET`` s (at most
+        ``QUIET_MAX``), so that none of them is taken for the first tick's answer."""
+        start = last = time.perf_counter()
+        while True:
+            got = self.endpoint.poll(0.01)
+            self._check_senders(0.0)
+            if self.pick is not None:
+                for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
+                    self._check_gripper(0.0, message)
+            now = time.perf_counter()
+            if got:
+                self.record.duplicates += len(got)
+                last = now
+            if now - last >= QUIET or now - start >= QUIET_MAX:
+                return
+
+    def exchange(
+        self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
+    ) -> Optional[np.ndarray]:
+        """The tick at ``t``: publish the status (and in the pick world, first, the gripper's status
+        and the parts' motion: ``extras``), take its command (None: none, keep the last torque;
+        ``record.fault`` says when that is a fault); the gripper command for the driver's next
+        tick is then ``gripper_opening(utime_of(t) + utime_of(T))`` when it came."""
         utime = utime_of(t)
+        wsg = utime + utime_of(self.s.period) if self.pick is not None else None
         self.record.tick_time.append(t)
         self.record.tick_wall.append(time.perf_counter())
         if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
             self._after_handshake = False
             self.record.duplicates += len(self.endpoint.poll(0.0))
         data = pack_status(t, q, v, tau)
+        self._set_companions(t, extras)
         self._pending = utime
         self._sent[utime] = self._publish(data)
         if len(self._sent) > 4096:
             for key in sorted(self._sent)[:2048]:
                 del self._sent[key]
         if self.s.lockstep:
-            if self._wait(t, utime, self.s.command_timeout, data, resend=True):
+            if self._wait(t, utime, self.s.command_timeout, data, resend=True, wsg=wsg):
                 return self._answered_tau
             self._fail(
                 t,
@@ -270,6 +411,8 @@ class CommandLink(LeafSystem):
         if session is None:
             raise RuntimeError("CommandLink runs inside `ptint hardware` only (no LCM session)")
         self._session = session
+        session.builds += 1
+        self._replanned = session.builds > 1  # a pick world's retry rebuilt the diagram
         self._plant = plant
         self._scratch = plant.CreateDefaultContext()  # a work area for the model's terms, no state
         nq, nv, nu = plant.num_positions(), plant.num_velocities(), plant.num_actuators()
@@ -278,8 +421,21 @@ class CommandLink(LeafSystem):
         self._limits = actuator_effort_limits(plant)
         self._state = self.DeclareVectorInputPort("state", nq + nv)
         self.DeclareVectorInputPort("target", 9)
-        # discrete state: [τ (nu), mode (0 commanded, 1 held), t_fault, q_hold (nq)]
-        self._xd = self.DeclareDiscreteState(nu + 2 + nq)
+        self._pick = session.pick
+        # discrete state: [τ (nu), mode (0 commanded, 1 held), t_fault, q_hold (nq), (pick) the gripper's
+        # opening command]
+        self._xd = self.DeclareDiscreteState(nu + 2 + nq + (1 if self._pick else 0))
+        if self._pick is not None:
+            self._fingers = self.DeclareVectorInputPort("gripper_state", 4)
+            self._drive = self.DeclareVectorInputPort("grip_force", 2)
+            self._parts = self.DeclareVectorInputPort("parts", PART_SIZE * self._pick.parts)
+            self.DeclareVectorOutputPort(
+                "gripper_command",
+                1,
+                self._calc_gripper,
+                prerequisites_of_calc={self.discrete_state_ticket(self._xd)},
+            )
+        self.DeclareInitializationDiscreteUpdateEvent(self._initialize)
         self.DeclarePeriodicDiscreteUpdateEvent(session.s.period, 0.0, self._update)
         self.DeclareVectorOutputPort(
             "actuation",
@@ -287,6 +443,40 @@ class CommandLink(LeafSystem):
             self._calc_actuation,
             prerequisites_of_calc={self.discrete_state_ticket(self._xd)},
         )
+
+    def wire_pick(self, builder, station, sequence):
+        """In the pick world's diagram (``worlds.pick.run.build_pick``): the station's gripper and
+        parts into the link, and the gripper command the link took (in place of the plan's
+        ``sequence``: the drive side runs it) out; returns that output port."""
+        builder.Connect(station.GetOutputPort("gripper_state"), self._fingers)
+        builder.Connect(station.GetOutputPort("grip_force"), self._drive)
+        mux = builder.AddNamedSystem("link_parts", Multiplexer([9, 15] * self._pick.parts))
+        for k in range(self._pick.parts):
+            builder.Connect(station.GetOutputPort(f"part_{k}_pose"), mux.get_input_port(2 * k))
+            builder.Connect(station.GetOutputPort(f"part_{k}_rotation"), mux.get_input_port(2 * k + 1))
+        builder.Connect(mux.get_output_port(), self._parts)
+        return self.GetOutputPort("gripper_command")
+
+    def _calc_gripper(self, context, output) -> None:
+        output.SetAtIndex(0, context.get_discrete_state(self._xd).value()[-1])
+
+    def _extras(self, context):
+        """The pick world's companions of a status: fingers, drive forces, the parts' motion."""
+        if self._pick is None:
+            return None
+        return self._fingers.Eval(context), self._drive.Eval(context), self._parts.Eval(context)
+
+    def _initialize(self, context, discrete_state) -> None:
+        """The hand-shake (``HardwareSession.handshake``) with the arm's start, once per session;
+        in the pick world the gripper command it brings is the driver's at t = 0."""
+        xd = context.get_discrete_state(self._xd).value().copy()
+        session = self._session
+        if session.handshake_s is None:
+            x = self._state.Eval(context)
+            session.handshake(x[: self._nq], x[self._nq :], np.zeros(self._nu), self._extras(context))
+            if self._pick is not None:
+                xd[-1] = session.gripper_opening(0)
+        discrete_state.get_mutable_vector(self._xd).SetFromVector(xd)
 
     def _calc_actuation(self, context, output) -> None:
         output.SetFromVector(context.get_discrete_state(self._xd).value()[: self._nu])
@@ -310,15 +500,27 @@ class CommandLink(LeafSystem):
         q, v = x[:nq], x[nq:]
         xd = context.get_discrete_state(self._xd).value().copy()
         tau, mode = xd[:nu], xd[nu]
-        if mode == 0.0 and t < session.s.duration - 0.5 * session.s.period:
-            command = session.exchange(t, q, v, tau)
-            if session.record.fault is not None:
-                mode, xd[nu + 1], xd[nu + 2 :] = 1.0, t, q
-            elif command is not None:
+        if mode == 0.0 and self._replanned:
+            session._fail(
+                t,
+                "replan unsupported",
+                f"the pick's grasp check before t = {t:.3f} s planned anew (a retry, an abort or a "
+                f"longer wait for the grasp): replanning is not supported across processes",
+            )
+        if mode == 0.0 and session.record.fault is None and t < session.s.duration - 0.5 * session.s.period:
+            command = session.exchange(t, q, v, tau.copy(), self._extras(context))
+            if session.record.fault is None and command is not None:
                 xd[:nu] = command
+            if session.record.fault is None and self._pick is not None:
+                opening = session.gripper_opening(utime_of(t) + utime_of(session.s.period))
+                if opening is not None:
+                    xd[-1] = opening
+                    session.record.gripper_commands += 1
+        if mode == 0.0 and session.record.fault is not None:
+            mode, xd[nu + 1], xd[nu + 2 : nu + 2 + nq] = 1.0, t, q
         if mode == 1.0:
             xd[nu] = 1.0
             if t - xd[nu + 1] >= session.s.hold_time - 1e-9:
                 raise LinkFault(session.record.fault)
-            xd[:nu] = self.hold_torque(q, v, xd[nu + 2 :])
+            xd[:nu] = self.hold_torque(q, v, xd[nu + 2 : nu + 2 + nq])  # the gripper keeps its last command
         discrete_state.get_mutable_vector(self._xd).SetFromVector(xd)

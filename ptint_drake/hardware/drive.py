@@ -43,16 +43,24 @@ from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, TargetView
 from ptint_drake.hardware.link import (
     COMMAND_CHANNEL,
+    PARTS_CHANNEL,
     STATUS_CHANNEL,
+    WSG_COMMAND_CHANNEL,
+    WSG_STATUS_CHANNEL,
     Endpoint,
     pack_command,
+    pack_wsg_command,
+    unpack_parts,
+    unpack_wsg_status,
     spread,
     status_torque,
     unpack_status,
     url_warning,
 )
+from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
-from ptint_drake.worlds.registry import objects_of, schedule_of
+from ptint_drake.systems.gripper import EMPTY, GRASP_STATES, HOLDING, LOST
+from ptint_drake.worlds.registry import objects_of, schedule_of, world_of
 
 
 # s: after integrating σ to a status's time t, a step this short takes the controller's events at t
@@ -99,8 +107,12 @@ class DriveRecord:
 
 
 def DriveDiagram(scenario: Scenario):
-    """(diagram, controller handles, joint count) of the scenario's controller alone (module
-    docstring)."""
+    """(diagram, controller handles, joint count, the world's controller side or None: the pick world's
+    ``worlds.pick.controller_side.PickControllerSide``) of the scenario's
+    controller alone (module docstring).  Inputs: ``state`` (the arm's [q; v]); in the pick world
+    also ``parts`` (``link.PART_SIZE`` a part) and ``gripper`` ([fingers (4), drive forces (2)], as
+    ``link.unpack_wsg_status`` gives them).  Outputs: ``actuation``; in the pick world also
+    ``grasp_state``."""
     plant = nominal_plant(scenario)
     builder = DiagramBuilder()
     n = plant.num_positions() + plant.num_velocities()
@@ -109,6 +121,9 @@ def DriveDiagram(scenario: Scenario):
     unsampled = copy.copy(scenario)  # the hardware samples and holds: no hold of its own here
     unsampled.controller = dataclasses.replace(scenario.controller, control_period=0.0)
     schedule, targets = schedule_of(scenario), objects_of(scenario)
+    # the world's own controller side (the pick world's targets, gripper and grasp observer), if any
+    pick = world_of(scenario).controller_side(builder, scenario, link_period(scenario))
+    target = pick.target if pick is not None else TargetView(builder, None, unsampled, schedule, targets)
     handles = AddControllerTo(
         builder,
         plant=plant,
@@ -117,14 +132,14 @@ def DriveDiagram(scenario: Scenario):
         state=state.get_output_port(),
         actuation=actuation.get_input_port(),
         scenario=unsampled,
-        target=TargetView(builder, None, unsampled, schedule, targets),
+        target=target,
         targets=targets,
     )
     builder.ExportInput(state.get_input_port(), "state")
     builder.ExportOutput(actuation.get_output_port(), "actuation")
     diagram = builder.Build()
     diagram.set_name("drive")
-    return diagram, handles, plant.num_actuators()
+    return diagram, handles, plant.num_actuators(), pick
 
 
 class _DriveLoop:
@@ -140,18 +155,29 @@ class _DriveLoop:
         url: Optional[str],
         warn: Callable[[str], None],
     ) -> None:
-        diagram, _, n = DriveDiagram(scenario)
-        self.n, self.settings, self.record = n, settings, record
+        diagram, _, n, pick = DriveDiagram(scenario)
+        self.n, self.settings, self.record, self.pick = n, settings, record, pick
+        self.period_us = int(round(settings.period * 1e6))
         # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
         # the hardware side rejects a torque beyond an effort limit as a fault
         self.limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
         self.simulator = Simulator(diagram)
         config = copy.copy(scenario.simulator)
+        own = world_of(scenario).simulator_config(scenario)
+        if own is not None:  # the world's integrator (the pick's: ``pick_simulator``), as in ``ptint run``
+            config = copy.copy(own)
         config.target_realtime_rate = 0.0  # the hardware's status paces the drive
         ApplySimulatorConfig(config, self.simulator)
         self.context = self.simulator.get_mutable_context()
-        self.state_in, self.out = diagram.get_input_port(0), diagram.get_output_port(0)
-        self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL)
+        self.state_in, self.out = diagram.GetInputPort("state"), diagram.GetOutputPort("actuation")
+        also = (WSG_STATUS_CHANNEL, PARTS_CHANNEL) if pick is not None else ()
+        self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also)
+        if pick is not None:
+            self.parts_in, self.gripper_in = diagram.GetInputPort("parts"), diagram.GetInputPort("gripper")
+            self.grasp_out = diagram.GetOutputPort("grasp_state")
+            self.companions: dict[int, dict] = {}  # utime → {"gripper": [fingers; forces], "parts": motion}
+            self.last_companion: Optional[dict] = None
+            self.checks = pick.reads
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
         if risk:
@@ -159,6 +185,7 @@ class _DriveLoop:
         self.answered: Optional[int] = None
         self.answer = b""
         self.last_q = self.last_v = None
+        self.started = False  # the pick world: the events at the first tick's time taken
         # what this drive sent lately (and the zero torque of the start): a status whose applied
         # torque is none of them shows a second sender's command taken by the hardware
         self.recent: deque = deque(maxlen=RECENT)
@@ -212,6 +239,8 @@ class _DriveLoop:
             and np.array_equal(v, self.last_v)
         ):
             self.record.repeats += 1
+            if self.pick is not None:
+                self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
             self.endpoint.publish(self.answer)
             return
         if answered is not None and utime < answered:
@@ -220,7 +249,57 @@ class _DriveLoop:
         if answered is not None:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
         self.check_applied(utime, data)
-        self.respond(t_recv, utime, q, v)
+        self.respond(t_recv, utime, q, v, self.companion(utime) if self.pick is not None else None)
+
+    def _collect(self) -> None:
+        """File the gripper statuses and parts messages received by their ``utime``."""
+        for data in self.endpoint.take_side(WSG_STATUS_CHANNEL):
+            try:
+                utime, fingers, force = unpack_wsg_status(data)
+            except ValueError as exc:
+                raise DriveFault(f"gripper status rejected: {exc}; stopped commanding") from None
+            self.companions.setdefault(utime, {})["gripper"] = np.concatenate([fingers, force])
+        for data in self.endpoint.take_side(PARTS_CHANNEL):
+            try:
+                utime, motion = unpack_parts(data, self.pick.parts)
+            except ValueError as exc:
+                raise DriveFault(f"parts message rejected: {exc}; stopped commanding") from None
+            self.companions.setdefault(utime, {})["parts"] = motion
+
+    def companion(self, utime: int) -> dict:
+        """The gripper status and the parts' motion of the tick ``utime`` (the hardware sends them
+        before the arm's status; a lost one comes again with the status's re-send); ``DriveFault``
+        after the status timeout without them."""
+        deadline = time.perf_counter() + self.settings.status_timeout
+        while True:
+            self._collect()
+            got = self.companions.get(utime, {})
+            if "gripper" in got and "parts" in got:
+                for old in [u for u in self.companions if u < utime]:
+                    del self.companions[old]
+                return got
+            if time.perf_counter() >= deadline:
+                missing = " and ".join(k for k in ("gripper", "parts") if k not in got)
+                raise DriveFault(
+                    f"no {missing} message for the status of t = {utime / 1e6:.3f} s within "
+                    f"{self.settings.status_timeout:g} s: stopped commanding"
+                )
+            self.endpoint.lcm.HandleSubscriptions(5)  # the arm's statuses stay in the inbox
+
+    def check_grasp(self, utime: int) -> None:
+        """At a grasp check of the plan (and, from a close command on, every ``SENSE_PERIOD``):
+        ``DriveFault`` when the gripper is not holding there (``empty`` or ``lost`` at a sense
+        time) — a retry or abort would plan anew, which is not supported across processes."""
+        what = self.checks.get(utime)
+        if what is None:
+            return
+        state = int(self.grasp_out.Eval(self.context)[0])
+        if state == HOLDING or (what == "sense" and state not in (EMPTY, LOST)):
+            return
+        raise DriveFault(
+            f"the grasp check at t = {utime / 1e6:.3f} s read {GRASP_STATES[state]!r}: a retry "
+            f"(a new plan) is not supported across processes; stopped commanding"
+        )
 
     def check_applied(self, utime: int, data: bytes) -> None:
         """``DriveFault`` (after NaN commands) when the status's applied torque is none of this
@@ -239,32 +318,66 @@ class _DriveLoop:
             f"sent a NaN command so that the hardware holds the arm, and stopped commanding"
         )
 
-    def torque(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    def torque(self, t: float, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None) -> np.ndarray:
         """The controller's torque at the status's time ``t`` for its [q; v] (module docstring),
-        clipped to the effort limits when saturating."""
+        clipped to the effort limits when saturating.  In the pick world ``companion`` holds the
+        tick's gripper status and parts' motion: the parts are read like the arm's state; the
+        gripper status is the grasp observer's at its update at ``t`` (a periodic update like
+        the one-process run's hold, which samples the arm after the plant's step)."""
         if self.answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
-            self.state_in.FixValue(self.context, np.concatenate([q, v]))
+            self._fix(q, v, companion)
             self.context.SetTime(t)
             self.simulator.Initialize()
+        elif companion is not None and (t > self.context.get_time() or not self.started):
+            # the pick world: σ over (t_prev, t] with the previous sample; the grasp check reads the
+            # observer there (as ``PickRun.at_stop``); then the events at t with that sample, the
+            # observer's update with this tick's gripper status, by a second ``AdvanceTo(t)`` (at
+            # the time reached it takes the events due, as ``ptint run``'s pick runner does at its
+            # stops: ``PickRun.advance_at_reached_stops``; the first tick, at t = 0 as the
+            # hand-shake, takes the events at t = 0 so); only then the new sample
+            self.started = True
+            self.simulator.AdvanceTo(t)
+            self.check_grasp(int(round(t * 1e6)))
+            self.gripper_in.FixValue(self.context, companion["gripper"])
+            self.simulator.AdvanceTo(t)
         elif t > self.context.get_time():
             # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
             # sees the discrete plant's state between two steps; then the events at t (segment
             # starts) with it too, and only then the new sample
             self.simulator.AdvanceTo(t)
             self.simulator.AdvanceTo(t + EVENT_STEP)
-        self.state_in.FixValue(self.context, np.concatenate([q, v]))
+        self._fix(q, v, companion)
         tau = np.array(self.out.Eval(self.context), dtype=float)
         if self.limits is not None and np.any(np.abs(tau) > self.limits):
             self.record.clipped += 1
             tau = np.clip(tau, -self.limits, self.limits)
         return tau
 
-    def respond(self, t_recv: float, utime: int, q: np.ndarray, v: np.ndarray) -> None:
-        """Send the command stamped ``utime`` answering a status checked, and record it."""
-        t = utime * 1e-6
-        tau = self.torque(t, q, v)
+    def _fix(self, q: np.ndarray, v: np.ndarray, companion: Optional[dict]) -> None:
+        """The diagram's inputs: a status's [q; v] and, in the pick world, its companions."""
+        self.state_in.FixValue(self.context, np.concatenate([q, v]))
+        if companion is not None:
+            self.parts_in.FixValue(self.context, companion["parts"])
+            self.gripper_in.FixValue(self.context, companion["gripper"])
+
+    def respond(
+        self, t_recv: float, utime: int, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None
+    ) -> None:
+        """Send the command stamped ``utime`` answering a status checked (in the pick world, first,
+        the gripper command for the driver's next tick), and record it."""
+        t = utime / 1e6
+        first = self.answered is None
+        tau = self.torque(t, q, v, companion)
         self.last_q, self.last_v = q, v
         self.answer = pack_command(utime, tau)
+        if self.pick is not None:
+            # the gripper's driver takes it at its next tick (the hand-shake's: at t = 0), as the
+            # one-process run's driver reads the plan's command at each of its ticks
+            at = utime if first else utime + self.period_us
+            self.gripper_answer = pack_wsg_command(
+                at, self.pick.sequence.opening(at / 1e6), self.pick.max_force
+            )
+            self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
         recent = self.recent
         if len(recent) == recent.maxlen and recent.count(recent[0]) == 1:
             self.sent_torques.discard(recent[0])

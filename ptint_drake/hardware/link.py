@@ -13,6 +13,23 @@ The messages are Drake's own (the ``drake`` Python package that ships with pydra
   ``utime`` of the status it answers, ``num_joints`` = 0 (no position), ``num_torques`` = n,
   ``joint_torque`` (N·m, in the plant's actuator order).
 
+The pick world adds Drake's gripper messages and one vector of the parts' motion:
+
+- ``lcmt_schunk_wsg_status`` (hardware → drive, channel ``SCHUNK_WSG_STATUS``, Drake's
+  ``hardware_sim`` name), one per tick, before the arm's status: ``utime`` as the arm's,
+  ``actual_position_mm`` = the opening between the pads (mm), ``actual_speed_mm_per_s`` = the faster
+  finger's speed (mm/s, ≥ 0: what ``systems.gripper.GraspObserver`` takes as the fingers' speed),
+  ``actual_force`` = the grip force, the smaller squeeze of the two finger drives (N, + squeezing).
+- ``lcmt_schunk_wsg_command`` (drive → hardware, ``SCHUNK_WSG_COMMAND``), one per status, before the
+  arm's command: ``utime`` = the tick at which the gripper's driver takes it (the answered status's
+  ``utime`` + T; the hand-shake's: 0), ``target_position_mm`` = the wanted opening (mm; 0 = close),
+  ``force`` = the grip force limit (N).
+- ``lcmt_scope`` (hardware → drive, ``PART_MOTION``), one per tick, before the arm's status:
+  ``utime`` as the arm's; ``value`` = per part (scenario order) its [x, ẋ, ẍ] (m, m/s, m/s²; the
+  centre, world frame) and [R row-major, ω, ω̇] (rad/s, rad/s²): ``pick.part_pose``'s ports, 24
+  doubles a part.  Drake has no message of a body's full motion (``lcmt_viewer_draw`` carries float
+  poses without velocities); ``lcmt_scope`` is its plain vector of doubles.
+
 LCM carries no sender identity and no authentication: the default URL stays on this machine
 (``ttl=0``) and ``url_warning`` names the risk of any other; the hardware side's checks
 (``command_link``) accept one command per status it sent.
@@ -20,16 +37,28 @@ LCM carries no sender identity and no authentication: the default URL stays on t
 
 from __future__ import annotations
 
+import socket
+import struct
 import time
 import urllib.parse
 from typing import Optional
 
 import numpy as np
-from drake import lcmt_iiwa_command, lcmt_iiwa_status
+from drake import (
+    lcmt_iiwa_command,
+    lcmt_iiwa_status,
+    lcmt_schunk_wsg_command,
+    lcmt_schunk_wsg_status,
+    lcmt_scope,
+)
 from pydrake.lcm import DrakeLcm
 
 STATUS_CHANNEL = "IIWA_STATUS"  # Drake's iiwa driver's channel names
 COMMAND_CHANNEL = "IIWA_COMMAND"
+WSG_STATUS_CHANNEL = "SCHUNK_WSG_STATUS"  # Drake's hardware_sim names
+WSG_COMMAND_CHANNEL = "SCHUNK_WSG_COMMAND"
+PARTS_CHANNEL = "PART_MOTION"
+PART_SIZE = 24  # doubles a part: [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15)
 
 
 def url_warning(url: str) -> Optional[str]:
@@ -54,12 +83,27 @@ class Endpoint:
     shared: two endpoints on one ``memq://`` instance talk inside one process), publishing on one
     channel and collecting another's messages with their arrival times (``inbox``)."""
 
-    def __init__(self, url: Optional[str], listen: str, publish: str, lcm: Optional[DrakeLcm] = None):
+    def __init__(
+        self, url: Optional[str], listen: str, publish: str, lcm: Optional[DrakeLcm] = None, also: tuple = ()
+    ):
         self.lcm = lcm if lcm is not None else DrakeLcm(url) if url else DrakeLcm()
         self.url = self.lcm.get_lcm_url()
         self.listen, self.publish_channel = listen, publish
         self.inbox: list[tuple[float, bytes]] = []
         self.lcm.Subscribe(listen, lambda data: self.inbox.append((time.perf_counter(), bytes(data))))
+        # the other channels listened to (``also``: the pick world's companions), each its own inbox
+        self.side: dict[str, list] = {c: [] for c in also}
+        for channel in also:
+            self.lcm.Subscribe(channel, lambda data, c=channel: self.side[c].append(bytes(data)))
+
+    def publish_on(self, channel: str, data: bytes) -> None:
+        """Publish ``data`` on another channel than the endpoint's own."""
+        self.lcm.Publish(channel, data)
+
+    def take_side(self, channel: str) -> list[bytes]:
+        """The messages received on ``channel`` (one of ``also``) since the last call, oldest first."""
+        out, self.side[channel] = self.side[channel], []
+        return out
 
     def publish(self, data: bytes) -> float:
         """Publish ``data``; returns the wall time (``perf_counter``) it was handed to LCM (taken
@@ -76,6 +120,67 @@ class Endpoint:
             pass
         out, self.inbox = self.inbox, []
         return out
+
+
+LCM_SHORT, LCM_FRAGMENT = 0x4C433032, 0x4C433033  # "LC02", "LC03": the magic of LCM's UDP packets
+
+
+class SenderWatch:
+    """Who publishes on some channels of a ``udpm://`` LCM group: a plain UDP socket joined to the
+    group beside LCM's own (both bind the port with ``SO_REUSEADDR``: each gets every packet),
+    reading each packet's source address and channel (LCM's packet header: magic, sequence
+    number, then the NUL-terminated channel; a fragmented message names its channel in its first
+    fragment).  Every process's LCM sends from a socket of its own, so two processes publishing
+    on one channel show two source addresses — a sender identity LCM's messages do not carry.
+    Unlike a ``DrakeLcm`` subscription, whose queue holds one message (pydrake's ``Subscribe``
+    returns no handle to deepen it), the kernel's socket buffer keeps every packet until read."""
+
+    def __init__(self, url: str, channels: tuple):
+        parsed = urllib.parse.urlparse(url)
+        group, port = parsed.hostname, parsed.port
+        self.channels = {c.encode() for c in channels}
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        if hasattr(socket, "SO_REUSEPORT"):
+            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        self.sock.bind(("", port))
+        membership = struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("0.0.0.0"))
+        self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
+        self.sock.setblocking(False)
+
+    @staticmethod
+    def for_url(url: str, channels: tuple) -> Optional["SenderWatch"]:
+        """A watch of ``url``'s group, or None where there is none (``memq://``) or the socket
+        cannot join it."""
+        if urllib.parse.urlparse(url).scheme != "udpm":
+            return None
+        try:
+            return SenderWatch(url, channels)
+        except OSError:
+            return None
+
+    def senders(self) -> list[tuple[str, tuple]]:
+        """(channel, source address) of every packet on the watched channels received since the
+        last call, oldest first."""
+        out = []
+        while True:
+            try:
+                data, source = self.sock.recvfrom(65536)
+            except (BlockingIOError, InterruptedError):
+                return out
+            if len(data) < 8:
+                continue
+            magic = struct.unpack(">I", data[:4])[0]
+            start = 8 if magic == LCM_SHORT else 20 if magic == LCM_FRAGMENT else None
+            if start is None or (magic == LCM_FRAGMENT and struct.unpack(">H", data[16:18])[0] != 0):
+                continue  # not LCM, or a later fragment (no channel name)
+            end = data.find(b"\0", start)
+            channel = data[start:end] if end > 0 else b""
+            if channel in self.channels:
+                out.append((channel.decode(), source))
+
+    def close(self) -> None:
+        self.sock.close()
 
 
 def utime_of(t: float) -> int:
@@ -133,6 +238,67 @@ def unpack_command(data: bytes, n: int) -> tuple[int, np.ndarray]:
     if m.num_joints not in (0, n):
         raise ValueError(f"a command of {m.num_joints} positions (torque-only: 0 or {n})")
     return m.utime, np.array(m.joint_torque, dtype=float)
+
+
+def pack_wsg_status(t: float, fingers: np.ndarray, drive_force: np.ndarray) -> bytes:
+    """An ``lcmt_schunk_wsg_status`` of the sample at ``t``: ``fingers`` = [q_left, q_right, v_left,
+    v_right] (m, m/s), ``drive_force`` = each finger drive's force (N, − squeezes)."""
+    m = lcmt_schunk_wsg_status()
+    m.utime = utime_of(t)
+    m.actual_position_mm = 1e3 * (float(fingers[0]) + float(fingers[1]))
+    m.actual_speed_mm_per_s = 1e3 * max(abs(float(fingers[2])), abs(float(fingers[3])))
+    m.actual_force = min(-float(drive_force[0]), -float(drive_force[1]))
+    return m.encode()
+
+
+def unpack_wsg_status(data: bytes) -> tuple[int, np.ndarray, np.ndarray]:
+    """(utime, fingers, drive force) of an ``lcmt_schunk_wsg_status`` in ``GraspObserver``'s input
+    layout: the opening split evenly between the fingers, each at the reported speed and each drive
+    squeezing with the reported force (what the observer's rule reads of them is exactly the
+    message's width, speed and force)."""
+    try:
+        m = lcmt_schunk_wsg_status.decode(data)
+    except Exception as exc:  # noqa: BLE001
+        raise ValueError(f"an undecodable gripper status ({type(exc).__name__})") from None
+    half, speed = 0.5 * (m.actual_position_mm / 1e3), m.actual_speed_mm_per_s / 1e3
+    return m.utime, np.array([half, half, speed, speed]), np.array([-m.actual_force, -m.actual_force])
+
+
+def pack_wsg_command(utime: int, opening: float, force: float) -> bytes:
+    """An ``lcmt_schunk_wsg_command`` for the gripper driver's tick ``utime``: the wanted opening (m;
+    ≤ 0: close) and the force limit (N)."""
+    m = lcmt_schunk_wsg_command()
+    m.utime, m.target_position_mm, m.force = int(utime), 1e3 * max(float(opening), 0.0), float(force)
+    return m.encode()
+
+
+def unpack_wsg_command(data: bytes) -> tuple[int, float, float]:
+    """(utime, opening in m, force in N) of an ``lcmt_schunk_wsg_command``; ValueError when undecodable."""
+    try:
+        m = lcmt_schunk_wsg_command.decode(data)
+    except Exception as exc:  # noqa: BLE001
+        raise ValueError(f"an undecodable gripper command ({type(exc).__name__})") from None
+    return m.utime, m.target_position_mm / 1e3, m.force
+
+
+def pack_parts(t: float, motion: np.ndarray) -> bytes:
+    """An ``lcmt_scope`` of the parts' motion at ``t`` (``PART_SIZE`` doubles a part)."""
+    m = lcmt_scope()
+    m.utime, m.size, m.value = utime_of(t), len(motion), [float(x) for x in motion]
+    return m.encode()
+
+
+def unpack_parts(data: bytes, parts: int) -> tuple[int, np.ndarray]:
+    """(utime, motion) of a parts message for ``parts`` parts; ValueError naming what is wrong."""
+    try:
+        m = lcmt_scope.decode(data)
+    except Exception as exc:  # noqa: BLE001
+        raise ValueError(f"an undecodable parts message ({type(exc).__name__})") from None
+    if m.size != PART_SIZE * parts:
+        raise ValueError(
+            f"a parts message of {m.size} values, the scenario's {parts} parts need {PART_SIZE * parts}"
+        )
+    return m.utime, np.array(m.value, dtype=float)
 
 
 def spread(values, scale: float = 1.0) -> Optional[dict]:

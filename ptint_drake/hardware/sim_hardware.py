@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import time
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -23,8 +22,25 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
-from ptint_drake.hardware.command_link import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
-from ptint_drake.hardware.link import COMMAND_CHANNEL, STATUS_CHANNEL, Endpoint, spread, url_warning
+from ptint_drake.hardware.command_link import (
+    ACTIVE,
+    SETTLED_SPEED,
+    HardwareSession,
+    LinkFault,
+    LinkSettings,
+    PickLink,
+)
+from ptint_drake.hardware.link import (
+    COMMAND_CHANNEL,
+    PARTS_CHANNEL,
+    STATUS_CHANNEL,
+    WSG_COMMAND_CHANNEL,
+    WSG_STATUS_CHANNEL,
+    Endpoint,
+    SenderWatch,
+    spread,
+    url_warning,
+)
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.report.run_outputs import run_metrics
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
@@ -41,14 +57,11 @@ def link_period(scenario: Scenario) -> float:
 
 
 def check_link_scenario(scenario: Scenario) -> None:
-    """What the LCM path does not carry yet (ScenarioError, one line): another world than the
-    interception world, a camera, an arm whose joints are not one actuator each."""
+    """What the LCM path does not carry yet (ScenarioError, one line): a world other than the
+    interception and pick worlds, a camera, an arm whose joints are not one actuator each."""
     world = world_of(scenario)
-    if world.name != "interception":
-        raise ScenarioError(
-            f"the {world.name} world over LCM is not supported yet (issue 35: the arm's "
-            f"status and torque commands only; no gripper or part messages)"
-        )
+    if world.name not in ("interception", "pick"):
+        raise ScenarioError(f"the {world.name} world over LCM is not supported yet (issue 35)")
     if scenario.measurement is not None and scenario.measurement.estimator != "none":
         raise ScenarioError(
             "measurement: a camera over LCM is not supported yet (the drive side sees no "
@@ -61,7 +74,13 @@ def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
     the hold), the plant discrete at T, and the simulator paced in real time unless lockstep."""
     out = copy.copy(scenario)
     out.controller = dataclasses.replace(scenario.controller, type=LINK_TYPE, params={}, control_period=0.0)
-    if scenario.multibody is None:
+    if scenario.multibody is None and scenario.pick is not None:
+        if settings.period != DEFAULT_PERIOD:  # the pick world's own plant steps at 1 ms
+            raise ScenarioError(
+                f"controller.control_period: the hardware side's plant steps at the control period "
+                f"({settings.period * 1e3:g} ms); set multibody.time_step to it"
+            )
+    elif scenario.multibody is None:
         out.multibody = MultibodyPlantConfig(time_step=settings.period)
     else:
         step = scenario.multibody.time_step
@@ -72,7 +91,10 @@ def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
             )
         out.multibody = copy.copy(scenario.multibody)
         out.multibody.time_step = settings.period
-    out.simulator = copy.copy(scenario.simulator)
+    # the world's own integrator (the pick's: one explicit Euler step per control period), kept
+    # although the slot runs unsampled here: the link is the hold
+    own = world_of(scenario).simulator_config(scenario)
+    out.simulator = copy.copy(own if own is not None else scenario.simulator)
     out.simulator.target_realtime_rate = 0.0 if settings.lockstep else settings.realtime_rate
     return out
 
@@ -96,7 +118,7 @@ def hold_report(series: dict, t_fault: float, nq: int) -> dict:
     }
 
 
-def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: float) -> dict:
+def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Optional[float]) -> dict:
     """metrics.json's ``hardware`` block."""
     r = session.record
     periods = np.diff(r.tick_wall) if len(r.tick_wall) > 1 else []
@@ -109,6 +131,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: fl
         "realtime_rate": None if settings.lockstep else settings.realtime_rate,
         "joints": session.n,
         "command_timeout_s": settings.command_timeout,
+        "sender_check": "source address" if session.watch is not None else "stamps only",
         "handshake_s": handshake_s,
         "round_trip_ms": spread(r.rtt, 1e3),
         "achieved_period_ms": spread(periods, 1e3),
@@ -124,6 +147,13 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: fl
         "fault_kind": r.fault_kind,
         "fault_time": r.fault_time,
     }
+    if session.pick is not None:
+        block |= {
+            "gripper_status_channel": WSG_STATUS_CHANNEL,
+            "gripper_command_channel": WSG_COMMAND_CHANNEL,
+            "parts_channel": PARTS_CHANNEL,
+            "gripper_commands_taken": r.gripper_commands,
+        }
     if not settings.lockstep and r.tick_wall:
         wall = np.asarray(r.tick_wall) - r.tick_wall[0]
         sim = (np.asarray(r.tick_time) - r.tick_time[0]) / settings.realtime_rate
@@ -151,20 +181,28 @@ def run_hardware(
             f"positions, {n} actuators)"
         )
     hw = hardware_scenario(scenario, settings)
-    endpoint = Endpoint(url, listen=COMMAND_CHANNEL, publish=STATUS_CHANNEL)
+    pick = scenario.pick
+    endpoint = Endpoint(
+        url,
+        listen=COMMAND_CHANNEL,
+        publish=STATUS_CHANNEL,
+        also=(WSG_COMMAND_CHANNEL,) if pick is not None else (),
+    )
     risk = url_warning(endpoint.url)
     if risk:
         warn(risk)
     session = HardwareSession(endpoint, n, actuator_effort_limits(plant), settings)
-    q0 = np.radians(scenario.robot.initial_q_deg)
+    session.watch = SenderWatch.for_url(endpoint.url, (COMMAND_CHANNEL, WSG_COMMAND_CHANNEL))
+    if pick is not None:
+        session.pick = PickLink(parts=len(pick.parts), max_force=pick.gripper.max_force)
     token = ACTIVE.set(session)
-    try:
-        t0 = time.perf_counter()
-        session.handshake(q0, np.zeros(n), np.zeros(n))
-        handshake_s = time.perf_counter() - t0
+    try:  # the hand-shake is the link's initialization event (``CommandLink``): the arm's start as built
         result = simulate(hw, progress=progress, warn=warn)
     finally:
         ACTIVE.reset(token)
+        if session.watch is not None:
+            session.watch.close()
+    handshake_s = session.handshake_s
     metrics = result.metrics
     record = session.record
     if record.fault is not None:

@@ -142,6 +142,18 @@ class World:
         """Draw one view of ``view_tasks`` into ``stage``; returns its name."""
         raise NotImplementedError
 
+    def simulator_config(self, scenario: Scenario):
+        """The integrator settings this world runs ``scenario`` with when they are its own (None:
+        the scenario's ``simulator``); ``ptint hardware`` and ``ptint drive`` keep them."""
+        return None
+
+    def controller_side(self, builder, scenario: Scenario, period: float):
+        """``ptint drive``'s part of this world beyond the arm's state: systems added to
+        ``builder`` that the controller aims with and their handles (``target``: its target
+        view), fed from exported inputs of what the hardware side sends; None: the world's
+        analytic targets suffice (``hardware.drive``)."""
+        return None
+
     def floor_diagram(self, scenario: Scenario, kind: str):
         """``ptint bench``'s floor diagrams (``studies.benchmark.floors``), or None."""
         return None

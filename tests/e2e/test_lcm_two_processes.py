@@ -17,6 +17,7 @@ pytestmark = pytest.mark.e2e
 
 HERE = Path(__file__).resolve().parents[1] / "lcm_link"
 CURVE = "curve_b075_tf15"
+PICK = "conveyor_pick_place"
 PERIOD = 1e-3
 # a process may take seconds to import pydrake and build its diagram when the suite loads both
 # cores (CI): a patient start-up, except where the start-up timeout is what a test checks
@@ -69,6 +70,59 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     assert link["round_trip_ms"]["count"] >= 2999 and link["round_trip_ms"]["median"] < 50.0
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert drive["commands_sent"] >= 3000 and drive["fault"] is None
+
+
+def test_pick_lockstep_places_like_one_process(tmp_path, run):
+    """Acceptance, the pick world: lockstep across two processes (arm, gripper and parts over
+    LCM; the targets, gripper sequence and grasp observer in the drive) = ptint run of
+    conveyor_pick_place (its control period and plant step are 1 ms already): every part placed,
+    the same verdict, the place error within 0.1 mm (measured: 0.155655 against 0.155582 mm, the
+    first 10 ms bit-identical, then round-off amplified by the contacts)."""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", PICK, *PATIENT, "--lockstep", "--quiet",
+                                         "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", PICK, *PATIENT, "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
+    metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
+    reference = run(PICK).metrics
+    assert metrics["status"] == reference["status"] == "ok" and metrics["reasons"] == reference["reasons"]
+    assert len(metrics["picks"]) == len(reference["picks"])
+    for pick, ref in zip(metrics["picks"], reference["picks"]):
+        assert pick["placed"] and ref["placed"]
+        assert abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 0.1
+        assert [a["state"] for a in pick["attempt_details"]] == [a["state"] for a in ref["attempt_details"]]
+    link = metrics["hardware"]
+    assert link["ticks"] == 5000 and link["fault"] is None
+    assert link["gripper_commands_taken"] == link["ticks"]  # one gripper command a tick
+    drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
+    assert drive["fault"] is None and drive["commands_sent"] >= 5000
+
+
+def test_pick_replan_is_refused_in_one_line(tmp_path):
+    """A grasp that is not confirmed would plan anew (a retry or an abort: a new diagram on both
+    sides), which is not supported across processes: with a width tolerance of 0.2 mm the pads,
+    sunk about 1 mm into the part, read ``empty`` at the first read after the close command; the
+    hardware then holds the arm and ends with one line; the drive, no longer answered, stops
+    with one line."""
+    strict = ("--set", "pick.width_tolerance=0.0002")
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", PICK, *PATIENT, *strict, "--lockstep", "--quiet",
+                                         "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", PICK, *PATIENT, *strict, "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == 1 and out["drive"]["rc"] == 1
+    assert "replanning is not supported across processes" in one_line(out["hw"]["stderr"])
+    one_line(out["drive"]["stderr"])
+    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    assert link["fault_kind"] == "replan unsupported" and 1.58 < link["fault_time"] < 1.86
+    assert link["hold"]["speed_at_end"] < 0.05
 
 
 def test_drive_killed_holds_the_arm(tmp_path):
@@ -131,8 +185,8 @@ def test_bad_commands_rejected_and_held(tmp_path, mode, words):
 
 
 def test_second_sender_detected(tmp_path):
-    """A second process answering the statuses too from t = 0.3 s: detected, reported, the arm
-    held (within 25 periods here; the issue asks 10: see the comment below)."""
+    """A second process answering the statuses too from t = 0.3 s: detected within 10 periods
+    (the issue's bound), reported, the arm held."""
     out = run_plan(
         [
             {
@@ -149,18 +203,16 @@ def test_second_sender_detected(tmp_path):
         ],
         tmp_path,
     )
-    # found by the hardware (two commands for one status) or, when LCM dropped one of them, by
-    # the drive (a torque applied that it did not send), which then sends a NaN command so that
-    # the hardware's checks hold the arm
+    # the hardware reads every packet's source address on the command channels (``link.SenderWatch``:
+    # a socket of its own beside LCM's, whose subscription queue holds one message and may drop
+    # the rogue's): the rogue's first command comes from another address than the drive's
     assert out["hw"]["rc"] == 1 and out["drive"]["rc"] == 1
-    hw_line, drive_line = one_line(out["hw"]["stderr"]), one_line(out["drive"]["stderr"])
-    assert "second sender" in hw_line or "second sender" in drive_line
+    hw_line = one_line(out["hw"]["stderr"])
+    assert "second sender" in hw_line, hw_line
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     first = int(out["rogue"]["stdout"].split()[1]) * 1e-6  # the stamp of the rogue's first command
-    # pydrake's DrakeLcm keeps Drake's subscription queue (its Python Subscribe returns no handle to
-    # deepen it): of two commands arriving while the hardware steps its plant, LCM may discard one
-    assert link["fault_kind"] in ("second sender", "bad command"), link["fault"]
-    assert first - 1e-9 <= link["fault_time"] <= first + 25 * PERIOD
+    assert link["fault_kind"] == "second sender" and link["sender_check"] == "source address"
+    assert first - 1e-9 <= link["fault_time"] <= first + 10 * PERIOD, (first, link["fault_time"])
     assert link["hold"]["speed_at_end"] < 0.05
 
 

@@ -127,7 +127,6 @@ def test_realtime_late_ticks_then_timeout():
 @pytest.mark.parametrize(
     "args, words",
     [
-        (("drive", "conveyor_pick_place"), "the pick world over LCM is not supported yet"),
         (("hardware", "curve_camera"), "measurement: a camera over LCM"),
         (("hardware", "curve_b075_tf15", "--drop-status", "1.5"), "--drop-status: must be in [0, 1)"),
         (("drive", "curve_b075_tf15", "--status-timeout", "0"), "--status-timeout: must be > 0"),

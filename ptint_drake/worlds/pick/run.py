@@ -127,13 +127,17 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
                               schedule=plan.schedule, state=st.GetOutputPort("state"),
                               actuation=saturation.get_input_port(), scenario=scenario, target=view)
     sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
-    builder.Connect(sequence.GetOutputPort("command"), st.GetInputPort("gripper_command"))
+    gripper = sequence.GetOutputPort("command")
+    wire = getattr(handles.system, "wire_pick", None)  # a slot system that commands the gripper itself
+    if wire is not None:  # (``ptint hardware``'s link: the commands come from the drive process)
+        gripper = wire(builder, st, sequence)
+    builder.Connect(gripper, st.GetInputPort("gripper_command"))
     observer = builder.AddNamedSystem("grasp_observer", GraspObserver(
         scenario.pick.gripper.max_force, scenario.pick.gripper.speed, scenario.pick.width_tolerance,
         period=station.config.time_step))
     builder.Connect(st.GetOutputPort("gripper_state"), observer.GetInputPort("finger_state"))
     builder.Connect(st.GetOutputPort("grip_force"), observer.GetInputPort("drive_force"))
-    builder.Connect(sequence.GetOutputPort("command"), observer.GetInputPort("command"))
+    builder.Connect(gripper, observer.GetInputPort("command"))
     builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
     probe = builder.AddNamedSystem("pick_probe", _probe(station))
     builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))

@@ -326,6 +326,15 @@ class PickWorld(World):
             write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, stage / "replay.html")
         return name
 
+    def simulator_config(self, scenario: Scenario):
+        return pick_simulator(scenario)
+
+    def controller_side(self, builder, scenario: Scenario, period: float):
+        """The targets, gripper sequence and grasp observer (``controller_side``)."""
+        from ptint_drake.worlds.pick.controller_side import AddPickControllerSide  # noqa: PLC0415
+
+        return AddPickControllerSide(builder, scenario, period, SENSE_PERIOD)
+
     def floor_diagram(self, scenario: Scenario, kind: str):
         """``"replay"``: the run beside its replayed-arm floor (``studies.FloorReplay``); no other kind."""
         return studies.FloorReplay(scenario, PickRun) if kind == "replay" else None

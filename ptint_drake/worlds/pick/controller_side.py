@@ -1,0 +1,99 @@
+"""The pick world's controller side alone, for a controller process that gets the world's state
+in messages (``ptint drive``, ``hardware.drive``): what the controller aims at, the gripper's
+commands and the grasp state, with no plant.
+
+``AddPickControllerSide`` adds to a builder: ``PickTargets`` (what each segment aims at) fed from
+an input of the parts' motion as received, ``GripperSequence`` (the plan's gripper commands) and
+``GraspObserver`` (``systems.gripper``: the grasp state) fed from an input of the gripper's
+reported fingers and drive forces.  The slots' places come from the scenario's tray (the station
+built once for its geometry: no state of it is read).
+
+==============  ==========  ================================================================
+port (export)   size        meaning
+==============  ==========  ================================================================
+``parts``       24 a part   input: per part (scenario order) [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15),
+                            ``pick.part_pose``'s ports
+``gripper``     6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each finger
+                            drive's force (N, − squeezes): ``GraspObserver``'s inputs
+``grasp_state`` 1           output: the observer's state (``systems.gripper.GRASP_STATES``)
+==============  ==========  ================================================================
+
+``grasp_reads`` gives when ``world.PickRun`` reads that state (its grasp checks and the reads
+every ``world.SENSE_PERIOD`` from a close command), on the control period's grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import Demultiplexer, PassThrough
+
+from ptint_drake.config.schema import Scenario
+from ptint_drake.systems.gripper import GraspObserver
+from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
+from ptint_drake.worlds.pick.station import MakePickStation
+from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
+from ptint_drake.worlds.pick.tasks import pick_plan
+
+PART_MOTION = (9, 15)  # a part's [x, ẋ, ẍ] and [R, ω, ω̇]
+
+
+@dataclass
+class PickControllerSide:
+    """What ``AddPickControllerSide`` added: the plan, the gripper sequence and observer, the parts'
+    count, the gripper's force limit (N), the grasp reads (``grasp_reads``) and the target view."""
+
+    plan: object
+    sequence: GripperSequence
+    observer: GraspObserver
+    parts: int
+    max_force: float
+    reads: dict
+    target: PortTargets
+
+
+def grasp_reads(plan, period: float, sense: float) -> dict:
+    """µs → "check" or "sense": the plan's grasp checks (not ``holding`` there: a new plan) and the
+    reads every ``sense`` s (``world.SENSE_PERIOD``) between each close command and its check
+    (``empty`` or ``lost`` there: a new plan), as ``world.PickRun`` stops for them."""
+    out = {}
+    for attempts in plan.attempts:
+        for a in attempts:
+            for j in range(1, int((a.check - a.close) / sense) + 1):
+                out[int(round(round((a.close + j * sense) / period) * period * 1e6))] = "sense"
+            out[int(round(a.check * 1e6))] = "check"
+    return out
+
+
+def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: float,
+                          sense: float) -> PickControllerSide:
+    """The pick world's controller side in ``builder`` (module docstring), its ports exported;
+    ``period``: the control period, ``sense``: ``grasp_reads``'s."""
+    pick = scenario.pick
+    plan = pick_plan(pick)
+    places = place_positions(MakePickStation(world_config(scenario)), plan)
+    count = len(pick.parts)
+    parts = builder.AddNamedSystem("status_parts", PassThrough(sum(PART_MOTION) * count))
+    split = builder.AddNamedSystem("parts_split", Demultiplexer(list(PART_MOTION) * count))
+    builder.Connect(parts.get_output_port(), split.get_input_port(0))
+    targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, count, places))
+    for k in range(count):
+        builder.Connect(split.get_output_port(2 * k), targets.GetInputPort(f"part_{k}_pose"))
+        builder.Connect(split.get_output_port(2 * k + 1), targets.GetInputPort(f"part_{k}_rotation"))
+    sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
+    gripper = builder.AddNamedSystem("status_gripper", PassThrough(6))
+    fingers = builder.AddNamedSystem("gripper_split", Demultiplexer([4, 2]))
+    builder.Connect(gripper.get_output_port(), fingers.get_input_port(0))
+    observer = builder.AddNamedSystem("grasp_observer", GraspObserver(
+        pick.gripper.max_force, pick.gripper.speed, pick.width_tolerance, period=period))
+    builder.Connect(fingers.get_output_port(0), observer.GetInputPort("finger_state"))
+    builder.Connect(fingers.get_output_port(1), observer.GetInputPort("drive_force"))
+    builder.Connect(sequence.GetOutputPort("command"), observer.GetInputPort("command"))
+    builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
+    builder.ExportInput(parts.get_input_port(), "parts")
+    builder.ExportInput(gripper.get_input_port(), "gripper")
+    builder.ExportOutput(observer.GetOutputPort("grasp_state"), "grasp_state")
+    target = PortTargets(targets.GetOutputPort("target"), targets.GetOutputPort("target_rotation"))
+    return PickControllerSide(plan, sequence, observer, count, pick.gripper.max_force,
+                              grasp_reads(plan, period, sense), target)
