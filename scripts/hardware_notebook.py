@@ -97,7 +97,8 @@ print(f"verdict {metrics['status']}: e(tf) = {seg['e_tf_norm'] * 1e3:.4f} mm, "
 def row(name, spread, unit="ms"):
     if spread is None:
         return f"| {name} | — | — | — |"
-    return f"| {name} | {spread['median']:.3f} {unit} | {spread['p99']:.3f} {unit} | {spread['max']:.3f} {unit} |"
+    cells = [f"{spread[k]:.3f} {unit}" for k in ("median", "p99", "max")]
+    return f"| {name} | " + " | ".join(cells) + " |"
 
 
 lines = ["| | median | p99 | max |", "|---|---|---|---|",
