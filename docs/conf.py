@@ -22,7 +22,7 @@ sys.path.insert(0, str(HERE / "_ext"))
 import ptint_reference  # noqa: E402
 
 ptint_reference.write_generated(HERE / "_generated")
-NOTEBOOKS = ("your_diagram", "camera", "which_controller", "pose", "pick_and_place")
+NOTEBOOKS = ("your_diagram", "camera", "which_controller", "pose", "pick_and_place", "hardware")
 (HERE / "tutorials").mkdir(exist_ok=True)
 for _name in NOTEBOOKS:
     _source = ROOT / "examples" / f"{_name}.ipynb"

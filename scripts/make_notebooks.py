@@ -23,6 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 sys.path.insert(0, str(ROOT / "tests"))
 from notebook_kernel import kernel_env, kernel_name  # noqa: E402
+from hardware_notebook import hardware  # noqa: E402
 from task_notebooks import pick_and_place, pose  # noqa: E402
 
 SETUP = """\
@@ -321,10 +322,11 @@ Image(filename=str(out / "tune.png"), width=520)""",
 ]
 
 NOTEBOOKS = {"your_diagram": YOUR_DIAGRAM, "camera": CAMERA, "which_controller": WHICH_CONTROLLER,
-             "pose": pose(SETUP), "pick_and_place": pick_and_place(SETUP)}
+             "pose": pose(SETUP), "pick_and_place": pick_and_place(SETUP), "hardware": hardware(SETUP)}
 # the cells whose printed numbers the test compares with the committed outputs
 TABLE_MARKERS = ('print(f"|e(0)|', "rows = []", 'print("controller', "tried K",
-                 'print("         | distance', 'print("t_grasp [s]')
+                 'print("         | distance', 'print("t_grasp [s]',
+                 'print(f"verdict {metrics')
 
 
 def notebook(cells: list) -> nbformat.NotebookNode:

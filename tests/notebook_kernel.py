@@ -13,7 +13,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
-NOTEBOOKS = ("your_diagram", "camera", "which_controller", "pose", "pick_and_place")
+NOTEBOOKS = ("your_diagram", "camera", "which_controller", "pose", "pick_and_place", "hardware")
 
 
 def kernel_name() -> str:

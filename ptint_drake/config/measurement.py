@@ -40,6 +40,10 @@ class RgbdCameraConfig:
     part_size: List[float] = field(default_factory=lambda: [0.03, 0.03, 0.03])
     # the conveyors' top surfaces; empty: the world derives one under each object's path
     belts: List[BeltRegionConfig] = field(default_factory=list)
+    # calibration error: [dx, dy, dz (m), droll, dpitch, dyaw (deg)] of the real camera from its
+    # configured pose, in the camera frame; the image is rendered there while the perception
+    # believes the configured pose (``robust`` draws it); empty: none
+    pose_error: List[float] = field(default_factory=list)
 
 @dataclass
 class MeasurementConfig:

@@ -154,6 +154,7 @@ class _DriveLoop:
         record: DriveRecord,
         url: Optional[str],
         warn: Callable[[str], None],
+        lcm=None,
     ) -> None:
         diagram, _, n, pick = DriveDiagram(scenario)
         self.n, self.settings, self.record, self.pick = n, settings, record, pick
@@ -171,7 +172,7 @@ class _DriveLoop:
         self.context = self.simulator.get_mutable_context()
         self.state_in, self.out = diagram.GetInputPort("state"), diagram.GetOutputPort("actuation")
         also = (WSG_STATUS_CHANNEL, PARTS_CHANNEL) if pick is not None else ()
-        self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also)
+        self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also, lcm=lcm)
         if pick is not None:
             self.parts_in, self.gripper_in = diagram.GetInputPort("parts"), diagram.GetInputPort("gripper")
             self.grasp_out = diagram.GetOutputPort("grasp_state")
@@ -284,7 +285,7 @@ class _DriveLoop:
                     f"no {missing} message for the status of t = {utime / 1e6:.3f} s within "
                     f"{self.settings.status_timeout:g} s: stopped commanding"
                 )
-            self.endpoint.lcm.HandleSubscriptions(5)  # the arm's statuses stay in the inbox
+            self.endpoint.pump(0.005)  # the arm's statuses stay in the inbox
 
     def check_grasp(self, utime: int) -> None:
         """At a grasp check of the plan (and, from a close command on, every ``SENSE_PERIOD``):
@@ -406,10 +407,12 @@ def run_drive(
     record: DriveRecord,
     url: Optional[str] = None,
     warn: Callable[[str], None] = print,
+    lcm=None,
 ) -> str:
     """Answer the hardware's statuses until the scenario's end (module docstring), recording
-    into ``record``; returns the URL used."""
-    loop = _DriveLoop(scenario, settings, record, url, warn)
+    into ``record``; returns the URL used.  ``lcm``: a ``DrakeLcm`` to use instead of one of
+    ``url`` (``in_memory``)."""
+    loop = _DriveLoop(scenario, settings, record, url, warn, lcm)
     while True:
         for t_recv, data in loop.wait():
             loop.take(t_recv, data)

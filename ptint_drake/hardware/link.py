@@ -37,8 +37,10 @@ LCM carries no sender identity and no authentication: the default URL stays on t
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import struct
+import threading
 import time
 import urllib.parse
 from typing import Optional
@@ -58,6 +60,10 @@ COMMAND_CHANNEL = "IIWA_COMMAND"
 WSG_STATUS_CHANNEL = "SCHUNK_WSG_STATUS"  # Drake's hardware_sim names
 WSG_COMMAND_CHANNEL = "SCHUNK_WSG_COMMAND"
 PARTS_CHANNEL = "PART_MOTION"
+MEMQ_NAP = 5e-5  # s: a memq:// wait's sleep between two non-blocking handles
+# one thread at a time in a memq:// LCM shared by two threads (``in_memory``): pydrake's calls keep
+# Python's interpreter lock while LCM takes its own, and LCM calls back into Python
+MEMQ_LOCK = threading.Lock()
 PART_SIZE = 24  # doubles a part: [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15)
 
 
@@ -88,6 +94,7 @@ class Endpoint:
     ):
         self.lcm = lcm if lcm is not None else DrakeLcm(url) if url else DrakeLcm()
         self.url = self.lcm.get_lcm_url()
+        self._guard = MEMQ_LOCK if self.url.startswith("memq") else contextlib.nullcontext()
         self.listen, self.publish_channel = listen, publish
         self.inbox: list[tuple[float, bytes]] = []
         self.lcm.Subscribe(listen, lambda data: self.inbox.append((time.perf_counter(), bytes(data))))
@@ -96,9 +103,18 @@ class Endpoint:
         for channel in also:
             self.lcm.Subscribe(channel, lambda data, c=channel: self.side[c].append(bytes(data)))
 
+    def pump(self, timeout_s: float) -> None:
+        """Handle what arrives within ``timeout_s`` into the inboxes (none drained here)."""
+        if self.url.startswith("memq"):
+            if self._handle() == 0:
+                time.sleep(MEMQ_NAP)
+        else:
+            self._handle(max(0, int(round(timeout_s * 1e3))))
+
     def publish_on(self, channel: str, data: bytes) -> None:
         """Publish ``data`` on another channel than the endpoint's own."""
-        self.lcm.Publish(channel, data)
+        with self._guard:
+            self.lcm.Publish(channel, data)
 
     def take_side(self, channel: str) -> list[bytes]:
         """The messages received on ``channel`` (one of ``also``) since the last call, oldest first."""
@@ -110,13 +126,31 @@ class Endpoint:
         before the call: on a busy machine the receiver may run, and answer, before ``Publish``
         returns to this process)."""
         sent = time.perf_counter()
-        self.lcm.Publish(self.publish_channel, data)
+        with self._guard:
+            self.lcm.Publish(self.publish_channel, data)
         return sent
 
+    def _handle(self, timeout_ms: int = 0) -> int:
+        with self._guard:
+            return self.lcm.HandleSubscriptions(timeout_ms)
+
     def poll(self, timeout_s: float) -> list[tuple[float, bytes]]:
-        """Messages received within ``timeout_s`` (0: only those waiting), oldest first."""
-        self.lcm.HandleSubscriptions(max(0, int(round(timeout_s * 1e3))))
-        while self.lcm.HandleSubscriptions(0) > 0:
+        """Messages received within ``timeout_s`` (0: only those waiting), oldest first.  On a
+        ``memq://`` LCM (both sides in one process, ``in_memory``) the wait is a sleep between
+        non-blocking handles: pydrake's ``HandleSubscriptions`` keeps Python's interpreter lock
+        while it blocks, which would stop the other side's thread."""
+        if self.url.startswith("memq"):
+            deadline = time.perf_counter() + timeout_s
+            while (
+                self._handle() == 0
+                and not self.inbox
+                and not any(self.side.values())
+                and time.perf_counter() < deadline
+            ):  # (the other side's thread may have handled them)
+                time.sleep(MEMQ_NAP)
+        else:
+            self._handle(max(0, int(round(timeout_s * 1e3))))
+        while self._handle() > 0:
             pass
         out, self.inbox = self.inbox, []
         return out

@@ -168,10 +168,12 @@ def run_hardware(
     url: Optional[str] = None,
     progress=None,
     warn: Callable[[str], None] = print,
+    lcm=None,
 ) -> dict:
     """Run ``scenario`` as hardware over LCM (module docstring) and write metrics.json and
     series.npz into ``out``; returns the metrics.  ``LinkFault`` when no controller answers
-    before the simulation starts (nothing is written)."""
+    before the simulation starts (nothing is written).  ``lcm``: a ``DrakeLcm`` to use instead of
+    one of ``url`` (a ``memq://`` one shared with a drive in this process: ``in_memory``)."""
     check_link_scenario(scenario)
     plant = nominal_plant(scenario)
     n = plant.num_actuators()
@@ -184,6 +186,7 @@ def run_hardware(
     pick = scenario.pick
     endpoint = Endpoint(
         url,
+        lcm=lcm,
         listen=COMMAND_CHANNEL,
         publish=STATUS_CHANNEL,
         also=(WSG_COMMAND_CHANNEL,) if pick is not None else (),

@@ -148,3 +148,70 @@ def test_bad_input_is_one_line(ptint_here, args, words, tmp_path):
     out = ptint_here(*args, "--out", tmp_path / "out")
     assert out.returncode == 2 and words in out.stderr, out.stderr
     assert len(out.stderr.strip().splitlines()) == 1 and not (tmp_path / "out").exists()
+
+
+def pick_pair():
+    """A hardware session of the pick world (1 part, a 30 N gripper) and the drive's endpoint."""
+    from ptint_drake.hardware.command_link import PickLink  # noqa: PLC0415
+    from ptint_drake.hardware.link import WSG_COMMAND_CHANNEL  # noqa: PLC0415
+
+    lcm = DrakeLcm("memq://")
+    hardware = Endpoint(None, listen=COMMAND_CHANNEL, publish=STATUS_CHANNEL, lcm=lcm,
+                        also=(WSG_COMMAND_CHANNEL,))
+    settings = LinkSettings(period=1e-3, duration=1.0, command_timeout=0.05)
+    session = HardwareSession(hardware, N, LIMITS, settings)
+    session.pick = PickLink(parts=1, max_force=30.0)
+    return session, lcm
+
+
+def pick_tick(session, lcm, t, gripper=()):
+    """Publish the arm's command for ``t`` after the gripper commands ``gripper``, then the tick."""
+    from ptint_drake.hardware.link import WSG_COMMAND_CHANNEL  # noqa: PLC0415
+
+    for data in gripper:
+        lcm.Publish(WSG_COMMAND_CHANNEL, data)
+    lcm.Publish(COMMAND_CHANNEL, pack_command(utime_of(t), np.zeros(N)))
+    extras = (np.zeros(4), np.zeros(2), np.zeros(24))
+    return session.exchange(t, np.zeros(N), np.zeros(N), np.zeros(N), extras)
+
+
+def test_the_gripper_command_for_the_next_tick_is_taken():
+    from ptint_drake.hardware.link import pack_wsg_command  # noqa: PLC0415
+
+    session, lcm = pick_pair()
+    pick_tick(session, lcm, 0.002, [pack_wsg_command(utime_of(0.003), 0.042, 30.0)])
+    assert session.record.fault is None and session.gripper_opening(utime_of(0.003)) == 0.042
+
+
+@pytest.mark.parametrize(
+    "opening, force, words",
+    [(np.nan, 30.0, "not finite"), (0.042, 45.0, "force 45 N outside [0, 30] N"), (0.042, -1.0, "outside")],
+)
+def test_bad_gripper_commands_are_faults(opening, force, words):
+    from ptint_drake.hardware.link import pack_wsg_command  # noqa: PLC0415
+
+    session, lcm = pick_pair()
+    pick_tick(session, lcm, 0.002, [pack_wsg_command(utime_of(0.003), opening, force)])
+    assert session.record.fault_kind == "bad command" and words in session.record.fault
+
+
+def test_two_gripper_commands_for_one_tick_are_a_second_sender():
+    from ptint_drake.hardware.link import pack_wsg_command  # noqa: PLC0415
+
+    session, lcm = pick_pair()
+    two = [pack_wsg_command(utime_of(0.003), 0.042, 30.0), pack_wsg_command(utime_of(0.003), 0.0, 30.0)]
+    pick_tick(session, lcm, 0.002, two)
+    assert session.record.fault_kind == "second sender"
+    assert "two different gripper commands" in session.record.fault
+
+
+def test_gripper_status_round_trip_keeps_what_the_observer_reads():
+    """The WSG status carries the opening, the faster finger's speed and the smaller squeeze;
+    unpacked, the grasp observer's rule reads the same three numbers."""
+    from ptint_drake.hardware.link import pack_wsg_status, unpack_wsg_status  # noqa: PLC0415
+
+    fingers, force = np.array([0.0148, 0.0151, -0.002, 0.003]), np.array([-29.5, -30.0])
+    utime, f, d = unpack_wsg_status(pack_wsg_status(0.5, fingers, force))
+    assert utime == 500000
+    assert abs((f[0] + f[1]) - (fingers[0] + fingers[1])) < 1e-15
+    assert abs(max(abs(f[2]), abs(f[3])) - 0.003) < 1e-15 and min(-d[0], -d[1]) == 29.5

@@ -95,6 +95,15 @@ def test_something_above_a_part_makes_its_fit_a_dropout_when_checked():
     assert checked and not good(checked) and "above it" in checked[0].reason
 
 
+def test_a_calibration_error_moves_what_the_perception_sees():
+    centre = np.array([0.30, 0.0, 0.115])
+    (ok,) = good(StaticScene(camera(), [(centre, 0.0)]).fits(0.0)[0])
+    shifted = camera(pose_error=[0.002, 0.0, 0.0, 0.0, 0.0, 0.0])
+    (off,) = good(StaticScene(shifted, [(centre, 0.0)]).fits(0.0)[0])
+    # the real camera 2 mm to its right: the part seen 2 mm to the left of where it is
+    assert np.linalg.norm(off.position - ok.position) == pytest.approx(0.002, abs=5e-4)
+
+
 def test_nothing_on_the_belt_gives_no_fit():
     assert StaticScene(camera(), []).fits(0.0)[0] == []
 

@@ -31,13 +31,13 @@ def test_the_five_joint_arm_is_not_checked():
 
 
 def test_a_six_joint_top_down_task_is_damped_by_default_and_nothing_else_is():
-    """controller.pinv_damping left out: 0.01 m/rad for top_down on 6 joints (docs/pick_place.md),
+    """controller.pinv_damping left out: 0.015 m/rad for top_down on 6 joints (docs/pick_place.md),
     the exact J⁺ for the 5-joint arm and the other tasks; a value written is kept."""
     from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
 
     _, text = scenario_text("conveyor_pick_place")
     six = ["robot.model=rvm1_6dof", f"robot.initial_q_deg={START_6DOF}"]
-    assert parse_with_overrides(text, six).controller.pinv_damping == 0.01
+    assert parse_with_overrides(text, six).controller.pinv_damping == 0.015
     assert parse_with_overrides(text, six + ["controller.pinv_damping=0"]).controller.pinv_damping == 0.0
     assert load_scenario("conveyor_pick_place").controller.pinv_damping == 0.0
     assert load_scenario("curve_pose").controller.pinv_damping == 0.0  # pose on rvm1_6dof: exact

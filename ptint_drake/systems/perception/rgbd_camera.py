@@ -68,6 +68,9 @@ def validate_camera(c: RgbdCameraConfig) -> None:
         at, eye = _vector(c.look_at, "look_at"), _vector(c.look_from, "look_from")
         if np.linalg.norm(at - eye) < 1e-6:
             raise _field_error("look_at", "must differ from look_from")
+    if c.pose_error and (len(c.pose_error) != 6 or not np.all(np.isfinite(np.asarray(c.pose_error, float)))):
+        raise _field_error("pose_error", "[dx, dy, dz (m), droll, dpitch, dyaw (deg)] or [], "
+                           f"got {c.pose_error!r}")
     for i, belt in enumerate(c.belts):
         _vector(belt.center, f"belts[{i}].center")
         d = _vector(belt.direction, f"belts[{i}].direction")
@@ -155,8 +158,12 @@ def AddRgbdCamera(builder: DiagramBuilder, scene_graph: SceneGraph, config: Rgbd
     info = camera_info(config)
     core = RenderCameraCore(RENDERER, info, ClippingRange(NEAR, FAR), RigidTransform())
     X_WC = camera_pose(config)
+    X_rendered = X_WC
+    if config.pose_error:  # the real camera, off its calibration (the perception keeps X_WC)
+        e = np.asarray(config.pose_error, dtype=float)
+        X_rendered = X_WC.multiply(RigidTransform(RollPitchYaw(np.radians(e[3:6])), e[0:3]))
     sensor = builder.AddNamedSystem(name, RgbdSensor(
-        scene_graph.world_frame_id(), X_WC, ColorRenderCamera(core, False),
+        scene_graph.world_frame_id(), X_rendered, ColorRenderCamera(core, False),
         DepthRenderCamera(core, DepthRange(DEPTH_NEAR, DEPTH_FAR))))
     builder.Connect(scene_graph.get_query_output_port(), sensor.query_object_input_port())
     noise = builder.AddNamedSystem(f"{name}_depth_noise", DepthNoise(

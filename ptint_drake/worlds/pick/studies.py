@@ -17,6 +17,7 @@ from pydrake.systems.framework import DiagramBuilder, EventStatus
 from pydrake.systems.primitives import Adder, LogVectorOutput, Saturation, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
+from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.config.pick import PHASES
 from ptint_drake.mass_scaling import scale_in_context
 from ptint_drake.worlds.pick.run import pick_simulator, world_config
@@ -26,6 +27,25 @@ from ptint_drake.worlds.pick.station import MakePickStation
 def mm_text(value) -> str:
     """A length in m as mm text ("n/a" when there is none)."""
     return "n/a" if value is None else f"{value * 1e3:.4g} mm"
+
+
+CAMERA_XYZ_ERROR = 0.0005  # m, ± per axis: an RGB-D camera's calibration error (issue 34)
+CAMERA_RPY_ERROR = 0.1  # deg, ± per axis
+DEPTH_NOISE_SCALE = (0.5, 2.0)  # × the D415-style depth noise
+
+
+def _camera_errors(measurement, seed: int) -> dict:
+    """An rgbd camera's calibration error and depth-noise scale of this sample, drawn from their
+    own generator (``default_rng([seed, 34])``: the other parameters' draws are unchanged)."""
+    camera = measurement.camera
+    if measurement.sensor != "rgbd" or camera is None:
+        return {}
+    rng = np.random.default_rng([seed, 34])
+    camera.pose_error = (list(rng.uniform(-CAMERA_XYZ_ERROR, CAMERA_XYZ_ERROR, 3))
+                         + list(rng.uniform(-CAMERA_RPY_ERROR, CAMERA_RPY_ERROR, 3)))
+    camera.depth_noise_scale *= float(rng.uniform(*DEPTH_NOISE_SCALE))
+    return {"camera_pose_error": [float(v) for v in camera.pose_error],
+            "depth_noise_scale": float(camera.depth_noise_scale)}
 
 
 def robust_sample(scenario, name: str, seed: int, u):
@@ -48,14 +68,20 @@ def robust_sample(scenario, name: str, seed: int, u):
         shift = float(u("part_lateral"))
         if not isinstance(part.lateral, list):  # a [min, max] range is drawn from measurement.seed
             part.lateral = float(np.clip(part.lateral + shift, -half, half))
+    camera = {}
     if scenario.measurement is not None:  # a camera's noise and the random placement: this sample's
         scenario.measurement.seed = seed
+        camera = _camera_errors(scenario.measurement, seed)
+        placed = placed_parts(pick.parts, seed)
+        camera |= {"placed_yaw_deg": [p.yaw_deg for p in placed],
+                   "placed_lateral": [p.lateral for p in placed], "placed_offset": [p.offset for p in placed]}
     scenario.name = f"{name}_seed{seed}"
-    return scenario, {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
-                      "part_friction": [p.friction for p in pick.parts],
-                      "belt_speed": [b.speed for b in pick.belts],
-                      "close_delay": [t.close_delay for t in pick.tasks],
-                      "part_lateral": [p.lateral for p in pick.parts]}
+    params = {"mass_scale": scenario.plant.mass_scale, "part_mass": [p.mass for p in pick.parts],
+              "part_friction": [p.friction for p in pick.parts],
+              "belt_speed": [b.speed for b in pick.belts],
+              "close_delay": [t.close_delay for t in pick.tasks],
+              "part_lateral": [p.lateral for p in pick.parts]}
+    return scenario, params | camera
 
 
 def robust_row(seed: int, params: dict, m: dict) -> dict:
