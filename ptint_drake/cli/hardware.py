@@ -60,7 +60,8 @@ def _add_hardware_parser(sub) -> None:
         help="the simulated world as hardware over LCM (with `ptint drive`; docs/hardware.md)",
         description="Run the scenario's world alone as the hardware: a discrete plant at the control period "
         "publishing the arm's status (lcmt_iiwa_status on IIWA_STATUS) and applying the torque "
-        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive`; a fault "
+        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive` (a pick "
+        "scenario adds the gripper's lcmt_schunk_wsg_status/command and the parts' motion); a fault "
         "(no command, a bad command, a second sender) holds the arm and ends the run with its "
         "reason. Writes metrics.json (the verdict, and a hardware block with the latency) and "
         "series.npz. Exit 0 ok, 1 missed or a fault, 2 bad input.",

@@ -276,7 +276,9 @@ class _DriveLoop:
             self._collect()
             got = self.companions.get(utime, {})
             if "gripper" in got and "parts" in got:
-                for old in [u for u in self.companions if u < utime]:
+                # taken: the next status of this time (the first tick after the hand-shake's)
+                # waits for its own
+                for old in [u for u in self.companions if u <= utime]:
                     del self.companions[old]
                 return got
             if time.perf_counter() >= deadline:
