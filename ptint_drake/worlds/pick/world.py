@@ -231,11 +231,13 @@ class PickRun(WorldRun):
         station = self.built.station
         scale_in_context(station.plant, station.plant.GetMyMutableContextFromRoot(new_context), station.arm,
                          self.scenario.plant.mass_scale)
-        targets = self.built.targets
-        tc = targets.GetMyMutableContextFromRoot(new_context)
-        value = targets.latch_value(tc)
-        if value is not None:  # the backoff's latch, before the controller captures its start
-            tc.SetDiscreteState(0, value)
+        for targets in (self.built.targets, self.built.true_targets):
+            if targets is None:
+                continue
+            tc = targets.GetMyMutableContextFromRoot(new_context)
+            value = targets.latch_value(tc)
+            if value is not None:  # the backoff's latch, before the controller captures its start
+                tc.SetDiscreteState(0, value)
 
     def _logs(self, context) -> dict:
         return {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
