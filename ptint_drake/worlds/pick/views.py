@@ -12,7 +12,8 @@ part's estimate (what the pick aimed at) minus the truth (the simulated part) ov
 its belt and across it (mm) and in yaw (deg, folded by the part's symmetry) — with each fit the
 estimators were given (dots, at the frame's time: the fit minus the truth then), the frames'
 times (grey ticks) and the prescribed grasp time (dashed) marked; up to 0.3 s past the grasp
-(after it the part is in the hand).
+(after it the part is in the hand); the vertical range is that from the first fit to the grasp
+(the nominal place drawn before the first fit may leave the axes).
 
 ``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
 from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
@@ -118,8 +119,14 @@ def estimate_figure(series: dict, metrics: dict, directions: list, symmetries: l
                   ("across the belt (mm)", 1e3 * error @ across, 1e3 * fit_error @ across),
                   ("yaw (deg)", yaw_error, fit_yaw_error))
         shown = stamps <= pick["t_grasp_prescribed"] + GRASP_TAIL
+        # the vertical range: from the first fit on to the grasp (before it, the nominal place)
+        seen = keep & (t >= (stamps[0] if len(stamps) else 0.0)) & (t <= pick["t_grasp_prescribed"])
         for ax, (label, values, fits) in zip(axes[row], panels):
             ax.plot(t[keep], values[keep], lw=1.2, label="estimate − truth")
+            if np.any(seen):
+                lo, hi = np.percentile(np.r_[values[seen], fits[shown]], [1, 99])
+                pad = max(0.25 * (hi - lo), 0.2)
+                ax.set_ylim(min(lo, 0.0) - pad, max(hi, 0.0) + pad)
             ax.plot(stamps[shown], fits[shown], ".", ms=3, color="tab:orange", label="fit − truth")
             ax.axhline(0.0, color="0.5", lw=0.5)
             for s in stamps[shown]:
