@@ -138,10 +138,12 @@ def _add_grid_parsers(sub) -> None:
     rb.add_argument("--range", action="append", type=opt.robust_range, metavar="NAME=LOW,HIGH",
                     help="override a parameter range (mass, friction, coulomb, payload, "
                          "disturbance, noise, latency; pick scenarios: part_mass, part_friction, "
-                         "belt_speed, close_jitter, part_lateral)")
+                         "belt_speed, close_jitter, part_lateral; rgbd picks: camera_xyz_error, "
+                         "camera_rpy_error, depth_noise_scale, placed_lateral)")
     rb.add_argument("--ranges", type=opt.ranges_preset, default="harsh", metavar="PRESET",
-                    help="the preset of ranges: harsh (default; pick ranges that reach failures) or "
-                         "mild (the study before them, seed for seed)")
+                    help="the preset of ranges: harsh (default; pick ranges that reach failures), "
+                         "mild (the study before them, seed for seed) or calibration (mild with an "
+                         "rgbd camera's calibration error at +-2 mm, +-0.5 deg)")
     _study_arguments(rb, "out/robust_NAME", workers_default="1")
     rb.set_defaults(func=cmd_robust)
 

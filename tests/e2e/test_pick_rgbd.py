@@ -43,3 +43,17 @@ def test_a_fit_forced_wrong_makes_the_pick_fail(monkeypatch):
     (pick,) = result.metrics["picks"]
     assert not result.ok and not pick["placed"]
     assert pick["estimate_error_mm"] > 10.0
+
+
+def test_e_true_is_against_the_simulated_part_and_e_estimate_against_the_estimate():
+    result = run_cached("conveyor_pick_place_rgbd")
+    series, (pick,) = result.series, result.metrics["picks"]
+    j = int(np.argmin(np.abs(series["t"] - pick["t_grasp_prescribed"])))
+    # the two targets differ at the grasp by the estimate's error, nothing else
+    np.testing.assert_allclose(series["target"][j, 0:3] - series["target_true"][j, 0:3],
+                               series["part_estimate_0"][j, 0:3] - series["part_true_0"][j, 0:3], atol=1e-9)
+    np.testing.assert_allclose(series["e_true"], series["x"] - series["target_true"][:, 0:3])
+    np.testing.assert_allclose(series["e_estimate"], series["x"] - series["target"][:, 0:3])
+    gap = 1e3 * np.linalg.norm(series["e_true"][j] - series["e_estimate"][j])
+    assert gap > 0.1  # the estimate is not the truth (1.65 mm off on this seed)
+    assert abs(gap - pick["estimate_error_mm"]) < 0.05

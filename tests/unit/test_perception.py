@@ -17,6 +17,7 @@ from ptint_drake.systems.perception.part_fit import fit_parts
 from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PartPoseEstimator,
                                                                  PerceptionConfig, belt_regions,
                                                                  belts_under_paths)
+from ptint_drake.systems.perception.rgbd_camera import cloud_camera_info
 from ptint_drake.systems.perception.static_scene import StaticScene
 from ptint_drake.systems.targets import LinearTarget
 
@@ -48,6 +49,15 @@ def test_box_fit_within_1mm_1deg_from_a_noiseless_render(yaw_deg):
     assert fit.symmetry == pytest.approx(math.pi / 2)  # a cube: yaw known up to 90°
     assert yaw_error_deg(fit.yaw, math.radians(yaw_deg), fit.symmetry) < 1.0
     assert fit.inliers > 200 and fit.residual < 2e-3 and np.all(np.diag(fit.covariance) > 0)
+
+
+@pytest.mark.parametrize("yaw_deg", [20.0, 45.0])
+def test_a_noiseless_fit_has_no_half_pixel_bias(yaw_deg):
+    """The cloud is back-projected where Drake renders (``rgbd_camera.RENDER_PIXEL_SHIFT``): with
+    CameraInfo's own principal point this fit is ~0.7 mm off (half a pixel footprint)."""
+    centre = np.array([0.305, 0.012, 0.115])
+    (fit,) = good(StaticScene(camera(), [(centre, math.radians(yaw_deg))]).fits(0.0)[0])
+    assert np.linalg.norm(fit.position - centre) < 0.15e-3
 
 
 def test_box_fit_with_d415_noise_within_1mm_1deg():
@@ -163,8 +173,8 @@ def test_derived_belts_of_parallel_paths_keep_their_own_parts():
     estimator = PartPoseEstimator(PerceptionConfig(scene.camera.info, scene.camera.X_WC, belts, "box",
                                                    [0.03] * 3, of, 30.0, 0.033))
     builder = DiagramBuilder()
-    to_cloud = builder.AddSystem(DepthImageToPointCloud(scene.camera.info, PixelType.kDepth32F, 1.0,
-                                                        BaseField.kXYZs))
+    to_cloud = builder.AddSystem(DepthImageToPointCloud(cloud_camera_info(scene.camera.info),
+                                                        PixelType.kDepth32F, 1.0, BaseField.kXYZs))
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     depth = scene.camera.noise.get_output_port().Eval(scene.camera.noise.GetMyContextFromRoot(scene.context))

@@ -81,14 +81,54 @@ def test_parts_of_different_sizes_are_rejected_with_a_camera(capsys, tmp_path):
 
 
 def test_a_robust_sample_of_an_rgbd_pick_draws_a_new_placement():
+    from ptint_drake.studies import robust  # noqa: PLC0415
     from ptint_drake.worlds.pick import studies  # noqa: PLC0415
 
-    middle = {"mass": 1.0, "part_mass": 0.1, "part_friction": 0.8, "belt_speed": 1.0}
-
-    def draw(seed):
+    def draw(seed):  # the same draws of the sample's own generator: only the placement's seed differs
         scenario, _ = studies.robust_sample(load_scenario("conveyor_pick_place_rgbd"), "c", seed,
-                                            lambda name, n=None: middle.get(name, 0.0))
+                                            robust.Draws(np.random.default_rng(0), robust.MILD))
         return placed_parts(scenario.pick.parts, scenario.measurement.seed)[0]
 
     a, b = draw(3), draw(4)
     assert a.yaw_deg != b.yaw_deg and a.lateral != b.lateral
+
+
+@pytest.mark.parametrize("preset, xyz, rpy", [("mild", 0.0005, 0.1), ("harsh", 0.0005, 0.1),
+                                              ("calibration", 0.002, 0.5)])
+def test_robust_draws_an_rgbd_picks_camera_errors_and_placement_from_its_preset(preset, xyz, rpy):
+    """The camera's calibration error and depth-noise scale come from the ``--ranges`` preset;
+    every part is placed at any yaw and within ±15 mm across its belt (issue 34), whatever the
+    scenario's own narrower range (assembly_pick_place_rgbd: ±4 mm)."""
+    from ptint_drake.scenario import scenario_text
+    from ptint_drake.studies import robust
+    from ptint_drake.worlds.pick.placement import placed_parts
+
+    name, text = scenario_text("assembly_pick_place_rgbd")
+    ranges = robust.PRESETS[preset]
+    pose, yaws, laterals, scales = [], [], [], []
+    for seed in range(12):
+        scenario, params = robust.sample_scenario(text, name, seed, ranges)
+        assert all(p.yaw_deg == "random" and p.lateral == [-0.015, 0.015] for p in scenario.pick.parts)
+        placed = placed_parts(scenario.pick.parts, scenario.measurement.seed)
+        assert [p.lateral for p in placed] == params["placed_lateral"]
+        pose.append(params["camera_pose_error"])
+        scales.append(params["depth_noise_scale"])
+        yaws += params["placed_yaw_deg"]
+        laterals += params["placed_lateral"]
+    pose = np.abs(np.array(pose))
+    assert pose[:, 0:3].max() <= xyz and pose[:, 0:3].max() > 0.6 * xyz
+    assert pose[:, 3:6].max() <= rpy and pose[:, 3:6].max() > 0.6 * rpy
+    assert 0.5 <= min(scales) and max(scales) <= 2.0
+    assert max(np.abs(laterals)) <= 0.015 and max(np.abs(laterals)) > 0.01
+    assert min(yaws) < -90.0 and max(yaws) > 90.0
+
+
+def test_a_narrow_belt_clips_the_robust_lateral_range_to_its_half_width():
+    from ptint_drake.scenario import scenario_text
+    from ptint_drake.studies import robust
+
+    name, text = scenario_text("conveyor_pick_place_rgbd")
+    ranges = robust.MILD | {"placed_lateral": (-0.5, 0.5)}
+    scenario, _ = robust.sample_scenario(text, name, 3, ranges)
+    half = scenario.pick.belts[0].width / 2
+    assert scenario.pick.parts[0].lateral == [-half, half]

@@ -42,7 +42,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Outpu
 from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
-from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
 from ptint_drake.systems.perception.part_fit import BeltRegion, belt_points, fit_parts, part_height
 
 # m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
@@ -253,8 +253,8 @@ def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstim
     """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of
     ``PartPoseEstimator`` (``measurement_i``, ``measured_rotation_i``, ``fits``)."""
     builder = DiagramBuilder()
-    cloud = builder.AddNamedSystem("depth_to_cloud", DepthImageToPointCloud(
-        config.info, PixelType.kDepth32F, 1.0, BaseField.kXYZs))
+    cloud = builder.AddNamedSystem("depth_to_cloud", DepthImageToPointCloud(  # (RENDER_PIXEL_SHIFT)
+        cloud_camera_info(config.info), PixelType.kDepth32F, 1.0, BaseField.kXYZs))
     pose = builder.AddNamedSystem("camera_pose", ConstantValueSource(AbstractValue.Make(config.X_WC)))
     builder.Connect(pose.get_output_port(), cloud.camera_pose_input_port())
     estimator = builder.AddNamedSystem("part_poses", PartPoseEstimator(config))

@@ -4,23 +4,23 @@ For each segment at its start, half-way and at tf: the station is re-posed from 
 (the arm's logged joint angles at the nearest logged time; the objects by their motion), the
 camera renders, and ``frames/seg{i}_{when}_color.png`` (the colour image with every fit's centre
 drawn: a green cross for a good fit, a red one for a rejected fit, with its symmetric yaw as a
-line) and ``..._depth.png`` (the noisy depth, near = bright, missing pixels black) are written.
+line) and ``..._depth.png`` (the noisy depth, near = bright, missing pixels black) are written
+(``systems.perception.frame_images``).
 Re-rendering after the run costs ~0.3 s for VTK's start-up plus a few ms per frame.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder, System
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.perception.part_pose_estimator import AddRgbdPerception
-from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, project
+from ptint_drake.systems.perception.frame_images import write_frame
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
 from ptint_drake.worlds.interception.station import MakeStation, Station
 
 
@@ -30,15 +30,6 @@ def _instants(scenario: Scenario) -> list[tuple[str, float]]:
         for label, t in (("start", ic.start), ("half", ic.start + 0.5 * ic.tf), ("tf", ic.start + ic.tf)):
             out.append((f"seg{i}_{label}", t))
     return out
-
-
-def _mark(draw: ImageDraw.ImageDraw, uv, yaw_uv, ok: bool) -> None:
-    u, v = uv
-    color = (40, 220, 40) if ok else (230, 40, 40)
-    draw.line([(u - 6, v), (u + 6, v)], fill=color, width=2)
-    draw.line([(u, v - 6), (u, v + 6)], fill=color, width=2)
-    if yaw_uv is not None:
-        draw.line([(u, v), tuple(yaw_uv)], fill=color, width=1)
 
 
 @dataclass
@@ -83,21 +74,5 @@ def write_camera_frames(scenario: Scenario, series: dict, stage: Path) -> list[s
         depth = np.array(system.GetOutputPort("depth_image").Eval(station_context).data)[:, :, 0]
         fits = estimator.fit_frame(estimator.GetInputPort("point_cloud").Eval(
             estimator.GetMyContextFromRoot(context)))
-        image = Image.fromarray(np.ascontiguousarray(color))
-        draw = ImageDraw.Draw(image)
-        for fit in fits:
-            if not np.all(np.isfinite(fit.position)):
-                continue
-            tip = fit.position + 0.02 * np.array([math.cos(fit.yaw), math.sin(fit.yaw), 0.0])
-            uv = project(X_WC, info, np.array([fit.position, tip]))[:, 0:2]
-            _mark(draw, uv[0], uv[1] if fit.symmetry > 0.0 else None, fit.ok)
-        image.save(folder / f"{label}_color.png")
-        finite = np.isfinite(depth) & (depth > 0.0)
-        shade = np.zeros(depth.shape, dtype=np.uint8)
-        if np.any(finite):
-            lo, hi = np.percentile(depth[finite], [1, 99])
-            near = np.clip((hi - depth[finite]) / max(hi - lo, 1e-6), 0.0, 1.0)
-            shade[finite] = (255 * near).astype(np.uint8)
-        Image.fromarray(shade).save(folder / f"{label}_depth.png")
-        names += [f"frames/{label}_color.png", f"frames/{label}_depth.png"]
+        names += write_frame(folder, label, color, depth, fits, X_WC, info)
     return names

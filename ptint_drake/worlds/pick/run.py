@@ -79,6 +79,8 @@ class PickBuilt:
     limits: np.ndarray  # the arm's effort limits (N·m)
     observer: GraspObserver = None  # the grasp state (systems.gripper)
     estimates: PartEstimates = None  # with an rgbd camera: what the pick aims at (pick.camera)
+    # with an rgbd camera: the same plan's targets read off the simulated parts (the metrics' truth)
+    true_targets: PickTargets = None
 
     def part_system(self):
         """The system whose ``part_k_pose`` / ``part_k_rotation`` the targets read: the camera's
@@ -111,13 +113,14 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     plan = pick_plan(scenario.pick, replans)
     n = len(station.parts)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, place_positions(station, plan)))
-    estimates, parts = None, st
+    estimates, parts, true_targets = None, st, None
     if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
         estimates = AddPartEstimates(builder, st.GetOutputPort("depth_image"), scenario)
         parts = estimates.parts
-    for k in range(n):
-        builder.Connect(parts.GetOutputPort(f"part_{k}_pose"), targets.GetInputPort(f"part_{k}_pose"))
-        builder.Connect(parts.GetOutputPort(f"part_{k}_rotation"), targets.GetInputPort(f"part_{k}_rotation"))
+        true_targets = builder.AddNamedSystem("pick_targets_true",
+                                              PickTargets(plan, n, place_positions(station, plan)))
+        _connect_parts(builder, st, true_targets, n)
+    _connect_parts(builder, parts, targets, n)
     arm = nominal_plant(scenario)
     limits = actuator_effort_limits(arm)
     saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
@@ -153,10 +156,38 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
                "plant_state": LogVectorOutput(st.GetOutputPort("plant_state"), builder, REPLAY_PERIOD)}
     loggers |= {f"controller/{name}": LogVectorOutput(port, builder, PROBE_PERIOD)
                 for name, port in handles.log_ports.items()}
+    if estimates is not None:
+        loggers |= _camera_loggers(builder, st, estimates, true_targets, n)
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
     install_stateless_derivatives(diagram)  # as simulation.build: Drake's nanobind bindings
-    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits, observer, estimates)
+    return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits, observer, estimates,
+                     true_targets)
+
+
+def _connect_parts(builder: DiagramBuilder, parts, targets: PickTargets, n: int) -> None:
+    """``parts``' ``part_k_pose`` / ``part_k_rotation`` into ``targets``' inputs."""
+    for k in range(n):
+        builder.Connect(parts.GetOutputPort(f"part_{k}_pose"), targets.GetInputPort(f"part_{k}_pose"))
+        builder.Connect(parts.GetOutputPort(f"part_{k}_rotation"), targets.GetInputPort(f"part_{k}_rotation"))
+
+
+def _camera_loggers(builder: DiagramBuilder, st, estimates: PartEstimates, true_targets: PickTargets,
+                    n: int) -> dict:
+    """With a camera, every ``PROBE_PERIOD``: the targets read off the simulated parts, and per part
+    the simulated and the estimated pose and rotation and the fit the estimators were last given
+    (``measurement_k``: [stamp, x, y, z, valid]; ``measured_rotation_k``: [stamp, R, valid])."""
+    out = {"target_true": LogVectorOutput(true_targets.GetOutputPort("target"), builder, PROBE_PERIOD)}
+    seen, fits = estimates.parts, estimates.perception
+    for k in range(n):
+        for name, port in ((f"part_true_{k}", st.GetOutputPort(f"part_{k}_pose")),
+                           (f"part_true_rotation_{k}", st.GetOutputPort(f"part_{k}_rotation")),
+                           (f"part_estimate_{k}", seen.GetOutputPort(f"part_{k}_pose")),
+                           (f"part_estimate_rotation_{k}", seen.GetOutputPort(f"part_{k}_rotation")),
+                           (f"fit_{k}", fits.GetOutputPort(f"measurement_{k}")),
+                           (f"fit_rotation_{k}", fits.GetOutputPort(f"measured_rotation_{k}"))):
+            out[name] = LogVectorOutput(port, builder, PROBE_PERIOD)
+    return out
 
 
 def _probe(station: PickStation) -> PickProbe:
@@ -224,9 +255,14 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
 def pick_series(built: PickBuilt, logs: dict) -> dict:
     """The run's time series (every ``PROBE_PERIOD``): the probe, the fingers, the arm's q, v, the
     tool point x, ẋ (forward kinematics of the logged arm state), the target the controller aimed
-    at and the error against it (``e_true``: the target *is* the part's simulated pose), the
+    at (``target``) and the error against the truth (``e_true``, ``edot_true``: against the same
+    plan's target read off the simulated parts — without a camera that *is* ``target``), the
     controller's telemetry (``tau`` commanded, ``tau_applied`` after the effort limits), and the
-    whole plant's state every ``REPLAY_PERIOD`` (``replay_t``, ``plant_state``) for the replay."""
+    whole plant's state every ``REPLAY_PERIOD`` (``replay_t``, ``plant_state``) for the replay.
+    With a camera also: ``target_true``, ``e_estimate`` / ``edot_estimate`` (against what the
+    controller aimed at, the estimate) and per part k, on the same times, ``part_true_k`` /
+    ``part_estimate_k`` ([x (3), R row-major (9)]) and ``fit_k`` ([stamp, x, y, z, valid, R (9)]:
+    the last fit the estimators were given)."""
     t, state = logs["state"]
     nq = built.arm.num_positions()
     kinematics = FrameKinematics(built.arm, built.arm.GetFrameByName(built.station.config.end_effector))
@@ -237,13 +273,23 @@ def pick_series(built: PickBuilt, logs: dict) -> dict:
     controller = {name.split("/", 1)[1]: data for name, (_, data) in logs.items()
                   if name.startswith("controller/")}
     series = dict(built.controller.telemetry(controller | {"t": t, "state": state}))
+    truth = logs["target_true"][1] if "target_true" in logs else target
     series |= {"t": t, "q": state[:, :nq], "v": state[:, nq:], "x": x, "xdot": xdot, "target": target,
-               "e_true": x - target[:, 0:3], "edot_true": xdot - target[:, 3:6],
+               "e_true": x - truth[:, 0:3], "edot_true": xdot - truth[:, 3:6],
                "tau_applied": np.clip(series["tau"], -built.limits, built.limits),
                "probe": logs["probe"][1], "grip_force": logs["grip_force"][1],
                "gripper_state": logs["gripper_state"][1], "state": state,
                "grip_forces": logs["grip_forces"][1], "grasp_state": logs["grasp_state"][1][:, 0],
                "replay_t": logs["plant_state"][0], "plant_state": logs["plant_state"][1]}
+    if "target_true" in logs:
+        series |= {"target_true": truth, "e_estimate": x - target[:, 0:3],
+                   "edot_estimate": xdot - target[:, 3:6]}
+        for k in range(len(built.station.parts)):
+            series[f"part_true_{k}"] = np.hstack([logs[f"part_true_{k}"][1][:, 0:3],
+                                                  logs[f"part_true_rotation_{k}"][1][:, 0:9]])
+            series[f"part_estimate_{k}"] = np.hstack([logs[f"part_estimate_{k}"][1][:, 0:3],
+                                                      logs[f"part_estimate_rotation_{k}"][1][:, 0:9]])
+            series[f"fit_{k}"] = np.hstack([logs[f"fit_{k}"][1], logs[f"fit_rotation_{k}"][1][:, 1:10]])
     return series
 
 

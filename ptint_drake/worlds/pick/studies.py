@@ -29,23 +29,28 @@ def mm_text(value) -> str:
     return "n/a" if value is None else f"{value * 1e3:.4g} mm"
 
 
-CAMERA_XYZ_ERROR = 0.0005  # m, ± per axis: an RGB-D camera's calibration error (issue 34)
-CAMERA_RPY_ERROR = 0.1  # deg, ± per axis
-DEPTH_NOISE_SCALE = (0.5, 2.0)  # × the D415-style depth noise
-
-
-def _camera_errors(measurement, seed: int) -> dict:
-    """An rgbd camera's calibration error and depth-noise scale of this sample, drawn from their
-    own generator (``default_rng([seed, 34])``: the other parameters' draws are unchanged)."""
+def _camera_errors(measurement, u) -> dict:
+    """An rgbd camera's calibration error (``camera_xyz_error`` per axis, m; ``camera_rpy_error``
+    per axis, deg) and depth-noise scale (``depth_noise_scale``, ×) of this sample, drawn by ``u``."""
     camera = measurement.camera
     if measurement.sensor != "rgbd" or camera is None:
         return {}
-    rng = np.random.default_rng([seed, 34])
-    camera.pose_error = (list(rng.uniform(-CAMERA_XYZ_ERROR, CAMERA_XYZ_ERROR, 3))
-                         + list(rng.uniform(-CAMERA_RPY_ERROR, CAMERA_RPY_ERROR, 3)))
-    camera.depth_noise_scale *= float(rng.uniform(*DEPTH_NOISE_SCALE))
-    return {"camera_pose_error": [float(v) for v in camera.pose_error],
+    camera.pose_error = [float(v) for v in np.r_[u("camera_xyz_error", 3), u("camera_rpy_error", 3)]]
+    camera.depth_noise_scale *= float(u("depth_noise_scale"))
+    return {"camera_pose_error": list(camera.pose_error),
             "depth_noise_scale": float(camera.depth_noise_scale)}
+
+
+def _random_placement(pick, u) -> None:
+    """An rgbd pick's parts placed at random: yaw any, lateral in ``u.bounds("placed_lateral")``
+    clipped to the part's belt's half width (drawn from the sample's seed by ``placement``; the
+    plan is not told)."""
+    low, high = u.bounds("placed_lateral")
+    belts = {b.name: b for b in pick.belts}
+    for part in pick.parts:
+        half = belts[part.belt].width / 2
+        part.yaw_deg = "random"
+        part.lateral = [max(low, -half), min(high, half)]
 
 
 def robust_sample(scenario, name: str, seed: int, u):
@@ -53,7 +58,8 @@ def robust_sample(scenario, name: str, seed: int, u):
     ranges are [0, 0], draws what the study drew before they existed): the arm's link masses; every
     part's mass and friction; every belt's speed (×); every task's close-command jitter (s, added
     to the close's time: ``close_delay``); every part's lateral offset on its belt (m, ``lateral``,
-    clipped to the belt's half width)."""
+    clipped to the belt's half width); with an rgbd camera, last, its calibration error and depth
+    noise (``_camera_errors``) and every part's random placement (``_random_placement``)."""
     scenario.plant.mass_scale = float(u("mass"))
     pick = scenario.pick
     for part in pick.parts:
@@ -71,7 +77,9 @@ def robust_sample(scenario, name: str, seed: int, u):
     camera = {}
     if scenario.measurement is not None:  # a camera's noise and the random placement: this sample's
         scenario.measurement.seed = seed
-        camera = _camera_errors(scenario.measurement, seed)
+        camera = _camera_errors(scenario.measurement, u)
+        if scenario.measurement.sensor == "rgbd":
+            _random_placement(pick, u)
         placed = placed_parts(pick.parts, seed)
         camera |= {"placed_yaw_deg": [p.yaw_deg for p in placed],
                    "placed_lateral": [p.lateral for p in placed], "placed_offset": [p.offset for p in placed]}

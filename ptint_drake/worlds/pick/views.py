@@ -7,6 +7,14 @@ the grip force (N): the measured contact force squeezing the part (the smaller o
 normal forces, as ``peak_grip_force_N``) with the drives' force thin beside it, and the part's
 height (mm); each attempt's prescribed grasp time (dashed) and close command (dotted) marked.
 
+``estimate_figure`` — ``estimates.png``, for a run with an RGB-D camera: per pick (a row), the
+part's estimate (what the pick aimed at) minus the truth (the simulated part) over time — along
+its belt and across it (mm) and in yaw (deg, folded by the part's symmetry) — with each fit the
+estimators were given (dots, at the frame's time: the fit minus the truth then), the frames'
+times (grey ticks) and the prescribed grasp time (dashed) marked; up to 0.3 s past the grasp
+(after it the part is in the hand); the vertical range is that from the first fit to the grasp
+(the nominal place drawn before the first fit may leave the axes).
+
 ``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
 from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
 recording, saved standalone with ``StaticHtml()`` (``replay``).
@@ -63,6 +71,70 @@ def pick_figure(series: dict, metrics: dict, path: Path) -> Path:
                 ax.axvline(attempt["t_close_command"], color="tab:red", ls=":", lw=0.8)
             ax.set_title(f"pick {row} ({pick['part']}): {label}", fontsize=9)
             ax.set_xlabel("t (s)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+GRASP_TAIL = 0.3  # s, drawn past a pick's prescribed grasp in estimates.png
+
+
+def _yaw(block: np.ndarray) -> np.ndarray:
+    """The yaw of the row-major rotations in columns 3:12 of [x (3), R (9)] rows."""
+    return np.arctan2(block[:, 6], block[:, 3])
+
+
+def estimate_figure(series: dict, metrics: dict, directions: list, symmetries: list, path: Path) -> Path:
+    """Draw ``estimates.png`` (module docstring); ``directions``: per part its belt's unit
+    direction, ``symmetries``: per part its yaw symmetry (rad; 0: none known, ``part_fit.yaw_symmetry``)."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    from ptint_drake.systems.perception.part_fit import fold_yaw  # noqa: PLC0415
+
+    t, picks = np.asarray(series["t"]), metrics["picks"]
+    fig, axes = plt.subplots(len(picks), 3, figsize=(13, 2.8 * len(picks)), squeeze=False)
+    for row, pick in enumerate(picks):
+        k = pick["part_index"]
+        true, estimate, fit = (np.asarray(series[f"{name}_{k}"])
+                               for name in ("part_true", "part_estimate", "fit"))
+        u = np.asarray(directions[k], float)
+        across = np.array([-u[1], u[0], 0.0])
+        keep = t <= pick["t_grasp_prescribed"] + GRASP_TAIL
+        error = estimate[:, 0:3] - true[:, 0:3]
+        stamps, first = np.unique(fit[:, 0], return_index=True)
+        valid = fit[first, 4] > 0.5
+        stamps, first = stamps[valid], first[valid]
+        at = np.searchsorted(t, stamps).clip(0, len(t) - 1)  # the truth at each frame's time
+        fit_error = fit[first, 1:4] - true[at, 0:3]
+        fit_yaw = np.arctan2(fit[first, 8], fit[first, 5])  # R[1, 0], R[0, 0] after [stamp, x, y, z, valid]
+        dyaw, fit_dyaw = _yaw(estimate) - _yaw(true), fit_yaw - _yaw(true[at])
+        # (a part of any yaw, symmetry 0: fold_yaw's 0 for each)
+        yaw_error = np.degrees(fold_yaw(dyaw, symmetries[k]) + 0.0 * dyaw)
+        fit_yaw_error = np.degrees(fold_yaw(fit_dyaw, symmetries[k]) + 0.0 * fit_dyaw)
+        panels = (("along the belt (mm)", 1e3 * error @ u, 1e3 * fit_error @ u),
+                  ("across the belt (mm)", 1e3 * error @ across, 1e3 * fit_error @ across),
+                  ("yaw (deg)", yaw_error, fit_yaw_error))
+        shown = stamps <= pick["t_grasp_prescribed"] + GRASP_TAIL
+        # the vertical range: from the first fit on to the grasp (before it, the nominal place)
+        seen = keep & (t >= (stamps[0] if len(stamps) else 0.0)) & (t <= pick["t_grasp_prescribed"])
+        for ax, (label, values, fits) in zip(axes[row], panels):
+            ax.plot(t[keep], values[keep], lw=1.2, label="estimate − truth")
+            if np.any(seen):
+                lo, hi = np.percentile(np.r_[values[seen], fits[shown]], [1, 99])
+                pad = max(0.25 * (hi - lo), 0.2)
+                ax.set_ylim(min(lo, 0.0) - pad, max(hi, 0.0) + pad)
+            ax.plot(stamps[shown], fits[shown], ".", ms=3, color="tab:orange", label="fit − truth")
+            ax.axhline(0.0, color="0.5", lw=0.5)
+            for s in stamps[shown]:
+                ax.axvline(s, ymin=0.0, ymax=0.04, color="0.5", lw=0.6)
+            ax.axvline(pick["t_grasp_prescribed"], color="k", ls="--", lw=0.8)
+            ax.set_title(f"pick {row} ({pick['part']}): estimate error {label}", fontsize=9)
+            ax.set_xlabel("t (s)")
+        axes[row][0].legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

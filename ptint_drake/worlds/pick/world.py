@@ -231,11 +231,13 @@ class PickRun(WorldRun):
         station = self.built.station
         scale_in_context(station.plant, station.plant.GetMyMutableContextFromRoot(new_context), station.arm,
                          self.scenario.plant.mass_scale)
-        targets = self.built.targets
-        tc = targets.GetMyMutableContextFromRoot(new_context)
-        value = targets.latch_value(tc)
-        if value is not None:  # the backoff's latch, before the controller captures its start
-            tc.SetDiscreteState(0, value)
+        for targets in (self.built.targets, self.built.true_targets):
+            if targets is None:
+                continue
+            tc = targets.GetMyMutableContextFromRoot(new_context)
+            value = targets.latch_value(tc)
+            if value is not None:  # the backoff's latch, before the controller captures its start
+                tc.SetDiscreteState(0, value)
 
     def _logs(self, context) -> dict:
         return {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
@@ -309,19 +311,28 @@ class PickWorld(World):
         return [Reason(None, code, f"pick {k}: {code}") for k, code in pick_reasons(metrics["picks"])]
 
     def figure_files(self, scenario: Scenario) -> list[str]:
-        return ["picks.png"]
+        return ["picks.png", "estimates.png"] if _has_camera(scenario) else ["picks.png"]
 
     def view_tasks(self, scenario: Scenario, series: dict, metrics: dict, stage: Path, figures: bool,
                    replay: bool, svg: bool) -> list[tuple]:
-        names = [n for n, on in (("pick_replay", replay), ("picks", figures)) if on]
+        camera = figures and _has_camera(scenario)  # the estimates' figure and the camera's frames
+        names = [n for n, on in (("pick_replay", replay), ("picks", figures), ("estimates", camera),
+                                 ("camera_frames", camera)) if on]
         text = dump_yaml(scenario)  # picklable, for a worker process
         return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
 
     def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:
-        from ptint_drake.worlds.pick.views import pick_figure, write_pick_replay  # noqa: PLC0415  (matplotlib)
+        from ptint_drake.worlds.pick.views import estimate_figure, pick_figure, write_pick_replay  # noqa: PLC0415
 
         if name == "picks":
             pick_figure(series, metrics, stage / "picks.png")
+        elif name == "estimates":
+            scenario = yaml_load_typed(schema=Scenario, data=args[0])
+            estimate_figure(series, metrics, *belt_frames(scenario), stage / "estimates.png")
+        elif name == "camera_frames":
+            from ptint_drake.worlds.pick.camera_frames import write_pick_camera_frames  # noqa: PLC0415
+
+            write_pick_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics, stage)
         else:
             write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, stage / "replay.html")
         return name
@@ -358,3 +369,17 @@ class PickWorld(World):
     def sweep_point(self, row: dict, scenario: Scenario, beta: float, tf: float, simulate, validate) -> dict:
         return studies.sweep_point(row, scenario, beta, tf, simulate, validate,
                                    lambda s: self.schedule(s).segments[-1].end)
+
+
+def _has_camera(scenario: Scenario) -> bool:
+    return scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
+
+
+def belt_frames(scenario: Scenario) -> tuple[list, list]:
+    """Per part: its belt's unit direction and its yaw symmetry (rad; ``part_fit.yaw_symmetry``)."""
+    from ptint_drake.systems.perception.part_fit import yaw_symmetry  # noqa: PLC0415
+
+    pick = scenario.pick
+    belts = {b.name: np.asarray(b.direction, float) for b in pick.belts}
+    return ([belts[p.belt] / np.linalg.norm(belts[p.belt]) for p in pick.parts],
+            [yaw_symmetry(p.shape, p.size) for p in pick.parts])
