@@ -3,7 +3,12 @@
 every controller setting at its default (the constant 0.015 m/rad damping: docs/pick_place.md).
 
 Not asserted on rvm1_5dof: measured there with the defaults, the can ends 4.4 mm off its slot and
-the block collides with its belt (missed after retry)."""
+the block collides with its belt (missed after retry).  The cause: pick 1's approach swings from the
+tray (y = −0.24 m) past the waist axis to the block (+y); the tool passed 106 mm from the axis, near
+the inner edge of the 5-joint arm's top-down workspace (none closer than ≈ 90 mm at z = 0.19 m), and
+slid into it (6 mm from the axis, wrist pitch at −90°, smallest singular value 1e-4 m, the arm
+thrashing into the tray and the can).  The unmirrored scenario passes within 108 mm and recovers
+after tilting the tool 33°: both are now warned before the run (tests/unit/test_pick_inner_reach.py)."""
 
 from pathlib import Path
 

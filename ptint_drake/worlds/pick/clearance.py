@@ -22,7 +22,7 @@ from scipy.special import betaincinv
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grippers import payload_warnings
-from ptint_drake.worlds.pick.singularity import singularity_warnings
+from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
@@ -111,9 +111,11 @@ def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float,
 
 def arm_warnings(scenario, built) -> list[str]:
     """Warnings before a pick run about the arm: the gripper plus a part beyond the arm's rated
-    payload (``grippers.payload_warnings``), a path past a singularity (``singularity``)."""
+    payload (``grippers.payload_warnings``), a path past a singularity or near the inner edge of a
+    5-joint arm's top-down workspace (``singularity``)."""
     station = built.station
     plant = station.plant
     gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
     return (payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
-                             station.config.parts) + singularity_warnings(scenario, built))
+                             station.config.parts) + singularity_warnings(scenario, built)
+            + inner_reach_warnings(scenario, built))

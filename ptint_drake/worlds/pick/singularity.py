@@ -10,18 +10,31 @@ pre-grasp, grasp, lift, carry, place and retreat points, each solved by Drake's
 the joint-space line between consecutive solutions; where the smallest singular value of the
 tool's 6 × n Jacobian (rotation rows × ``controller.rot_scale``, as the task weighs them) falls
 below ``MIN_SIGMA`` it returns one warning per task naming the phase.  Arms with fewer than 6
-joints (``rvm1_5dof``: a 5-D top-down task by design) are not checked.
+joints (``rvm1_5dof``: a 5-D top-down task by design) are not checked for that.
+
+A 5-joint arm on ``top_down`` has another edge: near its own waist axis it cannot point the tool
+down at all (``rvm1_5dof`` at z = 0.15-0.19 m: no top-down posture within its joint limits closer
+than about 90 mm, where the wrist pitch reaches its −90° limit), and its 6 × 5 least-squares
+Jacobian loses rank on the way there.  ``inner_reach_warnings`` follows the straight lines between
+the same waypoints (an approach's end where the part is at that end) and warns, one line per task,
+where one passes within ``INNER_MARGIN`` of that inner edge: a way from a tray on one side of the
+base to a part on the other.  Measured (issue 33): tests/two_belt_pick.yaml and its mirror image in
+y both swing past the base 106-108 mm from the axis; on the mirror image the arm slid into the
+inner edge (6 mm from the axis, the wrist pitch at −90°, the smallest singular value 1e-4 m, torque
+commands 4e9 N·m) and missed; on the original it recovered after tilting the tool 33°.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.multibody.tree import JacobianWrtVariable, JointIndex
 
 from ptint_drake.reachability import inverse_kinematics
 
 MIN_SIGMA = 0.01  # m: on rvm1_6dof (rot_scale 0.1 m/rad) about a wrist pitch of 10°
 SAMPLES = 12  # joint-space samples between two waypoints
+INNER_MARGIN = 0.04  # m: a path closer than this to the inner edge of the top-down workspace is warned
+INNER_SAMPLES = 41  # samples of the straight line between two waypoints
 
 
 def _sigma_min(plant, context, frame, q: np.ndarray, rot_scale: float) -> float:
@@ -91,3 +104,66 @@ def _warning(scenario, k: int, phase: str, sigma: float, q: np.ndarray) -> str:
     return (f"singularity: pick {k}'s {phase} passes near a singular posture of {scenario.robot.model} "
             f"(smallest singular value of the Jacobian {sigma:.3g} < {MIN_SIGMA:g} m near q = "
             f"{np.round(np.degrees(q), 1).tolist()} deg){advice}")
+
+
+def _waist_axis(arm) -> np.ndarray:
+    """(x, y) of the arm's first revolute joint axis (its waist), in the world."""
+    context = arm.CreateDefaultContext()
+    for i in range(arm.num_joints()):
+        joint = arm.get_joint(JointIndex(i))
+        if joint.num_velocities() == 1 and "revolute" in joint.type_name():
+            return joint.frame_on_child().CalcPoseInWorld(context).translation()[:2]
+    return np.zeros(2)
+
+
+def _path_points(scenario, built, arm, frame) -> list:
+    """(task, phase, x) of the start point and every waypoint, an approach's where its part is at the
+    approach's end (the approach aims at the moving part)."""
+    plan, config = built.plan, built.station.config
+    belts = {b.name: b for b in config.belts}
+    context = built.station.plant.CreateDefaultContext()
+    arm_context = arm.CreateDefaultContext()
+    arm.SetPositions(arm_context, np.radians(scenario.robot.initial_q_deg))
+    out = [(-1, "start", frame.CalcPoseInWorld(arm_context).translation())]
+    for k, phase, x in _waypoints(scenario, built):
+        if phase == "approach":
+            i = plan.segment_index(k, "approach", 0)
+            i_part = plan.segments[i].index
+            belt = belts[config.parts[i_part].belt]
+            start = built.station.parts[i_part].EvalPoseInWorld(context).translation()
+            end = plan.schedule.segments[i].end
+            x = start + belt.speed * end * np.asarray(belt.direction, dtype=float) + \
+                np.array([0.0, 0.0, scenario.pick.tasks[k].clearance])
+        out.append((k, phase, x))
+    return out
+
+
+def inner_reach_warnings(scenario, built) -> list[str]:
+    """One warning per task whose straight way to a waypoint passes within ``INNER_MARGIN`` of the
+    inner edge of a 5-joint arm's top-down workspace (module docstring); [] for other arms and
+    tasks."""
+    arm = built.arm
+    if arm.num_velocities() >= 6 or scenario.controller.task != "top_down":
+        return []
+    frame = arm.GetFrameByName(scenario.robot.end_effector)
+    axis = _waist_axis(arm)
+    q = np.radians(scenario.robot.initial_q_deg)
+    points = _path_points(scenario, built, arm, frame)
+    warned, out = set(), []
+    for (_, _, a), (k, phase, b) in zip(points, points[1:]):
+        line = a + np.linspace(0.0, 1.0, INNER_SAMPLES)[:, None] * (b - a)
+        radius = np.hypot(*(line[:, :2] - axis).T)
+        i = int(np.argmin(radius))
+        if k in warned or radius[i] <= INNER_MARGIN:
+            continue
+        p = line[i].copy()
+        p[:2] = axis + (p[:2] - axis) * (radius[i] - INNER_MARGIN) / radius[i]  # INNER_MARGIN nearer the axis
+        if inverse_kinematics(arm, frame, p, q, down=True) is None:
+            warned.add(k)
+            out.append(f"reach: pick {k}'s {phase} passes {1e3 * radius[i]:.0f} mm from the waist axis of "
+                       f"{scenario.robot.model} (at z = {p[2]:.3f} m), within {1e3 * INNER_MARGIN:g} mm of "
+                       f"where it can no longer point its tool down (a 5-joint arm; no top-down posture "
+                       f"{1e3 * (radius[i] - INNER_MARGIN):.0f} mm from the axis): the arm may tilt the tool "
+                       f"or fold into its wrist-pitch limit there (keep the tray and the belts on the same "
+                       f"side of the base, or farther from it)")
+    return out
