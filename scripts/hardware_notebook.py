@@ -72,7 +72,7 @@ if problem is None:  # two processes in a private namespace: hardware first, the
     drive = json.loads((out / "dr" / "drive.json").read_text())
     how = "two processes, private namespace"
 else:  # the same two sides as two threads over memq://
-    from ptint_drake.hardware.command_link import LinkSettings
+    from ptint_drake.hardware.session import LinkSettings
     from ptint_drake.hardware.in_memory import run_pair
     from ptint_drake.scenario import parse_with_overrides, scenario_text
 

@@ -151,7 +151,7 @@ def _warn(message: str) -> None:
 
 def _link_settings(args: argparse.Namespace, scenario):
     """``ptint hardware``'s options as the link's settings."""
-    from ptint_drake.hardware.command_link import LinkSettings  # noqa: PLC0415
+    from ptint_drake.hardware.session import LinkSettings  # noqa: PLC0415
     from ptint_drake.hardware.sim_hardware import link_period  # noqa: PLC0415
 
     return LinkSettings(
@@ -211,7 +211,7 @@ def _print_fault(link: dict, out) -> None:
 
 def cmd_hardware(args: argparse.Namespace) -> int:
     """``ptint hardware``: the world as hardware; exit 0 ok, 1 missed or a fault."""
-    from ptint_drake.hardware.command_link import LinkFault  # noqa: PLC0415
+    from ptint_drake.hardware.session import LinkFault  # noqa: PLC0415
     from ptint_drake.hardware.sim_hardware import check_link_scenario, run_hardware  # noqa: PLC0415
 
     loaded, out = scenario_and_out(args, prefix="hardware_")

@@ -21,7 +21,7 @@ It ends when it has answered the last tick
 (t ≥ duration − 1.5 T), or with ``DriveFault`` (one line): no status within the start-up timeout,
 no status for ``status_timeout`` s, a status of the wrong size, or a status whose applied torque
 (``joint_torque_commanded``) is none of the drive's recent commands — the hardware took a second
-sender's command (the drive's check beside the hardware's own, ``command_link``); the drive then
+sender's command (the drive's check beside the hardware's own, ``session``); the drive then
 sends a NaN command, which the hardware's checks reject by holding the arm.
 """
 

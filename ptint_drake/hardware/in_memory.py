@@ -17,7 +17,7 @@ from pathlib import Path
 from pydrake.lcm import DrakeLcm
 
 from ptint_drake.config.schema import Scenario
-from ptint_drake.hardware.command_link import LinkSettings
+from ptint_drake.hardware.session import LinkSettings
 from ptint_drake.hardware.drive import DriveRecord, DriveSettings, drive_summary, run_drive
 from ptint_drake.hardware.sim_hardware import run_hardware
 

@@ -32,7 +32,7 @@ The pick world adds Drake's gripper messages and one vector of the parts' motion
 
 LCM carries no sender identity and no authentication: the default URL stays on this machine
 (``ttl=0``) and ``url_warning`` names the risk of any other; the hardware side's checks
-(``command_link``) accept one command per status it sent.
+(``session``) accept one command per status it sent.
 """
 
 from __future__ import annotations

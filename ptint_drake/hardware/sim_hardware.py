@@ -22,7 +22,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
-from ptint_drake.hardware.command_link import (
+from ptint_drake.hardware.session import (
     ACTIVE,
     SETTLED_SPEED,
     HardwareSession,

@@ -260,7 +260,7 @@ def test_in_memory_pair_matches_two_processes(tmp_path):
     """The fallback where no private namespace can be made: hardware and drive as two threads
     over one ``memq://`` LCM (``hardware.in_memory``), the same messages and checks; lockstep
     gives the one-process result (no network at all, so this runs everywhere)."""
-    from ptint_drake.hardware.command_link import LinkSettings  # noqa: PLC0415
+    from ptint_drake.hardware.session import LinkSettings  # noqa: PLC0415
     from ptint_drake.hardware.in_memory import run_pair  # noqa: PLC0415
     from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
 

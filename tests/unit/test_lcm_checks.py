@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from pydrake.lcm import DrakeLcm
 
-from ptint_drake.hardware.command_link import HardwareSession, LinkSettings
+from ptint_drake.hardware.session import HardwareSession, LinkSettings
 from ptint_drake.hardware.link import (
     COMMAND_CHANNEL,
     STATUS_CHANNEL,
@@ -152,7 +152,7 @@ def test_bad_input_is_one_line(ptint_here, args, words, tmp_path):
 
 def pick_pair():
     """A hardware session of the pick world (1 part, a 30 N gripper) and the drive's endpoint."""
-    from ptint_drake.hardware.command_link import PickLink  # noqa: PLC0415
+    from ptint_drake.hardware.session import PickLink  # noqa: PLC0415
     from ptint_drake.hardware.link import WSG_COMMAND_CHANNEL  # noqa: PLC0415
 
     lcm = DrakeLcm("memq://")

@@ -1,0 +1,376 @@
+"""The hardware side's session on the LCM link: the status it publishes, the commands it takes
+and checks, the timing it records; ``command_link.CommandLink`` calls it at each tick.
+
+- **Lockstep** (``lockstep``): each tick waits for its command (re-sending the status every
+  ``resend`` s of wall time, so a lost status costs time, not the run), up to ``command_timeout``
+  of wall time.
+- **Real time**: the simulator paces the ticks; each tick waits at most ``budget`` × T for its
+  command, otherwise the previous torque stays (``late``); ``command_timeout`` / T ticks in a row
+  without a command is the timeout.
+
+Every command passes the checks before it reaches the plant (``HardwareSession._check``): its
+size, finite torques within the actuators' effort limits, and one command per status — LCM
+carries no sender identity, so a second sender shows up as a command for a status nobody asked
+about, two different commands for one status, or a time stamp that goes backwards.  A failed
+check or a timeout is a *fault*: the link stops publishing status, and the arm is held for
+``hold_time`` s (a position hold at the joint angles of the fault with gravity compensation,
+computed from the arm's model — the driver side may use its model; damping alone does not hold
+the RV-M1), then the run ends with ``LinkFault`` naming it.
+"""
+
+from __future__ import annotations
+
+import time
+from contextvars import ContextVar
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from ptint_drake.hardware.link import (
+    PARTS_CHANNEL,
+    WSG_COMMAND_CHANNEL,
+    WSG_STATUS_CHANNEL,
+    Endpoint,
+    pack_parts,
+    pack_status,
+    pack_wsg_status,
+    unpack_command,
+    unpack_wsg_command,
+    utime_of,
+)
+
+SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
+QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
+
+
+class LinkFault(Exception):
+    """A fault of the link (the message is the one-line reason)."""
+
+
+@dataclass
+class LinkSettings:
+    """The hardware side's timing and checks (``ptint hardware``'s options)."""
+
+    period: float  # s: T, the tick of the link and the plant's step
+    duration: float  # s of simulated time of the scenario
+    lockstep: bool = True
+    command_timeout: float = 0.25  # s of wall time without a command (see the module docstring)
+    startup_timeout: float = 10.0  # s of wall time for the first command
+    resend: float = 0.005  # s: lockstep re-sends an unanswered status after this wall time
+    hold_time: float = 0.5  # s simulated: the hold after a fault before the run ends
+    budget: float = 0.8  # real time: the part of T a tick waits for its command
+    realtime_rate: float = 1.0
+    drop_status: float = 0.0  # a test option: the fraction of status messages not sent
+    seed: int = 0
+
+
+@dataclass
+class PickLink:
+    """The pick world's part of the link: the parts' count and the gripper's force limit (N)."""
+
+    parts: int
+    max_force: float
+
+
+@dataclass
+class LinkRecord:
+    """What the hardware side measured of the link."""
+
+    rtt: list = field(default_factory=list)  # s wall: status published → its command received
+    tick_wall: list = field(default_factory=list)  # perf_counter of each tick's first publish
+    tick_time: list = field(default_factory=list)  # simulated t of each tick
+    statuses: int = 0  # status messages published (re-sends included)
+    dropped: int = 0  # status messages not sent (``drop_status``)
+    resends: int = 0
+    accepted: int = 0
+    duplicates: int = 0  # a command repeated for its status (an answer to a re-sent status)
+    late: int = 0  # real time: ticks whose command did not arrive within the budget
+    late_commands: int = 0  # commands that arrived after their tick
+    gripper_commands: int = 0  # gripper commands taken (pick world)
+    fault: Optional[str] = None
+    fault_time: Optional[float] = None
+    fault_kind: Optional[str] = None
+
+
+ACTIVE: ContextVar[Optional["HardwareSession"]] = ContextVar("ptint_hardware_session", default=None)
+
+
+class HardwareSession:
+    """The hardware side of the link: publishes status, takes and checks commands, records the
+    timing (``record``).  ``limits``: the actuators' effort limits (N·m, actuator order)."""
+
+    def __init__(self, endpoint: Endpoint, n: int, limits: np.ndarray, settings: LinkSettings):
+        self.endpoint, self.n, self.limits, self.s = endpoint, n, np.asarray(limits, float), settings
+        self.record = LinkRecord()
+        self._rng = np.random.default_rng(settings.seed)
+        self._answered: Optional[int] = None  # utime of the last status answered
+        self._answered_tau: Optional[np.ndarray] = None
+        self._pending: Optional[int] = None
+        self._sent: dict[int, float] = {}  # utime → wall time of its first publish
+        self._consecutive_late = 0
+        self._after_handshake = False
+        self.pick: Optional[PickLink] = None  # set for the pick world (``sim_hardware``)
+        self._wsg: dict[
+            int, tuple[float, float]
+        ] = {}  # gripper commands: driver's tick utime → (opening, force)
+        self._companions: list = []  # this tick's gripper status and parts messages (pick world)
+        self.handshake_s: Optional[float] = None  # wall s the hand-shake took
+        self.builds = 0  # CommandLinks built in this session (more than one: a pick replanned)
+        self.watch = (
+            None  # a ``link.SenderWatch`` of the command channels (udpm URLs), set by ``sim_hardware``
+        )
+        self._controller: Optional[tuple] = None  # the source address of the first command (the controller)
+
+    # -- the protocol -------------------------------------------------------------------------
+    def _publish(self, data: bytes) -> float:
+        for channel, message in self._companions:  # before the arm's status: it completes a tick
+            self.endpoint.publish_on(channel, message)
+        if self.s.drop_status > 0 and self._rng.random() < self.s.drop_status:
+            self.record.dropped += 1
+            return time.perf_counter()
+        self.record.statuses += 1
+        return self.endpoint.publish(data)
+
+    def _fail(self, t: float, kind: str, message: str) -> None:
+        if self.record.fault is None:
+            self.record.fault, self.record.fault_time, self.record.fault_kind = message, t, kind
+
+    def _check(self, t: float, data: bytes, t_recv: float) -> None:
+        """One received command against the checks (module docstring); a fault or its use."""
+        try:
+            utime, tau = unpack_command(data, self.n)
+        except ValueError as exc:
+            return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {exc}")
+        if not np.all(np.isfinite(tau)):
+            return self._fail(
+                t,
+                "bad command",
+                f"command rejected at t = {t:.3f} s: a non-finite torque {np.array2string(tau, precision=3)}",
+            )
+        over = np.abs(tau) > self.limits * (1 + 1e-9)
+        if np.any(over):
+            j = int(np.argmax(over))
+            return self._fail(
+                t,
+                "bad command",
+                f"command rejected at t = {t:.3f} s: joint {j} torque "
+                f"{tau[j]:.3g} N·m beyond its limit {self.limits[j]:.3g} N·m",
+            )
+        if utime == self._answered:
+            if np.array_equal(tau, self._answered_tau):
+                self.record.duplicates += 1
+                return None
+            return self._fail(
+                t,
+                "second sender",
+                f"two different commands for the status of t = "
+                f"{utime * 1e-6:.3f} s at t = {t:.3f} s: a second sender "
+                f"on {self.endpoint.listen}",
+            )
+        if utime == self._pending:
+            self._answered, self._answered_tau = utime, tau
+            self.record.accepted += 1
+            self.record.rtt.append(t_recv - self._sent[utime])
+            return None
+        if self._answered is not None and utime < self._answered:
+            return self._fail(
+                t,
+                "second sender",
+                f"command time stamps went backwards at t = {t:.3f} s "
+                f"({utime * 1e-6:.3f} s after {self._answered * 1e-6:.3f} s):"
+                f" a second sender on {self.endpoint.listen} or a "
+                f"restarted controller",
+            )
+        if utime in self._sent and (self._pending is None or utime < self._pending):
+            self.record.late_commands += 1  # real time: an answer after its tick
+            return None
+        return self._fail(
+            t,
+            "second sender",
+            f"a command for t = {utime * 1e-6:.6g} s that no status asked "
+            f"for, at t = {t:.3f} s: a second sender on {self.endpoint.listen}",
+        )
+
+    def _check_gripper(self, t: float, data: bytes) -> None:
+        """One received gripper command against the checks: finite, a force within [0, the
+        gripper's limit], one command per driver tick."""
+        try:
+            utime, opening, force = unpack_wsg_command(data)
+        except ValueError as exc:
+            return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: {exc}")
+        if not (np.isfinite(opening) and np.isfinite(force)):
+            return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: not finite")
+        if not 0.0 <= force <= self.pick.max_force * (1 + 1e-9):
+            return self._fail(
+                t,
+                "bad command",
+                f"gripper command rejected at t = {t:.3f} s: force "
+                f"{force:.3g} N outside [0, {self.pick.max_force:g}] N",
+            )
+        if utime in self._wsg and self._wsg[utime] != (opening, force):
+            return self._fail(
+                t,
+                "second sender",
+                f"two different gripper commands for t = {utime * 1e-6:.3f} s "
+                f"at t = {t:.3f} s: a second sender on {WSG_COMMAND_CHANNEL}",
+            )
+        self._wsg[utime] = (opening, force)
+        if len(self._wsg) > 4096:
+            for key in sorted(self._wsg)[:2048]:
+                del self._wsg[key]
+        return None
+
+    def gripper_opening(self, utime: int) -> Optional[float]:
+        """The gripper command (the wanted opening, m) for the driver's tick ``utime``, if received."""
+        got = self._wsg.get(utime)
+        return None if got is None else got[0]
+
+    def _check_senders(self, t: float) -> None:
+        """Every packet on the command channels must come from the controller's address (the first
+        command's): another is a second sender (``link.SenderWatch``)."""
+        if self.watch is None:
+            return
+        for channel, source in self.watch.senders():
+            if self._controller is None:
+                self._controller = source
+            elif source != self._controller:
+                self._fail(
+                    t,
+                    "second sender",
+                    f"a command on {channel} from a second sender at t = {t:.3f} s "
+                    f"(from {source[0]}:{source[1]}; the controller sends from "
+                    f"{self._controller[0]}:{self._controller[1]})",
+                )
+                return
+
+    def _complete(self, utime: int, wsg: Optional[int]) -> bool:
+        """Whether the answer to the status of ``utime`` is in: the arm's command, and in the pick
+        world the gripper command for the driver's tick ``wsg``."""
+        return self._answered == utime and (wsg is None or wsg in self._wsg)
+
+    def _wait(
+        self, t: float, utime: int, wait: float, data: bytes, resend: bool, wsg: Optional[int] = None
+    ) -> bool:
+        """Wait up to ``wait`` s (wall) for the command of ``utime`` (and the gripper command for
+        the driver's tick ``wsg``, when given); True when it came."""
+        deadline = time.perf_counter() + wait
+        last_sent = time.perf_counter()
+        while True:
+            now = time.perf_counter()
+            step = min(deadline - now, self.s.resend) if resend else deadline - now
+            for t_recv, message in self.endpoint.poll(max(step, 0.0)):
+                self._check(t, message, t_recv)
+            self._check_senders(t)
+            if self.pick is not None:
+                for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
+                    self._check_gripper(t, message)
+            if self.record.fault is not None:
+                return False
+            if self._complete(utime, wsg):
+                return True
+            now = time.perf_counter()
+            if now >= deadline:
+                return False
+            if resend and now - last_sent >= self.s.resend:
+                self.record.resends += 1
+                last_sent = self._publish(data)
+
+    def _set_companions(self, t: float, extras) -> None:
+        """The pick world's messages of the tick at ``t`` (``extras`` = fingers, drive forces, the
+        parts' motion; None: the arm alone)."""
+        if extras is None or self.pick is None:
+            self._companions = []
+            return
+        fingers, force, parts = extras
+        self._companions = [
+            (WSG_STATUS_CHANNEL, pack_wsg_status(t, fingers, force)),
+            (PARTS_CHANNEL, pack_parts(t, parts)),
+        ]
+
+    def handshake(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None) -> None:
+        """Before the simulation starts: the status of the start pose at t = 0 until its command
+        comes (a ``LinkFault`` after ``startup_timeout``), so that the controller may start
+        second and starts from the arm's pose; the first tick then sends the status of t = 0
+        after the plant's first step (a second sample of t = 0, answered anew)."""
+        start = time.perf_counter()
+        data = pack_status(0.0, q, v, tau)
+        self._set_companions(0.0, extras)
+        self._pending = 0
+        self._sent[0] = self._publish(data)
+        wsg = 0 if self.pick is not None else None  # the gripper command the driver takes at t = 0
+        if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True, wsg=wsg):
+            if self.record.fault is not None:
+                raise LinkFault(self.record.fault)
+            raise LinkFault(
+                f"no command within the start-up timeout of {self.s.startup_timeout:g} s on "
+                f"{self.endpoint.url} (channel {self.endpoint.listen}): is `ptint drive` running?"
+            )
+        self.handshake_s = time.perf_counter() - start
+        self._quiet()
+        self.record.rtt.clear()  # the start-up wait is no round trip
+        self.record.accepted = 0
+        # the tick at t = 0 samples the arm after the plant's first step: a new status of t = 0
+        self._answered, self._answered_tau, self._after_handshake = None, None, True
+
+    def _quiet(self) -> None:
+        """After the hand-shake: take the drive's answers to the hand-shake's re-sent statuses
+        (stamped t = 0 like the first tick's) until none came for ``QUIET`` s (at most
+        ``QUIET_MAX``), so that none of them is taken for the first tick's answer."""
+        start = last = time.perf_counter()
+        while True:
+            got = self.endpoint.poll(0.01)
+            self._check_senders(0.0)
+            if self.pick is not None:
+                for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
+                    self._check_gripper(0.0, message)
+            now = time.perf_counter()
+            if got:
+                self.record.duplicates += len(got)
+                last = now
+            if now - last >= QUIET or now - start >= QUIET_MAX:
+                return
+
+    def exchange(
+        self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
+    ) -> Optional[np.ndarray]:
+        """The tick at ``t``: publish the status (and in the pick world, first, the gripper's status
+        and the parts' motion: ``extras``), take its command (None: none, keep the last torque;
+        ``record.fault`` says when that is a fault); the gripper command for the driver's next
+        tick is then ``gripper_opening(utime_of(t) + utime_of(T))`` when it came."""
+        utime = utime_of(t)
+        wsg = utime + utime_of(self.s.period) if self.pick is not None else None
+        self.record.tick_time.append(t)
+        self.record.tick_wall.append(time.perf_counter())
+        if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
+            self._after_handshake = False
+            self.record.duplicates += len(self.endpoint.poll(0.0))
+        data = pack_status(t, q, v, tau)
+        self._set_companions(t, extras)
+        self._pending = utime
+        self._sent[utime] = self._publish(data)
+        if len(self._sent) > 4096:
+            for key in sorted(self._sent)[:2048]:
+                del self._sent[key]
+        if self.s.lockstep:
+            if self._wait(t, utime, self.s.command_timeout, data, resend=True, wsg=wsg):
+                return self._answered_tau
+            self._fail(
+                t,
+                "command timeout",
+                f"command timeout at t = {t:.3f} s (no command for {self.s.command_timeout * 1e3:.0f} ms)",
+            )
+            return None
+        if self._wait(t, utime, self.s.budget * self.s.period / self.s.realtime_rate, data, resend=False):
+            self._consecutive_late = 0
+            return self._answered_tau
+        if self.record.fault is None:
+            self.record.late += 1
+            self._consecutive_late += 1
+            if self._consecutive_late * self.s.period / self.s.realtime_rate >= self.s.command_timeout:
+                self._fail(
+                    t,
+                    "command timeout",
+                    f"command timeout at t = {t:.3f} s (no command for {self._consecutive_late} periods)",
+                )
+        return None
