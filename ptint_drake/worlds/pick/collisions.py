@@ -1,5 +1,7 @@
 """``CollisionProbe`` — which obstacle the arm or its gripper touches, read from the plant's
-contact results (the simulation's truth, for the metrics; a controller never sees it).
+contact results (the simulation's truth, for the metrics; a controller never sees it) through
+``contact_pairs.ContactPairs`` (the bodies of each contact, read once for this probe and the
+run's ``PickProbe``).
 
 An *obstacle* is every body the robot must not touch: each belt, the tray, the floor (the world
 body's geometry) and each part — a part only counts when it is not the one being grasped (the
@@ -9,7 +11,7 @@ contact with a finger (pad or stem), in contact with any other body of the arm o
 ==================  ===========  ======================================================
 port                size         meaning
 ==================  ===========  ======================================================
-``contact_results`` —            input: the plant's ContactResults
+``contact_pairs``   —            input: (body A, body B, where) per contact (``ContactPairs``)
 ``collisions``      2 · n        output: per obstacle [finger contact, other robot contact]
 ==================  ===========  ======================================================
 
@@ -22,7 +24,6 @@ from __future__ import annotations
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.multibody.plant import ContactResults
 from pydrake.systems.framework import LeafSystem
 
 FINGER, OTHER = 0, 1  # the flags' places in an obstacle's pair
@@ -31,30 +32,19 @@ FINGER, OTHER = 0, 1  # the flags' places in an obstacle's pair
 class CollisionProbe(LeafSystem):
     """Contact flags per obstacle (module docstring).  ``obstacles``: the obstacles' body index
     lists (a belt, the tray, the world body for the floor, a part), in output order;
-    ``fingers``, ``robot``: body indices of the fingers and of every arm and gripper body;
-    ``body_of_geometry``: GeometryId → body index (hydroelastic contacts report geometries)."""
+    ``fingers``, ``robot``: body indices of the fingers and of every arm and gripper body."""
 
-    def __init__(self, obstacles: list, fingers, robot, body_of_geometry: dict):
+    def __init__(self, obstacles: list, fingers, robot):
         super().__init__()
         self._obstacle = {int(b): k for k, bodies in enumerate(obstacles) for b in bodies}
         self._fingers = {int(b) for b in fingers}
         self._robot = {int(b) for b in robot}
-        self._geometry = body_of_geometry
-        self._contacts = self.DeclareAbstractInputPort("contact_results",
-                                                       AbstractValue.Make(ContactResults()))
+        self._pairs = self.DeclareAbstractInputPort("contact_pairs", AbstractValue.Make(()))
         self.DeclareVectorOutputPort("collisions", 2 * len(obstacles), self._calc)
-
-    def _pairs(self, results):
-        for i in range(results.num_point_pair_contacts()):
-            info = results.point_pair_contact_info(i)
-            yield int(info.bodyA_index()), int(info.bodyB_index())
-        for i in range(results.num_hydroelastic_contacts()):
-            surface = results.hydroelastic_contact_info(i).contact_surface()
-            yield self._geometry[surface.id_M()], self._geometry[surface.id_N()]
 
     def _calc(self, context, output) -> None:
         out = np.zeros(output.size())
-        for a, b in self._pairs(self._contacts.Eval(context)):
+        for a, b, _ in self._pairs.Eval(context):
             if b in self._robot:
                 a, b = b, a
             if a in self._robot and b in self._obstacle:

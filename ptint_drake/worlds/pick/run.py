@@ -143,6 +143,7 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     builder.Connect(gripper, observer.GetInputPort("command"))
     builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
     probe = builder.AddNamedSystem("pick_probe", _probe(station))
+    builder.Connect(st.GetOutputPort("contact_pairs"), probe.GetInputPort("contact_pairs"))
     builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
     builder.Connect(st.GetOutputPort("body_poses"), probe.GetInputPort("body_poses"))
     loggers = {"probe": LogVectorOutput(probe.GetOutputPort("probe"), builder, PROBE_PERIOD),
@@ -193,13 +194,10 @@ def _camera_loggers(builder: DiagramBuilder, st, estimates: PartEstimates, true_
 def _probe(station: PickStation) -> PickProbe:
     plant = station.plant
     robot = [b for m in (station.arm, station.gripper) for b in plant.GetBodyIndices(m)]
-    inspector = station.scene_graph.model_inspector()
-    geometry = {g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
-                for g in inspector.GetAllGeometryIds() if plant.GetBodyFromFrameId(inspector.GetFrameId(g))}
     tool = plant.GetFrameByName("fingertip_center", station.gripper)
     return PickProbe([b.index() for b in station.parts], [j.child_body().index() for j in station.belts],
                      plant.GetBodyByName("left_finger", station.gripper).index(),
-                     plant.GetBodyByName("right_finger", station.gripper).index(), robot, geometry,
+                     plant.GetBodyByName("right_finger", station.gripper).index(), robot,
                      (tool.body().index(), tool.GetFixedPoseInBodyFrame()))
 
 

@@ -25,6 +25,8 @@ port                size     meaning
 ``grip_force``      2        output: force of each finger's drive (N, + opens, − squeezes), the
                              gripper's net actuation after the force limit
 ``contact_results`` —        output: the plant's ContactResults (finger–part forces for metrics)
+``contact_pairs``   —        output: (body A, body B, where) per contact (``ContactPairs``: the
+                             contact results read once for ``collisions`` and the run's probe)
 ``collisions``      2·n      output: per obstacle (``PickStation.obstacles``: belts, tray, floor,
                              parts) [finger contact, other robot contact] (``CollisionProbe``)
 ``body_poses``      —        output: the plant's body poses (for logging parts, belts, fingers)
@@ -54,6 +56,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from ptint_drake.worlds.pick.camera import AddPickCamera
 from ptint_drake.worlds.pick.collisions import CollisionProbe
+from ptint_drake.worlds.pick.contact_pairs import ContactPairs
 from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
 from ptint_drake.worlds.pick.part_pose import PartPoses
 from ptint_drake.worlds.pick.scene import AddBelt, AddFloor, AddGripper, AddPart, AddTray, gripper_stroke
@@ -160,10 +163,10 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
     for joint, belt in zip(belts, config.belts):
         source = builder.AddNamedSystem(f"{belt.name}_speed", ConstantVectorSource([0.0, belt.speed]))
         builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(joint.model_instance()))
-    poses = builder.AddNamedSystem("part_poses", PartPoses([b.index() for b in parts]))
+    poses = builder.AddNamedSystem("part_poses", PartPoses(plant, parts))
     builder.Connect(plant.get_body_poses_output_port(), poses.get_input_port(0))
-    builder.Connect(plant.get_body_spatial_velocities_output_port(), poses.get_input_port(1))
-    builder.Connect(plant.get_body_spatial_accelerations_output_port(), poses.get_input_port(2))
+    builder.Connect(plant.get_state_output_port(), poses.get_input_port(1))
+    builder.Connect(plant.get_generalized_acceleration_output_port(), poses.get_input_port(2))
     builder.ExportInput(plant.get_actuation_input_port(arm), "actuation")
     builder.ExportInput(driver.GetInputPort("command"), "gripper_command")
     builder.ExportOutput(plant.get_state_output_port(arm), "state")
@@ -173,9 +176,12 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
     builder.ExportOutput(plant.get_state_output_port(gripper), "gripper_state")
     builder.ExportOutput(plant.get_net_actuation_output_port(gripper), "grip_force")
     builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
-    obstacles, collisions = _collision_probe(plant, scene_graph, config, arm, gripper, belts, parts)
+    obstacles, collisions = _collision_probe(plant, config, arm, gripper, belts, parts)
+    pairs = builder.AddNamedSystem("contact_pairs", ContactPairs(body_of_geometry(plant, scene_graph)))
     builder.AddNamedSystem("collision_probe", collisions)
-    builder.Connect(plant.get_contact_results_output_port(), collisions.get_input_port())
+    builder.Connect(plant.get_contact_results_output_port(), pairs.get_input_port())
+    builder.Connect(pairs.get_output_port(), collisions.get_input_port())
+    builder.ExportOutput(pairs.get_output_port(), "contact_pairs")
     builder.ExportOutput(collisions.get_output_port(), "collisions")
     builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     builder.ExportOutput(plant.get_state_output_port(), "plant_state")
@@ -190,7 +196,7 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
                        obstacles)
 
 
-def _collision_probe(plant, scene_graph, config, arm, gripper, belts, parts) -> tuple:
+def _collision_probe(plant, config, arm, gripper, belts, parts) -> tuple:
     """The obstacles' names (belts, "tray", "floor", parts) and their ``CollisionProbe``."""
     names = [b.name for b in config.belts] + ["tray", "floor"] + [p.name for p in config.parts]
     bodies = ([[j.child_body().index()] for j in belts] + [[plant.GetBodyByName("tray").index()],
@@ -198,7 +204,12 @@ def _collision_probe(plant, scene_graph, config, arm, gripper, belts, parts) -> 
               + [[b.index()] for b in parts])
     robot = [b for m in (arm, gripper) for b in plant.GetBodyIndices(m)]
     fingers = [plant.GetBodyByName(n, gripper).index() for n in ("left_finger", "right_finger")]
+    return names, CollisionProbe(bodies, fingers, robot)
+
+
+def body_of_geometry(plant: MultibodyPlant, scene_graph: SceneGraph) -> dict:
+    """GeometryId → body index of every geometry of the plant's bodies (hydroelastic contacts
+    report geometries)."""
     inspector = scene_graph.model_inspector()
-    geometry = {g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
-                for g in inspector.GetAllGeometryIds() if plant.GetBodyFromFrameId(inspector.GetFrameId(g))}
-    return names, CollisionProbe(bodies, fingers, robot, geometry)
+    return {g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
+            for g in inspector.GetAllGeometryIds() if plant.GetBodyFromFrameId(inspector.GetFrameId(g))}

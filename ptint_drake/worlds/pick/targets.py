@@ -37,13 +37,22 @@ import numpy as np
 from pydrake.math import RotationMatrix
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from ptint_drake.worlds.pick.tasks import PickPlan
+from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
+from ptint_drake.worlds.pick.tasks import PickPlan
+
+
+PART, LATCHED, SLOT = 0, 1, 2  # a segment's kind ("part", "latched", "slot") as ``_aims`` holds it
 
 
 class PickTargets(LeafSystem):
     """The active segment's target of a pick plan (module docstring).  ``places[i]`` is the world
-    position of segment i's place pose for "slot" segments (None otherwise)."""
+    position of segment i's place pose for "slot" segments (None otherwise).
+
+    Both outputs come from one cache entry, ``aim`` = [target; target_rotation] (24): the
+    controller reads both at every step and the loggers both at their samples, so each
+    (time, state, inputs) is computed once.  What depends on the segment alone (its kind, the
+    offset, a slot's place and yaw) is made once per plan (``_aims``)."""
 
     def __init__(self, plan: PickPlan, num_parts: int, places: Sequence):
         super().__init__()
@@ -54,8 +63,23 @@ class PickTargets(LeafSystem):
         DeclareSegmentStartEvents(self, plan.schedule, self._latch)
         for k, t in enumerate(plan.grasp_times):
             self.DeclarePeriodicUnrestrictedUpdateEvent(ONE_SHOT_PERIOD, t, self._grasp_latch(k))
-        self.DeclareVectorOutputPort("target", 9, self._calc_target)
-        self.DeclareVectorOutputPort("target_rotation", 15, self._calc_rotation)
+        self._starts = plan.schedule.starts
+        self._aims = [self._segment_aim(i) for i in range(len(plan.segments))]
+        self._aim = DeclareVectorCache(self, "target and target_rotation", 24, self._calc_aim,
+                                       {self.time_ticket(), self.xd_ticket(), self.all_input_ports_ticket()})
+        self.DeclareVectorOutputPort("target", 9, lambda c, o: o.SetFromVector(self._aim(c)[0:9]))
+        self.DeclareVectorOutputPort("target_rotation", 15, lambda c, o: o.SetFromVector(self._aim(c)[9:24]))
+
+    def _segment_aim(self, i: int) -> tuple:
+        """Segment i's (kind, part, offset, slot position, slot rotation (row-major), the
+        prescribed grasp time of a descend (None otherwise))."""
+        seg = self._plan.segments[i]
+        offset = np.asarray(seg.offset)
+        if seg.kind == "slot":
+            return (SLOT, None, offset, np.asarray(self.places[i]) + offset,
+                    RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
+        end = self._plan.schedule.segments[i].end if seg.phase == "descend" else None
+        return (PART if seg.kind == "part" else LATCHED, seg.index, offset, None, None, end)
 
     def _active(self, context) -> int:
         return max(self._plan.schedule.active(context.get_time()), 0)
@@ -86,42 +110,28 @@ class PickTargets(LeafSystem):
                 np.r_[pose[0:6], context.get_time(), R])
         return update
 
-    def _holding(self, context, i: int) -> bool:
-        """Segment i is a descend past its prescribed time whose grasp has been latched (the part
-        in the hand)."""
-        seg = self._plan.schedule.segments[i]
-        t0 = context.get_discrete_state(self._latched).get_value()[6]
-        return self._plan.segments[i].phase == "descend" and abs(t0 - seg.end) < 1e-9
-
-    def _calc_target(self, context, output) -> None:
-        i = self._active(context)
-        seg = self._plan.segments[i]
-        offset = np.asarray(seg.offset)
-        value = np.zeros(9)
+    def _calc_aim(self, context) -> np.ndarray:
+        """[target (9); target_rotation (15)] of the active segment (module docstring).  A descend
+        past its prescribed time whose grasp has been latched (the part in the hand) aims at the
+        latched motion."""
+        t = context.get_time()
+        i = max(bisect.bisect_right(self._starts, t) - 1, 0)  # the active segment (Schedule.active)
+        kind, part, offset, place, R_slot, grasp = self._aims[i]
+        value = np.zeros(24)
+        if kind == SLOT:
+            value[0:3], value[9:18] = place, R_slot
+            return value
         latched = context.get_discrete_state(self._latched).get_value()
-        if seg.kind == "part" and self._holding(context, i):
-            value[0:3] = latched[0:3] + latched[3:6] * (context.get_time() - latched[6]) + offset
-            value[3:6] = latched[3:6]
-        elif seg.kind == "part":
-            pose = self._poses[seg.index].Eval(context)
+        if kind == LATCHED:
+            value[0:3], value[9:18] = latched[0:3] + offset, latched[7:16]
+        elif grasp is not None and abs(latched[6] - grasp) < 1e-9:  # holding
+            value[0:3] = latched[0:3] + latched[3:6] * (t - latched[6]) + offset
+            value[3:6], value[9:18] = latched[3:6], latched[7:16]
+        else:
+            pose = self._poses[part].Eval(context)
             value[0:3], value[3:6] = pose[0:3] + offset, pose[3:6]
-        elif seg.kind == "latched":
-            value[0:3] = latched[0:3] + offset
-        else:
-            value[0:3] = np.asarray(self.places[i]) + offset
-        output.SetFromVector(value)
-
-    def _calc_rotation(self, context, output) -> None:
-        i = self._active(context)
-        seg = self._plan.segments[i]
-        value = np.zeros(15)
-        if seg.kind == "slot":
-            value[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
-        elif seg.kind == "latched" or self._holding(context, i):
-            value[0:9] = context.get_discrete_state(self._latched).get_value()[7:16]
-        else:
-            value[0:12] = self._rotations[seg.index].Eval(context)[0:12]
-        output.SetFromVector(value)
+            value[9:21] = self._rotations[part].Eval(context)[0:12]
+        return value
 
 
 class GripperSequence(LeafSystem):
