@@ -301,9 +301,15 @@ def test_realtime_run_completes(tmp_path):
         ],
         tmp_path,
     )
-    assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
-    link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
-    assert link["mode"] == "realtime" and link["ticks"] == 3000
+    assert out["drive"]["rc"] == 0, out
+    metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
+    link = metrics["hardware"]
+    assert link["mode"] == "realtime" and link["ticks"] == 3000 and link["fault"] is None, link
+    # the run completes; its verdict is ok unless the machine was loaded enough that late commands
+    # (each tick keeps the previous torque) cost the accuracy: then exit 1 with the late ticks
+    # counted (measured once in CI beside a Monte Carlo: 759 of 3000 ticks late, "segment 0: late", exit 1)
+    if out["hw"]["rc"] != 0:
+        assert out["hw"]["rc"] == 1 and metrics["status"] != "ok" and link["ticks_late"] > 0, out
     # paced at the 1 ms period (a free-running lockstep takes a fraction of it); the band is wide
     # because a loaded machine falls behind and catches up (measured 0.88 ms with CI beside it)
     assert link["lateness_ms"] is not None and 0.5 < link["achieved_period_ms"]["median"] < 2.0
