@@ -161,7 +161,7 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):
-            close = grasp - 0.5 * task.margin / pick.gripper.speed + task.close_delay
+            close = _planned_close(grasp, task, pick.gripper.speed)
             if j == 0 and first_close is not None:
                 close = first_close  # the test option (PickConfig.test_close_advance_s)
             commands.append(((replan.retries[j - 1] if j else approach), opening))
@@ -181,6 +181,12 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
         attempts.append(tuple(task_attempts))
     return PickPlan(Schedule(segments), tuple(plans), tuple(commands), tuple(closes), tuple(grasps), t,
                     tuple(widths), tuple(attempts))
+
+
+def _planned_close(grasp: float, task: PickTaskConfig, speed: float) -> float:
+    """When the close command goes out for a grasp at ``grasp``: the fingers meet the part (half
+    the ``margin`` at ``speed`` each) at the prescribed time, shifted by ``close_delay``."""
+    return grasp - 0.5 * task.margin / speed + task.close_delay
 
 
 SETTLE_BEFORE_DESCEND = 0.02  # s: the held arm descends this long before the fingers close past the part
@@ -205,7 +211,7 @@ def _closed_on_nothing(pick: PickConfig, task: PickTaskConfig, start: float) -> 
         return None, 0.0
     approach_end = start + task.approach.tf
     speed = pick.gripper.speed
-    close = approach_end + task.descend.tf - 0.5 * task.margin / speed + task.close_delay - advance
+    close = _planned_close(approach_end + task.descend.tf, task, speed) - advance
     if advance < 0.0:
         return close, 0.0
     closed = close + (task.margin + pick.width_tolerance) / (2.0 * speed)
