@@ -178,14 +178,41 @@ TRIAD_AXES = (("x", (1.0, 0.0, 0.0), RotationMatrix.MakeYRotation(np.pi / 2)),
               ("z", (0.0, 0.0, 1.0), RotationMatrix()))
 
 
+def draw_triad(meshcat: Meshcat, path: str, length: float, radius: float, alpha: float) -> None:
+    """Three cylinders under ``path`` along its frame's x (red), y (green) and z (blue) axes from
+    its origin (``path`` itself is placed by its caller)."""
+    for axis, rgb, R in TRIAD_AXES:
+        meshcat.SetObject(f"{path}/{axis}", Cylinder(radius, length), Rgba(*rgb, alpha))
+        meshcat.SetTransform(f"{path}/{axis}", RigidTransform(R, 0.5 * length * np.asarray(rgb)))
+
+
 def draw_triads(meshcat: Meshcat) -> None:
-    """``triads/gripper`` and ``triads/object``: three cylinders each along the frame's x (red),
-    y (green) and z (blue) axes from its origin (placed per frame by ``_record``)."""
+    """``triads/gripper`` and ``triads/object`` (``draw_triad``; placed per frame by ``_record``)."""
     for name, (length, radius, alpha) in TRIADS.items():
-        for axis, rgb, R in TRIAD_AXES:
-            path = f"triads/{name}/{axis}"
-            meshcat.SetObject(path, Cylinder(radius, length), Rgba(*rgb, alpha))
-            meshcat.SetTransform(path, RigidTransform(R, 0.5 * length * np.asarray(rgb)))
+        draw_triad(meshcat, f"triads/{name}", length, radius, alpha)
+
+
+def outline_segments(shape: str, size, sides: int = 24) -> tuple[np.ndarray, np.ndarray]:
+    """(starts, ends), each 3 × M: the edges of a box (``size`` [x, y, z]) or of a vertical
+    cylinder (``size`` [diameter, height]: its two rims as ``sides``-gons and four sides) centred
+    at the origin of its frame, for ``Meshcat.SetLineSegments``."""
+    if shape == "box":
+        half = 0.5 * np.asarray(size, float)
+        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
+        pairs = [(a, b) for a in range(8) for b in range(a + 1, 8)
+                 if np.count_nonzero(corners[a] != corners[b]) == 1]
+        return corners[[a for a, _ in pairs]].T.copy(), corners[[b for _, b in pairs]].T.copy()
+    radius, half = 0.5 * float(size[0]), 0.5 * float(size[1])
+    angles = np.linspace(0.0, 2.0 * np.pi, sides + 1)
+    rim = np.array([radius * np.cos(angles), radius * np.sin(angles)])
+    starts, ends = [], []
+    for z in (-half, half):
+        starts.append(np.vstack([rim[:, :-1], np.full(sides, z)]))
+        ends.append(np.vstack([rim[:, 1:], np.full(sides, z)]))
+    quarter = rim[:, 0:sides:max(sides // 4, 1)]
+    starts.append(np.vstack([quarter, np.full(quarter.shape[1], -half)]))
+    ends.append(np.vstack([quarter, np.full(quarter.shape[1], half)]))
+    return np.hstack(starts), np.hstack(ends)
 
 
 def _triad_poses(tool_pose: RigidTransform, orientation, k: int, active: int, p_obj) -> tuple:

@@ -17,7 +17,13 @@ times (grey ticks) and the prescribed grasp time (dashed) marked; up to 0.3 s pa
 
 ``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
 from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
-recording, saved standalone with ``StaticHtml()`` (``replay``).
+recording, saved standalone with ``StaticHtml()`` (``replay``).  With an RGB-D camera it also shows
+what the perception had (issue 34): the point cloud of each pick's first fit (magenta) and of its
+grasp (violet) — the frame re-rendered, cropped and downsampled as the perception did
+(``camera_frames.camera_views``) — from the frame's time for ``CLOUD_HOLD``, and per part its
+estimate (series ``part_estimate_k``, what the approach and the grasp aimed at) as a yellow outline
+of its known shape with a frame triad, beside the simulated part, until ``GRASP_TAIL`` past its
+pick's prescribed grasp (the part is in the hand then; the estimate runs on along the belt).
 """
 
 from __future__ import annotations
@@ -175,18 +181,91 @@ def replay_world(scenario):
     return plant, viz, meshcat, builder.Build().CreateDefaultContext()
 
 
-def write_pick_replay(scenario, series: dict, path: Path) -> int:
+CLOUD_HOLD = 0.25  # s, a frame's cloud stays shown after the frame (one replay frame is 33 ms; the
+# part moves on meanwhile: 25 mm at 0.1 m/s — paused at the frame's time the cloud sits on it)
+CLOUD_POINT_SIZE = 0.002  # m (the cloud's voxel is 1.5 mm)
+CLOUD_RGBA = {"first_fit": (1.0, 0.1, 0.8, 1.0), "grasp": (0.55, 0.25, 1.0, 1.0)}  # magenta, violet
+ESTIMATE_RGBA = (1.0, 0.85, 0.0, 1.0)  # yellow: seen on the blue parts and the black belts
+ESTIMATE_TRIAD = (0.04, 0.0015, 1.0)  # (length m, radius m, opacity) of the estimate's axes
+
+
+def draw_camera_clouds(meshcat, scenario, series: dict, metrics: dict) -> list[tuple[str, float]]:
+    """Each pick's cloud at its first fit and at its grasp (``camera_frames.camera_views``: the
+    frame re-rendered, cropped and downsampled as the perception did) as points under
+    ``camera/clouds/pick{i}_{first_fit,grasp}``, hidden until shown by ``show_at``;
+    returns [(path, the frame's time)]."""
+    from pydrake.geometry import Rgba  # noqa: PLC0415
+    from pydrake.perception import PointCloud  # noqa: PLC0415
+
+    from ptint_drake.worlds.pick.camera_frames import camera_views  # noqa: PLC0415
+
+    shown = []
+    for view in camera_views(scenario, series, metrics):
+        cloud = PointCloud(len(view.points))
+        cloud.mutable_xyzs()[:] = view.points.T
+        path = f"camera/clouds/{view.label}"
+        meshcat.SetObject(path, cloud, CLOUD_POINT_SIZE, Rgba(*CLOUD_RGBA[view.label.split("_", 1)[1]]))
+        meshcat.SetProperty(path, "visible", False)
+        shown.append((path, view.t))
+    return shown
+
+
+def draw_estimates(meshcat, scenario) -> None:
+    """Per part k, ``estimates/part_{k}``: its known shape's outline (``replay.outline_segments``)
+    in blue and a frame triad, posed by ``estimate_poses``."""
+    from pydrake.geometry import Rgba  # noqa: PLC0415
+
+    from ptint_drake.replay import draw_triad, outline_segments  # noqa: PLC0415
+
+    for k, part in enumerate(scenario.pick.parts):
+        starts, ends = outline_segments(part.shape, part.size)
+        meshcat.SetLineSegments(f"estimates/part_{k}/outline", starts, ends, 2.0, Rgba(*ESTIMATE_RGBA))
+        draw_triad(meshcat, f"estimates/part_{k}/triad", *ESTIMATE_TRIAD)
+
+
+def estimate_shown_until(scenario, metrics: dict) -> list[float]:
+    """Per part: until when its estimate is drawn — its pick's prescribed grasp + ``GRASP_TAIL``
+    (then it is in the hand and the estimate, a prediction along the belt, is no longer aimed at);
+    a part with no pick: the whole run."""
+    until = [np.inf] * len(scenario.pick.parts)
+    for pick in metrics["picks"]:
+        until[pick["part_index"]] = float(pick["t_grasp_prescribed"]) + GRASP_TAIL
+    return until
+
+
+def estimate_pose(series: dict, part: int, t: float):
+    """The part's estimate (series ``part_estimate_{part}``: [x, R row-major]) at the logged time
+    nearest ``t``, as a RigidTransform."""
+    from pydrake.math import RigidTransform, RotationMatrix  # noqa: PLC0415
+
+    times = np.asarray(series["t"])
+    row = np.asarray(series[f"part_estimate_{part}"])[min(int(np.searchsorted(times, t)), len(times) - 1)]
+    return RigidTransform(RotationMatrix.ProjectToRotationMatrix(np.reshape(row[3:12], (3, 3))), row[0:3])
+
+
+def write_pick_replay(scenario, series: dict, metrics: dict, path: Path) -> int:
     """Write ``replay.html`` (module docstring); returns its size in bytes."""
     from ptint_drake.replay import CAMERA, with_camera  # noqa: PLC0415
-
     plant, viz, meshcat, context = replay_world(scenario)
     plant_context = plant.GetMyMutableContextFromRoot(context)
     times, states = series["replay_t"], series["plant_state"]
+    clouds, until = [], []
+    if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
+        clouds = draw_camera_clouds(meshcat, scenario, series, metrics)
+        draw_estimates(meshcat, scenario)
+        until = estimate_shown_until(scenario, metrics)
     meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
     for t, x in zip(times, states):
         plant.SetPositions(plant_context, x[:plant.num_positions()])
         context.SetTime(float(t))
         viz.ForcedPublish(viz.GetMyContextFromRoot(context))
+        for cloud, t_frame in clouds:
+            meshcat.SetProperty(cloud, "visible", bool(t_frame - 1e-6 <= t < t_frame + CLOUD_HOLD),
+                                time_in_recording=float(t))
+        for k, end in enumerate(until):
+            meshcat.SetProperty(f"estimates/part_{k}", "visible", bool(t <= end), time_in_recording=float(t))
+            meshcat.SetTransform(f"estimates/part_{k}", estimate_pose(series, k, float(t)),
+                                 time_in_recording=float(t))
     meshcat.StopRecording()
     meshcat.PublishRecording()
     html = with_camera(meshcat.StaticHtml(), CAMERA)

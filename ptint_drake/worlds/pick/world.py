@@ -334,7 +334,8 @@ class PickWorld(World):
 
             write_pick_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics, stage)
         else:
-            write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, stage / "replay.html")
+            write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics,
+                              stage / "replay.html")
         return name
 
     def simulator_config(self, scenario: Scenario):
