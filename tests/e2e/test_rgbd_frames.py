@@ -1,6 +1,7 @@
 """The frames a ``measurement.sensor: rgbd`` run writes (issue 34, "seeing what the camera sees")."""
 
 import numpy as np
+import pytest
 from conftest import run_cached
 from PIL import Image
 
@@ -47,3 +48,91 @@ def test_a_camera_pick_writes_its_estimates_figure_and_frames_at_the_first_fit_a
         for rgb in marks:
             assert np.count_nonzero(np.all(color == rgb, axis=-1)) >= 12, (label, rgb)
         assert (tmp_path / "frames" / f"{label}_depth.png").exists()
+
+
+def _recording(html: str) -> tuple[list[dict], dict]:
+    """The meshcat commands of a recorded page (msgpack; typed arrays as (code, bytes)) and its
+    animation's tracks: {path: {property: {frame: value}}}."""
+    import base64
+    import re
+
+    msgpack = pytest.importorskip("msgpack")
+    payloads = re.findall(r'data:application/octet-binary;base64,([A-Za-z0-9+/=]+)"', html)
+    commands = [msgpack.unpackb(base64.b64decode(p), ext_hook=lambda code, data: (code, data))
+                for p in payloads]
+    animation = next(c for c in commands if c.get("type") == "set_animation")
+    tracks = {a["path"]: {tr["name"]: {k["time"]: k["value"] for k in tr["keys"]}
+                          for tr in a["clip"]["tracks"]} for a in animation["animations"]}
+    return commands, tracks
+
+
+def _truth_at(series: dict, part: int, t: float) -> tuple[np.ndarray, np.ndarray]:
+    times = np.asarray(series["t"])
+    row = np.asarray(series[f"part_true_{part}"])[min(int(np.searchsorted(times, t)), len(times) - 1)]
+    return row[0:3], row[3:12].reshape(3, 3)
+
+
+def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_beside_the_part(tmp_path):
+    from ptint_drake.worlds.pick.camera_frames import pick_instants
+    from ptint_drake.worlds.pick.views import CLOUD_HOLD, GRASP_TAIL
+    from ptint_drake.worlds.registry import world_of
+
+    result = run_cached("conveyor_pick_place_rgbd")
+    series, metrics = result.series, result.metrics
+    world = world_of(result.scenario)
+    task = world.view_tasks(result.scenario, series, metrics, tmp_path, False, True, False)[0]
+    assert task[0] == "pick_replay"
+    world.draw_view(*task)
+    html = (tmp_path / "replay.html").read_text()
+    assert html.startswith("<!DOCTYPE html>") and len(html) < 4_000_000
+    commands, tracks = _recording(html)
+    fps, replay_t = 30.0, np.asarray(series["replay_t"])
+    half = 0.5 * np.asarray(result.scenario.pick.parts[0].size)
+    instants = pick_instants(series, metrics)
+    assert [label for label, _, _ in instants] == ["pick0_first_fit", "pick0_grasp"]
+    for label, part, t in instants:
+        path = f"/drake/camera/clouds/{label}"
+        cloud = next(c for c in commands if c.get("type") == "set_object" and c["path"] == path)
+        _, data = cloud["object"]["geometries"][0]["data"]["attributes"]["position"]["array"]
+        points = np.frombuffer(data, dtype="<f4").reshape(-1, 3)
+        assert 0 < len(points) <= 5000, (label, len(points))
+        t_frame = float(replay_t[np.argmin(np.abs(replay_t - t))])  # the replay state rendered
+        x, R = _truth_at(series, part, t_frame)
+        inside = np.all(np.abs((points - x) @ R) <= half + 0.003, axis=1)  # within 3 mm of the part
+        # the first fit sees the part alone; at the grasp the fingers are beside it, in its band
+        assert np.mean(inside) >= (1.0 if label.endswith("first_fit") else 0.5), (label, np.mean(inside))
+        shown = tracks[path][".visible"]
+        on = sorted(f for f, v in shown.items() if v)
+        assert on and on[0] == int(np.floor(t_frame * fps + 1e-9)), (label, on[:3])
+        assert (on[-1] - on[0] + 1) / fps == pytest.approx(CLOUD_HOLD, abs=1.5 / fps)
+    # the estimate: a track over the run, what the series logged, near the part until the grasp
+    track = tracks["/drake/estimates/part_0"]
+    assert len(track[".position"]) >= 0.9 * len(replay_t)
+    estimate, times = np.asarray(series["part_estimate_0"]), np.asarray(series["t"])
+    grasp = metrics["picks"][0]["t_grasp_prescribed"]
+    frame_t = {}
+    for t in replay_t:  # a frame's key holds the last replay state in it
+        frame_t[int(np.floor(t * fps))] = float(t)
+    for frame, p in track[".position"].items():
+        t = frame_t[frame]
+        k = min(int(np.searchsorted(times, t)), len(times) - 1)
+        assert np.allclose(p, estimate[k, 0:3], atol=1e-6), frame
+        assert track[".visible"][frame] == (t <= grasp + GRASP_TAIL), frame
+        if 0.5 <= t <= grasp:  # fitted (the first fit is at ~0.03 s) and not yet in the hand
+            assert np.linalg.norm(np.asarray(p) - _truth_at(series, 0, t)[0]) <= 0.003, t
+    assert {f"/drake/estimates/part_0/triad/{a}" for a in "xyz"} <= {c.get("path") for c in commands}
+
+
+def test_a_pick_replay_without_a_camera_draws_no_clouds_or_estimates(tmp_path):
+    """The same run's motion replayed for the scenario without its camera: the page has neither."""
+    import dataclasses
+
+    from ptint_drake.worlds.pick.views import write_pick_replay
+
+    result = run_cached("conveyor_pick_place_rgbd")
+    plain = dataclasses.replace(result.scenario, measurement=None)
+    write_pick_replay(plain, result.series, result.metrics, tmp_path / "replay.html")
+    commands, tracks = _recording((tmp_path / "replay.html").read_text())
+    paths = {c.get("path") or "" for c in commands} | set(tracks)
+    assert not any("/camera/" in p or "/estimates/" in p for p in paths)
+    assert any("/drake/visualizer/" in p for p in tracks)  # the robot is replayed
