@@ -249,7 +249,7 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path) -> int:
     plant, viz, meshcat, context = replay_world(scenario)
     plant_context = plant.GetMyMutableContextFromRoot(context)
     times, states = series["replay_t"], series["plant_state"]
-    clouds, until = [], []
+    clouds, until, visible = [], [], {}
     if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
         clouds = draw_camera_clouds(meshcat, scenario, series, metrics)
         draw_estimates(meshcat, scenario)
@@ -259,11 +259,13 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path) -> int:
         plant.SetPositions(plant_context, x[:plant.num_positions()])
         context.SetTime(float(t))
         viz.ForcedPublish(viz.GetMyContextFromRoot(context))
-        for cloud, t_frame in clouds:
-            meshcat.SetProperty(cloud, "visible", bool(t_frame - 1e-6 <= t < t_frame + CLOUD_HOLD),
-                                time_in_recording=float(t))
-        for k, end in enumerate(until):
-            meshcat.SetProperty(f"estimates/part_{k}", "visible", bool(t <= end), time_in_recording=float(t))
+        shown = [(cloud, t_frame - 1e-6 <= t < t_frame + CLOUD_HOLD) for cloud, t_frame in clouds]
+        shown += [(f"estimates/part_{k}", t <= end) for k, end in enumerate(until)]
+        for name, on in shown:  # a key where it changes (a visibility track holds its last key)
+            if visible.get(name) != on:
+                meshcat.SetProperty(name, "visible", bool(on), time_in_recording=float(t))
+                visible[name] = on
+        for k in range(len(until)):
             meshcat.SetTransform(f"estimates/part_{k}", estimate_pose(series, k, float(t)),
                                  time_in_recording=float(t))
     meshcat.StopRecording()
