@@ -302,7 +302,9 @@ class PickWorld(World):
             raise ScenarioError(f"duration: {s.duration:g} s ends before the pick tasks do ({end:.3g} s)")
 
     def schedule(self, scenario: Scenario):
-        return pick_plan(scenario.pick).schedule
+        from ptint_drake.worlds.pick.route import routed_plan  # noqa: PLC0415  (the arm's model)
+
+        return routed_plan(scenario).schedule
 
     def prepare(self, scenario: Scenario, log: bool = True) -> PickRun:
         return PickRun(scenario)
