@@ -25,6 +25,22 @@ after it stays where the scenario put it.  The edge itself is found by bisection
 warns before the run.  ``routed_plan`` is the plan with its vias: what the run, the drive and the
 schedule use.  Planning uses the arm's kinematic model; at run time the via is a fixed target
 like a slot (``targets.PickTargets``): the controller stays model-free.
+
+A carry may also get a via halfway along it for the way its wrist turns (``_carry_turn``): the
+top-down task turns the tool to the slot's top-down yaw nearest its own (modulo π), and that way
+may take the wrist's roll past its joint limit (``tests/two_belt_pick_mirrored.yaml`` after the
+route: the block grasped at tool yaw 155°, the nearer branch of the slot's 60° is 240°, which
+needs rvm1_5dof's roll at −217°: it stopped at −180°, the block placed 36.8° off).  A
+joint-space continuation of the carry (IK from sample to sample, ``TURN_SAMPLES``) finds where it
+breaks; the via, turned halfway towards the other branch, makes the wrist turn the other way.
+
+Only arms with fewer than ``FULL_TOP_DOWN`` joints get vias (``rvm1_5dof``: its top-down
+posture at a point is unique, the inner edge is its wrist pitch's limit).  On ``rvm1_6dof`` the
+same test finds the same ways too near (its inner edge is at 75-85 mm as well) but the way around
+puts the tool 130 mm from the axis, where its forearm hangs nearly vertical over its
+roll-pitch-roll wrist's singularity: measured, with the vias it missed both two-belt scenarios
+(the mirrored one's descend 11.6 mm off at its tf, then collisions), without them it places every
+part of both (docs/pick_place.md).
 """
 
 from __future__ import annotations
@@ -46,6 +62,7 @@ VIA_STEP = 0.005  # m: the via's radius is searched in these steps
 EDGE_TOLERANCE = 0.002  # m: the inner edge's bisection stops at this width
 ROUTED = ("approach", "carry")  # the phases a via may split (the first attempt's approach)
 TURN_SAMPLES = 9  # samples of a carry's joint-space continuation
+FULL_TOP_DOWN = 6  # joints: an arm with as many has no via (module docstring)
 JUMP = np.radians(60.0)  # rad: a joint moving more than this between two samples breaks a continuation
 
 
@@ -270,6 +287,8 @@ def plan_vias(scenario, world: Nominal, replans: tuple = ()) -> tuple:
     edge and can be taken around it, and of every carry whose wrist turns into a joint limit and
     can turn the other way round (module docstring)."""
     pick, vias = scenario.pick, ()
+    if world.arm.num_velocities() >= FULL_TOP_DOWN:
+        return vias
     plan = pick_plan(pick, replans)
     paths = nominal_paths(world, plan)
     for i, seg in enumerate(plan.segments):
