@@ -58,9 +58,9 @@ def test_a_way_clear_of_the_axis_is_planned_as_before():
 
 
 def test_the_six_joint_arm_gets_no_via():
-    """rvm1_6dof: the same ways are too near its inner edge too, but a via 130 mm from the axis
-    sits over its wrist singularity (measured: both two-belt scenarios missed with it, and place
-    every part without it): its plan is the one without routing."""
+    """rvm1_6dof: the same ways are too near its inner edge too, but measured, both two-belt
+    scenarios missed with the vias and place every part without them: its plan is the one without
+    routing."""
     scenario = load_scenario(MIRRORED)
     scenario.robot.model, scenario.robot.initial_q_deg = "rvm1_6dof", [22.7, 46.5, 20.0, 0.0, 21.5, 0.0]
     assert route.routed_plan(scenario).segments == pick_plan(scenario.pick).segments

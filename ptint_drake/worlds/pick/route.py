@@ -36,11 +36,10 @@ breaks; the via, turned halfway towards the other branch, makes the wrist turn t
 
 Only arms with fewer than ``FULL_TOP_DOWN`` joints get vias (``rvm1_5dof``: its top-down
 posture at a point is unique, the inner edge is its wrist pitch's limit).  On ``rvm1_6dof`` the
-same test finds the same ways too near (its inner edge is at 75-85 mm as well) but the way around
-puts the tool 130 mm from the axis, where its forearm hangs nearly vertical over its
-roll-pitch-roll wrist's singularity: measured, with the vias it missed both two-belt scenarios
-(the mirrored one's descend 11.6 mm off at its tf, then collisions), without them it places every
-part of both (docs/pick_place.md).
+same test finds the same ways too near (its inner edge is at 75-85 mm as well), but measured with
+the vias it missed both two-belt scenarios (the via and the approach reached their targets, then
+the mirrored one's descend ended 11.6 mm and 18° off, and collisions followed; cause not
+isolated), and without them it places every part of both (docs/pick_place.md).
 """
 
 from __future__ import annotations
