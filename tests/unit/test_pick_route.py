@@ -8,7 +8,7 @@ import numpy as np
 from ptint_drake.robot import nominal_plant
 from ptint_drake.scenario import load_scenario
 from ptint_drake.worlds.pick import route
-from ptint_drake.worlds.pick.tasks import VIA_PART, pick_plan
+from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, pick_plan
 
 MIRRORED = str(Path(__file__).resolve().parents[1] / "two_belt_pick_mirrored.yaml")
 
@@ -64,3 +64,21 @@ def test_the_six_joint_arm_gets_no_via():
     scenario = load_scenario(MIRRORED)
     scenario.robot.model, scenario.robot.initial_q_deg = "rvm1_6dof", [22.7, 46.5, 20.0, 0.0, 21.5, 0.0]
     assert route.routed_plan(scenario).segments == pick_plan(scenario.pick).segments
+
+
+def test_a_carry_whose_wrist_would_turn_into_its_roll_limit_turns_the_other_way_round():
+    """two_belt_pick_mirrored: the block grasped at tool yaw 155°, the carry would turn the tool to
+    240° (the slot's 60° branch nearest it), rvm1_5dof's roll to −217° past its −180° limit; a via
+    halfway along the carry turns it to 107.5°, so that the carry ends at 60°.  tests/two_belt_pick
+    (its mirror image, the roll within its limits) gets no such via."""
+    scenario = load_scenario(MIRRORED)
+    plan = route.routed_plan(scenario)
+    turns = [n for n, s in enumerate(plan.segments) if s.kind == VIA_SLOT]
+    assert len(turns) == 1
+    j = turns[0]
+    assert (plan.segments[j].task, plan.segments[j + 1].phase) == (1, "carry")
+    assert np.isclose(np.degrees(plan.segments[j].yaw), 107.5, atol=0.5)
+    i = pick_plan(scenario.pick).segment_index(1, "carry")
+    assert np.isclose(plan.schedule[j + 1].end, pick_plan(scenario.pick).schedule[i].end)
+    original = load_scenario(str(Path(MIRRORED).with_name("two_belt_pick.yaml")))
+    assert not [s for s in route.routed_plan(original).segments if s.kind == VIA_SLOT]

@@ -34,8 +34,8 @@ needs rvm1_5dof's roll at −217°: it stopped at −180°, the block placed 36.
 joint-space continuation of the carry (IK from sample to sample, ``TURN_SAMPLES``) finds where it
 breaks; the via, turned halfway towards the other branch, makes the wrist turn the other way.
 
-Only arms with fewer than ``FULL_TOP_DOWN`` joints get vias (``rvm1_5dof``: its top-down
-posture at a point is unique, the inner edge is its wrist pitch's limit).  On ``rvm1_6dof`` the
+Only arms with fewer than ``FULL_TOP_DOWN`` joints get vias (``rvm1_5dof``: a 5-D top-down task
+by design, its inner edge its wrist pitch's limit).  On ``rvm1_6dof`` the
 same test finds the same ways too near (its inner edge is at 75-85 mm as well), but measured with
 the vias it missed both two-belt scenarios (the via and the approach reached their targets, then
 the mirrored one's descend ended 11.6 mm and 18° off, and collisions followed; cause not
