@@ -171,13 +171,20 @@ def _down(world: Nominal, x: np.ndarray, guess=None):
 
 def too_near(world: Nominal, path: np.ndarray) -> tuple:
     """(radius, nearest point) of a way that passes within ``INNER_MARGIN`` of the inner edge (no
-    top-down posture ``INNER_MARGIN`` nearer the axis than its nearest point), else None."""
+    top-down posture ``INNER_MARGIN`` nearer the axis than its nearest point, solved from the start
+    posture or else from the nearest point's own: from the start posture alone the solver missed
+    postures that exist, e.g. 98 mm from the axis at an azimuth of −25°, the edge there at 85 mm),
+    else None."""
     radius, point = _nearest(world, path)
     if radius <= INNER_MARGIN:
         return radius, point
-    if _down(world, _at(world, point, radius - INNER_MARGIN)) is None:
-        return radius, point
-    return None
+    inner = _at(world, point, radius - INNER_MARGIN)
+    if _down(world, inner) is not None:
+        return None
+    own = _down(world, point)
+    if own is not None and _down(world, inner, own) is not None:
+        return None
+    return radius, point
 
 
 def inner_edge(world: Nominal, point: np.ndarray, far: float = 0.6) -> float:
