@@ -71,7 +71,7 @@ def _aim(built, i: int, aims: dict, at_start: bool):
         rot = np.zeros(15)
         rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
         return built.targets.places[i] + offset, rot
-    if seg.kind == "via_slot":  # a via (pick.route): a fixed point, turned to the slot's yaw or as its part
+    if seg.kind == "via_slot":  # a via (pick.route): a fixed point turned to a yaw (via_part: as its part)
         rot = np.zeros(15)
         rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
         return offset, rot

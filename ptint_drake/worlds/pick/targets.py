@@ -22,8 +22,8 @@ aims at where the part was at the segment's start + offset, at rest.  Discrete s
 grasp time.  A "slot"
 segment aims at the fixed place pose, turned to the slot's yaw about the vertical.  A via segment
 (``pick.route``: the way around the arm's base) aims at its fixed point, at rest, turned as the
-segment after it will be: as its part (``via_part``, before an approach) or to the slot's yaw
-(``via_slot``, before a carry).
+segment after it will be: as its part (``via_part``, before an approach), or to a yaw
+(``via_slot``, before a carry: the slot's, or halfway to it the other way round).
 
 ``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a
 function of time: the plan's commands, piecewise constant (output ``command``), and the width of
