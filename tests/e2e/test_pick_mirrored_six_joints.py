@@ -2,13 +2,13 @@
 6-joint arm's damping measurement and not adjusted after a run) places both parts on rvm1_6dof with
 every controller setting at its default (the constant 0.015 m/rad damping: docs/pick_place.md).
 
-Not asserted on rvm1_5dof: measured there with the defaults, the can ends 4.4 mm off its slot and
-the block collides with its belt (missed after retry).  The cause: pick 1's approach swings from the
-tray (y = −0.24 m) past the waist axis to the block (+y); the tool passed 106 mm from the axis, near
-the inner edge of the 5-joint arm's top-down workspace (none closer than ≈ 90 mm at z = 0.19 m), and
-slid into it (6 mm from the axis, wrist pitch at −90°, smallest singular value 1e-4 m, the arm
-thrashing into the tray and the can).  The unmirrored scenario passes within 108 mm and recovers
-after tilting the tool 33°: both are now warned before the run (tests/unit/test_pick_inner_reach.py)."""
+Not run here on rvm1_5dof (a run of 12-40 s on the 2-core CI machine): before the way around the
+base (``worlds.pick.route``), the can ended 4.4 mm off its slot and the block collided with its belt
+there (pick 1's approach swung from the tray past the waist axis, 106 mm from it, into the inner edge
+of the 5-joint arm's top-down workspace); with the route's vias it places both (0.37 / 0.30 mm,
+docs/pick_place.md).  The plan's vias are tested in tests/unit/test_pick_route.py, and
+tests/e2e/test_pick_two_belts.py runs tests/two_belt_pick.yaml, whose rvm1_5dof plan has the same
+approach via, mirrored."""
 
 from pathlib import Path
 

@@ -5,7 +5,8 @@ the controller's design error dynamics e(t) = ξ(t) e(t0) (SPEC 2.1, ξ the time
 ξ(τ) = I⁻¹(1−β, 1−β; 1 − τ/tf)), the fingertip centre follows x(t) = p(t) + ξ(t) (x(t0) − p(t0)),
 with p(t) the target riding its belt at the belt's nominal speed.  ``check_pick_clearance``
 samples that path (the approach from the start pose, or from the previous task's retreat, to
-``clearance`` above the part; the descend onto the part's centre) and checks the fingers' vertical
+``clearance`` above the part, by way of its via if it has one: ``route``; the descend onto the
+part's centre) and checks the fingers' vertical
 extent (from the pads' lower edge to the fingers' top, read from the gripper's collision geometry)
 against each belt's slab wherever the open fingers (a disc of half the opening plus the finger's
 thickness) are over it.  A pass into a belt, or less than ``MIN_CLEARANCE`` above it, is a
@@ -24,6 +25,7 @@ from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grippers import payload_warnings
 from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
+from ptint_drake.worlds.pick.tasks import VIA_PART
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
 SAMPLES = 60  # points along each checked segment
@@ -74,6 +76,16 @@ def check_pick_clearance(scenario, built) -> None:
         start = station.parts[i_part].EvalPoseInWorld(context).translation()
         ride = belt.speed * np.asarray(belt.direction, dtype=float)
         radius = min(grasp_width(part) + task.margin, stroke) / 2 + thickness
+        via = [i for i, s in enumerate(plan.segments) if s.task == k and s.kind == VIA_PART]
+        if via:  # the way around the base (route): a fixed point first
+            seg = plan.schedule.segments[via[0]]
+            field = "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"
+            point = np.asarray(plan.segments[via[0]].offset)
+            tau = np.linspace(0.0, seg.tf, SAMPLES)
+            path = point + np.outer(_xi(tau, seg.tf, seg.beta), x0 - point)
+            for b in config.belts:
+                _check_belt(b, path, seg.start + tau, reach, top, radius, field, k, "via")
+            x0 = point
         for phase, field in (("approach", "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"),
                              ("descend", f"pick.parts[{i_part}].size")):
             seg = plan.schedule.segments[plan.segment_index(k, phase)]

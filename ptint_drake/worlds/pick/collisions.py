@@ -67,14 +67,14 @@ def collision_bodies(names: list, t: np.ndarray, flags: np.ndarray, window: tupl
 
 def pick_collisions(built, logs: dict, k: int) -> list:
     """``collision_bodies`` of task k of a built pick run (``run.PickBuilt``) from its ``logs``
-    (``"collisions"``: the station's port logged): its window runs from its approach's start (0
-    for the first task) to the next task's approach (the run's end for the last)."""
+    (``"collisions"``: the station's port logged): its window runs from its start (its first
+    approach's, or that of the via before it; 0 for the first task) to the next task's start (the
+    run's end for the last)."""
     if "collisions" not in logs:
         return []
     t, flags = logs["collisions"]
     plan = built.plan
-    starts = [plan.schedule.segments[plan.segment_index(j, "approach")].start
-              for j in range(len(plan.close_times))]
+    starts = [plan.attempts[j][0].start for j in range(len(plan.close_times))]  # (a via's start, if any)
     window = (0.0 if k == 0 else starts[k], starts[k + 1] if k + 1 < len(starts) else np.inf)
     own = built.station.config.parts[plan.segments[plan.segment_index(k, "approach")].index].name
     return collision_bodies(built.station.obstacles, t, flags, window, own)

@@ -34,7 +34,7 @@ from ptint_drake.systems.gripper import GraspObserver
 from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
-from ptint_drake.worlds.pick.tasks import pick_plan
+from ptint_drake.worlds.pick.route import routed_plan
 
 PART_MOTION = (9, 15)  # a part's [x, ẋ, ẍ] and [R, ω, ω̇]
 
@@ -71,7 +71,7 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     """The pick world's controller side in ``builder`` (module docstring), its ports exported;
     ``period``: the control period, ``sense``: ``grasp_reads``'s."""
     pick = scenario.pick
-    plan = pick_plan(pick)
+    plan = routed_plan(scenario)
     places = place_positions(MakePickStation(world_config(scenario)), plan)
     count = len(pick.parts)
     parts = builder.AddNamedSystem("status_parts", PassThrough(sum(PART_MOTION) * count))

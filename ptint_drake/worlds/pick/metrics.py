@@ -71,7 +71,15 @@ def _aim(built, i: int, aims: dict, at_start: bool):
         rot = np.zeros(15)
         rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
         return built.targets.places[i] + offset, rot
+    if seg.kind == "via_slot":  # a via (pick.route): a fixed point turned to a yaw (via_part: as its part)
+        rot = np.zeros(15)
+        rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
+        return offset, rot
     pose, rot = aims["parts"][seg.index]
+    if seg.kind == "via_part":
+        rot = rot.copy()
+        rot[9:15] = 0.0
+        return offset, rot
     if seg.kind == "latched":
         rot = rot.copy()
         rot[9:15] = 0.0

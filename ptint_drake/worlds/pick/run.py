@@ -36,7 +36,8 @@ from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.worlds.pick.probe import PickProbe
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
-from ptint_drake.worlds.pick.tasks import PickPlan, Replan, pick_plan
+from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.tasks import PickPlan, Replan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
@@ -110,7 +111,8 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     builder = DiagramBuilder()
     station = MakePickStation(world_config(scenario), scenario.measurement)
     st = builder.AddNamedSystem("pick_station", station.diagram)
-    plan = pick_plan(scenario.pick, replans)
+    arm = nominal_plant(scenario)
+    plan = routed_plan(scenario, replans, arm)  # the way around the base where one is needed (route)
     n = len(station.parts)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, place_positions(station, plan)))
     estimates, parts, true_targets = None, st, None
@@ -121,7 +123,6 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
                                               PickTargets(plan, n, place_positions(station, plan)))
         _connect_parts(builder, st, true_targets, n)
     _connect_parts(builder, parts, targets, n)
-    arm = nominal_plant(scenario)
     limits = actuator_effort_limits(arm)
     saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
     builder.Connect(saturation.get_output_port(), st.GetInputPort("actuation"))

@@ -14,27 +14,27 @@ joints (``rvm1_5dof``: a 5-D top-down task by design) are not checked for that.
 
 A 5-joint arm on ``top_down`` has another edge: near its own waist axis it cannot point the tool
 down at all (``rvm1_5dof`` at z = 0.15-0.19 m: no top-down posture within its joint limits closer
-than about 90 mm, where the wrist pitch reaches its −90° limit), and its 6 × 5 least-squares
-Jacobian loses rank on the way there.  ``inner_reach_warnings`` follows the straight lines between
-the same waypoints (an approach's end where the part is at that end) and warns, one line per task,
-where one passes within ``INNER_MARGIN`` of that inner edge: a way from a tray on one side of the
-base to a part on the other.  Measured (issue 33): tests/two_belt_pick.yaml and its mirror image in
-y both swing past the base 106-108 mm from the axis; on the mirror image the arm slid into the
-inner edge (6 mm from the axis, the wrist pitch at −90°, the smallest singular value 1e-4 m, torque
-commands 4e9 N·m) and missed; on the original it recovered after tilting the tool 33°.
+than about 85 mm, where the wrist pitch reaches its −90° limit), and its Jacobian loses rank on
+the way there.  The plan goes around it (``route``: a via on the far side of the axis); where no
+way around was found, ``inner_reach_warnings`` follows the plan's ways (``route.nominal_paths``)
+and warns, one line per task, where one passes within ``route.INNER_MARGIN`` of that inner edge.
+Measured (issue 33), before the route: tests/two_belt_pick.yaml and its mirror image in y both
+swung past the base 106-108 mm from the axis; on the mirror image the arm slid into the inner edge
+(6 mm from the axis, the wrist pitch at −90°, the smallest singular value 1e-4 m, torque commands
+4e9 N·m) and missed; on the original it recovered after tilting the tool 33°.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from pydrake.multibody.tree import JacobianWrtVariable, JointIndex
+from pydrake.multibody.tree import JacobianWrtVariable
 
 from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.worlds.pick.route import FULL_TOP_DOWN, INNER_MARGIN, nominal, nominal_paths, too_near
+from ptint_drake.worlds.pick.tasks import VIA_PART
 
 MIN_SIGMA = 0.01  # m: on rvm1_6dof (rot_scale 0.1 m/rad) about a wrist pitch of 10°
 SAMPLES = 12  # joint-space samples between two waypoints
-INNER_MARGIN = 0.04  # m: a path closer than this to the inner edge of the top-down workspace is warned
-INNER_SAMPLES = 41  # samples of the straight line between two waypoints
 
 
 def _sigma_min(plant, context, frame, q: np.ndarray, rot_scale: float) -> float:
@@ -46,10 +46,13 @@ def _sigma_min(plant, context, frame, q: np.ndarray, rot_scale: float) -> float:
 
 
 def _waypoints(scenario, built) -> list:
-    """(task, phase, x) of every waypoint after the start posture (nominal part positions)."""
+    """(task, phase, x) of every waypoint after the start posture (nominal part positions), a via
+    (``route``) before the approach or the carry it precedes."""
     plan, config = built.plan, built.station.config
     belts = {b.name: b for b in config.belts}
     context = built.station.plant.CreateDefaultContext()
+    vias = {(s.task, "approach" if s.kind == VIA_PART else "carry"): np.asarray(s.offset)
+            for s in plan.segments if s.phase == "via"}
     out = []
     for k, task in enumerate(scenario.pick.tasks):
         i_part = plan.segments[plan.segment_index(k, "approach")].index
@@ -58,9 +61,12 @@ def _waypoints(scenario, built) -> list:
         grasp = start + belt.speed * plan.grasp_times[k] * np.asarray(belt.direction, dtype=float)
         place = built.targets.places[plan.segment_index(k, "place")]
         up = lambda h: np.array([0.0, 0.0, h])  # noqa: E731
-        out += [(k, "approach", grasp + up(task.clearance)), (k, "descend", grasp),
-                (k, "lift", grasp + up(task.lift_height)), (k, "carry", place + up(task.lift_height)),
-                (k, "place", place), (k, "retreat", place + up(task.clearance))]
+        for phase, x in (("approach", grasp + up(task.clearance)), ("descend", grasp),
+                         ("lift", grasp + up(task.lift_height)), ("carry", place + up(task.lift_height)),
+                         ("place", place), ("retreat", place + up(task.clearance))):
+            if (k, phase) in vias:
+                out.append((k, "via", vias[(k, phase)]))
+            out.append((k, phase, x))
     return out
 
 
@@ -106,64 +112,28 @@ def _warning(scenario, k: int, phase: str, sigma: float, q: np.ndarray) -> str:
             f"{np.round(np.degrees(q), 1).tolist()} deg){advice}")
 
 
-def _waist_axis(arm) -> np.ndarray:
-    """(x, y) of the arm's first revolute joint axis (its waist), in the world."""
-    context = arm.CreateDefaultContext()
-    for i in range(arm.num_joints()):
-        joint = arm.get_joint(JointIndex(i))
-        if joint.num_velocities() == 1 and "revolute" in joint.type_name():
-            return joint.frame_on_child().CalcPoseInWorld(context).translation()[:2]
-    return np.zeros(2)
-
-
-def _path_points(scenario, built, arm, frame) -> list:
-    """(task, phase, x) of the start point and every waypoint, an approach's where its part is at the
-    approach's end (the approach aims at the moving part)."""
-    plan, config = built.plan, built.station.config
-    belts = {b.name: b for b in config.belts}
-    context = built.station.plant.CreateDefaultContext()
-    arm_context = arm.CreateDefaultContext()
-    arm.SetPositions(arm_context, np.radians(scenario.robot.initial_q_deg))
-    out = [(-1, "start", frame.CalcPoseInWorld(arm_context).translation())]
-    for k, phase, x in _waypoints(scenario, built):
-        if phase == "approach":
-            i = plan.segment_index(k, "approach", 0)
-            i_part = plan.segments[i].index
-            belt = belts[config.parts[i_part].belt]
-            start = built.station.parts[i_part].EvalPoseInWorld(context).translation()
-            end = plan.schedule.segments[i].end
-            x = start + belt.speed * end * np.asarray(belt.direction, dtype=float) + \
-                np.array([0.0, 0.0, scenario.pick.tasks[k].clearance])
-        out.append((k, phase, x))
-    return out
-
-
 def inner_reach_warnings(scenario, built) -> list[str]:
-    """One warning per task whose straight way to a waypoint passes within ``INNER_MARGIN`` of the
-    inner edge of a 5-joint arm's top-down workspace (module docstring); [] for other arms and
-    tasks."""
-    arm = built.arm
-    if arm.num_velocities() >= 6 or scenario.controller.task != "top_down":
+    """One warning per task whose way (``route.nominal_paths`` of the run's plan, its vias
+    included) passes within ``route.INNER_MARGIN`` of the inner edge of the arm's top-down
+    workspace: where ``route.plan_vias`` found no way around the base (module docstring); [] for
+    other tasks and for arms of ``route.FULL_TOP_DOWN`` joints or more (no vias there)."""
+    arm, plan = built.arm, built.plan
+    if scenario.controller.task != "top_down" or arm.num_velocities() >= FULL_TOP_DOWN:
         return []
-    frame = arm.GetFrameByName(scenario.robot.end_effector)
-    axis = _waist_axis(arm)
-    q = np.radians(scenario.robot.initial_q_deg)
-    points = _path_points(scenario, built, arm, frame)
+    world = nominal(scenario, arm)
     warned, out = set(), []
-    for (_, _, a), (k, phase, b) in zip(points, points[1:]):
-        line = a + np.linspace(0.0, 1.0, INNER_SAMPLES)[:, None] * (b - a)
-        radius = np.hypot(*(line[:, :2] - axis).T)
-        i = int(np.argmin(radius))
-        if k in warned or radius[i] <= INNER_MARGIN:
+    for seg, path in zip(plan.segments, nominal_paths(world, plan)):
+        if seg.task in warned:
             continue
-        p = line[i].copy()
-        p[:2] = axis + (p[:2] - axis) * (radius[i] - INNER_MARGIN) / radius[i]  # INNER_MARGIN nearer the axis
-        if inverse_kinematics(arm, frame, p, q, down=True) is None:
-            warned.add(k)
-            out.append(f"reach: pick {k}'s {phase} passes {1e3 * radius[i]:.0f} mm from the waist axis of "
-                       f"{scenario.robot.model} (at z = {p[2]:.3f} m), within {1e3 * INNER_MARGIN:g} mm of "
-                       f"where it can no longer point its tool down (a 5-joint arm; no top-down posture "
-                       f"{1e3 * (radius[i] - INNER_MARGIN):.0f} mm from the axis): the arm may tilt the tool "
-                       f"or fold into its wrist-pitch limit there (keep the tray and the belts on the same "
-                       f"side of the base, or farther from it)")
+        near = too_near(world, path)
+        if near is None:
+            continue
+        radius, point = near
+        warned.add(seg.task)
+        out.append(f"reach: pick {seg.task}'s {seg.phase} passes {1e3 * radius:.0f} mm from the waist axis "
+                   f"of {scenario.robot.model} (at z = {point[2]:.3f} m), within {1e3 * INNER_MARGIN:g} "
+                   f"mm of where it can no longer point its tool down (no top-down posture "
+                   f"{1e3 * max(radius - INNER_MARGIN, 0.0):.0f} mm from the axis), and no way around the "
+                   f"base was found: the arm may tilt the tool or fold into its wrist-pitch limit there "
+                   f"(keep the tray and the belts on the same side of the base, or farther from it)")
     return out

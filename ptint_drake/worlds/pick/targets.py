@@ -20,7 +20,10 @@ a target read off a part in the hand would follow the hand and hold nothing.  A 
 aims at where the part was at the segment's start + offset, at rest.  Discrete state ``latched``
 = [p, v, t₀, R] (m, m/s, s, row-major), updated at each "latched" segment's start and at each
 grasp time.  A "slot"
-segment aims at the fixed place pose, turned to the slot's yaw about the vertical.
+segment aims at the fixed place pose, turned to the slot's yaw about the vertical.  A via segment
+(``pick.route``: the way around the arm's base) aims at its fixed point, at rest, turned as the
+segment after it will be: as its part (``via_part``, before an approach), or to a yaw
+(``via_slot``, before a carry: the slot's, or halfway to it the other way round).
 
 ``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a
 function of time: the plan's commands, piecewise constant (output ``command``), and the width of
@@ -39,10 +42,10 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
-from ptint_drake.worlds.pick.tasks import PickPlan
+from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan
 
 
-PART, LATCHED, SLOT = 0, 1, 2  # a segment's kind ("part", "latched", "slot") as ``_aims`` holds it
+PART, LATCHED, SLOT, VIA = 0, 1, 2, 3  # a segment's kind ("part", "latched", "slot", "via_*") in ``_aims``
 
 
 class PickTargets(LeafSystem):
@@ -77,6 +80,9 @@ class PickTargets(LeafSystem):
         offset = np.asarray(seg.offset)
         if seg.kind == "slot":
             return (SLOT, None, offset, np.asarray(self.places[i]) + offset,
+                    RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
+        if seg.kind in (VIA_PART, VIA_SLOT):  # a fixed point; turned as its part, or to a yaw
+            return (VIA, seg.index if seg.kind == VIA_PART else None, offset, offset,
                     RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
         end = self._plan.schedule.segments[i].end if seg.phase == "descend" else None
         return (PART if seg.kind == "part" else LATCHED, seg.index, offset, None, None, end)
@@ -120,6 +126,10 @@ class PickTargets(LeafSystem):
         value = np.zeros(24)
         if kind == SLOT:
             value[0:3], value[9:18] = place, R_slot
+            return value
+        if kind == VIA:
+            value[0:3] = place
+            value[9:18] = R_slot if part is None else self._rotations[part].Eval(context)[0:9]
             return value
         latched = context.get_discrete_state(self._latched).get_value()
         if kind == LATCHED:

@@ -19,6 +19,11 @@ other, each a prescribed-time interception (SPEC 2.1) of its own target:
    open at this segment's tf + ``dwell``;
 6. ``retreat`` — ``clearance`` above the slot, starting ``dwell`` after the fingers opened.
 
+A *via* (``Via``: ``worlds.pick.route`` decides where one is needed) splits a task's first approach or
+its carry in two: first a segment of its own (phase ``via``) to a fixed point, then the approach or
+carry itself, the two together taking the segment's tf (so every later prescribed time stays
+where it was): the way around the arm's base when the straight way passes too near its waist axis.
+
 Times: the approach starts at the task's ``start``; each later segment starts at the previous
 one's prescribed time, the lift and the retreat ``dwell`` later.  A task starts after the previous
 task's retreat (``start`` = 0: right after it).  ``pick_plan`` turns the block into the schedule,
@@ -50,6 +55,25 @@ class PlanSegment:
     offset: tuple
     yaw: float = 0.0
     attempt: int = 0
+
+
+VIA_PART, VIA_SLOT = "via_part", "via_slot"  # the kinds of a via segment (``Via``)
+
+
+@dataclass(frozen=True)
+class Via:
+    """A fixed point on the way of task ``task``'s ``phase`` ("approach": its first attempt's, or
+    "carry"): a segment of its own (phase ``via``, kind ``via_part`` before an approach: the tool
+    turned as part ``index`` is; ``via_slot`` before a carry: turned to the slot's yaw) aims at
+    ``position`` (world, m) for the fraction ``share`` of the phase's tf, the phase the rest;
+    ``yaw`` (rad; before a carry only): the tool's yaw there instead of the slot's (the way the
+    wrist turns: ``route``)."""
+
+    task: int
+    phase: str
+    position: tuple
+    share: float
+    yaw: Optional[float] = None
 
 
 @dataclass(frozen=True)
@@ -104,17 +128,27 @@ def _up(h: float) -> tuple:
 
 
 def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float, replan: Replan,
-                   hold: float = 0.0):
-    """The segments of task k, their plan entries, the attempts' (approach start, grasp) and the end;
-    ``hold``: how long the first attempt waits at its pre-grasp pose before its descend (s)."""
+                   hold: float = 0.0, vias: tuple = ()):
+    """The segments of task k, their plan entries, the attempts' (start, grasp) and the end;
+    ``hold``: how long the first attempt waits at its pre-grasp pose before its descend (s);
+    ``vias``: the task's ``Via`` (at most one per phase)."""
     segments, plans, attempts = [], [], []
+    routes = {v.phase: v for v in vias if v.task == k}
 
     def add(phase, kind, index, offset, yaw, t, attempt=0, until=np.inf):
         move = getattr(task, phase)
         tf = min(move.tf, until - t)  # a descend cut short by its retry (the grasp found empty)
+        end = t + tf
+        via = routes.get(phase) if attempt == 0 else None
+        if via is not None:  # the way around the base: the phase's tf shared by the via and the phase
+            segments.append(Segment(t, via.share * tf, move.beta))
+            plans.append(PlanSegment(k, "via", VIA_PART if phase == "approach" else VIA_SLOT,
+                                     index, tuple(float(c) for c in via.position),
+                                     yaw if via.yaw is None else float(via.yaw), attempt))
+            t, tf = t + via.share * tf, end - (t + via.share * tf)  # (its end: t + tf, as without a via)
         segments.append(Segment(t, tf, move.beta))
         plans.append(PlanSegment(k, phase, kind, index, offset, yaw, attempt))
-        return t + tf
+        return end
 
     t = start
     retries = replan.retries
@@ -141,10 +175,10 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, sta
     return segments, plans, attempts, t
 
 
-def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
+def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPlan:
     """The plan of the ``pick`` block (``check_tasks`` first for one-line errors), with the
     retries and lift delays a run decided (``replans``: one ``Replan`` per task, none: the plan
-    before the run)."""
+    before the run) and the ways around the base (``vias``: ``Via``, ``route.routed_plan``)."""
     names = [p.name for p in pick.parts]
     segments, plans, commands, closes, grasps, widths, attempts = [], [], [], [], [], [], []
     t = 0.0
@@ -157,7 +191,7 @@ def pick_plan(pick: PickConfig, replans: tuple = ()) -> PickPlan:
         width = grasp_width(pick.parts[part])
         opening = width + task.margin
         first_close, hold = _closed_on_nothing(pick, task, start)
-        segs, plan, tries, t = _task_segments(k, task, part, float(slot_yaw), start, replan, hold)
+        segs, plan, tries, t = _task_segments(k, task, part, float(slot_yaw), start, replan, hold, vias)
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):

@@ -49,6 +49,7 @@ from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pic
                                          pick_simulator, segment_aims)
 from ptint_drake.reachability import inverse_kinematics
 from ptint_drake.systems.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST
+from ptint_drake.worlds.pick.route import routed_plan
 from ptint_drake.worlds.pick.tasks import Replan, check_tasks, pick_plan
 
 GRASP_WAIT = 0.05  # s, the lift's wait for ``holding`` while the fingers are still closing
@@ -302,7 +303,7 @@ class PickWorld(World):
             raise ScenarioError(f"duration: {s.duration:g} s ends before the pick tasks do ({end:.3g} s)")
 
     def schedule(self, scenario: Scenario):
-        return pick_plan(scenario.pick).schedule
+        return routed_plan(scenario).schedule  # with its vias (route), as the run's
 
     def prepare(self, scenario: Scenario, log: bool = True) -> PickRun:
         return PickRun(scenario)
