@@ -67,13 +67,14 @@ def collision_bodies(names: list, t: np.ndarray, flags: np.ndarray, window: tupl
 
 def pick_collisions(built, logs: dict, k: int) -> list:
     """``collision_bodies`` of task k of a built pick run (``run.PickBuilt``) from its ``logs``
-    (``"collisions"``: the station's port logged): its window runs from its approach's start (0
-    for the first task) to the next task's approach (the run's end for the last)."""
+    (``"collisions"``: the station's port logged): its window runs from its first approach's
+    start (0 for the first task) to the next task's first approach (the run's end for the last):
+    a retry's segments are the task's own."""
     if "collisions" not in logs:
         return []
     t, flags = logs["collisions"]
     plan = built.plan
-    starts = [plan.schedule.segments[plan.segment_index(j, "approach")].start
+    starts = [plan.schedule.segments[plan.segment_index(j, "approach", attempt=0)].start
               for j in range(len(plan.close_times))]
     window = (0.0 if k == 0 else starts[k], starts[k + 1] if k + 1 < len(starts) else np.inf)
     own = built.station.config.parts[plan.segments[plan.segment_index(k, "approach")].index].name
