@@ -98,7 +98,7 @@ def test_a_robust_sample_of_an_rgbd_pick_draws_a_new_placement():
 def test_robust_draws_an_rgbd_picks_camera_errors_and_placement_from_its_preset(preset, xyz, rpy):
     """The camera's calibration error and depth-noise scale come from the ``--ranges`` preset;
     every part is placed at any yaw and within ±15 mm across its belt (issue 34), whatever the
-    scenario's own narrower range (assembly_pick_place_rgbd: ±4 mm)."""
+    scenario's own range."""
     from ptint_drake.scenario import scenario_text
     from ptint_drake.studies import robust
     from ptint_drake.worlds.pick.placement import placed_parts
@@ -132,3 +132,25 @@ def test_a_narrow_belt_clips_the_robust_lateral_range_to_its_half_width():
     scenario, _ = robust.sample_scenario(text, name, 3, ranges)
     half = scenario.pick.belts[0].width / 2
     assert scenario.pick.parts[0].lateral == [-half, half]
+
+
+def test_a_part_that_can_reach_onto_the_next_belt_is_warned_about_before_the_run():
+    """40 mm belts 50 mm apart (assembly_pick_place's) with parts ±15 mm across at any yaw: a
+    30 mm cube reaches 36.2 mm from its centre line, over the 10 mm gap onto the next belt; the
+    bundled camera scenario's 80 mm belts 90 mm apart keep it on its own."""
+    from ptint_drake.config.pick import BeltConfig, PickConfig
+    from ptint_drake.worlds.pick.placement import bridging_warnings
+
+    assert bridging_warnings(load_scenario("assembly_pick_place_rgbd").pick) == []
+    belts = [BeltConfig(name="a", center=[0.30, 0.0, 0.1], width=0.04),
+             BeltConfig(name="b", center=[0.25, 0.0, 0.1], width=0.04)]
+    cube = PartConfig(belt="a", yaw_deg="random", lateral=[-0.015, 0.015])
+    (line,) = bridging_warnings(PickConfig(belts=belts, parts=[cube]))
+    assert line.startswith("pick.parts[0] (part)") and "36.2 mm" in line and "onto b" in line
+    assert "its edge 30.0 mm" in line
+    # at yaw 0 a cube 4 mm toward b reaches 19 mm: clear of it (30 mm); 15 mm away from b: clear
+    assert bridging_warnings(PickConfig(belts=belts, parts=[PartConfig(belt="a", lateral=0.004)])) == []
+    away = PartConfig(belt="a", lateral=-0.015, yaw_deg=45.0)
+    assert bridging_warnings(PickConfig(belts=belts, parts=[away])) == []
+    lower = [belts[0], BeltConfig(name="b", center=[0.25, 0.0, 0.0], width=0.04)]
+    assert bridging_warnings(PickConfig(belts=lower, parts=[cube])) == []  # 100 mm below: not a bridge

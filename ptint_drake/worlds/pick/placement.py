@@ -11,6 +11,8 @@ the targets and the controller never read these draws: they see the parts throug
 range's middle, no jitter, yaw 0 when random): where a pick aims before its part is seen.
 
 Without a camera nothing could find such a part: ``check_placement`` rejects it (one line).
+``bridging_warnings`` warns before the run when a part's placement lets it reach onto another
+belt (it would ride both: dragged, turned and tilted by the one it was not put on).
 """
 
 from __future__ import annotations
@@ -83,3 +85,54 @@ def nominal_parts(parts: list) -> list[PartConfig]:
     """The parts as the configuration alone places them (``nominal_pose``)."""
     return [dataclasses.replace(p, yaw_deg=nominal_yaw_deg(p), lateral=nominal_lateral(p), offset_jitter=0.0)
             for p in parts]
+
+
+def _across_reach(part: PartConfig, v: np.ndarray) -> float:
+    """m: how far the part's footprint reaches from its centre along the horizontal unit ``v``
+    (any yaw when random: a box's half diagonal; a cylinder's radius)."""
+    if part.shape != "box":
+        return 0.5 * float(part.size[0])
+    if isinstance(part.yaw_deg, str):
+        return 0.5 * math.hypot(float(part.size[0]), float(part.size[1]))
+    yaw = math.radians(float(part.yaw_deg))
+    x, y = np.array([math.cos(yaw), math.sin(yaw)]), np.array([-math.sin(yaw), math.cos(yaw)])
+    return 0.5 * (float(part.size[0]) * abs(x @ v[:2]) + float(part.size[1]) * abs(y @ v[:2]))
+
+
+def bridging_warnings(pick) -> list[str]:
+    """One line per part whose placement (its lateral range, its yaw — any when random) lets its
+    footprint reach over a parallel neighbouring belt at its own belt's height (within the part's
+    height): it would rest on two belts.  Belts at an angle to the part's are not checked."""
+    belts = {b.name: b for b in pick.belts}
+    out = []
+    for k, part in enumerate(pick.parts):
+        own = belts.get(part.belt)
+        if own is None:
+            continue
+        u = np.asarray(own.direction, float)
+        v = np.array([-u[1], u[0], 0.0])  # left of the travel (``lateral`` +)
+        lateral = part.lateral if isinstance(part.lateral, list) else [part.lateral, part.lateral]
+        reach = _across_reach(part, v)
+        low, high = float(lateral[0]) - reach, float(lateral[1]) + reach
+        height = float(part.size[2] if part.shape == "box" else part.size[1])
+        for other in pick.belts:
+            d = np.asarray(other.direction, float)
+            if other.name == own.name or abs(abs(d @ u) - 1.0) > 1e-6:
+                continue
+            offset = np.asarray(other.center, float) - np.asarray(own.center, float)
+            if abs(offset[2]) >= height:
+                continue
+            centre = float(offset @ v)
+            near, far = centre - 0.5 * other.width, centre + 0.5 * other.width
+            if high > near and low < far:
+                edge = near if centre > 0 else far
+                out.append(f"pick.parts[{k}] ({part.name}): placed {_mm(lateral)} across {own.name}, it "
+                           f"reaches {1000 * (high if centre > 0 else -low):.1f} mm to that side and onto "
+                           f"{other.name} (its edge {1000 * abs(edge):.1f} mm from {own.name}'s centre "
+                           f"line): it would ride both belts")
+    return out
+
+
+def _mm(lateral: list) -> str:
+    a, b = (1000 * float(v) for v in lateral)
+    return f"{a:g} mm" if a == b else f"{a:g}…{b:g} mm"

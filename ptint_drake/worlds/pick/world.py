@@ -44,7 +44,7 @@ from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
-from ptint_drake.worlds.pick.placement import check_placement
+from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
                                          pick_simulator, segment_aims)
 from ptint_drake.reachability import inverse_kinematics
@@ -83,7 +83,8 @@ class PickRun(WorldRun):
     def pre_run_warnings(self) -> list[str]:
         check_pick_reachable(self.scenario, self.built)
         check_pick_clearance(self.scenario, self.built)  # the fingers clear of the belts
-        return sampled_control_warnings(self.scenario) + arm_warnings(self.scenario, self.built)
+        return (sampled_control_warnings(self.scenario) + arm_warnings(self.scenario, self.built)
+                + bridging_warnings(self.scenario.pick))
 
     def initialize(self, context) -> None:
         station = self.built.station
