@@ -1,15 +1,19 @@
 """Part poses fitted to a point cloud in the world frame, from configured geometry only.
 
-``fit_parts(points, belts, shape, size)`` does, per configured belt (``BeltRegion``: a
+``fit_parts(points, belts, shape, size)`` does, over the configured belts (``BeltRegion``: a
 horizontal rectangle, the conveyor's top surface):
 
-1. background removal: keep the points above the belt's rectangle (a part may overhang its ends
-   by half its diagonal; across, the belt's width must hold the part) whose height over the belt
-   plane is in (``BELT_BAND``, part height + ``TOP_BAND``] — the belt itself, anything beside
-   it and anything well above a part are dropped;
-2. clustering: points closer than ``CLUSTER_RADIUS`` are connected (scipy ``cKDTree`` pairs,
+1. background removal: keep the points above a belt's rectangle widened by the part's
+   half-diagonal (of its top face) along and across — a part whose centre is on its belt may
+   overhang the belt's ends and edges by that much, and its top face must stay whole — whose
+   height over that belt's plane is in (``BELT_BAND``, part height + ``TOP_BAND``]: the belt
+   itself, anything beside it and anything well above a part are dropped;
+2. clustering, over all belts' points at once (a point in two belts' bands is one point):
+   points closer than ``CLUSTER_RADIUS`` are connected (scipy ``cKDTree`` pairs,
    ``connected_components``); a cluster whose top face is k ≥ 2 parts' area (parts touching) is
-   split by k-means on its top-face points (scipy ``kmeans2``, fixed seed);
+   split by k-means on its top-face points (scipy ``kmeans2``, fixed seed); each part is then
+   on the belt whose centre line passes nearest its fitted centre (the belt under its centre:
+   a part overhanging into a neighbour belt's band is fitted once, on its own belt);
 3. the fit to the known shape, from the top face (points within ``TOP_BAND`` of the highest):
    a box — the minimum-area rectangle around the top face's convex hull (scipy ``ConvexHull``;
    rotating calipers over its edges) gives the centre (x, y) and the yaw, folded by the box's
@@ -97,15 +101,38 @@ def _top_sides(shape: str, size) -> tuple[float, float]:
     return (float(size[0]), float(size[1])) if shape == "box" else (float(size[0]), float(size[0]))
 
 
-def belt_points(points: np.ndarray, belt: BeltRegion, shape: str, size) -> np.ndarray:
-    """The points (N×3) above ``belt``'s rectangle in its part band (step 1)."""
+def reach(shape: str, size) -> float:
+    """m: half the diagonal of the part's top face (of the square around a cylinder's): how far a
+    part whose centre is on a belt may overhang its edges."""
+    return 0.5 * math.hypot(*_top_sides(shape, size))
+
+
+def in_band(points: np.ndarray, belt: BeltRegion, shape: str, size) -> np.ndarray:
+    """Per point (N×3): above ``belt``'s rectangle widened by ``reach`` and in its part band (step 1)."""
     u, v = belt.frame()
     d = points - belt.center
     along, across, up = d @ u, d @ v, d[:, 2]
-    reach = 0.5 * math.hypot(*_top_sides(shape, size))
-    keep = ((np.abs(along) <= 0.5 * belt.length + reach) & (np.abs(across) <= 0.5 * belt.width)
+    r = reach(shape, size)
+    return ((np.abs(along) <= 0.5 * belt.length + r) & (np.abs(across) <= 0.5 * belt.width + r)
             & (up > BELT_BAND) & (up <= part_height(shape, size) + TOP_BAND))
+
+
+def belt_points(points: np.ndarray, belts: list[BeltRegion], shape: str, size) -> np.ndarray:
+    """The points (N×3) in any of ``belts``' part bands (step 1), each once."""
+    keep = np.zeros(len(points), dtype=bool)
+    for belt in belts:
+        keep |= in_band(points, belt, shape, size)
     return points[keep]
+
+
+def nearest_belt(xy: np.ndarray, belts: list[BeltRegion]) -> int:
+    """The belt whose centre line (a segment: the belt's length) passes nearest the point ``xy``."""
+    distances = []
+    for belt in belts:
+        u, v = belt.frame()
+        d = np.array([xy[0] - belt.center[0], xy[1] - belt.center[1], 0.0])
+        distances.append(math.hypot(d @ v, max(abs(d @ u) - 0.5 * belt.length, 0.0)))
+    return int(np.argmin(distances))
 
 
 def clusters(points: np.ndarray) -> list[np.ndarray]:
@@ -260,11 +287,14 @@ def fit_parts(points: np.ndarray, belts: list[BeltRegion], shape: str, size, *,
     """Every part seen on ``belts`` (see the module docstring); failed fits included (``ok``
     False, with their ``reason``) so a caller can name why a part was not seen."""
     fits = []
-    for i, belt in enumerate(belts):
-        for cluster in clusters(belt_points(points, belt, shape, size)):
-            if len(cluster) < min_points // 2:
-                continue  # specks: noise, an edge of something
-            for part in _split(cluster, shape, size):
-                fits.append(fit_part(part, i, shape, size, min_points=min_points, footprint=footprint,
-                                     spacing=spacing))
+    if not belts:
+        return fits
+    for cluster in clusters(belt_points(points, belts, shape, size)):
+        if len(cluster) < min_points // 2:
+            continue  # specks: noise, an edge of something
+        for part in _split(cluster, shape, size):
+            fit = fit_part(part, 0, shape, size, min_points=min_points, footprint=footprint, spacing=spacing)
+            # the belt under its centre (a failed fit: under its top face's middle)
+            fit.belt = nearest_belt(fit.position if fit.ok else _top_face(part).mean(axis=0), belts)
+            fits.append(fit)
     return fits

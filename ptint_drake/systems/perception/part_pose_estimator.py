@@ -142,8 +142,7 @@ class PartPoseEstimator(LeafSystem):
             z = xyz[2]
             boxed = xyz[:, np.flatnonzero((z >= self._lo[2]) & (z <= self._hi[2]))].T
             boxed = boxed[np.all((boxed >= self._lo) & (boxed <= self._hi), axis=1)]
-        bands = [belt_points(boxed, b, self._c.shape, self._c.size) for b in self._c.belts]
-        points = np.concatenate(bands) if bands else np.zeros((0, 3))
+        points = belt_points(boxed, self._c.belts, self._c.shape, self._c.size)
         if len(points) == 0:
             return points
         kept = PointCloud(len(points))
