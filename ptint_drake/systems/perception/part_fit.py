@@ -160,25 +160,24 @@ def _hull(xy: np.ndarray) -> np.ndarray | None:
 
 def min_area_rectangle(xy: np.ndarray) -> tuple[np.ndarray, float, float, float] | None:
     """(centre, yaw of side a, side a, side b) of the smallest rectangle around ``xy``
-    (rotating calipers: one side lies on a convex-hull edge)."""
+    (rotating calipers: one side lies on a convex-hull edge; all edges at once)."""
     hull = _hull(xy)
     if hull is None:
         return None
-    best = None
-    for p, q in zip(hull, np.roll(hull, -1, axis=0)):
-        edge = q - p
-        if not np.any(edge):
-            continue
-        angle = math.atan2(edge[1], edge[0])
-        c, s = math.cos(angle), math.sin(angle)
-        local = hull @ np.array([[c, -s], [s, c]])  # coordinates along (a, b)
-        lo, hi = local.min(axis=0), local.max(axis=0)
-        area = float(np.prod(hi - lo))
-        if best is None or area < best[0]:
-            mid = 0.5 * (lo + hi)
-            centre = np.array([c * mid[0] - s * mid[1], s * mid[0] + c * mid[1]])
-            best = (area, centre, angle, *(hi - lo))
-    return None if best is None else best[1:]
+    edges = np.roll(hull, -1, axis=0) - hull
+    edges = edges[np.any(edges != 0.0, axis=1)]
+    if len(edges) == 0:
+        return None
+    angles = np.arctan2(edges[:, 1], edges[:, 0])
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    a = c * hull[:, 0] + s * hull[:, 1]  # per edge (rows), the hull's coordinates along (a, b)
+    b = c * hull[:, 1] - s * hull[:, 0]
+    lo_a, hi_a, lo_b, hi_b = a.min(axis=1), a.max(axis=1), b.min(axis=1), b.max(axis=1)
+    k = int(np.argmin((hi_a - lo_a) * (hi_b - lo_b)))  # (the first of equal areas)
+    mid_a, mid_b = 0.5 * (lo_a[k] + hi_a[k]), 0.5 * (lo_b[k] + hi_b[k])
+    ck, sk = float(c[k, 0]), float(s[k, 0])
+    centre = np.array([ck * mid_a - sk * mid_b, sk * mid_a + ck * mid_b])
+    return centre, float(angles[k]), float(hi_a[k] - lo_a[k]), float(hi_b[k] - lo_b[k])
 
 
 def _circle(xy: np.ndarray) -> tuple[np.ndarray, float] | None:
