@@ -143,7 +143,8 @@ def clusters(points: np.ndarray) -> list[np.ndarray]:
     n = len(points)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
     count, labels = connected_components(graph, directed=False)
-    groups = [points[labels == k] for k in range(count)]
+    order = np.argsort(labels, kind="stable")  # (each group's points in their order)
+    groups = np.split(points[order], np.cumsum(np.bincount(labels, minlength=count))[:-1])
     return sorted(groups, key=len, reverse=True)
 
 
