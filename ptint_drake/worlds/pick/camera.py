@@ -26,7 +26,9 @@ The world reads ``seen`` at each descend's start: a part never seen is not grasp
 
 The perceived belts: ``measurement.camera.belts`` when given; otherwise each pick belt's top
 surface (its centre at t = 0, its direction and length) ``BELT_MARGIN`` wider on each side than
-the belt (a 30 mm cube turned 45° overhangs a 40 mm belt by 1.2 mm each side).
+the belt.  The perception's background removal keeps a further half-diagonal of the part on each
+side (``part_fit.in_band``: a 30 mm cube 13 mm off a 40 mm belt's centre line overhangs its edge
+by up to 14 mm) and gives each part to the belt whose centre line is nearest its fitted centre.
 """
 
 from __future__ import annotations
