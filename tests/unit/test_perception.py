@@ -28,7 +28,7 @@ TILT = math.radians(30.0)  # from vertical, 0.5 m from the belt
 def camera(noise: float = 0.0, **kw) -> RgbdCameraConfig:
     return RgbdCameraConfig(look_at=[0.3, 0.0, 0.1], look_from=[0.3 - 0.5 * math.sin(TILT), 0.0,
                                                                   0.1 + 0.5 * math.cos(TILT)],
-                            belts=[BELT], depth_noise_scale=noise, **kw)
+                            depth_noise_scale=noise, **({"belts": [BELT]} | kw))
 
 
 def good(fits):
@@ -206,3 +206,22 @@ def test_depth_noise_grows_with_depth_squared_and_drops_grazing_pixels():
     noisy = noisy_depth(grazing, info, np.random.default_rng(2))
     assert 0.5 < np.mean(noisy[2:22, 20:-20] == 0.0) < 0.95
     assert np.array_equal(noisy_depth(flat, info, np.random.default_rng(1), scale=0.0), flat)
+
+
+@pytest.mark.parametrize("yaw_deg", [0.0, 20.0, 45.0])
+def test_parts_overhanging_their_belts_toward_each_other_are_fitted_once_on_their_own_belts(yaw_deg):
+    """30 mm cubes 13 mm off the centre lines of two 40 mm belts 50 mm apart, toward each other: at
+    45° their corners are 34 mm from their lines, 14 mm over their belts' edges and into the
+    other belt's band.  The crop keeps each belt's band widened by the part's half-diagonal, so
+    the top faces stay whole (cut at the belt's edge, the cube at 0° was 22 mm wide: not seen);
+    each part is fitted once, on the belt under its centre."""
+    a = BeltRegionConfig(center=[0.3, 0.0, 0.1], direction=[0.0, 1.0, 0.0], length=0.4, width=0.04)
+    b = BeltRegionConfig(center=[0.35, 0.0, 0.1], direction=[0.0, 1.0, 0.0], length=0.4, width=0.04)
+    parts = [(np.array([0.313, 0.0, 0.115]), math.radians(yaw_deg)),  # on a, 13 mm toward b
+             (np.array([0.337, 0.06, 0.115]), math.radians(yaw_deg + 10.0))]  # on b, 13 mm toward a
+    fits = StaticScene(camera(belts=[a, b]), parts, object_belts=[0, 1]).fits(0.0)[0]
+    assert len(fits) == 2 and all(f.ok for f in fits), [(f.belt, f.reason) for f in fits]
+    for belt, (centre, yaw) in enumerate(parts):
+        (fit,) = [f for f in fits if f.belt == belt]
+        assert np.linalg.norm(fit.position - centre) < 1e-3
+        assert yaw_error_deg(fit.yaw, yaw, fit.symmetry) < 1.0

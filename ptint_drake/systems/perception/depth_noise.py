@@ -22,6 +22,10 @@ k and the seed: ``numpy.random.default_rng([seed, k])``):
   minimum depth"), closer pixels are missing.
 
 Missing pixels are 0 (Drake's "too close" value), which ``DepthImageToPointCloud`` drops (NaN).
+The per-pixel arithmetic is one compiled pass (``_noisy_pixels``: numba, float32, the operations
+and their order of the array form it replaced, so the image is the same to the last bit on the
+frames of tests/unit/test_perception.py); the random draws stay numpy's (``default_rng([seed,
+k])``: the same stream).  ≈ 11 ms → ≈ 2.5 ms a 424 × 240 frame (measured, issue 34).
 Not modelled: the IR projector's pattern, temporal correlation, the sensor's own resolution
 and filtering, rolling shutter, multipath on shiny parts.
 """
@@ -31,6 +35,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 from pydrake.systems.sensors import CameraInfo, ImageDepth32F
@@ -61,44 +66,72 @@ def _rays(info: CameraInfo) -> tuple[np.ndarray, np.ndarray]:
     return np.broadcast_to(u, shape), np.broadcast_to(v[:, None], shape)
 
 
+_DEGREES = np.float32(180.0) / np.float32(np.pi)  # numpy's float32 degrees factor
+
+
+@njit(cache=True, error_model="numpy")  # (0 / 0: NaN, as numpy)
+def _noisy_pixels(z, rx, ry, draw, normal, sigma_per_z2, cos_from2, cos_to2, grazing_from, grazing_span,
+                  edge_jump, edge_missing, min_z, out):  # pragma: no cover  (compiled)
+    """``noisy_depth``'s arithmetic per pixel (float32 throughout, the array form's order):
+    ``z`` (H × W, raw), ``rx`` (W), ``ry`` (H): the rays' x / z and y / z; ``draw`` (2 × H × W)
+    and ``normal`` (H × W): the frame's draws; result in ``out``."""
+    h, w = z.shape
+    zero = np.float32(0.0)
+    zz = np.empty((h, w), np.float32)
+    for i in range(h):
+        for j in range(w):
+            v = z[i, j]
+            zz[i, j] = v if (np.isfinite(v) and v > zero) else zero
+    for i in range(h):
+        for j in range(w):
+            d = zz[i, j]
+            grazing_p = zero
+            if 0 < i < h - 1 and 0 < j < w - 1:  # (the border has no central difference: no normal)
+                x, y = rx[j] * d, ry[i] * d
+                dux = rx[j + 1] * zz[i, j + 1] - rx[j - 1] * zz[i, j - 1]
+                duy = ry[i] * zz[i, j + 1] - ry[i] * zz[i, j - 1]
+                duz = zz[i, j + 1] - zz[i, j - 1]
+                dvx = rx[j] * zz[i + 1, j] - rx[j] * zz[i - 1, j]
+                dvy = ry[i + 1] * zz[i + 1, j] - ry[i - 1] * zz[i - 1, j]
+                dvz = zz[i + 1, j] - zz[i - 1, j]
+                nx, ny, nz = duy * dvz - duz * dvy, duz * dvx - dux * dvz, dux * dvy - duy * dvx
+                dot = nx * x + ny * y + nz * d
+                cos2 = dot * dot / ((nx * nx + ny * ny + nz * nz) * (x * x + y * y + d * d))
+                if cos2 < cos_from2:  # (NaN: not grazing)
+                    c = min(max(cos2, cos_to2), cos_from2)
+                    angle = np.float32(np.arccos(np.sqrt(c))) * _DEGREES
+                    grazing_p = (angle - grazing_from) / grazing_span
+            jump = ((j > 0 and abs(d - zz[i, j - 1]) > edge_jump)
+                    or (j < w - 1 and abs(zz[i, j + 1] - d) > edge_jump)
+                    or (i > 0 and abs(d - zz[i - 1, j]) > edge_jump)
+                    or (i < h - 1 and abs(zz[i + 1, j] - d) > edge_jump))
+            missing = (draw[0, i, j] < grazing_p) or (jump and draw[1, i, j] < edge_missing) or d < min_z
+            v = z[i, j]
+            if not (np.isfinite(v) and v > zero):
+                out[i, j] = v
+            elif missing:
+                out[i, j] = zero
+            else:
+                out[i, j] = d + normal[i, j] * sigma_per_z2 * d * d
+
+
 def noisy_depth(depth: np.ndarray, info: CameraInfo, rng: np.random.Generator, scale: float = 1.0,
                 rays: tuple | None = None) -> np.ndarray:
     """``depth`` (H × W, m; inf or 0 where nothing) with the errors of the module docstring.
     ``scale`` multiplies the noise (0: the image is returned unchanged)."""
-    z = np.asarray(depth, dtype=np.float32)
+    z = np.ascontiguousarray(depth, dtype=np.float32)
     if scale <= 0.0:
         return z.copy()
-    valid = np.isfinite(z) & (z > 0.0)
-    zz = np.where(valid, z, np.float32(0.0))
     rx, ry = rays if rays is not None else _rays(info)
-    x, y = rx * zz, ry * zz
-    # tangents from the neighbours (central differences), normal = du × dv
-    dux, duy, duz = (np.zeros_like(zz) for _ in range(3))
-    dvx, dvy, dvz = (np.zeros_like(zz) for _ in range(3))
-    dux[:, 1:-1], duy[:, 1:-1] = x[:, 2:] - x[:, :-2], y[:, 2:] - y[:, :-2]
-    duz[:, 1:-1] = zz[:, 2:] - zz[:, :-2]
-    dvx[1:-1], dvy[1:-1], dvz[1:-1] = x[2:] - x[:-2], y[2:] - y[:-2], zz[2:] - zz[:-2]
-    nx, ny, nz = duy * dvz - duz * dvy, duz * dvx - dux * dvz, dux * dvy - duy * dvx
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cos2 = (nx * x + ny * y + nz * zz) ** 2 / ((nx * nx + ny * ny + nz * nz) * (x * x + y * y + zz * zz))
+    draw = rng.random((2, *z.shape), dtype=np.float32)
+    normal = rng.standard_normal(z.shape, dtype=np.float32)
     cos_from, cos_to = math.cos(math.radians(GRAZING_FROM_DEG)), math.cos(math.radians(GRAZING_TO_DEG))
-    # probability linear in the angle between the two limits (computed where it is not 0)
-    grazing = np.flatnonzero(cos2 < cos_from ** 2)  # NaN (no neighbours): not grazing
-    p_grazing = np.zeros(zz.shape, dtype=np.float32)
-    angle = np.degrees(np.arccos(np.sqrt(np.clip(cos2.flat[grazing], cos_to ** 2, cos_from ** 2))))
-    p_grazing.flat[grazing] = (angle - GRAZING_FROM_DEG) / (GRAZING_TO_DEG - GRAZING_FROM_DEG)
-    jump = np.zeros(zz.shape, dtype=bool)
-    dz_u = np.abs(np.diff(zz, axis=1)) > EDGE_JUMP
-    dz_v = np.abs(np.diff(zz, axis=0)) > EDGE_JUMP
-    jump[:, 1:] |= dz_u
-    jump[:, :-1] |= dz_u
-    jump[1:, :] |= dz_v
-    jump[:-1, :] |= dz_v
-    draw = rng.random((2, *zz.shape), dtype=np.float32)
-    missing = (draw[0] < p_grazing) | (jump & (draw[1] < EDGE_MISSING)) | (zz < D415_MIN_Z)
-    noisy = zz + rng.standard_normal(zz.shape, dtype=np.float32) * np.float32(scale * NOISE_PER_Z2) * zz * zz
-    out = np.where(valid, noisy, z)
-    out[valid & missing] = 0.0
+    f32 = np.float32
+    out = np.empty_like(z)
+    _noisy_pixels(z, np.ascontiguousarray(rx[0]), np.ascontiguousarray(ry[:, 0]), draw, normal,
+                  f32(scale * NOISE_PER_Z2), f32(cos_from ** 2), f32(cos_to ** 2), f32(GRAZING_FROM_DEG),
+                  f32(GRAZING_TO_DEG - GRAZING_FROM_DEG), f32(EDGE_JUMP), f32(EDGE_MISSING), f32(D415_MIN_Z),
+                  out)
     return out
 
 
@@ -111,6 +144,8 @@ class DepthNoise(LeafSystem):
         super().__init__()
         self._info, self._rate, self._seed, self._scale = info, float(rate_hz), int(seed), float(scale)
         self._rays = _rays(info)
+        # the compiled pass loaded (or compiled: once per machine) while the diagram is built
+        noisy_depth(np.ones((3, 3), np.float32), CameraInfo(3, 3, 1.0), np.random.default_rng(0))
         blank = AbstractValue.Make(ImageDepth32F(info.width(), info.height()))
         self._in = self.DeclareAbstractInputPort("depth_image", blank)
         self._out = self.DeclareAbstractOutputPort(

@@ -1,15 +1,19 @@
 """Part poses fitted to a point cloud in the world frame, from configured geometry only.
 
-``fit_parts(points, belts, shape, size)`` does, per configured belt (``BeltRegion``: a
+``fit_parts(points, belts, shape, size)`` does, over the configured belts (``BeltRegion``: a
 horizontal rectangle, the conveyor's top surface):
 
-1. background removal: keep the points above the belt's rectangle (a part may overhang its ends
-   by half its diagonal; across, the belt's width must hold the part) whose height over the belt
-   plane is in (``BELT_BAND``, part height + ``TOP_BAND``] — the belt itself, anything beside
-   it and anything well above a part are dropped;
-2. clustering: points closer than ``CLUSTER_RADIUS`` are connected (scipy ``cKDTree`` pairs,
+1. background removal: keep the points above a belt's rectangle widened by the part's
+   half-diagonal (of its top face) along and across — a part whose centre is on its belt may
+   overhang the belt's ends and edges by that much, and its top face must stay whole — whose
+   height over that belt's plane is in (``BELT_BAND``, part height + ``TOP_BAND``]: the belt
+   itself, anything beside it and anything well above a part are dropped;
+2. clustering, over all belts' points at once (a point in two belts' bands is one point):
+   points closer than ``CLUSTER_RADIUS`` are connected (scipy ``cKDTree`` pairs,
    ``connected_components``); a cluster whose top face is k ≥ 2 parts' area (parts touching) is
-   split by k-means on its top-face points (scipy ``kmeans2``, fixed seed);
+   split by k-means on its top-face points (scipy ``kmeans2``, fixed seed); each part is then
+   on the belt whose centre line passes nearest its fitted centre (the belt under its centre:
+   a part overhanging into a neighbour belt's band is fitted once, on its own belt);
 3. the fit to the known shape, from the top face (points within ``TOP_BAND`` of the highest):
    a box — the minimum-area rectangle around the top face's convex hull (scipy ``ConvexHull``;
    rotating calipers over its edges) gives the centre (x, y) and the yaw, folded by the box's
@@ -97,15 +101,38 @@ def _top_sides(shape: str, size) -> tuple[float, float]:
     return (float(size[0]), float(size[1])) if shape == "box" else (float(size[0]), float(size[0]))
 
 
-def belt_points(points: np.ndarray, belt: BeltRegion, shape: str, size) -> np.ndarray:
-    """The points (N×3) above ``belt``'s rectangle in its part band (step 1)."""
+def reach(shape: str, size) -> float:
+    """m: half the diagonal of the part's top face (of the square around a cylinder's): how far a
+    part whose centre is on a belt may overhang its edges."""
+    return 0.5 * math.hypot(*_top_sides(shape, size))
+
+
+def in_band(points: np.ndarray, belt: BeltRegion, shape: str, size) -> np.ndarray:
+    """Per point (N×3): above ``belt``'s rectangle widened by ``reach`` and in its part band (step 1)."""
     u, v = belt.frame()
     d = points - belt.center
     along, across, up = d @ u, d @ v, d[:, 2]
-    reach = 0.5 * math.hypot(*_top_sides(shape, size))
-    keep = ((np.abs(along) <= 0.5 * belt.length + reach) & (np.abs(across) <= 0.5 * belt.width)
+    r = reach(shape, size)
+    return ((np.abs(along) <= 0.5 * belt.length + r) & (np.abs(across) <= 0.5 * belt.width + r)
             & (up > BELT_BAND) & (up <= part_height(shape, size) + TOP_BAND))
+
+
+def belt_points(points: np.ndarray, belts: list[BeltRegion], shape: str, size) -> np.ndarray:
+    """The points (N×3) in any of ``belts``' part bands (step 1), each once."""
+    keep = np.zeros(len(points), dtype=bool)
+    for belt in belts:
+        keep |= in_band(points, belt, shape, size)
     return points[keep]
+
+
+def nearest_belt(xy: np.ndarray, belts: list[BeltRegion]) -> int:
+    """The belt whose centre line (a segment: the belt's length) passes nearest the point ``xy``."""
+    distances = []
+    for belt in belts:
+        u, v = belt.frame()
+        d = np.array([xy[0] - belt.center[0], xy[1] - belt.center[1], 0.0])
+        distances.append(math.hypot(d @ v, max(abs(d @ u) - 0.5 * belt.length, 0.0)))
+    return int(np.argmin(distances))
 
 
 def clusters(points: np.ndarray) -> list[np.ndarray]:
@@ -116,7 +143,8 @@ def clusters(points: np.ndarray) -> list[np.ndarray]:
     n = len(points)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
     count, labels = connected_components(graph, directed=False)
-    groups = [points[labels == k] for k in range(count)]
+    order = np.argsort(labels, kind="stable")  # (each group's points in their order)
+    groups = np.split(points[order], np.cumsum(np.bincount(labels, minlength=count))[:-1])
     return sorted(groups, key=len, reverse=True)
 
 
@@ -133,25 +161,24 @@ def _hull(xy: np.ndarray) -> np.ndarray | None:
 
 def min_area_rectangle(xy: np.ndarray) -> tuple[np.ndarray, float, float, float] | None:
     """(centre, yaw of side a, side a, side b) of the smallest rectangle around ``xy``
-    (rotating calipers: one side lies on a convex-hull edge)."""
+    (rotating calipers: one side lies on a convex-hull edge; all edges at once)."""
     hull = _hull(xy)
     if hull is None:
         return None
-    best = None
-    for p, q in zip(hull, np.roll(hull, -1, axis=0)):
-        edge = q - p
-        if not np.any(edge):
-            continue
-        angle = math.atan2(edge[1], edge[0])
-        c, s = math.cos(angle), math.sin(angle)
-        local = hull @ np.array([[c, -s], [s, c]])  # coordinates along (a, b)
-        lo, hi = local.min(axis=0), local.max(axis=0)
-        area = float(np.prod(hi - lo))
-        if best is None or area < best[0]:
-            mid = 0.5 * (lo + hi)
-            centre = np.array([c * mid[0] - s * mid[1], s * mid[0] + c * mid[1]])
-            best = (area, centre, angle, *(hi - lo))
-    return None if best is None else best[1:]
+    edges = np.roll(hull, -1, axis=0) - hull
+    edges = edges[np.any(edges != 0.0, axis=1)]
+    if len(edges) == 0:
+        return None
+    angles = np.arctan2(edges[:, 1], edges[:, 0])
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    a = c * hull[:, 0] + s * hull[:, 1]  # per edge (rows), the hull's coordinates along (a, b)
+    b = c * hull[:, 1] - s * hull[:, 0]
+    lo_a, hi_a, lo_b, hi_b = a.min(axis=1), a.max(axis=1), b.min(axis=1), b.max(axis=1)
+    k = int(np.argmin((hi_a - lo_a) * (hi_b - lo_b)))  # (the first of equal areas)
+    mid_a, mid_b = 0.5 * (lo_a[k] + hi_a[k]), 0.5 * (lo_b[k] + hi_b[k])
+    ck, sk = float(c[k, 0]), float(s[k, 0])
+    centre = np.array([ck * mid_a - sk * mid_b, sk * mid_a + ck * mid_b])
+    return centre, float(angles[k]), float(hi_a[k] - lo_a[k]), float(hi_b[k] - lo_b[k])
 
 
 def _circle(xy: np.ndarray) -> tuple[np.ndarray, float] | None:
@@ -260,11 +287,14 @@ def fit_parts(points: np.ndarray, belts: list[BeltRegion], shape: str, size, *,
     """Every part seen on ``belts`` (see the module docstring); failed fits included (``ok``
     False, with their ``reason``) so a caller can name why a part was not seen."""
     fits = []
-    for i, belt in enumerate(belts):
-        for cluster in clusters(belt_points(points, belt, shape, size)):
-            if len(cluster) < min_points // 2:
-                continue  # specks: noise, an edge of something
-            for part in _split(cluster, shape, size):
-                fits.append(fit_part(part, i, shape, size, min_points=min_points, footprint=footprint,
-                                     spacing=spacing))
+    if not belts:
+        return fits
+    for cluster in clusters(belt_points(points, belts, shape, size)):
+        if len(cluster) < min_points // 2:
+            continue  # specks: noise, an edge of something
+        for part in _split(cluster, shape, size):
+            fit = fit_part(part, 0, shape, size, min_points=min_points, footprint=footprint, spacing=spacing)
+            # the belt under its centre (a failed fit: under its top face's middle)
+            fit.belt = nearest_belt(fit.position if fit.ok else _top_face(part).mean(axis=0), belts)
+            fits.append(fit)
     return fits

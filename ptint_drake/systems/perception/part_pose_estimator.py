@@ -43,7 +43,8 @@ from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
-from ptint_drake.systems.perception.part_fit import BeltRegion, belt_points, fit_parts, part_height
+from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, BeltRegion, belt_points, fit_parts,
+                                                     part_height, reach)
 
 # m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
 # position error of a 30 mm cube's fit at 0.5 m is 0.2-0.7 mm (tests/unit/test_perception.py)
@@ -119,18 +120,21 @@ class PartPoseEstimator(LeafSystem):
         output.set_value(list(context.get_abstract_state(self._fits).get_value()))
 
     def _crop_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The box around the belts' part bands (``part_fit.in_band``): their rectangles widened by
+        the part's reach, from ``BELT_BAND`` above the belts (the belt surface is most of the
+        cloud there: the cheap test drops it) to the part's height + ``TOP_BAND``."""
         if not self._c.belts:
             return np.zeros(3), np.zeros(3)
         corners = []
-        reach = 0.5 * math.hypot(*np.asarray(self._c.size, float)[:2])
-        top = part_height(self._c.shape, self._c.size) + 0.01
+        r = reach(self._c.shape, self._c.size)
+        top = part_height(self._c.shape, self._c.size) + TOP_BAND
         for b in self._c.belts:
             u, v = b.frame()
             for su in (-1, 1):
                 for sv in (-1, 1):
-                    for h in (0.0, top):
-                        corners.append(np.asarray(b.center, float) + su * (0.5 * b.length + reach) * u
-                                       + sv * (0.5 * b.width + reach) * v + [0.0, 0.0, h])
+                    for h in (BELT_BAND, top):
+                        corners.append(np.asarray(b.center, float) + su * (0.5 * b.length + r) * u
+                                       + sv * (0.5 * b.width + r) * v + [0.0, 0.0, h])
         corners = np.array(corners)
         return corners.min(axis=0), corners.max(axis=0)
 
@@ -142,8 +146,7 @@ class PartPoseEstimator(LeafSystem):
             z = xyz[2]
             boxed = xyz[:, np.flatnonzero((z >= self._lo[2]) & (z <= self._hi[2]))].T
             boxed = boxed[np.all((boxed >= self._lo) & (boxed <= self._hi), axis=1)]
-        bands = [belt_points(boxed, b, self._c.shape, self._c.size) for b in self._c.belts]
-        points = np.concatenate(bands) if bands else np.zeros((0, 3))
+        points = belt_points(boxed, self._c.belts, self._c.shape, self._c.size)
         if len(points) == 0:
             return points
         kept = PointCloud(len(points))

@@ -26,7 +26,9 @@ The world reads ``seen`` at each descend's start: a part never seen is not grasp
 
 The perceived belts: ``measurement.camera.belts`` when given; otherwise each pick belt's top
 surface (its centre at t = 0, its direction and length) ``BELT_MARGIN`` wider on each side than
-the belt (a 30 mm cube turned 45° overhangs a 40 mm belt by 1.2 mm each side).
+the belt.  The perception's background removal keeps a further half-diagonal of the part on each
+side (``part_fit.in_band``: a 30 mm cube 13 mm off a 40 mm belt's centre line overhangs its edge
+by up to 14 mm) and gives each part to the belt whose centre line is nearest its fitted centre.
 """
 
 from __future__ import annotations
@@ -154,24 +156,27 @@ class EstimatedParts(LeafSystem):
             self.DeclareVectorOutputPort(f"part_{k}_rotation", 15, self._rotation_calc(k))
         self.DeclareVectorOutputPort("seen", n, self._seen_calc)
 
-    def _seen(self, context, k: int) -> bool:
-        return bool(np.any(self._estimates[k].Eval(context)[0:3] != 0.0))
+    def _estimate(self, context, k: int):
+        """Part k's position estimate, or None before its estimator has a sample (all zero)."""
+        value = self._estimates[k].Eval(context)
+        return value if value[0] != 0.0 or value[1] != 0.0 or value[2] != 0.0 else None
 
     def _pose_calc(self, k: int):
         def calc(context, output):
             p, v, _ = self._nominal[k]
-            if self._seen(context, k):  # on its belt: its height and no vertical motion are known
-                value = self._estimates[k].Eval(context).copy()
+            value = self._estimate(context, k)
+            if value is not None:  # on its belt: its height and no vertical motion are known
                 u = v / max(np.linalg.norm(v), 1e-12)
-                value[2], value[3:6], value[6:9] = p[2], (value[3:6] @ u) * u, 0.0
-                output.SetFromVector(value)
+                out = value.copy()
+                out[2], out[3:6], out[6:9] = p[2], (value[3:6] @ u) * u, 0.0
+                output.SetFromVector(out)
                 return
             output.SetFromVector(np.concatenate([p + v * context.get_time(), v, np.zeros(3)]))
         return calc
 
     def _rotation_calc(self, k: int):
         def calc(context, output):
-            if self._seen(context, k):
+            if self._estimate(context, k) is not None:
                 output.SetFromVector(self._rotations[k].Eval(context))
                 return
             value = np.zeros(15)
@@ -180,7 +185,8 @@ class EstimatedParts(LeafSystem):
         return calc
 
     def _seen_calc(self, context, output) -> None:
-        output.SetFromVector([float(self._seen(context, k)) for k in range(len(self._nominal))])
+        n = len(self._nominal)
+        output.SetFromVector([float(self._estimate(context, k) is not None) for k in range(n)])
 
 
 @dataclass
