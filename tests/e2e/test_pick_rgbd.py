@@ -29,6 +29,27 @@ def test_a_part_never_seen_is_not_grasped():
     assert result.metrics["reasons"] == ["pick 0: part not seen"]
 
 
+def test_a_part_fitted_twice_is_not_grasped(monkeypatch):
+    """Two fits give the estimate no velocity to aim with: no grasp, ``pick 0: part not seen``
+    (robust assembly_pick_place_rgbd sample 39: fitted once, grasped 107 mm behind the part)."""
+    from ptint_drake.worlds.pick.camera import MIN_FITS
+
+    real, frames = part_pose_estimator.fit_parts, []
+
+    def twice(*args, **kwargs):  # the first two frames with a good fit, then nothing
+        fits = real(*args, **kwargs)
+        if any(f.ok for f in fits):
+            frames.append(1)
+        return fits if len(frames) <= 2 else []
+
+    monkeypatch.setattr(part_pose_estimator, "fit_parts", twice)
+    result = simulate(load_scenario("conveyor_pick_place_rgbd"))
+    (pick,) = result.metrics["picks"]
+    assert MIN_FITS == 3 and len(frames) > 2
+    assert result.metrics["reasons"] == ["pick 0: part not seen"]
+    assert not pick["grasped"] and all(d["peak_grip_force_N"] == 0.0 for d in pick["attempt_details"])
+
+
 def test_a_fit_forced_wrong_makes_the_pick_fail(monkeypatch):
     real = part_pose_estimator.fit_parts
 

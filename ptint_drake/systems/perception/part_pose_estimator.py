@@ -25,7 +25,8 @@ Outputs: ``measurement_i`` (5: [stamp, x, y, z, valid]) and ``measured_rotation_
 ``rotation_estimator.AddRotationEstimators`` read — ``quality_i`` (7: [stamp, inliers, residual
 (m), the position covariance's diagonal (m²), valid]) of the same sample, and ``fits`` (list of
 ``PartFit`` of the newest processed frame, failed fits included, with their quality and
-covariance: what a pick world's part-pose source would read).
+covariance: what a pick world's part-pose source would read), and ``fit_counts`` (n: per
+object, the fits accepted so far, counted when its frame is processed).
 """
 
 from __future__ import annotations
@@ -98,7 +99,7 @@ class PartPoseEstimator(LeafSystem):
         self._footprint = distance / config.info.focal_y()
         self._cloud_in = self.DeclareAbstractInputPort("point_cloud", AbstractValue.Make(PointCloud()))
         self._buffer = self.DeclareDiscreteState(np.zeros(self._slots * self._n * _WIDTH))
-        # per object: [seen, x, y, z, yaw]
+        # per object: [fits accepted so far, x, y, z, yaw] of the last accepted fit
         self._memory = self.DeclareDiscreteState(np.zeros(self._n * 5))
         self._fits = self.DeclareAbstractState(AbstractValue.Make([]))
         self._timing = self.DeclareAbstractState(AbstractValue.Make({}))
@@ -113,8 +114,13 @@ class PartPoseEstimator(LeafSystem):
                 f"measured_rotation_{i}", 11, self._rotation_calc(i), prerequisites_of_calc=prerequisites))
             self.DeclareVectorOutputPort(f"quality_{i}", QUALITY_SIZE, self._quality_calc(i),
                                          prerequisites_of_calc=prerequisites)
+        self.DeclareVectorOutputPort("fit_counts", self._n, self._fit_counts_calc,
+                                     prerequisites_of_calc={self.xd_ticket()})
         self.DeclareAbstractOutputPort("fits", lambda: AbstractValue.Make([]), self._fits_calc,
                                        prerequisites_of_calc={self.abstract_state_ticket(self._fits)})
+
+    def _fit_counts_calc(self, context, output) -> None:
+        output.SetFromVector(context.get_discrete_state(self._memory).value().reshape(self._n, 5)[:, 0])
 
     def _fits_calc(self, context, output) -> None:
         output.set_value(list(context.get_abstract_state(self._fits).get_value()))
@@ -210,7 +216,7 @@ class PartPoseEstimator(LeafSystem):
             if memory[i, 0] > 0.5 and fit.symmetry > 0.0:
                 step = fit.symmetry
                 yaw = memory[i, 4] + ((fit.yaw - memory[i, 4] + 0.5 * step) % step - 0.5 * step)
-            memory[i] = [1.0, *fit.position, yaw]
+            memory[i] = [memory[i, 0] + 1.0, *fit.position, yaw]  # (column 0: the fits accepted)
             c, s = math.cos(yaw), math.sin(yaw)
             R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
             slot[i] = [t, *fit.position, 1.0, *R.ravel(), fit.inliers, fit.residual,

@@ -21,8 +21,9 @@ extrapolates the last fits' jitter (measured on conveyor_pick_place_rgbd seed 1:
 the grasp) — and the filtered yaw; before, the part's *nominal* pose — its configured offset, the middle
 of its lateral range, its configured yaw (0 when random), moving at its belt's speed
 (``placement.nominal_parts``: configuration only).  ``seen`` (n): 1 for each part seen so far.
-The world reads ``seen`` at each descend's start: a part never seen is not grasped
-(``world.PickRun``: ``pick k: part not seen``).
+The world reads ``seen`` and the perception's ``fit_counts`` at each descend's start: a part never
+seen, or fitted fewer than ``MIN_FITS`` times, is not grasped (``world.PickRun``: ``pick k: part
+not seen``).
 
 The perceived belts: ``measurement.camera.belts`` when given; otherwise each pick belt's top
 surface (its centre at t = 0, its direction and length) ``BELT_MARGIN`` wider on each side than
@@ -54,6 +55,11 @@ from ptint_drake.systems.perception.rgbd_camera import (AddRgbdCamera, RgbdCamer
 from ptint_drake.systems.rotation_estimator import RotationEstimator
 from ptint_drake.worlds.pick.placement import nominal_parts
 
+# a part is aimed at only after this many accepted fits (``world.PickRun``; fewer: ``pick k: part
+# not seen``): one fit gives no velocity, and a grasp aimed at it lands wherever the part is not
+# (robust assembly_pick_place_rgbd sample 39: part1 fitted once, at t = 0, grasped 107 mm behind it,
+# both attempts empty, the next pick collided); three, so that one bad fit does not set the velocity
+MIN_FITS = 3
 BELT_MARGIN = 0.006  # m, a perceived belt's extra width on each side of the pick belt
 # rad²/s³, the rotation filter's white angular acceleration for a part riding a belt (it does not
 # spin: 1e-4 of the default ``rotation_estimator.Q_SPIN``, so that the yaw rate averages the fits

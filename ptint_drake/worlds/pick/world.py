@@ -39,7 +39,7 @@ from ptint_drake.metrics import Reason, drive_metrics
 from ptint_drake.run_warnings import sampled_control_warnings
 from ptint_drake.worlds.base import World, WorldRun
 from ptint_drake.worlds.pick import studies
-from ptint_drake.worlds.pick.camera import check_pick_camera, estimate_metrics
+from ptint_drake.worlds.pick.camera import MIN_FITS, check_pick_camera, estimate_metrics
 from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
@@ -129,7 +129,8 @@ class PickRun(WorldRun):
 
     def _unseen(self, context, k: int, t: float) -> bool:
         """With a camera, at task k's descend start: record its part's estimate against the truth
-        (``estimates``); if the part was never seen, no grasp: the task backs off at once (no close
+        (``estimates``); if the part was never seen — or fitted fewer than ``camera.MIN_FITS``
+        times, too few for a velocity to aim at — no grasp: the task backs off at once (no close
         command) and its check reads ``part not seen``.  True when it did."""
         plan = self.built.plan
         i = plan.segment_index(k, "descend")
@@ -137,10 +138,12 @@ class PickRun(WorldRun):
         if not last or abs(plan.schedule.segments[i].start - t) > 1e-9:
             return False
         part = plan.segments[i].index
-        parts = self.built.estimates.parts
-        if parts.GetOutputPort("seen").Eval(parts.GetMyContextFromRoot(context))[part] > 0.5:
+        parts, estimator = self.built.estimates.parts, self.built.estimates.estimator
+        fits = int(estimator.GetOutputPort("fit_counts").Eval(estimator.GetMyContextFromRoot(context))[part])
+        seen = parts.GetOutputPort("seen").Eval(parts.GetMyContextFromRoot(context))[part] > 0.5
+        if seen and fits >= MIN_FITS:
             return False
-        self.checks[k].append({"state": "not seen", "t": t})
+        self.checks[k].append({"state": "not seen", "t": t, "fits": fits})
         self.refused[k] = "part not seen"
         self.replans[k] = Replan(self.replans[k].retries, 0.0, abort=t)
         self._rebuild()
