@@ -192,15 +192,16 @@ SHARED = {  # file::test -> the unit's name
     "test_pick_rgbd.py::test_e_true_is_against_the_simulated_part_and_e_estimate_against_the_estimate":
         "rgbd_stock_run",
 }
-# measured 2026-12-03 (load 5-10 on the 2 cores: about 2.5 x the CPU seconds); the notebooks
-# estimated (60 s each, the six took ~6 min together)
+# measured 2026-12-03 on one process (load 5-10 on the 2 cores: about 2.5 x the CPU seconds); the
+# notebooks on two processes (the whole suite, 841 s at load 5-7; the three not listed < 12 s)
 UNIT_SECONDS = {
     "test_visuals.py": 195,
     "test_tune.py::test_tune_finds_gains_for_a_heavy_six_joint_arm": 99,
     "test_runner.py": 85,
     "test_robustness.py": 63,
-    **{f"test_notebooks.py::test_notebook_runs_and_reproduces_its_tables[{name}]": 60
-       for name in ("pick_and_place", "hardware", "camera", "pose", "which_controller", "your_diagram")},
+    **{f"test_notebooks.py::test_notebook_runs_and_reproduces_its_tables[{name}]": seconds
+       for name, seconds in (("which_controller", 36), ("camera", 25), ("pick_and_place", 20),
+                             ("hardware", 10), ("pose", 10), ("your_diagram", 10))},
     "test_sweep.py": 60,
     "test_tune.py::test_tune_on_the_paper_robot_says_how_it_compares": 57,
     "test_lcm_two_processes.py::test_pick_lockstep_places_like_one_process": 53,
