@@ -167,11 +167,16 @@ class GraspObserver(LeafSystem):
         return CLOSING
 
     def _update(self, context, state) -> None:
+        # the command first: an open command decides ``open`` without the other inputs (most steps)
+        command = float(self._command.Eval(context)[0])
+        if command > 0.0:
+            state.get_mutable_vector(self._grasp).SetAtIndex(0, float(OPEN))
+            return
         previous = int(context.get_discrete_state(self._grasp).get_value()[0])
         held = float(context.get_discrete_state(self._held).get_value()[0])
         fingers = self._fingers.Eval(context)
-        code = self.decide(previous, float(self._command.Eval(context)[0]), fingers,
-                           self._drive.Eval(context), float(self._width.Eval(context)[0]), held)
+        code = self.decide(previous, command, fingers, self._drive.Eval(context),
+                           float(self._width.Eval(context)[0]), held)
         state.get_mutable_vector(self._grasp).SetAtIndex(0, float(code))
         if code == HOLDING and previous != HOLDING:  # the encoder's width on the part
             state.get_mutable_vector(self._held).SetAtIndex(0, float(fingers[0]) + float(fingers[1]))

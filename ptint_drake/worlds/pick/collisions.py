@@ -36,19 +36,21 @@ class CollisionProbe(LeafSystem):
 
     def __init__(self, obstacles: list, fingers, robot):
         super().__init__()
-        self._obstacle = {int(b): k for k, bodies in enumerate(obstacles) for b in bodies}
-        self._fingers = {int(b) for b in fingers}
-        self._robot = {int(b) for b in robot}
+        # what the flags are made of (read by ``probe.PickProbe``, which computes the same flags)
+        self.obstacle_of = {int(b): k for k, bodies in enumerate(obstacles) for b in bodies}
+        self.fingers = frozenset(int(b) for b in fingers)
+        self.robot = frozenset(int(b) for b in robot)
+        self.num_flags = 2 * len(obstacles)
         self._pairs = self.DeclareAbstractInputPort("contact_pairs", AbstractValue.Make(()))
-        self.DeclareVectorOutputPort("collisions", 2 * len(obstacles), self._calc)
+        self.DeclareVectorOutputPort("collisions", self.num_flags, self._calc)
 
     def _calc(self, context, output) -> None:
         out = np.zeros(output.size())
         for a, b, _ in self._pairs.Eval(context):
-            if b in self._robot:
+            if b in self.robot:
                 a, b = b, a
-            if a in self._robot and b in self._obstacle:
-                out[2 * self._obstacle[b] + (FINGER if a in self._fingers else OTHER)] = 1.0
+            if a in self.robot and b in self.obstacle_of:
+                out[2 * self.obstacle_of[b] + (FINGER if a in self.fingers else OTHER)] = 1.0
         output.SetFromVector(out)
 
 

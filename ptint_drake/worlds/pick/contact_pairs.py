@@ -1,10 +1,10 @@
 """``ContactPairs`` — the pairs of bodies in contact, read once from the plant's contact results.
 
-The station's ``CollisionProbe`` and the run's ``PickProbe`` both ask which bodies touch, at the
-same logged instants.  Reading a ``ContactResults`` from Python costs a binding call per contact
-and per field (about 3 µs a contact on Drake 1.51's bindings, a part resting on a belt alone
-making 5 point contacts), so it is read here once per contact result and the two read this
-system's output.
+The station's ``CollisionProbe`` reads its output.  Reading a ``ContactResults`` from Python costs
+a binding call per contact and per field (about 3 µs a contact on Drake 1.51's bindings, a part
+resting on a belt alone making 5 point contacts), so it is read here once per contact result.
+(A pick run logs ``probe.PickProbe`` instead, which reads the contacts itself, once for its
+flags, pad forces and the same collision flags.)
 
 Its output ``contact_pairs`` is a tuple with one ``(body A, body B, where)`` per contact, in the
 order of the contact results: the point pairs first (``where`` = i ≥ 0, the point pair's index),

@@ -51,8 +51,10 @@ class PartPoses(LeafSystem):
             q0, v0 = body.floating_positions_start(), body.floating_velocities_start_in_v()
             where = (int(body.index()), slice(q0 + 4, q0 + 7), slice(nq + v0, nq + v0 + 3),
                      slice(nq + v0 + 3, nq + v0 + 6), slice(v0, v0 + 3), slice(v0 + 3, v0 + 6))
-            self.DeclareVectorOutputPort(f"part_{k}_pose", 9, self._pose_calc(where))
-            self.DeclareVectorOutputPort(f"part_{k}_rotation", 15, self._rotation_calc(where))
+            # the inputs alone (not the time): a logger's sample between two plant steps reuses them
+            inputs = {self.all_input_ports_ticket()}
+            self.DeclareVectorOutputPort(f"part_{k}_pose", 9, self._pose_calc(where), inputs)
+            self.DeclareVectorOutputPort(f"part_{k}_rotation", 15, self._rotation_calc(where), inputs)
 
     def _pose_calc(self, where):
         _, p, _, v, _, a = where

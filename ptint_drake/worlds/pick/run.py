@@ -41,6 +41,7 @@ from ptint_drake.worlds.pick.tasks import PickPlan, Replan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
+PROBE_LOG = "probe_values"  # the probe's one log ([probe; grip_forces; collisions]: ``split_logs``)
 
 
 def world_config(scenario: Scenario) -> PickWorldConfig:
@@ -144,15 +145,12 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     builder.Connect(gripper, observer.GetInputPort("command"))
     builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
     probe = builder.AddNamedSystem("pick_probe", _probe(station))
-    builder.Connect(st.GetOutputPort("contact_pairs"), probe.GetInputPort("contact_pairs"))
     builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
     builder.Connect(st.GetOutputPort("body_poses"), probe.GetInputPort("body_poses"))
-    loggers = {"probe": LogVectorOutput(probe.GetOutputPort("probe"), builder, PROBE_PERIOD),
-               "grip_forces": LogVectorOutput(probe.GetOutputPort("grip_forces"), builder, PROBE_PERIOD),
+    loggers = {PROBE_LOG: LogVectorOutput(probe.GetOutputPort("values"), builder, PROBE_PERIOD),
                "grasp_state": LogVectorOutput(observer.GetOutputPort("grasp_state"), builder, PROBE_PERIOD),
                "grip_force": LogVectorOutput(st.GetOutputPort("grip_force"), builder, PROBE_PERIOD),
                "gripper_state": LogVectorOutput(st.GetOutputPort("gripper_state"), builder, PROBE_PERIOD),
-               "collisions": LogVectorOutput(st.GetOutputPort("collisions"), builder, PROBE_PERIOD),
                "state": LogVectorOutput(st.GetOutputPort("state"), builder, PROBE_PERIOD),
                "target": LogVectorOutput(targets.GetOutputPort("target"), builder, PROBE_PERIOD),
                "plant_state": LogVectorOutput(st.GetOutputPort("plant_state"), builder, REPLAY_PERIOD)}
@@ -199,7 +197,19 @@ def _probe(station: PickStation) -> PickProbe:
     return PickProbe([b.index() for b in station.parts], [j.child_body().index() for j in station.belts],
                      plant.GetBodyByName("left_finger", station.gripper).index(),
                      plant.GetBodyByName("right_finger", station.gripper).index(), robot,
-                     (tool.body().index(), tool.GetFixedPoseInBodyFrame()))
+                     (tool.body().index(), tool.GetFixedPoseInBodyFrame()), station.collision_probe,
+                     station.body_of_geometry)
+
+
+def split_logs(built: PickBuilt, logs: dict) -> dict:
+    """``logs`` ({name: (times, rows)} of ``built.loggers``) with the probe's one log split into
+    ``probe``, ``grip_forces`` and ``collisions`` (``PickProbe.blocks``)."""
+    logs = dict(logs)
+    if PROBE_LOG in logs:
+        t, values = logs.pop(PROBE_LOG)
+        blocks = built.diagram.GetSubsystemByName("pick_probe").blocks
+        logs |= {name: (t, np.ascontiguousarray(values[:, block])) for name, block in blocks.items()}
+    return logs
 
 
 def pick_simulator(scenario: Scenario) -> SimulatorConfig:

@@ -80,6 +80,8 @@ class PickStation:
     slots: list  # Frame slot_k on the tray
     driver: GripperDriver
     obstacles: list = None  # names of the ``collisions`` port's obstacles, in its order
+    collision_probe: CollisionProbe = None  # the system behind the ``collisions`` port
+    body_of_geometry: dict = None  # GeometryId → body index (``body_of_geometry``)
 
     def start_running(self, plant_context) -> None:
         """Sets, in ``plant_context``, every belt at its speed and every part moving with its belt."""
@@ -177,7 +179,8 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
     builder.ExportOutput(plant.get_net_actuation_output_port(gripper), "grip_force")
     builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
     obstacles, collisions = _collision_probe(plant, config, arm, gripper, belts, parts)
-    pairs = builder.AddNamedSystem("contact_pairs", ContactPairs(body_of_geometry(plant, scene_graph)))
+    geometry = body_of_geometry(plant, scene_graph)
+    pairs = builder.AddNamedSystem("contact_pairs", ContactPairs(geometry))
     builder.AddNamedSystem("collision_probe", collisions)
     builder.Connect(plant.get_contact_results_output_port(), pairs.get_input_port())
     builder.Connect(pairs.get_output_port(), collisions.get_input_port())
@@ -193,7 +196,7 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
     diagram = builder.Build()
     diagram.set_name("pick_station")
     return PickStation(diagram, plant, scene_graph, config, arm, gripper, belts, parts, slots, driver,
-                       obstacles)
+                       obstacles, collisions, geometry)
 
 
 def _collision_probe(plant, config, arm, gripper, belts, parts) -> tuple:

@@ -38,7 +38,9 @@ from typing import Sequence
 
 import numpy as np
 from pydrake.math import RotationMatrix
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
 
 from ptint_drake.systems.cache import DeclareVectorCache
 from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
@@ -144,31 +146,39 @@ class PickTargets(LeafSystem):
         return value
 
 
-class GripperSequence(LeafSystem):
-    """The plan's gripper commands as a piecewise-constant signal of time (module docstring)."""
+def _zero_order_hold(pairs: Sequence) -> PiecewisePolynomial:
+    """A piecewise-constant signal of time through ``pairs`` [(t, value)] (sorted by t, stable: of
+    commands at one time the last holds from it): the value of the last pair with t_i ≤ t, the
+    first before it, the last after it — Drake's zero-order hold, whose segment at a break is the
+    one that starts there."""
+    times, values = [], []
+    for t, v in sorted(pairs, key=lambda c: c[0]):
+        if times and float(t) == times[-1]:
+            values[-1] = float(v)
+            continue
+        times.append(float(t)), values.append(float(v))
+    times.append(times[-1] + 1.0), values.append(values[-1])  # the last value held on
+    return PiecewisePolynomial.ZeroOrderHold(times, np.array([values]))
+
+
+class GripperSequence(Diagram):
+    """The plan's gripper commands as a piecewise-constant signal of time (module docstring): two
+    Drake ``TrajectorySource``s of zero-order holds (``_zero_order_hold``), C++ at every step."""
 
     def __init__(self, commands: Sequence, widths: Sequence = ()):
         super().__init__()
-        commands = sorted(commands, key=lambda c: c[0])
-        self._times = [float(t) for t, _ in commands]
-        self._values = [float(v) for _, v in commands]
-        widths = sorted(widths, key=lambda c: c[0]) or [(0.0, 0.0)]
-        self._width_times = [float(t) for t, _ in widths]
-        self._widths = [float(w) for _, w in widths]
-        self.DeclareVectorOutputPort("command", 1, self._calc, prerequisites_of_calc={self.time_ticket()})
-        self.DeclareVectorOutputPort("part_width", 1, self._calc_width,
-                                     prerequisites_of_calc={self.time_ticket()})
+        self._command = _zero_order_hold(commands)
+        self._width = _zero_order_hold(widths or [(0.0, 0.0)])
+        builder = DiagramBuilder()
+        for name, trajectory in (("command", self._command), ("part_width", self._width)):
+            source = builder.AddNamedSystem(name, TrajectorySource(trajectory))
+            builder.ExportOutput(source.get_output_port(), name)
+        builder.BuildInto(self)
 
     def opening(self, t: float) -> float:
         """The commanded opening at time t (m; 0: close)."""
-        return self._values[max(bisect.bisect_right(self._times, t) - 1, 0)]
+        return float(self._command.value(t)[0, 0])
 
     def part_width(self, t: float) -> float:
         """The width of the part the active task grasps at time t (m)."""
-        return self._widths[max(bisect.bisect_right(self._width_times, t) - 1, 0)]
-
-    def _calc(self, context, output) -> None:
-        output.SetAtIndex(0, self.opening(context.get_time()))
-
-    def _calc_width(self, context, output) -> None:
-        output.SetAtIndex(0, self.part_width(context.get_time()))
+        return float(self._width.value(t)[0, 0])
