@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import numpy as np
 from pydrake.geometry import Box
-from scipy.special import betaincinv
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grippers import payload_warnings
 from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
+from ptint_drake.worlds.pick.route import xi
 from ptint_drake.worlds.pick.tasks import VIA_PART
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
@@ -50,10 +50,6 @@ def finger_extent(station) -> tuple:
             reach, top = max(reach, corners[:, 2].max()), max(top, -corners[:, 2].min())
             thickness = max(thickness, np.abs(corners[:, 0]).max())
     return reach, top, thickness
-
-
-def _xi(tau: np.ndarray, tf: float, beta: float) -> np.ndarray:
-    return betaincinv(1.0 - beta, 1.0 - beta, np.clip(1.0 - tau / tf, 0.0, 1.0))
 
 
 def check_pick_clearance(scenario, built) -> None:
@@ -82,7 +78,7 @@ def check_pick_clearance(scenario, built) -> None:
             field = "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"
             point = np.asarray(plan.segments[via[0]].offset)
             tau = np.linspace(0.0, seg.tf, SAMPLES)
-            path = point + np.outer(_xi(tau, seg.tf, seg.beta), x0 - point)
+            path = point + np.outer(xi(tau, seg.tf, seg.beta), x0 - point)
             for b in config.belts:
                 _check_belt(b, path, seg.start + tau, reach, top, radius, field, k, "via")
             x0 = point
@@ -95,7 +91,7 @@ def check_pick_clearance(scenario, built) -> None:
             target = start + np.outer(t, ride) + lift
             if phase == "descend":
                 x0 = start + seg.start * ride + [0.0, 0.0, task.clearance]
-            path = target + np.outer(_xi(tau, seg.tf, seg.beta), x0 - target[0])
+            path = target + np.outer(xi(tau, seg.tf, seg.beta), x0 - target[0])
             for b in config.belts:
                 _check_belt(b, path, t, reach, top, radius, field, k, phase)
             x0 = path[-1]

@@ -51,8 +51,9 @@ from pydrake.multibody.tree import JointIndex
 from scipy.special import betaincinv
 
 from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.worlds.pick.camera import nominal_paths as nominal_motions
 from ptint_drake.worlds.pick.placement import nominal_parts
-from ptint_drake.worlds.pick.scene import part_shape, part_start_pose, tray_pose
+from ptint_drake.worlds.pick.scene import part_shape, tray_pose
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
 
 INNER_MARGIN = 0.04  # m: a way closer than this to the inner edge of the top-down workspace is too near
@@ -99,13 +100,8 @@ def waist_axis(arm) -> np.ndarray:
 def nominal(scenario, arm) -> Nominal:
     """The ``Nominal`` of a pick scenario (configuration and the arm's model only)."""
     pick = scenario.pick
-    belts = {b.name: b for b in pick.belts}
-    parts, yaws = [], []
-    for part in nominal_parts(pick.parts):
-        belt = belts[part.belt]
-        yaws.append(float(np.radians(part.yaw_deg)))
-        d = np.asarray(belt.direction, float)
-        parts.append((part_start_pose(part, belt).translation(), belt.speed * d / np.linalg.norm(d)))
+    parts = nominal_motions(pick)
+    yaws = [float(np.radians(part.yaw_deg)) for part in nominal_parts(pick.parts)]
     X_WT = tray_pose(pick.tray)
     names = [p.name for p in pick.parts]
     places = []
