@@ -7,7 +7,7 @@ the arm's model file alone — the controller knows nothing of the gripper, the 
 payload), ``PickTargets`` (what each segment aims at, from the parts' simulated poses),
 ``GripperSequence`` (open, close at the prescribed time, open), ``GraspObserver`` (the grasp
 state from the fingers' width, speed and drive force: ``systems.gripper``) and ``PickProbe``
-(poses, contacts and pad forces, logged every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it
+(poses, contacts and pad forces, recorded every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it
 through the one runner
 (``worlds.runner``), stopping at every segment's start and end; its metrics carry the segments and
 ``picks`` (``metrics``).
@@ -41,7 +41,6 @@ from ptint_drake.worlds.pick.tasks import PickPlan, Replan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
-PROBE_LOG = "probe_values"  # the probe's one log ([probe; grip_forces; collisions]: ``split_logs``)
 
 
 def world_config(scenario: Scenario) -> PickWorldConfig:
@@ -146,9 +145,8 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
     probe = builder.AddNamedSystem("pick_probe", _probe(station))
     builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
-    builder.Connect(st.GetOutputPort("body_poses"), probe.GetInputPort("body_poses"))
-    loggers = {PROBE_LOG: LogVectorOutput(probe.GetOutputPort("values"), builder, PROBE_PERIOD),
-               "grasp_state": LogVectorOutput(observer.GetOutputPort("grasp_state"), builder, PROBE_PERIOD),
+    builder.Connect(st.GetOutputPort("plant_state"), probe.GetInputPort("plant_state"))
+    loggers = {"grasp_state": LogVectorOutput(observer.GetOutputPort("grasp_state"), builder, PROBE_PERIOD),
                "grip_force": LogVectorOutput(st.GetOutputPort("grip_force"), builder, PROBE_PERIOD),
                "gripper_state": LogVectorOutput(st.GetOutputPort("gripper_state"), builder, PROBE_PERIOD),
                "state": LogVectorOutput(st.GetOutputPort("state"), builder, PROBE_PERIOD),
@@ -194,21 +192,23 @@ def _probe(station: PickStation) -> PickProbe:
     plant = station.plant
     robot = [b for m in (station.arm, station.gripper) for b in plant.GetBodyIndices(m)]
     tool = plant.GetFrameByName("fingertip_center", station.gripper)
-    return PickProbe([b.index() for b in station.parts], [j.child_body().index() for j in station.belts],
+    return PickProbe(plant, [b.index() for b in station.parts],
+                     [j.child_body().index() for j in station.belts],
                      plant.GetBodyByName("left_finger", station.gripper).index(),
                      plant.GetBodyByName("right_finger", station.gripper).index(), robot,
                      (tool.body().index(), tool.GetFixedPoseInBodyFrame()), station.collision_probe,
-                     station.body_of_geometry)
+                     station.body_of_geometry, PROBE_PERIOD)
 
 
-def split_logs(built: PickBuilt, logs: dict) -> dict:
-    """``logs`` ({name: (times, rows)} of ``built.loggers``) with the probe's one log split into
-    ``probe``, ``grip_forces`` and ``collisions`` (``PickProbe.blocks``)."""
-    logs = dict(logs)
-    if PROBE_LOG in logs:
-        t, values = logs.pop(PROBE_LOG)
-        blocks = built.diagram.GetSubsystemByName("pick_probe").blocks
-        logs |= {name: (t, np.ascontiguousarray(values[:, block])) for name, block in blocks.items()}
+def pick_logs(built: PickBuilt, context) -> dict:
+    """{name: (times, rows)} of a pick run's loggers in ``context`` (the diagram's root context),
+    with the probe's samples (``PickProbe.log``) split into ``probe``, ``grip_forces`` and
+    ``collisions`` (``PickProbe.blocks``)."""
+    logs = {name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
+            for name, logger in built.loggers.items()}
+    probe = built.diagram.GetSubsystemByName("pick_probe")
+    t, values = probe.log(probe.GetMyContextFromRoot(context))
+    logs |= {name: (t, np.ascontiguousarray(values[:, block])) for name, block in probe.blocks.items()}
     return logs
 
 

@@ -46,7 +46,7 @@ from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLAN
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
-                                         pick_simulator, segment_aims, split_logs)
+                                         pick_logs, pick_simulator, segment_aims)
 from ptint_drake.reachability import inverse_kinematics
 from ptint_drake.systems.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST
 from ptint_drake.worlds.pick.route import routed_plan
@@ -245,9 +245,7 @@ class PickRun(WorldRun):
                 tc.SetDiscreteState(0, value)
 
     def _logs(self, context) -> dict:
-        return split_logs(self.built, {
-            name: (logger.FindLog(context).sample_times().copy(), logger.FindLog(context).data().T.copy())
-            for name, logger in self.built.loggers.items()})
+        return pick_logs(self.built, context)
 
     def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
         built = self.built
