@@ -36,7 +36,7 @@ class CollisionProbe(LeafSystem):
 
     def __init__(self, obstacles: list, fingers, robot):
         super().__init__()
-        # what the flags are made of (read by ``probe.PickProbe``, which computes the same flags)
+        # what the flags are made of (read by ``probe.PickProbe``, which records the same flags)
         self.obstacle_of = {int(b): k for k, bodies in enumerate(obstacles) for b in bodies}
         self.fingers = frozenset(int(b) for b in fingers)
         self.robot = frozenset(int(b) for b in robot)

@@ -3,8 +3,8 @@
 The station's ``CollisionProbe`` reads its output.  Reading a ``ContactResults`` from Python costs
 a binding call per contact and per field (about 3 µs a contact on Drake 1.51's bindings, a part
 resting on a belt alone making 5 point contacts), so it is read here once per contact result.
-(A pick run logs ``probe.PickProbe`` instead, which reads the contacts itself, once for its
-flags, pad forces and the same collision flags.)
+(A pick run records ``probe.PickProbe`` instead: it keeps each sample's contact results and
+reads them after the run, for its flags, pad forces and the same collision flags.)
 
 Its output ``contact_pairs`` is a tuple with one ``(body A, body B, where)`` per contact, in the
 order of the contact results: the point pairs first (``where`` = i ≥ 0, the point pair's index),
