@@ -14,13 +14,15 @@ from ptint_drake.worlds.pick.station import MakePickStation
 INTO_BELT_DEG = [0.0, 76.2, -5.9, 17.7, 0.0]  # the fingers inside the belt (test_pick_collisions)
 
 
-def _recorded(initial_q_deg, until: float = 0.02):
+def _recorded(initial_q_deg, until: float = 0.02, max_copies: int | None = None):
     config = world_config(load_scenario("conveyor_pick_place"))
     config.initial_q_deg = initial_q_deg
     station = MakePickStation(config)
     builder = DiagramBuilder()
     st = builder.AddNamedSystem("pick_station", station.diagram)
     probe = builder.AddNamedSystem("pick_probe", _probe(station))
+    if max_copies is not None:
+        probe.max_copies = max_copies
     builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
     builder.Connect(st.GetOutputPort("plant_state"), probe.GetInputPort("plant_state"))
     states = LogVectorOutput(st.GetOutputPort("plant_state"), builder, PROBE_PERIOD)
@@ -34,7 +36,9 @@ def _recorded(initial_q_deg, until: float = 0.02):
     simulator.AdvanceTo(until / 2)
     simulator.AdvanceTo(until)
     diagram.ForcedPublish(context)  # a forced publish is a sample too (VectorLogSink's triggers)
-    t, rows = probe.log(probe.GetMyContextFromRoot(context))
+    probe_context = probe.GetMyContextFromRoot(context)
+    t, rows = probe.log(probe_context)
+    probe.read = probe.copies_read(probe_context)
     return station, probe, t, rows, states.FindLog(context), collisions.FindLog(context)
 
 
@@ -62,3 +66,11 @@ def test_collision_flags_are_the_stations_and_a_fresh_context_has_no_samples():
     assert rows[1:, probe.blocks["probe"].stop - 8].all()  # and the belt flag
     fresh = probe.CreateDefaultContext()
     assert len(probe.log(fresh)[0]) == 0
+
+
+def test_copies_read_during_the_run_past_the_bound_give_the_same_rows():
+    _, probe, t, rows, _, _ = _recorded(INTO_BELT_DEG)
+    _, bounded, t_bounded, rows_bounded, _, _ = _recorded(INTO_BELT_DEG, max_copies=3)
+    assert bounded.read == 9 and probe.read == 0  # 12 samples, 3 copies kept at most
+    assert np.array_equal(t, t_bounded) and np.array_equal(rows, rows_bounded)
+    assert rows[:, probe.blocks["collisions"]].any()  # (there were robot contacts to read)

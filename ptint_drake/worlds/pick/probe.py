@@ -27,7 +27,9 @@ from Python costs a binding call per contact and field (about 3 µs a contact on
 bindings, a part resting on a belt alone making 5 point contacts): read in the loop it was
 ~0.07 s per simulated second of ``assembly_pick_place``, now paid once after the run.  A sample
 with hydroelastic contacts is read at once (its flags and pad force vectors kept), since a copy
-would keep every contact surface's mesh alive until the run ends.
+would keep every contact surface's mesh alive until the run ends; past ``MAX_COPIES`` kept copies
+(20 s of samples, ~50 MB) the oldest are read during the run, ``READ_BATCH`` at a time, so a long
+run's memory stays bounded (``copies_read``).
 
 ==================  ===========  ======================================================
 port                size         meaning
@@ -42,6 +44,7 @@ port                size         meaning
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -55,6 +58,19 @@ from ptint_drake.worlds.pick.contact_pairs import contact_force
 PART_WIDTH = 10  # values per part in the probe's output
 LEFT, RIGHT, OTHER = 7, 8, 9  # the contact flags' places in a part's block
 BELT = -8  # the belt flag's place; the tool's pose is the last 7 values
+
+
+MAX_COPIES = 10_000  # kept ContactResults copies (20 s at 2 ms; ~5 kB each with 20 point contacts)
+READ_BATCH = 1_000  # past MAX_COPIES, the oldest copies read at once
+
+
+@dataclass
+class _Samples:
+    """A context's samples: (t, [q; v], a ContactResults copy or its reading) each; the copies
+    start at ``first_copy`` (older ones were read in the run, ``PickProbe._record``)."""
+
+    samples: list = field(default_factory=list)
+    first_copy: int = 0
 
 
 class PickProbe(LeafSystem):
@@ -90,8 +106,10 @@ class PickProbe(LeafSystem):
                   | set(self._collision_robot))
         self._table = {(a, b): act for a in bodies for b in bodies if (act := self._action(a, b))[0]}
         # the samples, per context (as VectorLogSink keeps its log: a cache entry nothing invalidates)
-        keep = ValueProducer(allocate=lambda: AbstractValue.Make([]), calc=lambda context, value: None)
+        keep = ValueProducer(allocate=lambda: AbstractValue.Make(_Samples()),
+                             calc=lambda context, value: None)
         self._log = self.DeclareCacheEntry("samples", keep, {self.nothing_ticket()})
+        self.max_copies = MAX_COPIES
         self.DeclarePeriodicPublishEvent(period, 0.0, self._record)
         self.DeclareForcedPublishEvent(self._record)
 
@@ -117,14 +135,26 @@ class PickProbe(LeafSystem):
             flags.append(n + BELT)
         return tuple(flags), force
 
-    def _samples(self, context) -> list:
+    def _samples(self, context) -> _Samples:
         return self._log.get_mutable_cache_entry_value(context).GetMutableValueOrThrow()
 
+    def copies_read(self, context) -> int:
+        """How many of the samples kept in ``context`` were read during the run (``max_copies``)."""
+        return self._samples(context).first_copy
+
     def _record(self, context) -> None:
-        """Keep this instant: its time, the plant's [q; v] and its contacts (module docstring)."""
+        """Keep this instant: its time, the plant's [q; v] and its contacts (module docstring);
+        past ``max_copies`` kept copies, read the oldest ``READ_BATCH`` now (bounded memory)."""
         results = self._contacts.Eval(context)
         contacts = self._read(results) if results.num_hydroelastic_contacts() else copy.copy(results)
-        self._samples(context).append((context.get_time(), self._state.Eval(context).copy(), contacts))
+        log = self._samples(context)
+        log.samples.append((context.get_time(), self._state.Eval(context).copy(), contacts))
+        if len(log.samples) - log.first_copy > self.max_copies:
+            for i in range(log.first_copy, log.first_copy + min(READ_BATCH, self.max_copies)):
+                t, x, kept = log.samples[i]
+                if isinstance(kept, ContactResults):
+                    log.samples[i] = (t, x, self._read(kept))
+            log.first_copy += min(READ_BATCH, self.max_copies)
 
     def _read(self, results: ContactResults) -> tuple:
         """(the row's places each contact sets to 1, (place, force vector) of each pad on a
@@ -151,7 +181,7 @@ class PickProbe(LeafSystem):
 
     def log(self, context) -> tuple[np.ndarray, np.ndarray]:
         """(times, rows) of the samples kept in ``context`` (module docstring)."""
-        samples = self._samples(context)
+        samples = self._samples(context).samples
         plant, n = self._plant, self.blocks["probe"].stop
         plant_context = plant.CreateDefaultContext()
         parts = [plant.get_body(BodyIndex(b)) for b in self._parts]
