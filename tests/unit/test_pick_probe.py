@@ -8,7 +8,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.scenario import load_scenario
 from ptint_drake.worlds.pick.probe import PART_WIDTH
-from ptint_drake.worlds.pick.run import PROBE_PERIOD, _probe, world_config
+from ptint_drake.worlds.pick.run import PROBE_PERIOD, AddPickProbe, world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 
 INTO_BELT_DEG = [0.0, 76.2, -5.9, 17.7, 0.0]  # the fingers inside the belt (test_pick_collisions)
@@ -20,11 +20,9 @@ def _recorded(initial_q_deg, until: float = 0.02, max_copies: int | None = None)
     station = MakePickStation(config)
     builder = DiagramBuilder()
     st = builder.AddNamedSystem("pick_station", station.diagram)
-    probe = builder.AddNamedSystem("pick_probe", _probe(station))
+    probe = AddPickProbe(builder, st, station)
     if max_copies is not None:
         probe.max_copies = max_copies
-    builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
-    builder.Connect(st.GetOutputPort("plant_state"), probe.GetInputPort("plant_state"))
     states = LogVectorOutput(st.GetOutputPort("plant_state"), builder, PROBE_PERIOD)
     collisions = LogVectorOutput(st.GetOutputPort("collisions"), builder, PROBE_PERIOD)
     diagram = builder.Build()

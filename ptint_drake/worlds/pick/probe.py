@@ -150,11 +150,12 @@ class PickProbe(LeafSystem):
         log = self._samples(context)
         log.samples.append((context.get_time(), self._state.Eval(context).copy(), contacts))
         if len(log.samples) - log.first_copy > self.max_copies:
-            for i in range(log.first_copy, log.first_copy + min(READ_BATCH, self.max_copies)):
+            batch = min(READ_BATCH, self.max_copies)
+            for i in range(log.first_copy, log.first_copy + batch):
                 t, x, kept = log.samples[i]
-                if isinstance(kept, ContactResults):
+                if isinstance(kept, ContactResults):  # (a hydroelastic sample was read when kept)
                     log.samples[i] = (t, x, self._read(kept))
-            log.first_copy += min(READ_BATCH, self.max_copies)
+            log.first_copy += batch
 
     def _read(self, results: ContactResults) -> tuple:
         """(the row's places each contact sets to 1, (place, force vector) of each pad on a

@@ -143,9 +143,7 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     builder.Connect(st.GetOutputPort("grip_force"), observer.GetInputPort("drive_force"))
     builder.Connect(gripper, observer.GetInputPort("command"))
     builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
-    probe = builder.AddNamedSystem("pick_probe", _probe(station))
-    builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
-    builder.Connect(st.GetOutputPort("plant_state"), probe.GetInputPort("plant_state"))
+    AddPickProbe(builder, st, station)
     loggers = {"grasp_state": LogVectorOutput(observer.GetOutputPort("grasp_state"), builder, PROBE_PERIOD),
                "grip_force": LogVectorOutput(st.GetOutputPort("grip_force"), builder, PROBE_PERIOD),
                "gripper_state": LogVectorOutput(st.GetOutputPort("gripper_state"), builder, PROBE_PERIOD),
@@ -186,6 +184,16 @@ def _camera_loggers(builder: DiagramBuilder, st, estimates: PartEstimates, true_
                            (f"fit_rotation_{k}", fits.GetOutputPort(f"measured_rotation_{k}"))):
             out[name] = LogVectorOutput(port, builder, PROBE_PERIOD)
     return out
+
+
+def AddPickProbe(builder: DiagramBuilder, st, station: PickStation) -> PickProbe:
+    """Add ``PickProbe`` as ``pick_probe``, fed by the station system ``st`` (``station``'s
+    diagram in ``builder``): its contact results and the plant's [q; v], recorded every
+    ``PROBE_PERIOD``.  Returns the probe (``probe.log(context)`` after the run)."""
+    probe = builder.AddNamedSystem("pick_probe", _probe(station))
+    builder.Connect(st.GetOutputPort("contact_results"), probe.GetInputPort("contact_results"))
+    builder.Connect(st.GetOutputPort("plant_state"), probe.GetInputPort("plant_state"))
+    return probe
 
 
 def _probe(station: PickStation) -> PickProbe:
