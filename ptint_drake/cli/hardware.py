@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import signal
 import sys
 from pathlib import Path
 from typing import Callable
@@ -99,7 +100,8 @@ def _add_hardware_link_options(hw: argparse.ArgumentParser) -> None:
         "--command-timeout",
         type=seconds("--command-timeout"),
         default=0.25,
-        help="s without a command before the arm is held (default 0.25)",
+        help="s without a command before the arm is held (default 0.25; in real time "
+        "--silent-periods decides)",
     )
     hw.add_argument(
         "--startup-timeout",
@@ -107,6 +109,14 @@ def _add_hardware_link_options(hw: argparse.ArgumentParser) -> None:
         default=10.0,
         help="s to wait for the first command (default 10)",
     )
+    hw.add_argument(
+        "--silent-periods",
+        type=_periods,
+        default=5,
+        help="without --lockstep: control periods in a row without a command before the arm is held "
+        "(default 5; a loaded virtual machine may stall a process longer: see docs/hardware.md)",
+    )
+    _add_priority_option(hw, "without --lockstep: ")
     hw.add_argument(
         "--hold-time",
         type=seconds("--hold-time"),
@@ -139,10 +149,46 @@ def _add_drive_parser(sub) -> None:
         default=10.0,
         help="s to wait for the first status (default 10)",
     )
+    _add_priority_option(dr, "")
     dr.add_argument("--out", help="output folder (default out/drive_NAME)")
     dr.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     dr.add_argument("--quiet", action="store_true", help="accepted like the other commands")
     dr.set_defaults(func=cmd_drive)
+
+
+def _periods(text: str) -> int:
+    """An argparse type: a count of control periods, >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise OptionError(f"--silent-periods: expected an integer >= 1, got {text!r}") from None
+    if value < 1:
+        raise OptionError(f"--silent-periods: must be >= 1, got {text}")
+    return value
+
+
+def _priority(text: str) -> int:
+    """An argparse type: a SCHED_FIFO priority, 0 (none) to 99."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise OptionError(f"--priority: expected an integer 0-99, got {text!r}") from None
+    if not 0 <= value <= 99:
+        raise OptionError(f"--priority: must be in 0-99, got {text}")
+    return value
+
+
+def _add_priority_option(parser: argparse.ArgumentParser, when: str) -> None:
+    """``--priority``: the loop's real-time scheduling (``hardware.priority``)."""
+    from ptint_drake.hardware.priority import DEFAULT_PRIORITY  # noqa: PLC0415
+
+    parser.add_argument(
+        "--priority",
+        type=_priority,
+        default=DEFAULT_PRIORITY,
+        help=f"{when}SCHED_FIFO priority of the control loop where the system permits it (root or "
+        f"an rtprio limit; else a warning), 0 for the default scheduler (default {DEFAULT_PRIORITY})",
+    )
 
 
 def _warn(message: str) -> None:
@@ -164,6 +210,8 @@ def _link_settings(args: argparse.Namespace, scenario):
         realtime_rate=args.realtime_rate,
         drop_status=args.drop_status,
         seed=args.seed,
+        priority=args.priority,
+        silent_periods=args.silent_periods,
     )
 
 
@@ -236,6 +284,8 @@ def cmd_hardware(args: argparse.Namespace) -> int:
         if scenario.pick is None:
             _print_segments(scenario.name, metrics["segments"])
         _print_fault(link, out)
+        if link.get("stop_signal"):  # stopped by a signal: the shell's code for it, after the hold
+            return 128 + int(getattr(signal, link["stop_signal"]))
         return 1
     if scenario.pick is not None:  # the pick world's lines and verdict, as `ptint run` prints them
         from ptint_drake.worlds.registry import world_of  # noqa: PLC0415
@@ -270,6 +320,7 @@ def cmd_drive(args: argparse.Namespace) -> int:
         duration=scenario.duration,
         startup_timeout=args.startup_timeout,
         status_timeout=args.status_timeout,
+        priority=args.priority,
     )
     record = DriveRecord()
     fault, url = None, args.url

@@ -19,16 +19,17 @@ Torques beyond the actuators' effort limits are clipped to them (``limits.satura
 default: where ``ptint run``'s station saturates; the hardware side rejects them as a fault).
 It ends when it has answered the last tick
 (t ≥ duration − 1.5 T), or with ``DriveFault`` (one line): no status within the start-up timeout,
-no status for ``status_timeout`` s, a status of the wrong size, or a status whose applied torque
-(``joint_torque_commanded``) is none of the drive's recent commands — the hardware took a second
-sender's command (the drive's check beside the hardware's own, ``session``); the drive then
-sends a NaN command, which the hardware's checks reject by holding the arm.
+no status for ``status_timeout`` s, or a status of the wrong size.  The drive never stops the arm
+by a message (no NaN, nothing the hardware must reject): it stops commanding, and the hardware
+holds the arm after ``LinkSettings.silent_periods`` periods without a command.  A second sender
+is the hardware's to find, by the packets' source addresses (``link.SenderWatch``); the drive
+does not compare the status's torque echo with its own commands (a driver may add its own
+terms, e.g. gravity compensation, to what it reports).
 """
 
 from __future__ import annotations
 
 import copy
-from collections import deque
 import dataclasses
 import time
 from dataclasses import dataclass, field
@@ -53,10 +54,11 @@ from ptint_drake.hardware.link import (
     unpack_parts,
     unpack_wsg_status,
     spread,
-    status_torque,
     unpack_status,
     url_warning,
 )
+from ptint_drake.hardware.priority import DEFAULT_PRIORITY, request_realtime, scheduler_name
+from ptint_drake.hardware.session import quiet_collector
 from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
 from ptint_drake.systems.gripper import EMPTY, GRASP_STATES, HOLDING, LOST
@@ -66,10 +68,9 @@ from ptint_drake.worlds.registry import objects_of, schedule_of, world_of
 # s: after integrating σ to a status's time t, a step this short takes the controller's events at t
 # (a segment's start stores s(t0)) with that status's state, as the one-process run's do
 EVENT_STEP = 1e-9
-STOP_REPEATS = 3  # NaN commands sent to stop a hardware that took a second sender's command
 # statuses lost within this many periods of the run's end: the run ended (a timeout then is not a fault)
 END_SLACK = 20
-RECENT = 200  # commands remembered for the check of the applied torque (real time applies late ones)
+WARM_UP_PERIODS = 3  # control periods of the throwaway run after the hand-shake (``warm_up``)
 
 
 class DriveFault(Exception):
@@ -84,6 +85,7 @@ class DriveSettings:
     duration: float
     startup_timeout: float = 10.0  # s wall for the first status
     status_timeout: float = 0.5  # s wall without a status once running
+    priority: int = DEFAULT_PRIORITY  # SCHED_FIFO priority of the loop (0: none; ``hardware.priority``)
 
 
 @dataclass
@@ -169,6 +171,7 @@ class _DriveLoop:
             config = copy.copy(own)
         config.target_realtime_rate = 0.0  # the hardware's status paces the drive
         ApplySimulatorConfig(config, self.simulator)
+        self.config = config
         self.context = self.simulator.get_mutable_context()
         self.state_in, self.out = diagram.GetInputPort("state"), diagram.GetOutputPort("actuation")
         also = (WSG_STATUS_CHANNEL, PARTS_CHANNEL) if pick is not None else ()
@@ -187,10 +190,6 @@ class _DriveLoop:
         self.answer = b""
         self.last_q = self.last_v = None
         self.started = False  # the pick world: the events at the first tick's time taken
-        # what this drive sent lately (and the zero torque of the start): a status whose applied
-        # torque is none of them shows a second sender's command taken by the hardware
-        self.recent: deque = deque(maxlen=RECENT)
-        self.sent_torques = {tuple(np.zeros(n))}
         self.end = settings.duration - 1.5 * settings.period
         self.quiet_end = False
         self.last_seen = time.perf_counter()
@@ -249,7 +248,6 @@ class _DriveLoop:
             return
         if answered is not None:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
-        self.check_applied(utime, data)
         self.respond(t_recv, utime, q, v, self.companion(utime) if self.pick is not None else None)
 
     def _collect(self) -> None:
@@ -302,23 +300,6 @@ class _DriveLoop:
         raise DriveFault(
             f"the grasp check at t = {utime / 1e6:.3f} s read {GRASP_STATES[state]!r}: a retry "
             f"(a new plan) is not supported across processes; stopped commanding"
-        )
-
-    def check_applied(self, utime: int, data: bytes) -> None:
-        """``DriveFault`` (after NaN commands) when the status's applied torque is none of this
-        drive's recent commands."""
-        applied = status_torque(data)
-        if tuple(applied) in self.sent_torques:
-            return
-        # the hardware obeys someone else: make its checks hold the arm (a command it must
-        # reject, sent a few times: LCM may drop one), then stop
-        stop = pack_command(utime, np.full(self.n, np.nan))
-        for _ in range(STOP_REPEATS):
-            self.endpoint.publish(stop)
-        raise DriveFault(
-            f"the hardware applied torques this drive did not send, at t = {utime * 1e-6:.3f} s "
-            f"({np.array2string(applied, precision=3)}): a second sender on {COMMAND_CHANNEL}; "
-            f"sent a NaN command so that the hardware holds the arm, and stopped commanding"
         )
 
     def torque(self, t: float, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None) -> np.ndarray:
@@ -381,12 +362,9 @@ class _DriveLoop:
                 at, self.pick.sequence.opening(at / 1e6), self.pick.max_force
             )
             self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
-        recent = self.recent
-        if len(recent) == recent.maxlen and recent.count(recent[0]) == 1:
-            self.sent_torques.discard(recent[0])
-        recent.append(tuple(tau))
-        self.sent_torques.add(recent[-1])
         sent = self.endpoint.publish(self.answer)
+        if first:
+            self.warm_up(t)
         self.answered = utime
         record = self.record
         record.commands += 1
@@ -397,6 +375,18 @@ class _DriveLoop:
         record.q.append(q)
         record.v.append(v)
         record.tau.append(tau)
+
+    def warm_up(self, t: float) -> None:
+        """After answering the hand-shake: a throwaway run of the controller over a few periods
+        from a copy of its context (the hand-shake's inputs), so that every compiled kernel the
+        integration and the events call is loaded before the first tick, which must be answered
+        within a period (measured: the first real-time ticks answered 1-2 ms late without it,
+        five in a row, a hold).  The hardware waits ``session.QUIET`` s after the hand-shake."""
+        scratch = Simulator(self.simulator.get_system(), self.context.Clone())
+        ApplySimulatorConfig(self.config, scratch)
+        scratch.Initialize()
+        scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
+        self.out.Eval(scratch.get_context())
 
     def finished(self) -> bool:
         """Whether the last tick (t >= duration - 1.5 T) has been answered."""
@@ -415,6 +405,10 @@ def run_drive(
     into ``record``; returns the URL used.  ``lcm``: a ``DrakeLcm`` to use instead of one of
     ``url`` (``in_memory``)."""
     loop = _DriveLoop(scenario, settings, record, url, warn, lcm)
+    quiet_collector()
+    refused = request_realtime(settings.priority) if lcm is None else None  # (memq: one process)
+    if refused:
+        warn(refused)
     while True:
         for t_recv, data in loop.wait():
             loop.take(t_recv, data)
@@ -438,6 +432,7 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "last_t": record.last_t,
         "compute_ms": spread(record.compute, 1e3),
         "commands_clipped": record.clipped,
+        "scheduler": scheduler_name(),
     }
 
 

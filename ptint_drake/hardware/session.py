@@ -5,8 +5,9 @@ and checks, the timing it records; ``command_link.CommandLink`` calls it at each
   ``resend`` s of wall time, so a lost status costs time, not the run), up to ``command_timeout``
   of wall time.
 - **Real time**: the simulator paces the ticks; each tick waits at most ``budget`` × T for its
-  command, otherwise the previous torque stays (``late``); ``command_timeout`` / T ticks in a row
-  without a command is the timeout.
+  command, otherwise the previous torque stays (``late``); ``silent_periods`` ticks in a row
+  without a command (5: a dead or silent controller) is the timeout, so the arm is held within
+  that many control periods of the last command.
 
 Every command passes the checks before it reaches the plant (``HardwareSession._check``): its
 size, finite torques within the actuators' effort limits, and one command per status — LCM
@@ -20,13 +21,18 @@ the RV-M1), then the run ends with ``LinkFault`` naming it.
 
 from __future__ import annotations
 
+import gc
+import signal
+import threading
 import time
+from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
 
+from ptint_drake.hardware.priority import DEFAULT_PRIORITY, request_realtime
 from ptint_drake.hardware.link import (
     PARTS_CHANNEL,
     WSG_COMMAND_CHANNEL,
@@ -44,6 +50,16 @@ SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
 
 
+def quiet_collector() -> None:
+    """Before a real-time loop: collect once, then move every object alive into the collector's
+    permanent generation (``gc.freeze``), so that a later full collection does not walk the
+    interpreter's, pydrake's and numba's hundreds of thousands of start-up objects: such a pass
+    takes milliseconds, several control periods of an arm's link.  The collector stays on for
+    what the loop itself allocates."""
+    gc.collect()
+    gc.freeze()
+
+
 class LinkFault(Exception):
     """A fault of the link (the message is the one-line reason)."""
 
@@ -55,7 +71,8 @@ class LinkSettings:
     period: float  # s: T, the tick of the link and the plant's step
     duration: float  # s of simulated time of the scenario
     lockstep: bool = True
-    command_timeout: float = 0.25  # s of wall time without a command (see the module docstring)
+    command_timeout: float = 0.25  # s of wall time a lockstep tick waits for its command
+    silent_periods: int = 5  # real time: ticks in a row without a command before the hold
     startup_timeout: float = 10.0  # s of wall time for the first command
     resend: float = 0.005  # s: lockstep re-sends an unanswered status after this wall time
     hold_time: float = 0.5  # s simulated: the hold after a fault before the run ends
@@ -63,6 +80,7 @@ class LinkSettings:
     realtime_rate: float = 1.0
     drop_status: float = 0.0  # a test option: the fraction of status messages not sent
     seed: int = 0
+    priority: int = DEFAULT_PRIORITY  # real time: SCHED_FIFO priority of the loop (0: none; ``priority``)
 
 
 @dataclass
@@ -86,11 +104,14 @@ class LinkRecord:
     accepted: int = 0
     duplicates: int = 0  # a command repeated for its status (an answer to a re-sent status)
     late: int = 0  # real time: ticks whose command did not arrive within the budget
+    late_run_max: int = 0  # real time: the most ticks in a row without a command
     late_commands: int = 0  # commands that arrived after their tick
     gripper_commands: int = 0  # gripper commands taken (pick world)
+    last_command_t: Optional[float] = None  # simulated t of the last command accepted
     fault: Optional[str] = None
     fault_time: Optional[float] = None
     fault_kind: Optional[str] = None
+    stop_signal: Optional[int] = None  # SIGINT or SIGTERM received: the run was stopped (held)
 
 
 ACTIVE: ContextVar[Optional["HardwareSession"]] = ContextVar("ptint_hardware_session", default=None)
@@ -121,6 +142,19 @@ class HardwareSession:
             None  # a ``link.SenderWatch`` of the command channels (udpm URLs), set by ``sim_hardware``
         )
         self._controller: Optional[tuple] = None  # the source address of the first command (the controller)
+        self.warn = None  # a callable for warnings during the run (``sim_hardware``)
+        self._stop: Optional[int] = None  # a signal received (``stop_on_signals``), not yet acted on
+
+    # -- stopping -------------------------------------------------------------------------------
+    def request_stop(self, signum: int) -> None:
+        """A stop asked for (SIGINT or SIGTERM): the next tick, or the wait for a command, is the
+        fault ``stopped``, and the arm is held as after any other fault."""
+        self._stop = signum
+
+    def _check_stop(self, t: float) -> None:
+        if self._stop is not None and self.record.fault is None:
+            self.record.stop_signal = self._stop
+            self._fail(t, "stopped", f"stopped by {signal.Signals(self._stop).name} at t = {t:.3f} s")
 
     # -- the protocol -------------------------------------------------------------------------
     def _publish(self, data: bytes) -> float:
@@ -171,6 +205,7 @@ class HardwareSession:
         if utime == self._pending:
             self._answered, self._answered_tau = utime, tau
             self.record.accepted += 1
+            self.record.last_command_t = utime * 1e-6
             self.record.rtt.append(t_recv - self._sent[utime])
             return None
         if self._answered is not None and utime < self._answered:
@@ -262,6 +297,7 @@ class HardwareSession:
             for t_recv, message in self.endpoint.poll(max(step, 0.0)):
                 self._check(t, message, t_recv)
             self._check_senders(t)
+            self._check_stop(t)
             if self.pick is not None:
                 for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
                     self._check_gripper(t, message)
@@ -293,6 +329,11 @@ class HardwareSession:
         comes (a ``LinkFault`` after ``startup_timeout``), so that the controller may start
         second and starts from the arm's pose; the first tick then sends the status of t = 0
         after the plant's first step (a second sample of t = 0, answered anew)."""
+        quiet_collector()
+        if not self.s.lockstep:  # after the diagram's build: the loop alone runs at that priority
+            refused = request_realtime(self.s.priority)
+            if refused and self.warn is not None:
+                self.warn(refused)
         start = time.perf_counter()
         data = pack_status(0.0, q, v, tau)
         self._set_companions(0.0, extras)
@@ -340,6 +381,9 @@ class HardwareSession:
         tick is then ``gripper_opening(utime_of(t) + utime_of(T))`` when it came."""
         utime = utime_of(t)
         wsg = utime + utime_of(self.s.period) if self.pick is not None else None
+        self._check_stop(t)
+        if self.record.fault is not None:
+            return None
         self.record.tick_time.append(t)
         self.record.tick_wall.append(time.perf_counter())
         if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
@@ -367,10 +411,39 @@ class HardwareSession:
         if self.record.fault is None:
             self.record.late += 1
             self._consecutive_late += 1
-            if self._consecutive_late * self.s.period / self.s.realtime_rate >= self.s.command_timeout:
+            self.record.late_run_max = max(self.record.late_run_max, self._consecutive_late)
+            if self._consecutive_late >= self.s.silent_periods:
                 self._fail(
                     t,
                     "command timeout",
-                    f"command timeout at t = {t:.3f} s (no command for {self._consecutive_late} periods)",
+                    f"command timeout at t = {t:.3f} s (no command for {self._consecutive_late} "
+                    f"periods: the controller is silent or gone)",
                 )
         return None
+
+
+@contextmanager
+def stop_on_signals(session: HardwareSession):
+    """While the block runs, SIGINT and SIGTERM ask ``session`` to stop (``request_stop``): the arm
+    is held for ``hold_time`` and the run ends with its metrics written, as after any fault.  The
+    first signal puts the previous handlers back, so a second one acts as it did before (Ctrl-C
+    twice: ``KeyboardInterrupt``).  Outside the main thread (``in_memory``'s hardware thread)
+    nothing is installed: Python delivers signals to the main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {}
+
+    def handler(signum, _frame):
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+        session.request_stop(signum)
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        previous[sig] = signal.signal(sig, handler)
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            if signal.getsignal(sig) is handler:
+                signal.signal(sig, old)

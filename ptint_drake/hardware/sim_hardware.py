@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import signal
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -22,6 +23,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
+from ptint_drake.hardware.priority import scheduler_name
 from ptint_drake.hardware.session import (
     ACTIVE,
     SETTLED_SPEED,
@@ -29,6 +31,7 @@ from ptint_drake.hardware.session import (
     LinkFault,
     LinkSettings,
     PickLink,
+    stop_on_signals,
 )
 from ptint_drake.hardware.link import (
     COMMAND_CHANNEL,
@@ -131,7 +134,9 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "realtime_rate": None if settings.lockstep else settings.realtime_rate,
         "joints": session.n,
         "command_timeout_s": settings.command_timeout,
+        "silent_periods": None if settings.lockstep else settings.silent_periods,
         "sender_check": "source address" if session.watch is not None else "stamps only",
+        "scheduler": scheduler_name(),
         "handshake_s": handshake_s,
         "round_trip_ms": spread(r.rtt, 1e3),
         "achieved_period_ms": spread(periods, 1e3),
@@ -142,10 +147,13 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "commands_accepted": r.accepted,
         "commands_duplicated": r.duplicates,
         "ticks_late": r.late,
+        "late_run_max": r.late_run_max,
         "commands_late": r.late_commands,
         "fault": r.fault,
         "fault_kind": r.fault_kind,
         "fault_time": r.fault_time,
+        "stop_signal": None if r.stop_signal is None else signal.Signals(r.stop_signal).name,
+        "last_command_t": r.last_command_t,
     }
     if session.pick is not None:
         block |= {
@@ -196,11 +204,13 @@ def run_hardware(
         warn(risk)
     session = HardwareSession(endpoint, n, actuator_effort_limits(plant), settings)
     session.watch = SenderWatch.for_url(endpoint.url, (COMMAND_CHANNEL, WSG_COMMAND_CHANNEL))
+    session.warn = warn
     if pick is not None:
         session.pick = PickLink(parts=len(pick.parts), max_force=pick.gripper.max_force)
     token = ACTIVE.set(session)
     try:  # the hand-shake is the link's initialization event (``CommandLink``): the arm's start as built
-        result = simulate(hw, progress=progress, warn=warn)
+        with stop_on_signals(session):
+            result = simulate(hw, progress=progress, warn=warn)
     finally:
         ACTIVE.reset(token)
         if session.watch is not None:

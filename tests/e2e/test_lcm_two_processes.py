@@ -5,6 +5,7 @@ without one the tests say so and the memq:// unit tests run the checks), one tes
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -23,6 +24,11 @@ PERIOD = 1e-3
 # a process may take seconds to import pydrake and build its diagram when the suite loads both
 # cores (CI): a patient start-up, except where the start-up timeout is what a test checks
 PATIENT = ("--startup-timeout", "60")
+# real time on the loaded 2-core virtual machine of CI: a process (or the machine's virtual CPU)
+# may stall for several milliseconds (measured: sleeps overshooting by up to 8 ms at load 4.5 even
+# under SCHED_FIFO), so the real-time tests that are not about the hold's reaction give a slack
+# of 50 periods; the default 5 is measured by scripts/link_faults.py and tests/unit/test_lcm_checks.py
+SLACK = ("--silent-periods", "50")
 
 
 def ptint(*args: str) -> list[str]:
@@ -46,7 +52,7 @@ def one_line(stderr: str) -> str:
 
 def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     """Acceptance: lockstep across two processes (the drive started second) = ptint run with
-    the control period and plant step at 1 ms: same verdict, e(tf) within 0.1 mm (measured:
+    the control period and plant step at 1 ms: same verdict, e(tf) within 1e-9 m (measured:
     within 1e-10 m)."""
     out = run_plan(
         [
@@ -65,7 +71,7 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     reference = run(CURVE, "{controller: {control_period: 0.001}, multibody: {time_step: 0.001}}").metrics
     assert metrics["status"] == reference["status"] == "ok"
     for seg, ref in zip(metrics["segments"], reference["segments"]):
-        assert abs(seg["e_tf_norm"] - ref["e_tf_norm"]) <= 1e-4
+        assert abs(seg["e_tf_norm"] - ref["e_tf_norm"]) <= 1e-9  # measured: within 1e-10 m
     link = metrics["hardware"]
     assert link["ticks"] == 3000 and link["fault"] is None
     assert link["round_trip_ms"]["count"] >= 2999 and link["round_trip_ms"]["median"] < 50.0
@@ -128,10 +134,13 @@ def test_pick_replan_is_refused_in_one_line(tmp_path):
 
 def test_drive_killed_holds_the_arm(tmp_path):
     """The drive SIGKILLed mid-run (real time, at 30 % of the run): the hardware holds the arm
-    within its timeout (joint speeds below 0.05 rad/s within 0.2 s) and exits 1 with the reason."""
+    after exactly its silent periods without a command (here 20: a loaded CI machine stalls a
+    process for several ms, ``SLACK``; the default 5 is scripts/link_faults.py's row), joint
+    speeds below 0.05 rad/s within 0.2 s, and exits 1 with the reason."""
     out = run_plan(
         [
-            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT, "--out", str(tmp_path / "hw"))},
+            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT, "--silent-periods", "20",
+                                         "--out", str(tmp_path / "hw"))},
             {"name": "drive", "argv": ptint("drive", CURVE, *PATIENT), "kill_when": ["hw", " 30 %"]},
         ],
         tmp_path,
@@ -140,7 +149,32 @@ def test_drive_killed_holds_the_arm(tmp_path):
     assert "command timeout at t" in one_line(out["hw"]["stderr"])
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     assert link["fault_kind"] == "command timeout" and 0.8 < link["fault_time"] < 2.5
+    assert "no command for 20 periods" in link["fault"]
+    # from the last command taken to the hold: 20 ticks (the last command's own tick is not silent)
+    assert abs(link["fault_time"] - link["last_command_t"] - 20 * PERIOD) < 1e-9, link
     assert link["hold"]["settled_s_after_fault"] <= 0.2 and link["hold"]["speed_at_end"] < 0.05
+
+
+@pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGINT", 130)])
+def test_hardware_signal_holds_and_writes(tmp_path, sig, code):
+    """SIGTERM / SIGINT to ``ptint hardware`` mid-run (real time): the arm held for the hold
+    time, metrics.json written with the fault ``stopped``, the exit code the shell gives that
+    signal; the drive, no longer answered, stops with one line."""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT, *SLACK, "--out", str(tmp_path / "hw")),
+             "kill_when": ["hw", " 30 %"], "signal": sig},
+            {"name": "drive", "argv": ptint("drive", CURVE, *PATIENT, "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["hw"]["rc"] == code and out["drive"]["rc"] == 1, out
+    assert f"stopped by {sig} at t" in one_line(out["hw"]["stderr"])
+    metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
+    link = metrics["hardware"]
+    assert metrics["status"] == "failed" and link["fault_kind"] == "stopped" and link["stop_signal"] == sig
+    assert 0.8 < link["fault_time"] < 2.5 and link["hold"]["speed_at_end"] < 0.05
+    assert link["hold"]["held_until"] >= link["fault_time"] + 0.5 - 2 * PERIOD
 
 
 def test_hardware_killed_stops_the_drive(tmp_path):
@@ -296,8 +330,8 @@ def test_realtime_run_completes(tmp_path):
     out = run_plan(
         [
             {"name": "hw",
-             "argv": ptint("hardware", CURVE, *PATIENT, "--quiet", "--out", str(tmp_path / "hw"))},
-            {"name": "drive", "argv": ptint("drive", CURVE, *PATIENT)},
+             "argv": ptint("hardware", CURVE, *PATIENT, *SLACK, "--quiet", "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", CURVE, *PATIENT, "--out", str(tmp_path / "dr"))},
         ],
         tmp_path,
     )
@@ -314,3 +348,9 @@ def test_realtime_run_completes(tmp_path):
     # because a loaded machine falls behind and catches up (measured 0.88 ms with CI beside it)
     assert link["lateness_ms"] is not None and 0.5 < link["achieved_period_ms"]["median"] < 2.0
     assert np.isfinite(link["round_trip_ms"]["p99"])
+    # both loops ran under SCHED_FIFO where the machine permits it (root: CI), else said why
+    drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
+    if os.geteuid() == 0:
+        assert link["scheduler"] == drive["scheduler"] == "SCHED_FIFO 10", (link, drive)
+    else:
+        assert "real-time scheduling (SCHED_FIFO 10) refused" in out["drive"]["stderr"]

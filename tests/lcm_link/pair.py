@@ -2,7 +2,8 @@
 what became of each as JSON: ``python pair.py PLAN_JSON``.
 
 PLAN: a list of {"name", "argv", "delay" (s before starting), "kill_when" ([other name, text]:
-SIGKILL once that process's stderr shows the text, e.g. a progress line), "timeout" (s)}.
+a signal once that process's stderr shows the text, e.g. a progress line), "signal" (its name,
+default "SIGKILL"), "timeout" (s)}.
 Result: {name: {"rc", "stdout", "stderr", "started", "ended", "killed"}}, wall times in s from
 the plan's start.
 """
@@ -10,6 +11,7 @@ the plan's start.
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
 import tempfile
@@ -44,7 +46,7 @@ def main() -> None:
             if proc.poll() is None:
                 when = step.get("kill_when")
                 if when and p["killed"] is None and when[1] in (folder / f"{when[0]}.err").read_text():
-                    proc.kill()
+                    proc.send_signal(getattr(signal, step.get("signal", "SIGKILL")))
                     p["killed"] = now
                 elif now - p["started"] >= step.get("timeout", 120.0):
                     proc.kill()

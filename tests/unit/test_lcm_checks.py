@@ -115,13 +115,44 @@ def test_a_repeated_answer_is_no_fault():
 
 
 def test_realtime_late_ticks_then_timeout():
+    """Real time: a silent controller is held after ``silent_periods`` ticks without a command
+    (5 by default: 5 ms at 1 kHz, where the old rule kept the last torque for 50-250 ms)."""
     session, _ = pair(lockstep=False)
     for k in range(1, 100):  # each tick waits 0.8 ms for its command, then keeps the last torque
         tick(session, k * 1e-3)
         if session.record.fault:
             break
-    # 50 periods in a row without a command = the 50 ms command timeout
-    assert session.record.late == k == 50 and session.record.fault_kind == "command timeout"
+    assert session.record.late == k == 5 and session.record.fault_kind == "command timeout"
+    assert session.record.late_run_max == 5 and "5 periods" in session.record.fault
+
+
+def test_realtime_a_late_tick_between_answers_is_no_fault():
+    """Four ticks in a row without a command, then one answered: the run goes on (late ticks
+    counted, the longest run of them recorded), and the count starts again."""
+    session, _ = pair(lockstep=False, silent_periods=5)
+    t = 0.0
+    for _ in range(3):
+        for _ in range(4):
+            t += 1e-3
+            tick(session, t)
+        t += 1e-3
+        assert np.array_equal(tick(session, t, [pack_command(utime_of(t), np.ones(N))]), np.ones(N))
+    assert session.record.fault is None and session.record.late == 12 and session.record.late_run_max == 4
+
+
+@pytest.mark.parametrize("lockstep", [True, False])
+def test_a_stop_signal_is_a_fault_held_like_the_others(lockstep):
+    """SIGTERM / SIGINT (``request_stop``): the next tick is the fault ``stopped``, naming the
+    signal and the time; no status is published for it."""
+    import signal  # noqa: PLC0415
+
+    session, _ = pair(lockstep=lockstep)
+    tick(session, 0.001, [pack_command(utime_of(0.001), np.ones(N))])
+    sent = session.record.statuses
+    session.request_stop(signal.SIGTERM)
+    assert tick(session, 0.002) is None
+    assert session.record.fault_kind == "stopped" and session.record.stop_signal == signal.SIGTERM
+    assert session.record.fault == "stopped by SIGTERM at t = 0.002 s" and session.record.statuses == sent
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,44 @@
+"""Real-time scheduling for the two link processes, where the system permits it.
+
+A control loop at 1 kHz answers each status within a period; the hardware side holds the arm
+after ``LinkSettings.silent_periods`` ticks (5 ms at 1 kHz) without a command.  Under Linux's
+default scheduler a process that wakes on a busy machine may wait several milliseconds for a
+core (measured on the 2-core machine at load 3.6: 4 of 5 clean real-time runs had 5 ticks in a
+row without a command, each a spurious hold), so ``ptint drive`` and the real-time ``ptint
+hardware`` ask for ``SCHED_FIFO`` (``os.sched_setscheduler``), as a robot's control PC runs its
+loop.  That needs ``CAP_SYS_NICE`` (root, or an ``rtprio`` entry in
+``/etc/security/limits.conf``); without it the process keeps the default scheduler and says so
+in one warning.  Both loops sleep in ``select`` between messages, so a FIFO priority never spins
+a core; the kernel's real-time throttling (``sched_rt_runtime_us``) leaves the rest of the
+machine 5 % in any case.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Optional
+
+DEFAULT_PRIORITY = 10  # SCHED_FIFO priority (1-99); low enough to leave the kernel's threads above it
+
+
+def request_realtime(priority: int) -> Optional[str]:
+    """Ask for ``SCHED_FIFO`` at ``priority`` for this process (0: keep the default scheduler);
+    returns a warning when the system refused, else None."""
+    if priority <= 0 or not hasattr(os, "sched_setscheduler"):
+        return None
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except (PermissionError, OSError) as exc:
+        return (f"real-time scheduling (SCHED_FIFO {priority}) refused ({exc.strerror or exc}): on a "
+                f"loaded machine late commands may hold the arm; run as root, give the user an "
+                f"rtprio limit, or pass --priority 0 to silence this")
+    return None
+
+
+def scheduler_name() -> str:
+    """This process's scheduling policy as metrics report it: ``SCHED_FIFO 10`` or ``default``."""
+    if not hasattr(os, "sched_getscheduler"):
+        return "default"
+    if os.sched_getscheduler(0) == os.SCHED_FIFO:
+        return f"SCHED_FIFO {os.sched_getparam(0).sched_priority}"
+    return "default"
