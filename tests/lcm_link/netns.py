@@ -6,8 +6,8 @@ multicast stays on this machine; no packet can reach the host's own network).
 ``224.0.0.0/4 dev lo``): ``unshare -n`` as root, so that the processes keep root's real
 capabilities (the link's loops ask for SCHED_FIFO, ``hardware.priority``); otherwise
 ``unshare -rn``, a user namespace beside the network one, whose root cannot change scheduling.
-Tests that need two processes call ``require_netns()``, which does not skip silently: without a namespace it warns
-with the reason and skips, and the single-process in-memory tests (``memq://``,
+Tests that need two processes call ``require_netns()``, which does not skip silently: without
+a namespace it warns with the reason and skips, and the single-process in-memory tests (``memq://``,
 tests/unit/test_lcm_checks.py) still run the same checks.
 """
 
