@@ -61,11 +61,12 @@ def _add_hardware_parser(sub) -> None:
         help="the simulated world as hardware over LCM (with `ptint drive`; docs/hardware.md)",
         description="Run the scenario's world alone as the hardware: a discrete plant at the control period "
         "publishing the arm's status (lcmt_iiwa_status on IIWA_STATUS) and applying the torque "
-        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive` (a pick "
-        "scenario adds the gripper's lcmt_schunk_wsg_status/command and the parts' motion); a fault "
-        "(no command, a bad command, a second sender) holds the arm and ends the run with its "
-        "reason. Writes metrics.json (the verdict, and a hardware block with the latency) and "
-        "series.npz. Exit 0 ok, 1 missed or a fault, 2 bad input.",
+        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive` (a station "
+        "with a gripper adds the gripper's lcmt_schunk_wsg_status/command and its objects' motion); a "
+        "fault (no command, a bad command, a second sender) holds the arm and ends the run with its "
+        "reason, and so do SIGINT and SIGTERM (exit 130, 143). Writes metrics.json (the verdict, and "
+        "a hardware block with the latency) and series.npz. Exit 0 ok, 1 missed or a fault, 2 bad "
+        "input.",
     )
     hw.add_argument("scenario", help="a bundled scenario name (ptint list) or a YAML file")
     _add_hardware_link_options(hw)
@@ -281,16 +282,16 @@ def cmd_hardware(args: argparse.Namespace) -> int:
     link = metrics["hardware"]
     _print_link(link)
     if link["fault"]:
-        if scenario.pick is None:
-            _print_segments(scenario.name, metrics["segments"])
+        _print_segments(scenario.name, metrics.get("segments", []))
         _print_fault(link, out)
         if link.get("stop_signal"):  # stopped by a signal: the shell's code for it, after the hold
             return 128 + int(getattr(signal, link["stop_signal"]))
         return 1
-    if scenario.pick is not None:  # the pick world's lines and verdict, as `ptint run` prints them
-        from ptint_drake.worlds.registry import world_of  # noqa: PLC0415
+    from ptint_drake.worlds.registry import world_of  # noqa: PLC0415
 
-        return world_of(scenario).report(scenario, metrics, out)
+    own = world_of(scenario).report(scenario, metrics, out)  # the world's own lines, as `ptint run`'s
+    if own is not None:
+        return own
     _print_segments(scenario.name, metrics["segments"])
     if metrics["status"] != "ok":
         print(f"{scenario.name}: {metrics['status'].upper()} ({'; '.join(metrics['reasons'])}); wrote {out}/")

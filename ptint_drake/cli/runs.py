@@ -70,6 +70,18 @@ def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
             + (f"MISSED ({', '.join(reasons)})" if reasons else "ok"))
 
 
+def _sim_line(metrics: dict, out) -> str:
+    """The run's cost line: what every world's ``sim`` block has (the realtime factor, the steps),
+    and the derivative evaluations and saturation where the world reports them."""
+    sim = metrics["sim"]
+    parts = [f"realtime factor {sim['realtime_factor']:.2f} end to end", f"{sim['steps']} steps"]
+    if "derivative_evaluations" in sim:
+        parts.append(f"{sim['derivative_evaluations']} derivative evaluations")
+    if metrics.get("saturated_fraction") is not None:
+        parts[-1] += f", saturated {100 * metrics['saturated_fraction']:.1f} % of the time"
+    return ", ".join(parts) + f"; wrote {out}/"
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     """One scenario: its outputs, a line per segment; exit 1 when a segment missed or the run failed."""
     from ptint_drake.report.run_outputs import run_and_write  # noqa: PLC0415
@@ -87,10 +99,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         return own
     for i, seg in enumerate(metrics["segments"]):
         print(_segment_line(scenario.name, i, seg, scenario.criteria))
-    sim = metrics["sim"]
-    print(f"realtime factor {sim['realtime_factor']:.2f} end to end, {sim['steps']} steps, "
-          f"{sim['derivative_evaluations']} derivative evaluations, saturated "
-          f"{100 * metrics['saturated_fraction']:.1f} % of the time; wrote {out}/")
+    print(_sim_line(metrics, out))
     for message in metrics["warnings"][metrics["warnings_before_run"]:]:
         warn(message)
     if metrics["status"] == "failed":

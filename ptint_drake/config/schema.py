@@ -11,15 +11,26 @@ the field types.)
 """
 
 from dataclasses import dataclass, field
-from typing import ClassVar, List, Optional
+from typing import ClassVar, Dict, List, Optional
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
-from ptint_drake.config.controller import ControllerConfig
+from ptint_drake.config.controller import ControllerConfig, ParamValue
 from ptint_drake.config.criteria import Criteria
 from ptint_drake.config.measurement import MeasurementConfig
 from ptint_drake.config.pick import PickConfig
+
+
+@dataclass
+class WorldConfig:
+    """A world of the user's own (``worlds.registry``): ``type`` = ``"module:Class"``, a
+    ``worlds.World`` subclass in the user's file (looked up like a plugin controller: the
+    scenario's folder, the current directory, ``PYTHONPATH``), constructed with no arguments;
+    ``params``: its settings, which it reads from the scenario."""
+
+    type: str = ""
+    params: Dict[str, ParamValue] = field(default_factory=dict)
 
 
 @dataclass
@@ -144,6 +155,8 @@ class Scenario:
     # a pick and place (``worlds.pick``): the world and the tasks, whose segments replace
     # ``interceptions`` (None: an interception scenario)
     pick: Optional[PickConfig] = None
+    # a world of the user's own (``WorldConfig``; None: the world of the blocks above)
+    world: Optional[WorldConfig] = None
     name: str = ""
     # not a YAML field: the folder of the file the scenario was loaded from, where a plugin
     # controller's module is looked for first (``controllers.plugin``); set by loading, carried

@@ -78,23 +78,23 @@ def _error(message: str):
     return ScenarioError(" ".join(message.split()))
 
 
-def load_class(type_: str, folders: Sequence[str] = ()) -> type:
+def load_class(type_: str, folders: Sequence[str] = (), field: str = "controller.type") -> type:
     """The class named by ``module:Class``, its module looked for in ``folders`` first (then
-    ``sys.path``); ScenarioError (one line) if it cannot be had."""
+    ``sys.path``); ScenarioError (one line, naming the scenario's ``field``) if it cannot be had."""
     module_name, _, class_name = type_.partition(":")
     saved = list(sys.path)
     sys.path[:0] = list(folders)
     try:
         module = importlib.import_module(module_name)
     except Exception as exc:  # any failure of the user's module is one line
-        raise _error(f"controller.type: cannot import {module_name!r} for {type_!r} "
+        raise _error(f"{field}: cannot import {module_name!r} for {type_!r} "
                      f"({type(exc).__name__}: {exc}); looked in the scenario's folder, the "
                      f"current directory and PYTHONPATH") from None
     finally:
         sys.path[:] = saved
     cls = getattr(module, class_name, None)
     if not isinstance(cls, type):
-        raise _error(f"controller.type: {module_name!r} has no class {class_name!r} ({type_!r})")
+        raise _error(f"{field}: {module_name!r} has no class {class_name!r} ({type_!r})")
     return cls
 
 

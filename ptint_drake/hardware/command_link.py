@@ -48,7 +48,7 @@ class CommandLink(LeafSystem):
             raise RuntimeError("CommandLink runs inside `ptint hardware` only (no LCM session)")
         self._session = session
         session.builds += 1
-        self._replanned = session.builds > 1  # a pick world's retry rebuilt the diagram
+        self._replanned = session.builds > 1  # a world planned anew (a retry) and rebuilt the diagram
         self._plant = plant
         self._scratch = plant.CreateDefaultContext()  # a work area for the model's terms, no state
         nq, nv, nu = plant.num_positions(), plant.num_velocities(), plant.num_actuators()
@@ -57,14 +57,14 @@ class CommandLink(LeafSystem):
         self._limits = actuator_effort_limits(plant)
         self._state = self.DeclareVectorInputPort("state", nq + nv)
         self.DeclareVectorInputPort("target", 9)
-        self._pick = session.pick
-        # discrete state: [τ (nu), mode (0 commanded, 1 held), t_fault, q_hold (nq), (pick) the gripper's
+        self._ports = session.ports
+        # discrete state: [τ (nu), mode (0 commanded, 1 held), t_fault, q_hold (nq), (a gripper) its
         # opening command]
-        self._xd = self.DeclareDiscreteState(nu + 2 + nq + (1 if self._pick else 0))
-        if self._pick is not None:
+        self._xd = self.DeclareDiscreteState(nu + 2 + nq + (1 if self._ports else 0))
+        if self._ports is not None:
             self._fingers = self.DeclareVectorInputPort("gripper_state", 4)
             self._drive = self.DeclareVectorInputPort("grip_force", 2)
-            self._parts = self.DeclareVectorInputPort("parts", PART_SIZE * self._pick.parts)
+            self._parts = self.DeclareVectorInputPort("parts", PART_SIZE * self._ports.objects)
             self.DeclareVectorOutputPort(
                 "gripper_command",
                 1,
@@ -80,14 +80,15 @@ class CommandLink(LeafSystem):
             prerequisites_of_calc={self.discrete_state_ticket(self._xd)},
         )
 
-    def wire_pick(self, builder, station, sequence):
-        """In the pick world's diagram (``worlds.pick.run.build_pick``): the station's gripper and
-        parts into the link, and the gripper command the link took (in place of the plan's
-        ``sequence``: the drive side runs it) out; returns that output port."""
+    def wire_station(self, builder, station, sequence):
+        """In a world's diagram with a gripper (``World.link_ports``): the station's gripper and
+        objects (``part_k_pose`` / ``part_k_rotation``) into the link, and the gripper command the
+        link took (in place of the world's ``sequence``: the drive side runs it) out; returns that
+        output port."""
         builder.Connect(station.GetOutputPort("gripper_state"), self._fingers)
         builder.Connect(station.GetOutputPort("grip_force"), self._drive)
-        mux = builder.AddNamedSystem("link_parts", Multiplexer([9, 15] * self._pick.parts))
-        for k in range(self._pick.parts):
+        mux = builder.AddNamedSystem("link_parts", Multiplexer([9, 15] * self._ports.objects))
+        for k in range(self._ports.objects):
             builder.Connect(station.GetOutputPort(f"part_{k}_pose"), mux.get_input_port(2 * k))
             builder.Connect(station.GetOutputPort(f"part_{k}_rotation"), mux.get_input_port(2 * k + 1))
         builder.Connect(mux.get_output_port(), self._parts)
@@ -97,20 +98,20 @@ class CommandLink(LeafSystem):
         output.SetAtIndex(0, context.get_discrete_state(self._xd).value()[-1])
 
     def _extras(self, context):
-        """The pick world's companions of a status: fingers, drive forces, the parts' motion."""
-        if self._pick is None:
+        """The station's companions of a status: fingers, drive forces, the objects' motion."""
+        if self._ports is None:
             return None
         return self._fingers.Eval(context), self._drive.Eval(context), self._parts.Eval(context)
 
     def _initialize(self, context, discrete_state) -> None:
         """The hand-shake (``HardwareSession.handshake``) with the arm's start, once per session;
-        in the pick world the gripper command it brings is the driver's at t = 0."""
+        with a gripper the gripper command it brings is the driver's at t = 0."""
         xd = context.get_discrete_state(self._xd).value().copy()
         session = self._session
         if session.handshake_s is None:
             x = self._state.Eval(context)
             session.handshake(x[: self._nq], x[self._nq :], np.zeros(self._nu), self._extras(context))
-            if self._pick is not None:
+            if self._ports is not None:
                 xd[-1] = session.gripper_opening(0)
         discrete_state.get_mutable_vector(self._xd).SetFromVector(xd)
 
@@ -140,14 +141,14 @@ class CommandLink(LeafSystem):
             session._fail(
                 t,
                 "replan unsupported",
-                f"the pick's grasp check before t = {t:.3f} s planned anew (a retry, an abort or a "
-                f"longer wait for the grasp): replanning is not supported across processes",
+                f"the world planned anew before t = {t:.3f} s (a retry, an abort or a longer wait for "
+                f"the grasp): replanning is not supported across processes",
             )
         if mode == 0.0 and session.record.fault is None and t < session.s.duration - 0.5 * session.s.period:
             command = session.exchange(t, q, v, tau.copy(), self._extras(context))
             if session.record.fault is None and command is not None:
                 xd[:nu] = command
-            if session.record.fault is None and self._pick is not None:
+            if session.record.fault is None and self._ports is not None:
                 opening = session.gripper_opening(utime_of(t) + utime_of(session.s.period))
                 if opening is not None:
                     xd[-1] = opening

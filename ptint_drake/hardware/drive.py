@@ -109,11 +109,12 @@ class DriveRecord:
 
 
 def DriveDiagram(scenario: Scenario):
-    """(diagram, controller handles, joint count, the world's controller side or None: the pick world's
-    ``worlds.pick.controller_side.PickControllerSide``) of the scenario's
-    controller alone (module docstring).  Inputs: ``state`` (the arm's [q; v]); in the pick world
+    """(diagram, controller handles, joint count, the world's controller side or None:
+    ``World.controller_side``, e.g. a world's targets, gripper sequence and grasp observer) of the
+    scenario's controller alone (module docstring).  Inputs: ``state`` (the arm's [q; v]); with a
+    controller side
     also ``parts`` (``link.PART_SIZE`` a part) and ``gripper`` ([fingers (4), drive forces (2)], as
-    ``link.unpack_wsg_status`` gives them).  Outputs: ``actuation``; in the pick world also
+    ``link.unpack_wsg_status`` gives them).  Outputs: ``actuation``; with a controller side also
     ``grasp_state``."""
     plant = nominal_plant(scenario)
     builder = DiagramBuilder()
@@ -123,9 +124,9 @@ def DriveDiagram(scenario: Scenario):
     unsampled = copy.copy(scenario)  # the hardware samples and holds: no hold of its own here
     unsampled.controller = dataclasses.replace(scenario.controller, control_period=0.0)
     schedule, targets = schedule_of(scenario), objects_of(scenario)
-    # the world's own controller side (the pick world's targets, gripper and grasp observer), if any
-    pick = world_of(scenario).controller_side(builder, scenario, link_period(scenario))
-    target = pick.target if pick is not None else TargetView(builder, None, unsampled, schedule, targets)
+    # the world's own controller side (its targets, gripper sequence and grasp observer), if any
+    side = world_of(scenario).controller_side(builder, scenario, link_period(scenario))
+    target = side.target if side is not None else TargetView(builder, None, unsampled, schedule, targets)
     handles = AddControllerTo(
         builder,
         plant=plant,
@@ -141,7 +142,7 @@ def DriveDiagram(scenario: Scenario):
     builder.ExportOutput(actuation.get_output_port(), "actuation")
     diagram = builder.Build()
     diagram.set_name("drive")
-    return diagram, handles, plant.num_actuators(), pick
+    return diagram, handles, plant.num_actuators(), side
 
 
 class _DriveLoop:
@@ -158,8 +159,8 @@ class _DriveLoop:
         warn: Callable[[str], None],
         lcm=None,
     ) -> None:
-        diagram, _, n, pick = DriveDiagram(scenario)
-        self.n, self.settings, self.record, self.pick = n, settings, record, pick
+        diagram, _, n, side = DriveDiagram(scenario)
+        self.n, self.settings, self.record, self.side = n, settings, record, side
         self.period_us = int(round(settings.period * 1e6))
         # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
         # the hardware side rejects a torque beyond an effort limit as a fault
@@ -167,21 +168,21 @@ class _DriveLoop:
         self.simulator = Simulator(diagram)
         config = copy.copy(scenario.simulator)
         own = world_of(scenario).simulator_config(scenario)
-        if own is not None:  # the world's integrator (the pick's: ``pick_simulator``), as in ``ptint run``
+        if own is not None:  # the world's own integrator settings, as in ``ptint run``
             config = copy.copy(own)
         config.target_realtime_rate = 0.0  # the hardware's status paces the drive
         ApplySimulatorConfig(config, self.simulator)
         self.config = config
         self.context = self.simulator.get_mutable_context()
         self.state_in, self.out = diagram.GetInputPort("state"), diagram.GetOutputPort("actuation")
-        also = (WSG_STATUS_CHANNEL, PARTS_CHANNEL) if pick is not None else ()
+        also = (WSG_STATUS_CHANNEL, PARTS_CHANNEL) if side is not None else ()
         self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also, lcm=lcm)
-        if pick is not None:
+        if side is not None:
             self.parts_in, self.gripper_in = diagram.GetInputPort("parts"), diagram.GetInputPort("gripper")
             self.grasp_out = diagram.GetOutputPort("grasp_state")
             self.companions: dict[int, dict] = {}  # utime → {"gripper": [fingers; forces], "parts": motion}
             self.last_companion: Optional[dict] = None
-            self.checks = pick.reads
+            self.checks = side.reads
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
         if risk:
@@ -189,7 +190,7 @@ class _DriveLoop:
         self.answered: Optional[int] = None
         self.answer = b""
         self.last_q = self.last_v = None
-        self.started = False  # the pick world: the events at the first tick's time taken
+        self.started = False  # with a controller side: the events at the first tick's time taken
         self.end = settings.duration - 1.5 * settings.period
         self.quiet_end = False
         self.last_seen = time.perf_counter()
@@ -239,7 +240,7 @@ class _DriveLoop:
             and np.array_equal(v, self.last_v)
         ):
             self.record.repeats += 1
-            if self.pick is not None:
+            if self.side is not None:
                 self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
             self.endpoint.publish(self.answer)
             return
@@ -248,7 +249,7 @@ class _DriveLoop:
             return
         if answered is not None:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
-        self.respond(t_recv, utime, q, v, self.companion(utime) if self.pick is not None else None)
+        self.respond(t_recv, utime, q, v, self.companion(utime) if self.side is not None else None)
 
     def _collect(self) -> None:
         """File the gripper statuses and parts messages received by their ``utime``."""
@@ -260,7 +261,7 @@ class _DriveLoop:
             self.companions.setdefault(utime, {})["gripper"] = np.concatenate([fingers, force])
         for data in self.endpoint.take_side(PARTS_CHANNEL):
             try:
-                utime, motion = unpack_parts(data, self.pick.parts)
+                utime, motion = unpack_parts(data, self.side.parts)
             except ValueError as exc:
                 raise DriveFault(f"parts message rejected: {exc}; stopped commanding") from None
             self.companions.setdefault(utime, {})["parts"] = motion
@@ -304,7 +305,7 @@ class _DriveLoop:
 
     def torque(self, t: float, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None) -> np.ndarray:
         """The controller's torque at the status's time ``t`` for its [q; v] (module docstring),
-        clipped to the effort limits when saturating.  In the pick world ``companion`` holds the
+        clipped to the effort limits when saturating.  With a controller side ``companion`` holds the
         tick's gripper status and parts' motion: the parts are read like the arm's state; the
         gripper status is the grasp observer's at its update at ``t`` (a periodic update like
         the one-process run's hold, which samples the arm after the plant's step)."""
@@ -313,12 +314,12 @@ class _DriveLoop:
             self.context.SetTime(t)
             self.simulator.Initialize()
         elif companion is not None and (t > self.context.get_time() or not self.started):
-            # the pick world: σ over (t_prev, t] with the previous sample; the grasp check reads the
-            # observer there (as ``PickRun.at_stop``); then the events at t with that sample, the
-            # observer's update with this tick's gripper status, by a second ``AdvanceTo(t)`` (at
-            # the time reached it takes the events due, as ``ptint run``'s pick runner does at its
-            # stops: ``PickRun.advance_at_reached_stops``; the first tick, at t = 0 as the
-            # hand-shake, takes the events at t = 0 so); only then the new sample
+            # a controller side: σ over (t_prev, t] with the previous sample; the grasp check reads
+            # the observer there (as the world's run does at its stop); then the events at t with
+            # that sample, the observer's update with this tick's gripper status, by a second
+            # ``AdvanceTo(t)`` (at the time reached it takes the events due, as ``ptint run``'s
+            # runner does at its stops: ``WorldRun.advance_at_reached_stops``; the first tick, at
+            # t = 0 as the hand-shake, takes the events at t = 0 so); only then the new sample
             self.started = True
             self.simulator.AdvanceTo(t)
             self.check_grasp(int(round(t * 1e6)))
@@ -338,7 +339,7 @@ class _DriveLoop:
         return tau
 
     def _fix(self, q: np.ndarray, v: np.ndarray, companion: Optional[dict]) -> None:
-        """The diagram's inputs: a status's [q; v] and, in the pick world, its companions."""
+        """The diagram's inputs: a status's [q; v] and, with a controller side, its companions."""
         self.state_in.FixValue(self.context, np.concatenate([q, v]))
         if companion is not None:
             self.parts_in.FixValue(self.context, companion["parts"])
@@ -347,19 +348,19 @@ class _DriveLoop:
     def respond(
         self, t_recv: float, utime: int, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None
     ) -> None:
-        """Send the command stamped ``utime`` answering a status checked (in the pick world, first,
+        """Send the command stamped ``utime`` answering a status checked (with a gripper, first,
         the gripper command for the driver's next tick), and record it."""
         t = utime / 1e6
         first = self.answered is None
         tau = self.torque(t, q, v, companion)
         self.last_q, self.last_v = q, v
         self.answer = pack_command(utime, tau)
-        if self.pick is not None:
+        if self.side is not None:
             # the gripper's driver takes it at its next tick (the hand-shake's: at t = 0), as the
             # one-process run's driver reads the plan's command at each of its ticks
             at = utime if first else utime + self.period_us
             self.gripper_answer = pack_wsg_command(
-                at, self.pick.sequence.opening(at / 1e6), self.pick.max_force
+                at, self.side.sequence.opening(at / 1e6), self.side.max_force
             )
             self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
         sent = self.endpoint.publish(self.answer)

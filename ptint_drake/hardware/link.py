@@ -13,7 +13,8 @@ The messages are Drake's own (the ``drake`` Python package that ships with pydra
   ``utime`` of the status it answers, ``num_joints`` = 0 (no position), ``num_torques`` = n,
   ``joint_torque`` (N·m, in the plant's actuator order).
 
-The pick world adds Drake's gripper messages and one vector of the parts' motion:
+A station with a gripper (``worlds.base.LinkPorts``) adds Drake's gripper messages and one vector
+of its objects' motion:
 
 - ``lcmt_schunk_wsg_status`` (hardware → drive, channel ``SCHUNK_WSG_STATUS``, Drake's
   ``hardware_sim`` name), one per tick, before the arm's status: ``utime`` as the arm's,
@@ -26,7 +27,7 @@ The pick world adds Drake's gripper messages and one vector of the parts' motion
   ``force`` = the grip force limit (N).
 - ``lcmt_scope`` (hardware → drive, ``PART_MOTION``), one per tick, before the arm's status:
   ``utime`` as the arm's; ``value`` = per part (scenario order) its [x, ẋ, ẍ] (m, m/s, m/s²; the
-  centre, world frame) and [R row-major, ω, ω̇] (rad/s, rad/s²): ``pick.part_pose``'s ports, 24
+  centre, world frame) and [R row-major, ω, ω̇] (rad/s, rad/s²): the station's object ports, 24
   doubles a part.  Drake has no message of a body's full motion (``lcmt_viewer_draw`` carries float
   poses without velocities); ``lcmt_scope`` is its plain vector of doubles.
 
@@ -98,7 +99,7 @@ class Endpoint:
         self.listen, self.publish_channel = listen, publish
         self.inbox: list[tuple[float, bytes]] = []
         self.lcm.Subscribe(listen, lambda data: self.inbox.append((time.perf_counter(), bytes(data))))
-        # the other channels listened to (``also``: the pick world's companions), each its own inbox
+        # the other channels listened to (``also``: the station's companions), each its own inbox
         self.side: dict[str, list] = {c: [] for c in also}
         for channel in also:
             self.lcm.Subscribe(channel, lambda data, c=channel: self.side[c].append(bytes(data)))

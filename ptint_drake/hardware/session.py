@@ -33,6 +33,7 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.hardware.priority import DEFAULT_PRIORITY, request_realtime
+from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.hardware.link import (
     PARTS_CHANNEL,
     WSG_COMMAND_CHANNEL,
@@ -84,14 +85,6 @@ class LinkSettings:
 
 
 @dataclass
-class PickLink:
-    """The pick world's part of the link: the parts' count and the gripper's force limit (N)."""
-
-    parts: int
-    max_force: float
-
-
-@dataclass
 class LinkRecord:
     """What the hardware side measured of the link."""
 
@@ -106,7 +99,7 @@ class LinkRecord:
     late: int = 0  # real time: ticks whose command did not arrive within the budget
     late_run_max: int = 0  # real time: the most ticks in a row without a command
     late_commands: int = 0  # commands that arrived after their tick
-    gripper_commands: int = 0  # gripper commands taken (pick world)
+    gripper_commands: int = 0  # gripper commands taken (a station with a gripper)
     last_command_t: Optional[float] = None  # simulated t of the last command accepted
     fault: Optional[str] = None
     fault_time: Optional[float] = None
@@ -131,13 +124,13 @@ class HardwareSession:
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
         self._after_handshake = False
-        self.pick: Optional[PickLink] = None  # set for the pick world (``sim_hardware``)
+        self.ports: Optional[LinkPorts] = None  # the station's gripper and objects (``sim_hardware``)
         self._wsg: dict[
             int, tuple[float, float]
         ] = {}  # gripper commands: driver's tick utime → (opening, force)
-        self._companions: list = []  # this tick's gripper status and parts messages (pick world)
+        self._companions: list = []  # this tick's gripper status and objects' motion (``ports``)
         self.handshake_s: Optional[float] = None  # wall s the hand-shake took
-        self.builds = 0  # CommandLinks built in this session (more than one: a pick replanned)
+        self.builds = 0  # CommandLinks built in this session (more than one: a world planned anew)
         self.watch = (
             None  # a ``link.SenderWatch`` of the command channels (udpm URLs), set by ``sim_hardware``
         )
@@ -236,12 +229,12 @@ class HardwareSession:
             return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: {exc}")
         if not (np.isfinite(opening) and np.isfinite(force)):
             return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: not finite")
-        if not 0.0 <= force <= self.pick.max_force * (1 + 1e-9):
+        if not 0.0 <= force <= self.ports.gripper_max_force * (1 + 1e-9):
             return self._fail(
                 t,
                 "bad command",
                 f"gripper command rejected at t = {t:.3f} s: force "
-                f"{force:.3g} N outside [0, {self.pick.max_force:g}] N",
+                f"{force:.3g} N outside [0, {self.ports.gripper_max_force:g}] N",
             )
         if utime in self._wsg and self._wsg[utime] != (opening, force):
             return self._fail(
@@ -280,8 +273,8 @@ class HardwareSession:
                 return
 
     def _complete(self, utime: int, wsg: Optional[int]) -> bool:
-        """Whether the answer to the status of ``utime`` is in: the arm's command, and in the pick
-        world the gripper command for the driver's tick ``wsg``."""
+        """Whether the answer to the status of ``utime`` is in: the arm's command, and with a
+        gripper the gripper command for the driver's tick ``wsg``."""
         return self._answered == utime and (wsg is None or wsg in self._wsg)
 
     def _wait(
@@ -298,7 +291,7 @@ class HardwareSession:
                 self._check(t, message, t_recv)
             self._check_senders(t)
             self._check_stop(t)
-            if self.pick is not None:
+            if self.ports is not None:
                 for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
                     self._check_gripper(t, message)
             if self.record.fault is not None:
@@ -313,9 +306,9 @@ class HardwareSession:
                 last_sent = self._publish(data)
 
     def _set_companions(self, t: float, extras) -> None:
-        """The pick world's messages of the tick at ``t`` (``extras`` = fingers, drive forces, the
-        parts' motion; None: the arm alone)."""
-        if extras is None or self.pick is None:
+        """The station's messages of the tick at ``t`` beside the arm's (``extras`` = fingers,
+        drive forces, the objects' motion; None: the arm alone)."""
+        if extras is None or self.ports is None:
             self._companions = []
             return
         fingers, force, parts = extras
@@ -339,7 +332,7 @@ class HardwareSession:
         self._set_companions(0.0, extras)
         self._pending = 0
         self._sent[0] = self._publish(data)
-        wsg = 0 if self.pick is not None else None  # the gripper command the driver takes at t = 0
+        wsg = 0 if self.ports is not None else None  # the gripper command the driver takes at t = 0
         if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True, wsg=wsg):
             if self.record.fault is not None:
                 raise LinkFault(self.record.fault)
@@ -362,7 +355,7 @@ class HardwareSession:
         while True:
             got = self.endpoint.poll(0.01)
             self._check_senders(0.0)
-            if self.pick is not None:
+            if self.ports is not None:
                 for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
                     self._check_gripper(0.0, message)
             now = time.perf_counter()
@@ -375,12 +368,12 @@ class HardwareSession:
     def exchange(
         self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
     ) -> Optional[np.ndarray]:
-        """The tick at ``t``: publish the status (and in the pick world, first, the gripper's status
-        and the parts' motion: ``extras``), take its command (None: none, keep the last torque;
+        """The tick at ``t``: publish the status (and with a gripper, first, the gripper's status
+        and the objects' motion: ``extras``), take its command (None: none, keep the last torque;
         ``record.fault`` says when that is a fault); the gripper command for the driver's next
         tick is then ``gripper_opening(utime_of(t) + utime_of(T))`` when it came."""
         utime = utime_of(t)
-        wsg = utime + utime_of(self.s.period) if self.pick is not None else None
+        wsg = utime + utime_of(self.s.period) if self.ports is not None else None
         self._check_stop(t)
         if self.record.fault is not None:
             return None

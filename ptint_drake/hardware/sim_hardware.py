@@ -30,7 +30,6 @@ from ptint_drake.hardware.session import (
     HardwareSession,
     LinkFault,
     LinkSettings,
-    PickLink,
     stop_on_signals,
 )
 from ptint_drake.hardware.link import (
@@ -60,11 +59,9 @@ def link_period(scenario: Scenario) -> float:
 
 
 def check_link_scenario(scenario: Scenario) -> None:
-    """What the LCM path does not carry yet (ScenarioError, one line): a world other than the
-    interception and pick worlds, a camera, an arm whose joints are not one actuator each."""
-    world = world_of(scenario)
-    if world.name not in ("interception", "pick"):
-        raise ScenarioError(f"the {world.name} world over LCM is not supported yet (issue 35)")
+    """What the LCM path does not carry yet (ScenarioError, one line): a camera.  (An arm whose
+    joints are not one actuator each is refused by ``run_hardware``, which has the model.)"""
+    world_of(scenario)  # a plugin world that cannot be had is a one-line error here
     if scenario.measurement is not None and scenario.measurement.estimator != "none":
         raise ScenarioError(
             "measurement: a camera over LCM is not supported yet (the drive side sees no "
@@ -77,11 +74,14 @@ def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
     the hold), the plant discrete at T, and the simulator paced in real time unless lockstep."""
     out = copy.copy(scenario)
     out.controller = dataclasses.replace(scenario.controller, type=LINK_TYPE, params={}, control_period=0.0)
-    if scenario.multibody is None and scenario.pick is not None:
-        if settings.period != DEFAULT_PERIOD:  # the pick world's own plant steps at 1 ms
+    world = world_of(scenario)
+    own = world.own_plant_step(scenario) if scenario.multibody is None else None
+    if own is not None:
+        if abs(settings.period - own) > 1e-12:  # the world's own plant step
             raise ScenarioError(
                 f"controller.control_period: the hardware side's plant steps at the control period "
-                f"({settings.period * 1e3:g} ms); set multibody.time_step to it"
+                f"({settings.period * 1e3:g} ms), the {world.name} world's at {own * 1e3:g} ms; set "
+                f"multibody.time_step to the control period"
             )
     elif scenario.multibody is None:
         out.multibody = MultibodyPlantConfig(time_step=settings.period)
@@ -94,10 +94,10 @@ def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
             )
         out.multibody = copy.copy(scenario.multibody)
         out.multibody.time_step = settings.period
-    # the world's own integrator (the pick's: one explicit Euler step per control period), kept
+    # the world's own integrator (e.g. one explicit Euler step per control period), kept
     # although the slot runs unsampled here: the link is the hold
-    own = world_of(scenario).simulator_config(scenario)
-    out.simulator = copy.copy(own if own is not None else scenario.simulator)
+    config = world.simulator_config(scenario)
+    out.simulator = copy.copy(config if config is not None else scenario.simulator)
     out.simulator.target_realtime_rate = 0.0 if settings.lockstep else settings.realtime_rate
     return out
 
@@ -155,7 +155,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "stop_signal": None if r.stop_signal is None else signal.Signals(r.stop_signal).name,
         "last_command_t": r.last_command_t,
     }
-    if session.pick is not None:
+    if session.ports is not None:
         block |= {
             "gripper_status_channel": WSG_STATUS_CHANNEL,
             "gripper_command_channel": WSG_COMMAND_CHANNEL,
@@ -191,13 +191,13 @@ def run_hardware(
             f"positions, {n} actuators)"
         )
     hw = hardware_scenario(scenario, settings)
-    pick = scenario.pick
+    ports = world_of(scenario).link_ports(scenario)
     endpoint = Endpoint(
         url,
         lcm=lcm,
         listen=COMMAND_CHANNEL,
         publish=STATUS_CHANNEL,
-        also=(WSG_COMMAND_CHANNEL,) if pick is not None else (),
+        also=(WSG_COMMAND_CHANNEL,) if ports is not None else (),
     )
     risk = url_warning(endpoint.url)
     if risk:
@@ -205,8 +205,7 @@ def run_hardware(
     session = HardwareSession(endpoint, n, actuator_effort_limits(plant), settings)
     session.watch = SenderWatch.for_url(endpoint.url, (COMMAND_CHANNEL, WSG_COMMAND_CHANNEL))
     session.warn = warn
-    if pick is not None:
-        session.pick = PickLink(parts=len(pick.parts), max_force=pick.gripper.max_force)
+    session.ports = ports
     token = ACTIVE.set(session)
     try:  # the hand-shake is the link's initialization event (``CommandLink``): the arm's start as built
         with stop_on_signals(session):

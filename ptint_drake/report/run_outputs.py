@@ -21,7 +21,7 @@ from pathlib import Path
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
 from ptint_drake.simulation import build, simulate
-from ptint_drake.worlds.registry import world_named, world_of
+from ptint_drake.worlds.registry import world_key, world_named, world_of
 
 
 def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figures: bool = True,
@@ -114,8 +114,8 @@ def view_tasks(scenario: Scenario, series: dict, metrics: dict, stage: Path, fig
     """``view_task`` arguments for a run's figures (PNG, and SVG when ``svg``) and its
     ``replay.html``, written in ``stage`` (the world's ``view_tasks``)."""
     world = world_of(scenario)
-    return [(world.name, *task) for task in world.view_tasks(scenario, series, metrics, stage, figures,
-                                                             replay, svg)]
+    key = world_key(scenario)
+    return [(key, *task) for task in world.view_tasks(scenario, series, metrics, stage, figures, replay, svg)]
 
 
 @contextmanager

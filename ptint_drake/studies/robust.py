@@ -63,7 +63,6 @@ from ptint_drake.scenario import LoadedScenario, ScenarioError, dump_yaml, parse
 from ptint_drake.simulation import simulate
 from ptint_drake.studies.runner import run_tasks
 from ptint_drake.worlds.registry import world_of
-from ptint_drake.systems.camera import MeasurementConfig
 
 RANGES = {
     "mass": (0.7, 1.5),
@@ -107,6 +106,11 @@ class Draws:
     def __call__(self, key: str, size=None):
         return self._rng.uniform(*self._ranges[key], size)
 
+    @property
+    def rng(self) -> np.random.Generator:
+        """The sample's generator, for draws outside the ranges (in the order called)."""
+        return self._rng
+
     def bounds(self, key: str) -> tuple[float, float]:
         low, high = self._ranges[key]
         return float(low), float(high)
@@ -117,42 +121,7 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
     scenario = parse_scenario(text, name)
     rng = np.random.default_rng(seed)
     u = Draws(rng, ranges)
-    own = world_of(scenario).robust_sample(scenario, name, seed, u)
-    if own is not None:
-        return own
-    nv = len(scenario.robot.initial_q_deg)
-    p = scenario.plant
-    p.mass_scale = float(u("mass"))
-    p.damping_scale = float(u("friction"))
-    p.coulomb = u("coulomb", nv).tolist()
-    p.payload_kg = float(u("payload"))
-    bound = ranges["disturbance"]
-    p.disturbance.amplitude = u("disturbance", nv).tolist()
-    p.disturbance.frequency_hz = float(rng.uniform(0.5, 3.0))
-    p.disturbance.phase = rng.uniform(0.0, 2 * np.pi, nv).tolist()
-    p.disturbance.step = rng.uniform(-bound[1], bound[1], nv).tolist()
-    p.disturbance.step_time = float(rng.uniform(0.0, scenario.duration))
-    m = _camera(scenario, ranges)
-    noise, latency = float(u("noise")), float(u("latency"))
-    if m is not None:
-        m.noise_std, m.latency, m.seed = noise, latency, int(seed)
-    scenario.name = f"{name}_seed{seed}"
-    params = {"mass_scale": p.mass_scale, "damping_scale": p.damping_scale, "coulomb": p.coulomb,
-              "payload_kg": p.payload_kg, "disturbance_amplitude": p.disturbance.amplitude,
-              "disturbance_frequency_hz": p.disturbance.frequency_hz,
-              "disturbance_step": p.disturbance.step, "disturbance_step_time": p.disturbance.step_time,
-              "noise_std": noise, "latency": latency}
-    return scenario, params
-
-
-def _camera(scenario, ranges: dict):
-    """The sample's camera (``estimator: auto``; the scenario's own if it has one), or None
-    when the noise and latency ranges are both [0, 0]."""
-    if max(ranges["noise"]) <= 0.0 and max(ranges["latency"]) <= 0.0:
-        return scenario.measurement
-    if scenario.measurement is None or scenario.measurement.estimator == "none":
-        scenario.measurement = MeasurementConfig()
-    return scenario.measurement
+    return world_of(scenario).robust_sample(scenario, name, seed, u)
 
 
 def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dict:
@@ -167,24 +136,7 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
     except Exception as exc:  # noqa: BLE001  (any other: still a verdict, named by its type)
         return {"seed": seed, "params": params, "ok": False, "status": "error",
                 "error": " ".join(f"{type(exc).__name__}: {exc}".split())[:300]}
-    m = result.metrics
-    e_tf = [s["e_tf_norm"] for s in m["segments"]]
-    own = world_of(scenario).robust_row(seed, params, m)
-    if own is not None:
-        return own
-    return {
-        "seed": seed, "params": params,
-        "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
-        "status": m["status"],
-        "e_tf": e_tf,
-        "e_tf_max": max((v for v in e_tf if v is not None), default=None) if all(
-            v is not None for v in e_tf) else None,
-        "hold_max": max((s["e_hold_max_norm"] or 0.0) for s in m["segments"]),
-        "torque_peak": m["torque_peak"],
-        "saturated_fraction": m["saturated_fraction"],
-        "realtime_factor": m["sim"]["realtime_factor"],
-        "warnings": m["warnings"],
-    }
+    return world_of(scenario).robust_row(seed, params, result.metrics)
 
 
 def _percentiles(values) -> dict:
@@ -211,7 +163,8 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                      workers=workers or (None if executor or dask else 1), dask=dask,
                      executor=executor, progress=report, stats=stats, folders=loaded.folders)
     wall = time.perf_counter() - t0
-    finished = [r for r in rows if r.get("e_tf_max") is not None and "torque_peak" in r]
+    finished = [r for r in rows if r.get("e_tf_max") is not None]
+    torqued = [r for r in finished if r.get("torque_peak") is not None]  # a world that logs torques
     failed_first = sorted(rows, key=lambda r: (r["ok"], -(r.get("e_tf_max") or np.inf)))
     worst = failed_first[0]
     worst_scenario, _ = sample_scenario(text, name, worst["seed"], ranges)
@@ -226,7 +179,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                       "e_tf_max": r.get("e_tf_max"), "error": r.get("error")}
                      for r in rows if not r["ok"]],
         "e_tf_percentiles": _percentiles([r["e_tf_max"] for r in finished]),
-        "torque_peak_percentiles": _percentiles([max(r["torque_peak"]) for r in finished]),
+        "torque_peak_percentiles": _percentiles([max(r["torque_peak"]) for r in torqued]),
         "hold_max_percentiles": _percentiles([r["hold_max"] for r in finished]),
         "worst": {"seed": worst["seed"], "ok": worst["ok"], "e_tf": worst.get("e_tf"),
                   "params": worst["params"]},
@@ -250,7 +203,7 @@ def histogram(result: dict, out_dir: Path) -> None:
 
     if "pick_success_rate" in result:
         return _pick_histogram(result, out_dir)
-    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None and "torque_peak" in r]
+    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None]
     n, n_ok = result["samples"], sum(1 for r in result["rows"] if r["ok"])
     n_failed = n - len(rows)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
@@ -260,10 +213,11 @@ def histogram(result: dict, out_dir: Path) -> None:
         lo, hi = min(e.min(), 1.0) / 1.5, max(e.max(), 1.0) * 1.5
         ok = np.array([r["ok"] for r in rows])
         edges = np.geomspace(lo, hi, bins + 1)
-        torque = np.array([max(r["torque_peak"]) for r in rows])
+        torque = np.array([max(r["torque_peak"]) for r in rows if r.get("torque_peak") is not None])
         groups = [(ok, "intercepted", "tab:blue"), (~ok, "missed", "tab:red")]
         groups = [g for g in groups if g[0].any()]  # no legend entry for an empty group
-        for ax, values, b in ((axes[0], e, edges), (axes[1], torque, bins)):
+        plots = [(axes[0], e, edges)] + ([(axes[1], torque, bins)] if len(torque) == len(rows) else [])
+        for ax, values, b in plots:
             ax.hist([values[m] for m, _, _ in groups], bins=b, stacked=True, edgecolor="white",
                     linewidth=0.6,
                     color=[c for _, _, c in groups], label=[lab for _, lab, _ in groups])
@@ -275,7 +229,8 @@ def histogram(result: dict, out_dir: Path) -> None:
         ax.set_ylabel("samples")
         ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3, axis="y")
-        ax.legend(fontsize=8)
+        if ax.get_legend_handles_labels()[0]:  # (no torques: a world that does not log them)
+            ax.legend(fontsize=8)
     failed = f", {n_failed} failed before the end" if n_failed else ""
     fig.suptitle(f"{result['scenario']}: {n_ok} of {n} samples intercepted "
                  f"({100 * result['success_rate']:.1f} %){failed}")

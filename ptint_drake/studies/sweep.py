@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 # Imported here, not in the worker function: forked workers then inherit them ready.
-from ptint_drake.figures import plt, save, uniform_derivatives
+from ptint_drake.figures import plt, save
 from ptint_drake.outputs import write_text_atomic
 from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, validate
 from ptint_drake.simulation import simulate
@@ -40,35 +40,11 @@ def sweep_point(text: str, name: str, beta: float, tf: float) -> dict:
     row = {"beta": beta, "tf": tf, "error": ""}
     try:
         scenario = parse_scenario(text, name)
-        own = world_of(scenario).sweep_point(row, scenario, beta, tf, simulate, validate)
-        if own is not None:
-            return own
-        for ic in scenario.interceptions:
-            ic.beta, ic.tf = beta, tf
-        last = scenario.interceptions[-1]
-        scenario.duration = max(scenario.duration, last.start + 2.0 * tf)
-        validate(scenario)
-        result = simulate(scenario)
+        return world_of(scenario).sweep_point(row, scenario, beta, tf, simulate, validate)
     except (ScenarioError, RuntimeError) as exc:
         row["error"] = " ".join(str(exc).split())[:200]
         row["ok"] = False
         return row
-    m = result.metrics
-    segs = m["segments"]
-    _, _, _, jerk = uniform_derivatives(result.series["t"], result.series["xdot"])
-    row.update({
-        "e0": max(s["e0_norm"] for s in segs),
-        "e_tf": max(s["e_tf_norm"] for s in segs),
-        "e_half": min(s["e_half_norm"] for s in segs),
-        "hold": max(s["e_hold_max_norm"] for s in segs),
-        "peak_torque": float(np.max(m["torque_peak"])),
-        "peak_torque_after_startup": float(np.max(m["torque_peak_after_startup"])),
-        "peak_jerk": float(np.max(np.linalg.norm(jerk, axis=1))),
-        "realtime_factor": m["sim"]["realtime_factor"],
-        "steps": m["sim"]["steps"],
-        "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
-    })
-    return row
 
 
 def run_sweep(loaded: LoadedScenario, betas, tfs, executor: Executor = None, workers: int = None,

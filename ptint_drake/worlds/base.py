@@ -26,6 +26,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
+import numpy as np
+
+from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.metrics import Reason
 from ptint_drake.systems.schedule import Schedule
@@ -48,6 +51,16 @@ class RunResult:
     @property
     def ok(self) -> bool:
         return self.metrics.get("status") == "ok"
+
+
+@dataclass(frozen=True)
+class LinkPorts:
+    """A station's ports that cross ``ptint hardware``'s link beside the arm's (``World.link_ports``):
+    a gripper (status out, command in; ``gripper_max_force`` N, the commands' limit) and the
+    motion of ``objects`` bodies, in the station's order (``link.PART_SIZE`` doubles each)."""
+
+    gripper_max_force: float
+    objects: int
 
 
 class WorldRun:
@@ -154,33 +167,102 @@ class World:
         analytic targets suffice (``hardware.drive``)."""
         return None
 
+    def own_plant_step(self, scenario: Scenario) -> Optional[float]:
+        """The plant step (s) this world sets itself when ``scenario`` has no ``multibody`` block
+        (None: the scenario decides, continuous without one); ``ptint hardware`` steps the plant
+        at the control period and refuses a world whose own step differs."""
+        return None
+
+    def link_ports(self, scenario: Scenario) -> Optional["LinkPorts"]:
+        """What this world's station sends and takes over ``ptint hardware``'s LCM link beside
+        the arm's status and torque (None: the arm alone)."""
+        return None
+
     def floor_diagram(self, scenario: Scenario, kind: str):
         """``ptint bench``'s floor diagrams (``studies.benchmark.floors``), or None."""
         return None
 
-    # Hooks of the studies and the command line: None (or {}) where the world takes the common path.
+    # Hooks of the studies and the command line.  Each default below belongs to no world: it
+    # reads only what every world has (the arm, its plant block, the verdict), or refuses in one
+    # line what only some worlds can do; a world overrides what it does its own way.
 
     def report(self, scenario: Scenario, metrics: dict, out) -> Optional[int]:
-        """Print ``ptint run``'s lines of a finished run and return the exit code, or None."""
+        """Print ``ptint run``'s lines of a finished run and return the exit code, or None: the
+        command's own lines (the verdict and its reasons, which every world's metrics carry)."""
         return None
 
     def tune_refusal(self, name: str) -> Optional[str]:
-        """Why ``ptint tune`` cannot search this world's scenario ``name`` (None: it can)."""
-        return None
+        """Why ``ptint tune`` cannot search this world's scenario ``name`` (None: it can).  The
+        default refuses: tune reads the interceptor's segment verdicts of a world that says it can."""
+        return (f"scenario: {name} belongs to the {self.name} world, which ptint tune does not "
+                f"search (World.tune_refusal)")
 
-    def robust_sample(self, scenario: Scenario, name: str, seed: int, u) -> Optional[tuple]:
-        """(scenario, params) of a ``robust`` sample drawn with ``u(key, size=None)``, or None."""
-        return None
+    def robust_sample(self, scenario: Scenario, name: str, seed: int, u) -> tuple:
+        """(scenario, params) of a ``robust`` sample drawn with ``u(key, size=None)`` (``u.rng``:
+        the sample's generator): by default the arm's own deviations, which every world has —
+        link masses, joint friction, Coulomb friction, a payload, a disturbance torque
+        (``arm_sample``)."""
+        return arm_sample(scenario, name, seed, u)
 
-    def robust_row(self, seed: int, params: dict, metrics: dict) -> Optional[dict]:
-        """What a ``robust`` sample keeps of its metrics, or None."""
-        return None
+    def robust_row(self, seed: int, params: dict, metrics: dict) -> dict:
+        """What a ``robust`` sample keeps of its metrics: by default the verdict and what every
+        run reports, and per segment of the interceptor's schedule e(tf) and the hold."""
+        return segment_row(seed, params, metrics)
 
     def robust_summary(self, rows: list) -> dict:
         """This world's entries of robust.json's summary."""
         return {}
 
     def sweep_point(self, row: dict, scenario: Scenario, beta: float, tf: float, simulate, validate
-                    ) -> Optional[dict]:
-        """A ``sweep`` grid point (β of every segment, tf), simulated, or None."""
-        return None
+                    ) -> dict:
+        """A ``sweep`` grid point (β of every segment, tf), simulated into ``row``.  The default
+        refuses in one line (``ScenarioError``): a β × tf grid is a world's own."""
+        raise ScenarioError(f"scenario: the {self.name} world has no β × tf grid to sweep "
+                            f"(World.sweep_point)")
+
+
+def arm_sample(scenario: Scenario, name: str, seed: int, u) -> tuple:
+    """The arm's deviations of a ``robust`` sample, drawn in this order (a sample is reproduced
+    from its seed): ``plant.mass_scale``, ``damping_scale``, ``coulomb`` (per joint),
+    ``payload_kg``, the disturbance's amplitude (per joint), frequency (0.5-3 Hz), phase, step
+    (± the disturbance range) and step time (``studies.robust``'s ranges).  A camera is a
+    world's own: the interception world draws its noise and latency after these."""
+    nv = len(scenario.robot.initial_q_deg)
+    rng = u.rng
+    p = scenario.plant
+    p.mass_scale = float(u("mass"))
+    p.damping_scale = float(u("friction"))
+    p.coulomb = u("coulomb", nv).tolist()
+    p.payload_kg = float(u("payload"))
+    bound = u.bounds("disturbance")
+    p.disturbance.amplitude = u("disturbance", nv).tolist()
+    p.disturbance.frequency_hz = float(rng.uniform(0.5, 3.0))
+    p.disturbance.phase = rng.uniform(0.0, 2 * np.pi, nv).tolist()
+    p.disturbance.step = rng.uniform(-bound[1], bound[1], nv).tolist()
+    p.disturbance.step_time = float(rng.uniform(0.0, scenario.duration))
+    scenario.name = f"{name}_seed{seed}"
+    params = {"mass_scale": p.mass_scale, "damping_scale": p.damping_scale, "coulomb": p.coulomb,
+              "payload_kg": p.payload_kg, "disturbance_amplitude": p.disturbance.amplitude,
+              "disturbance_frequency_hz": p.disturbance.frequency_hz,
+              "disturbance_step": p.disturbance.step, "disturbance_step_time": p.disturbance.step_time}
+    return scenario, params
+
+
+def segment_row(seed: int, params: dict, m: dict) -> dict:
+    """A ``robust`` row of any world's metrics: the verdict, and per segment e(tf) and the hold."""
+    segments = m.get("segments", [])
+    e_tf = [s.get("e_tf_norm") for s in segments]
+    finished = bool(e_tf) and all(v is not None for v in e_tf)
+    return {
+        "seed": seed, "params": params,
+        "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
+        "status": m["status"],
+        "reasons": m.get("reasons", []),
+        "e_tf": e_tf,
+        "e_tf_max": max(e_tf) if finished else None,
+        "hold_max": max(((s.get("e_hold_max_norm") or 0.0) for s in segments), default=None),
+        "torque_peak": m.get("torque_peak"),
+        "saturated_fraction": m.get("saturated_fraction"),
+        "realtime_factor": m["sim"]["realtime_factor"],
+        "warnings": m.get("warnings", []),
+    }

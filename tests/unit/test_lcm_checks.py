@@ -182,16 +182,17 @@ def test_bad_input_is_one_line(ptint_here, args, words, tmp_path):
 
 
 def pick_pair():
-    """A hardware session of the pick world (1 part, a 30 N gripper) and the drive's endpoint."""
-    from ptint_drake.hardware.session import PickLink  # noqa: PLC0415
+    """A hardware session of a station with a gripper (1 object, a 30 N gripper: the pick world's
+    ``link_ports``) and the drive's endpoint."""
     from ptint_drake.hardware.link import WSG_COMMAND_CHANNEL  # noqa: PLC0415
+    from ptint_drake.worlds.base import LinkPorts  # noqa: PLC0415
 
     lcm = DrakeLcm("memq://")
     hardware = Endpoint(None, listen=COMMAND_CHANNEL, publish=STATUS_CHANNEL, lcm=lcm,
                         also=(WSG_COMMAND_CHANNEL,))
     settings = LinkSettings(period=1e-3, duration=1.0, command_timeout=0.05)
     session = HardwareSession(hardware, N, LIMITS, settings)
-    session.pick = PickLink(parts=1, max_force=30.0)
+    session.ports = LinkPorts(gripper_max_force=30.0, objects=1)
     return session, lcm
 
 

@@ -23,8 +23,10 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
+from ptint_drake.config.measurement import MeasurementConfig
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
+from ptint_drake.derivatives import uniform_derivatives
 from ptint_drake.metrics import Reason, run_metrics, segments_reasons
 from ptint_drake.reachability import check_reachable
 from ptint_drake.run_warnings import (joint_limit_warnings, sampled_control_warnings, singularity_warnings,
@@ -35,7 +37,7 @@ from ptint_drake.systems.signals import TARGET
 from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
 from ptint_drake.systems.targets import active_target_values
 from ptint_drake.watchdog import Watchdog
-from ptint_drake.worlds.base import World, WorldRun
+from ptint_drake.worlds.base import World, WorldRun, arm_sample
 from ptint_drake.worlds.interception import views
 from ptint_drake.worlds.interception.checks import check_interceptions
 from ptint_drake.worlds.interception.floors import floor_diagram
@@ -211,6 +213,49 @@ class InterceptionWorld(World):
 
     def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:
         return views.draw_view(name, series, metrics, stage, title, args)
+
+    def tune_refusal(self, name: str) -> None:
+        return None  # tune searches this world's segment verdicts
+
+    def robust_sample(self, scenario: Scenario, name: str, seed: int, u) -> tuple:
+        """The arm's deviations (``arm_sample``), then the camera's noise std and latency: the
+        scenario's camera, or an ``auto`` one when either range is above 0 (else the analytic
+        target, the paper's setting)."""
+        scenario, params = arm_sample(scenario, name, seed, u)
+        m = scenario.measurement
+        if max(u.bounds("noise")) > 0.0 or max(u.bounds("latency")) > 0.0:
+            if m is None or m.estimator == "none":
+                scenario.measurement = m = MeasurementConfig()
+        noise, latency = float(u("noise")), float(u("latency"))
+        if m is not None:
+            m.noise_std, m.latency, m.seed = noise, latency, int(seed)
+        return scenario, params | {"noise_std": noise, "latency": latency}
+
+    def sweep_point(self, row: dict, scenario: Scenario, beta: float, tf: float, simulate, validate) -> dict:
+        """Every interception's β and tf set (the duration long enough for the last one's hold),
+        simulated; ``row`` gets the extremes over the segments (``studies.sweep.COLUMNS``)."""
+        for ic in scenario.interceptions:
+            ic.beta, ic.tf = beta, tf
+        last = scenario.interceptions[-1]
+        scenario.duration = max(scenario.duration, last.start + 2.0 * tf)
+        validate(scenario)
+        result = simulate(scenario)
+        m = result.metrics
+        segs = m["segments"]
+        _, _, _, jerk = uniform_derivatives(result.series["t"], result.series["xdot"])
+        row.update({
+            "e0": max(s["e0_norm"] for s in segs),
+            "e_tf": max(s["e_tf_norm"] for s in segs),
+            "e_half": min(s["e_half_norm"] for s in segs),
+            "hold": max(s["e_hold_max_norm"] for s in segs),
+            "peak_torque": float(np.max(m["torque_peak"])),
+            "peak_torque_after_startup": float(np.max(m["torque_peak_after_startup"])),
+            "peak_jerk": float(np.max(np.linalg.norm(jerk, axis=1))),
+            "realtime_factor": m["sim"]["realtime_factor"],
+            "steps": m["sim"]["steps"],
+            "ok": m["status"] == "ok",  # the one verdict (metrics.verdict, the scenario's criteria)
+        })
+        return row
 
     def floor_diagram(self, scenario: Scenario, kind: str):
         if kind == "controller":

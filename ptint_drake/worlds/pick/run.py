@@ -132,7 +132,7 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
                               actuation=saturation.get_input_port(), scenario=scenario, target=view)
     sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
     gripper = sequence.GetOutputPort("command")
-    wire = getattr(handles.system, "wire_pick", None)  # a slot system that commands the gripper itself
+    wire = getattr(handles.system, "wire_station", None)  # a slot system that commands the gripper itself
     if wire is not None:  # (``ptint hardware``'s link: the commands come from the drive process)
         gripper = wire(builder, st, sequence)
     builder.Connect(gripper, st.GetInputPort("gripper_command"))

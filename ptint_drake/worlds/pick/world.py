@@ -26,6 +26,7 @@ the plan's end later, the run is lengthened by as much (metrics ``duration``).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Optional
 
 from pydrake.common.yaml import yaml_load_typed
 
@@ -37,7 +38,7 @@ from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.mass_scaling import scale_in_context
 from ptint_drake.metrics import Reason, drive_metrics
 from ptint_drake.run_warnings import sampled_control_warnings
-from ptint_drake.worlds.base import World, WorldRun
+from ptint_drake.worlds.base import LinkPorts, World, WorldRun
 from ptint_drake.worlds.pick import studies
 from ptint_drake.worlds.pick.camera import MIN_FITS, check_pick_camera, estimate_metrics
 from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
@@ -46,7 +47,7 @@ from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLAN
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
-                                         pick_logs, pick_simulator, segment_aims)
+                                         pick_logs, pick_simulator, segment_aims, world_config)
 from ptint_drake.reachability import inverse_kinematics
 from ptint_drake.systems.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST
 from ptint_drake.worlds.pick.route import routed_plan
@@ -344,6 +345,14 @@ class PickWorld(World):
 
     def simulator_config(self, scenario: Scenario):
         return pick_simulator(scenario)
+
+    def own_plant_step(self, scenario: Scenario) -> Optional[float]:
+        """The station's plant step (``pick.time_step``) unless ``multibody`` sets it."""
+        return world_config(scenario).time_step if scenario.multibody is None else None
+
+    def link_ports(self, scenario: Scenario) -> LinkPorts:
+        """The gripper (its force limit) and every part's motion."""
+        return LinkPorts(gripper_max_force=scenario.pick.gripper.max_force, objects=len(scenario.pick.parts))
 
     def controller_side(self, builder, scenario: Scenario, period: float):
         """The targets, gripper sequence and grasp observer (``controller_side``)."""
