@@ -45,7 +45,8 @@ def test_run_touches_at_tf_and_not_before(tmp_path):
 def test_robust_draws_the_arm_and_judges_by_the_world(tmp_path):
     """``ptint robust`` on the plugin world: the arm's own deviations (the protocol's default),
     each sample judged by the world's verdict."""
-    done = run("robust", TOUCH, "--samples", "3", "--workers", "1", "--out", str(tmp_path / "r"), cwd=tmp_path)
+    done = run("robust", TOUCH, "--samples", "3", "--workers", "1", "--out", str(tmp_path / "r"),
+               cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     result = json.loads((tmp_path / "r" / "robust.json").read_text())
     assert result["samples"] == 3 and result["success_rate"] == 1.0, result["failures"]
@@ -68,7 +69,8 @@ def test_hardware_and_drive_lockstep_match_one_process(tmp_path):
     plan = [
         {"name": "hw", "argv": ptint("hardware", TOUCH, "--startup-timeout", "60", "--lockstep", "--quiet",
                                      "--out", str(tmp_path / "hw"))},
-        {"name": "drive", "argv": ptint("drive", TOUCH, "--startup-timeout", "60", "--out", str(tmp_path / "dr"))},
+        {"name": "drive",
+         "argv": ptint("drive", TOUCH, "--startup-timeout", "60", "--out", str(tmp_path / "dr"))},
     ]
     done = run_in_netns([sys.executable, str(PAIR), json.dumps(plan)], timeout=200, cwd=tmp_path)
     out = json.loads(done.stdout)
