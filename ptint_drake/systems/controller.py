@@ -305,9 +305,14 @@ def smc_torque(K, J, s_x, damping: float = 0.0) -> np.ndarray:
 def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.ndarray,
                       damping: float, rate: float) -> np.ndarray:
     """τ_ns = −D (I − J⁺J)(q̇ + r (q − q_start)): joint damping toward the start posture,
-    projected so that it does not move the gripper point (zero for a square, full-rank J)."""
+    projected so that it does not move the gripper point (zero for a square, full-rank J).  At a
+    singular J (e.g. a 7-joint arm stretched straight up, q = 0) the projection takes J J^T's
+    pseudo-inverse instead of failing."""
     w = v + rate * (q - q_start)
-    return -damping * (w - J.T @ np.linalg.solve(J @ J.T, J @ w))
+    try:
+        return -damping * (w - J.T @ np.linalg.solve(J @ J.T, J @ w))
+    except np.linalg.LinAlgError:
+        return -damping * (w - J.T @ (np.linalg.pinv(J @ J.T) @ (J @ w)))
 
 
 def null_space_terms(gains, plant, posture=None):

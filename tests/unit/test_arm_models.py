@@ -211,3 +211,22 @@ def test_every_bundled_model_parses_with_an_empty_cache(tmp_path):
     assert result.returncode == 0, result.stderr[-2000:]
     assert result.stdout.count("ok ") == len(files)
     assert not (tmp_path / "cache" / "drake").exists() or not any((tmp_path / "cache" / "drake").rglob("*"))
+
+
+def test_null_space_term_at_a_singular_jacobian():
+    """At q = 0 the iiwa stands straight up and its 3 × 7 position Jacobian has rank 1: the
+    null-space term (controller.null_space_damping, built once at q = 0 when the diagram is
+    made) is finite there and still leaves the tool point alone."""
+    from pydrake.multibody.tree import JacobianWrtVariable  # noqa: PLC0415
+
+    from ptint_drake.systems.controller import null_space_torque  # noqa: PLC0415
+
+    plant, _ = _plant("iiwa14")
+    context = plant.CreateDefaultContext()
+    J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, plant.GetFrameByName("tool"),
+                                                np.zeros(3), plant.world_frame(), plant.world_frame())
+    assert np.linalg.matrix_rank(J) == 1  # every pitch axis moves the tool along x only
+    rng = np.random.default_rng(1)
+    tau = null_space_torque(J, np.zeros(7), rng.normal(size=7), rng.normal(size=7), 10.0, 2.0)
+    assert np.all(np.isfinite(tau)) and np.linalg.norm(tau) > 0.0
+    np.testing.assert_allclose(J @ tau, 0.0, atol=1e-9)
