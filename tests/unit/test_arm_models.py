@@ -230,3 +230,41 @@ def test_null_space_term_at_a_singular_jacobian():
     tau = null_space_torque(J, np.zeros(7), rng.normal(size=7), rng.normal(size=7), 10.0, 2.0)
     assert np.all(np.isfinite(tau)) and np.linalg.norm(tau) > 0.0
     np.testing.assert_allclose(J @ tau, 0.0, atol=1e-9)
+
+
+def test_limit_push_is_zero_inside_and_grows_into_the_band():
+    from ptint_drake.systems.controller import limit_push  # noqa: PLC0415
+
+    lower, upper = np.array([-1.0, -1.0, -np.inf]), np.array([1.0, 1.0, np.inf])
+    push = limit_push(np.array([0.95, -0.85, 5.0]), lower, upper, 0.1)
+    np.testing.assert_allclose(push, [0.05, 0.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(limit_push(np.array([-0.97, 0.0, 0.0]), lower, upper, 0.1), [-0.07, 0, 0],
+                               atol=1e-15)
+
+
+def test_posture_task_pushes_a_joint_away_from_its_limit_in_the_null_space():
+    """iiwa at rest, joint 4 one degree from its −120° limit, margin 10°: the posture task's torque
+    moves joint 4 away from the limit (a positive torque) and leaves the tool point alone."""
+    from pydrake.multibody.tree import JacobianWrtVariable  # noqa: PLC0415
+
+    from ptint_drake.config.controller import ControllerGains  # noqa: PLC0415
+    from ptint_drake.systems.controller import null_space_terms, null_space_torque  # noqa: PLC0415
+
+    plant, _ = _plant("iiwa14")
+    q = np.radians([0.0, 30.0, 0.0, -119.0, 0.0, 60.0, 0.0])
+    gains = ControllerGains(null_space_damping=10.0, null_space_limit_margin_deg=10.0)
+    D, rate, rest, limits = null_space_terms(gains, plant, posture=q)  # rest = here: no posture pull
+    np.testing.assert_allclose(rest, q)
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q)
+    J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, plant.GetFrameByName("tool"),
+                                                np.zeros(3), plant.world_frame(), plant.world_frame())
+    tau = null_space_torque(J, q, np.zeros(7), rest, D, rate, limits)
+    assert tau[3] > 0.0
+    np.testing.assert_allclose(J @ tau, 0.0, atol=1e-9)
+    off = null_space_terms(ControllerGains(null_space_damping=10.0), plant, posture=q)
+    assert off[3] is None and np.allclose(null_space_torque(J, q, np.zeros(7), rest, D, rate, off[3]), 0.0)
+    # a rest posture given in the scenario replaces the start posture
+    rest_given = null_space_terms(ControllerGains(null_space_damping=10.0, null_space_posture_deg=[0.0] * 7),
+                                  plant, posture=q)[2]
+    np.testing.assert_allclose(rest_given, np.zeros(7))
