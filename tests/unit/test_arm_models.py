@@ -19,6 +19,7 @@ from pydrake.multibody.tree import RevoluteJoint
 from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.rvm1 import bundled_models, model_path
+from ptint_drake.scenario import bundled_scenarios
 
 ROOT = Path(__file__).resolve().parents[2]
 D = math.pi / 180.0
@@ -194,8 +195,8 @@ def test_no_remote_drake_models():
 
 
 def test_every_bundled_model_parses_with_an_empty_cache(tmp_path):
-    """Every bundled arm and gripper parses with HOME and XDG_CACHE_HOME in a fresh folder (nothing
-    downloaded earlier can help), in a subprocess."""
+    """Every bundled arm and gripper, and every bundled scenario's plant, parses with HOME and
+    XDG_CACHE_HOME in a fresh folder (nothing downloaded earlier can help), in a subprocess."""
     files = sorted(str(p) for p in (ROOT / "models").iterdir() if p.suffix in (".urdf", ".sdf"))
     assert len(files) >= 8
     code = ("import sys\nfrom pydrake.multibody.parsing import Parser\n"
@@ -204,12 +205,19 @@ def test_every_bundled_model_parses_with_an_empty_cache(tmp_path):
             "    plant = MultibodyPlant(0.0)\n"
             "    Parser(plant).AddModels(path)\n"
             "    plant.Finalize()\n"
-            "    print('ok', path)\n")
-    env = dict(os.environ, HOME=str(tmp_path), XDG_CACHE_HOME=str(tmp_path / "cache"))
+            "    print('ok', path)\n"
+            "from ptint_drake.robot import make_plant\n"
+            "from ptint_drake.scenario import bundled_scenarios, load_scenario\n"
+            "for name in bundled_scenarios():\n"
+            "    make_plant(load_scenario(name))\n"
+            "    print('scenario', name)\n")
+    env = dict(os.environ, HOME=str(tmp_path), XDG_CACHE_HOME=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
     result = subprocess.run([sys.executable, "-c", code, *files], capture_output=True, text=True,
                             env=env, check=False, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]
     assert result.stdout.count("ok ") == len(files)
+    assert result.stdout.count("scenario ") == len(bundled_scenarios())
     assert not (tmp_path / "cache" / "drake").exists() or not any((tmp_path / "cache" / "drake").rglob("*"))
 
 
