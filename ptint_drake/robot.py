@@ -86,6 +86,10 @@ def make_plant(scenario: Scenario) -> MultibodyPlant:
             f"robot.initial_q_deg: the model has {plant.num_positions()} joints, "
             f"got {len(scenario.robot.initial_q_deg)} angles"
             + (" (the default, the 3-joint rvm1's: give one angle per joint)" if default else ""))
+    rest = getattr(scenario.controller, "null_space_posture_deg", None) or []
+    if rest and len(rest) != plant.num_positions():
+        raise ScenarioError(f"controller.null_space_posture_deg: the model has {plant.num_positions()} "
+                            f"joints, got {len(rest)} angles")
     return plant
 
 

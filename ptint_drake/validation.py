@@ -47,7 +47,8 @@ def validate(s) -> None:
 def _validate_controller(c) -> None:
     for name in ("K", "Lambda", "k", "k_hold", "epsilon", "delta"):
         positive(getattr(c, name), f"controller.{name}")
-    for name in ("alpha_hold", "pinv_damping", "null_space_damping", "null_space_rate"):
+    for name in ("alpha_hold", "pinv_damping", "null_space_damping", "null_space_rate",
+                 "null_space_limit_margin_deg"):
         nonnegative(getattr(c, name), f"controller.{name}")
     if not known_type(c.type):
         raise ScenarioError(f"controller.type: must be one of {', '.join(CONTROLLERS)}, or {plugin.FORM}, "

@@ -228,6 +228,7 @@ def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=
     if drift:  # redundant arm: does J⁺ leave it drifting in its null space?
         result["self_motion_final"] = max(drift)
         result["drifts"] = max(drift) > DRIFT_ANGLE
+        result["null_space_damping"] = float(scenario.controller.null_space_damping)
     # tune.json's contract names the chosen value smallest_working; for φ it is the largest
     result |= {"gains": gains, "smallest_working": {settings.gain: value, "per_variant": best},
                "scenario_obj": _portable(_set_gain(scenario, settings.gain, value))}
@@ -267,9 +268,12 @@ def summary_line(result: dict) -> str:
     line = (f"{gain} = {value:.4g} (margin {result['margin']:g}: e(tf) {parts}; {relation}) "
             f"after {result['runs']} runs in {result['wall_time_s']:.0f} s")
     if "drifts" in result:
+        damping = result.get("null_space_damping", 0.0)
+        advice = (f" — it drifts with controller.null_space_damping {damping:g}: a larger value holds "
+                  "it closer" if damping > 0.0
+                  else " — it drifts: consider controller.null_space_damping (e.g. 10)")
         line += (f"; redundant arm: {result['self_motion_final']:.2g} rad from its start posture in the "
-                 f"null space at the end" + (" — it drifts: consider controller.null_space_damping "
-                                             "(e.g. 10)" if result["drifts"] else ""))
+                 f"null space at the end" + (advice if result["drifts"] else ""))
     return line
 
 

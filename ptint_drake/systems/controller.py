@@ -302,23 +302,52 @@ def smc_torque(K, J, s_x, damping: float = 0.0) -> np.ndarray:
     return sliding_mode_torque(K, Ja, np.ascontiguousarray(s_x, dtype=float), float(damping))
 
 
+# The joint-limit term of the null-space posture task: per radian inside the margin band, this
+# many times the pull toward the rest posture (issue 45).
+LIMIT_WEIGHT = 10.0
+
+
+def limit_push(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, margin: float) -> np.ndarray:
+    """How deep each joint is inside the band of width ``margin`` (rad) before its limits:
+    positive near the upper limit, negative near the lower one, 0 in between (and for a joint
+    without limits)."""
+    q = np.asarray(q, dtype=float)
+    return np.maximum(q - (upper - margin), 0.0) - np.maximum((lower + margin) - q, 0.0)
+
+
 def null_space_torque(J: np.ndarray, q: np.ndarray, v: np.ndarray, q_start: np.ndarray,
-                      damping: float, rate: float) -> np.ndarray:
-    """τ_ns = −D (I − J⁺J)(q̇ + r (q − q_start)): joint damping toward the start posture,
-    projected so that it does not move the gripper point (zero for a square, full-rank J)."""
+                      damping: float, rate: float, limits=None) -> np.ndarray:
+    """τ_ns = −D (I − J⁺J)(q̇ + r (q − q_start) + r w_L limit_push(q)): joint damping toward the
+    start (rest) posture and away from the joint limits (``limits`` = (lower, upper, margin), or
+    None; w_L = ``LIMIT_WEIGHT``), projected so that it does not move the gripper point (zero for
+    a square, full-rank J).  At a singular J (e.g. a 7-joint arm stretched straight up, q = 0) the
+    projection takes J J^T's pseudo-inverse instead of failing."""
     w = v + rate * (q - q_start)
-    return -damping * (w - J.T @ np.linalg.solve(J @ J.T, J @ w))
+    if limits is not None:
+        w = w + rate * LIMIT_WEIGHT * limit_push(q, *limits)
+    try:
+        return -damping * (w - J.T @ np.linalg.solve(J @ J.T, J @ w))
+    except np.linalg.LinAlgError:
+        return -damping * (w - J.T @ (np.linalg.pinv(J @ J.T) @ (J @ w)))
 
 
 def null_space_terms(gains, plant, posture=None):
-    """(D, r, q_start) of ``null_space_torque`` for ``gains`` (a ``ControllerGains``), or None
-    when it is off: ``gains.null_space_damping`` = 0, or no redundancy (nv ≤ the task's
-    dimension).  q_start is
-    ``posture``, by default the plant's default positions (needs nq = nv)."""
+    """(D, r, q_rest, limits) of ``null_space_torque`` for ``gains`` (a ``ControllerGains``), or
+    None when it is off: ``gains.null_space_damping`` = 0, or no redundancy (nv ≤ the task's
+    dimension).  q_rest is ``gains.null_space_posture_deg`` when given, else ``posture``, by
+    default the plant's default positions (needs nq = nv); ``limits`` = (lower, upper, margin)
+    from the plant's position limits and ``gains.null_space_limit_margin_deg``, or None (0)."""
     if not (gains.null_space_damping > 0.0 and plant.num_velocities() > TASK_DIM[gains.task]):
         return None
-    start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
-    return (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float))
+    rest = list(getattr(gains, "null_space_posture_deg", None) or [])
+    if rest:
+        start = np.radians(np.asarray(rest, dtype=float))
+    else:
+        start = plant.GetPositions(plant.CreateDefaultContext()) if posture is None else posture
+    margin = float(getattr(gains, "null_space_limit_margin_deg", 0.0))
+    limits = None if margin <= 0.0 else (plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits(),
+                                         np.radians(margin))
+    return (gains.null_space_damping, gains.null_space_rate, np.asarray(start, float), limits)
 
 
 class SlidingModeController(LeafSystem):
@@ -332,7 +361,7 @@ class SlidingModeController(LeafSystem):
 
     def __init__(self, nv: int, K=50.0, actuation_matrix=None, pinv_damping: float = 0.0,
                  null_space=None, dim: int = 3):
-        """``null_space`` = (D, r, q_start) adds ``null_space_torque`` and an input ``state``
+        """``null_space`` = (D, r, q_start, limits) adds ``null_space_torque`` and an input ``state``
         ([q; v], nq = nv) to read q and q̇."""
         super().__init__()
         self._null_space = null_space
@@ -364,6 +393,6 @@ class SlidingModeController(LeafSystem):
         tau = self.torque(self._s_x_in.Eval(context), J)
         if self._null_space:
             qv = self._state_in.Eval(context)
-            D, rate, q_start = self._null_space
-            tau = tau + null_space_torque(J, qv[:self._nv], qv[self._nv:], q_start, D, rate)
+            D, rate, q_start, limits = self._null_space
+            tau = tau + null_space_torque(J, qv[:self._nv], qv[self._nv:], q_start, D, rate, limits)
         return tau

@@ -248,9 +248,9 @@ class InterceptorLaw(LeafSystem):
                 sigma = sigma - captured[1 + n:]
             row = self._pose_row(t, qv, sigma, captured, target, rotation)
         if self._null_space is not None:  # redundant arms, optional (off by default)
-            D, rate, q_start = self._null_space
+            D, rate, q_start, limits = self._null_space
             J = self._kinematics.compute(qv[:self._nq], qv[self._nq:])[2]
-            row[self._tau] += null_space_torque(J, qv[:self._nq], qv[self._nq:], q_start, D, rate)
+            row[self._tau] += null_space_torque(J, qv[:self._nq], qv[self._nq:], q_start, D, rate, limits)
         return row
 
     def rows(self, t: np.ndarray, qv: np.ndarray, sigma: np.ndarray, captured: np.ndarray,

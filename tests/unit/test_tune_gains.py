@@ -44,3 +44,16 @@ def test_a_position_task_has_no_rot_scale_to_tune(tmp_path, capsys):
     assert cli.main(["tune", "curve_b075_tf15", "--gain", "rot_scale", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--gain: rot_scale" in err and not out.exists()
+
+
+def test_drift_advice_names_the_damping_already_set():
+    """A redundant arm that still drifts with controller.null_space_damping set is told to raise it,
+    not to set it (issue 45's arms run with 10)."""
+    base = {"gain": "K", "gains": {"K": 75.35}, "margin": 2.0, "variants": ["nominal"],
+            "smallest_working": {"per_variant": {"nominal": {"e_tf_norm": 7e-5}}},
+            "paper_value": 50.0, "runs": 39, "wall_time_s": 11.0, "self_motion_final": 0.56,
+            "drifts": True}
+    assert "consider controller.null_space_damping (e.g. 10)" in tune.summary_line(base)
+    line = tune.summary_line(base | {"null_space_damping": 10.0})
+    assert "drifts with controller.null_space_damping 10: a larger value" in line
+    assert "(e.g. 10)" not in line

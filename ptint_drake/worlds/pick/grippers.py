@@ -34,8 +34,10 @@ DATASHEETS = {
 }
 
 # kg, including the hand: the Mitsubishi RV-M1's rated payload (models/README.md); the 6-joint
-# model is hypothetical, in the RV-M1's size, and is held to the same
-RATED_PAYLOAD = {"rvm1": 1.2, "rvm1_5dof": 1.2, "rvm1_6dof": 1.2}
+# model is hypothetical, in the RV-M1's size, and is held to the same.  The iiwa 14 R820's, the
+# Panda's and the UR5e's rated payloads at the flange (their data sheets; models/README.md, issue 45)
+RATED_PAYLOAD = {"rvm1": 1.2, "rvm1_5dof": 1.2, "rvm1_6dof": 1.2, "iiwa14": 14.0, "panda": 3.0,
+                 "ur5e": 5.0}
 
 
 def check_gripper(gripper) -> None:
