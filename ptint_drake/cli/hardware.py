@@ -181,7 +181,7 @@ def _priority(text: str) -> int:
 
 def _add_priority_option(parser: argparse.ArgumentParser, when: str) -> None:
     """``--priority``: the loop's real-time scheduling (``hardware.priority``)."""
-    from ptint_drake.hardware.priority import DEFAULT_PRIORITY  # noqa: PLC0415
+    from ptint_drake.hardware.process import DEFAULT_PRIORITY  # noqa: PLC0415
 
     parser.add_argument(
         "--priority",

@@ -32,7 +32,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import time
-from dataclasses import dataclass, field
 from typing import Callable, Optional
 
 import numpy as np
@@ -53,12 +52,11 @@ from ptint_drake.hardware.link import (
     pack_wsg_command,
     unpack_parts,
     unpack_wsg_status,
-    spread,
     unpack_status,
     url_warning,
 )
-from ptint_drake.hardware.priority import DEFAULT_PRIORITY, request_realtime, scheduler_name
-from ptint_drake.hardware.session import quiet_collector
+from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
+from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
 from ptint_drake.systems.gripper import EMPTY, GRASP_STATES, HOLDING, LOST
@@ -75,37 +73,6 @@ WARM_UP_PERIODS = 3  # control periods of the throwaway run after the hand-shake
 
 class DriveFault(Exception):
     """The drive stopped commanding (the message is the one-line reason)."""
-
-
-@dataclass
-class DriveSettings:
-    """The drive side's timeouts (``ptint drive``'s options)."""
-
-    period: float
-    duration: float
-    startup_timeout: float = 10.0  # s wall for the first status
-    status_timeout: float = 0.5  # s wall without a status once running
-    priority: int = DEFAULT_PRIORITY  # SCHED_FIFO priority of the loop (0: none; ``hardware.priority``)
-
-
-@dataclass
-class DriveRecord:
-    """What the drive received and sent."""
-
-    statuses: int = 0
-    repeats: int = 0  # statuses received again (re-sent by the hardware)
-    stale: int = 0  # statuses older than one already answered
-    gaps: int = 0  # ticks skipped between two statuses (lost or not sent)
-    commands: int = 0
-    compute: list = field(default_factory=list)  # s wall: status received → command sent
-    clipped: int = 0  # commands clipped to the actuators' effort limits
-    url: Optional[str] = None  # the LCM URL in use
-    first_t: Optional[float] = None
-    last_t: Optional[float] = None
-    t: list = field(default_factory=list)
-    q: list = field(default_factory=list)
-    v: list = field(default_factory=list)
-    tau: list = field(default_factory=list)
 
 
 def DriveDiagram(scenario: Scenario):
@@ -417,31 +384,5 @@ def run_drive(
             return loop.endpoint.url
 
 
-def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dict:
-    """drive.json: what the drive received and sent."""
-    return {
-        "url": url,
-        "status_channel": STATUS_CHANNEL,
-        "command_channel": COMMAND_CHANNEL,
-        "period": settings.period,
-        "statuses_received": record.statuses,
-        "statuses_repeated": record.repeats,
-        "statuses_stale": record.stale,
-        "ticks_missing": record.gaps,
-        "commands_sent": record.commands,
-        "first_t": record.first_t,
-        "last_t": record.last_t,
-        "compute_ms": spread(record.compute, 1e3),
-        "commands_clipped": record.clipped,
-        "scheduler": scheduler_name(),
-    }
-
-
-def drive_series(record: DriveRecord) -> dict:
-    """The statuses received and commands sent, as arrays (drive_series.npz)."""
-    return {
-        "t": np.asarray(record.t),
-        "q": np.asarray(record.q),
-        "v": np.asarray(record.v),
-        "tau": np.asarray(record.tau),
-    }
+__all__ = ["DriveDiagram", "DriveFault", "DriveRecord", "DriveSettings", "drive_series", "drive_summary",
+           "run_drive"]

@@ -21,18 +21,15 @@ the RV-M1), then the run ends with ``LinkFault`` naming it.
 
 from __future__ import annotations
 
-import gc
 import signal
-import threading
 import time
-from contextlib import contextmanager
 from contextvars import ContextVar
-from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
 
-from ptint_drake.hardware.priority import DEFAULT_PRIORITY, request_realtime
+from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
+from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.hardware.link import (
     PARTS_CHANNEL,
@@ -51,60 +48,8 @@ SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
 
 
-def quiet_collector() -> None:
-    """Before a real-time loop: collect once, then move every object alive into the collector's
-    permanent generation (``gc.freeze``), so that a later full collection does not walk the
-    interpreter's, pydrake's and numba's hundreds of thousands of start-up objects: such a pass
-    takes milliseconds, several control periods of an arm's link.  The collector stays on for
-    what the loop itself allocates."""
-    gc.collect()
-    gc.freeze()
-
-
 class LinkFault(Exception):
     """A fault of the link (the message is the one-line reason)."""
-
-
-@dataclass
-class LinkSettings:
-    """The hardware side's timing and checks (``ptint hardware``'s options)."""
-
-    period: float  # s: T, the tick of the link and the plant's step
-    duration: float  # s of simulated time of the scenario
-    lockstep: bool = True
-    command_timeout: float = 0.25  # s of wall time a lockstep tick waits for its command
-    silent_periods: int = 5  # real time: ticks in a row without a command before the hold
-    startup_timeout: float = 10.0  # s of wall time for the first command
-    resend: float = 0.005  # s: lockstep re-sends an unanswered status after this wall time
-    hold_time: float = 0.5  # s simulated: the hold after a fault before the run ends
-    budget: float = 0.8  # real time: the part of T a tick waits for its command
-    realtime_rate: float = 1.0
-    drop_status: float = 0.0  # a test option: the fraction of status messages not sent
-    seed: int = 0
-    priority: int = DEFAULT_PRIORITY  # real time: SCHED_FIFO priority of the loop (0: none; ``priority``)
-
-
-@dataclass
-class LinkRecord:
-    """What the hardware side measured of the link."""
-
-    rtt: list = field(default_factory=list)  # s wall: status published → its command received
-    tick_wall: list = field(default_factory=list)  # perf_counter of each tick's first publish
-    tick_time: list = field(default_factory=list)  # simulated t of each tick
-    statuses: int = 0  # status messages published (re-sends included)
-    dropped: int = 0  # status messages not sent (``drop_status``)
-    resends: int = 0
-    accepted: int = 0
-    duplicates: int = 0  # a command repeated for its status (an answer to a re-sent status)
-    late: int = 0  # real time: ticks whose command did not arrive within the budget
-    late_run_max: int = 0  # real time: the most ticks in a row without a command
-    late_commands: int = 0  # commands that arrived after their tick
-    gripper_commands: int = 0  # gripper commands taken (a station with a gripper)
-    last_command_t: Optional[float] = None  # simulated t of the last command accepted
-    fault: Optional[str] = None
-    fault_time: Optional[float] = None
-    fault_kind: Optional[str] = None
-    stop_signal: Optional[int] = None  # SIGINT or SIGTERM received: the run was stopped (held)
 
 
 ACTIVE: ContextVar[Optional["HardwareSession"]] = ContextVar("ptint_hardware_session", default=None)
@@ -415,28 +360,3 @@ class HardwareSession:
         return None
 
 
-@contextmanager
-def stop_on_signals(session: HardwareSession):
-    """While the block runs, SIGINT and SIGTERM ask ``session`` to stop (``request_stop``): the arm
-    is held for ``hold_time`` and the run ends with its metrics written, as after any fault.  The
-    first signal puts the previous handlers back, so a second one acts as it did before (Ctrl-C
-    twice: ``KeyboardInterrupt``).  Outside the main thread (``in_memory``'s hardware thread)
-    nothing is installed: Python delivers signals to the main thread only."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {}
-
-    def handler(signum, _frame):
-        for sig, old in previous.items():
-            signal.signal(sig, old)
-        session.request_stop(signum)
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        previous[sig] = signal.signal(sig, handler)
-    try:
-        yield
-    finally:
-        for sig, old in previous.items():
-            if signal.getsignal(sig) is handler:
-                signal.signal(sig, old)

@@ -23,14 +23,13 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
-from ptint_drake.hardware.priority import scheduler_name
+from ptint_drake.hardware.process import scheduler_name, stop_on_signals
 from ptint_drake.hardware.session import (
     ACTIVE,
     SETTLED_SPEED,
     HardwareSession,
     LinkFault,
     LinkSettings,
-    stop_on_signals,
 )
 from ptint_drake.hardware.link import (
     COMMAND_CHANNEL,
@@ -169,6 +168,23 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
     return block
 
 
+def link_metrics(result, session: HardwareSession, settings: LinkSettings, n: int) -> dict:
+    """The run's metrics with the link's: a fault is the verdict (``failed``, its reason), and
+    the ``hardware`` block (``link_block``; after a fault, how the hold went)."""
+    metrics, record = result.metrics, session.record
+    if record.fault is not None:
+        metrics["failure"] = {"time": record.fault_time, "message": record.fault}
+        metrics["status"], metrics["reasons"] = "failed", [record.fault]
+        metrics["reason_codes"] = [
+            {"segment": None, "code": record.fault_kind.replace(" ", "_"), "message": record.fault}
+        ]
+    block = link_block(session, settings, session.handshake_s)
+    if record.fault is not None:
+        block["hold"] = hold_report(result.series, record.fault_time, n)
+    metrics["hardware"] = block
+    return metrics
+
+
 def run_hardware(
     scenario: Scenario,
     settings: LinkSettings,
@@ -214,20 +230,7 @@ def run_hardware(
         ACTIVE.reset(token)
         if session.watch is not None:
             session.watch.close()
-    handshake_s = session.handshake_s
-    metrics = result.metrics
-    record = session.record
-    if record.fault is not None:
-        metrics["failure"] = {"time": record.fault_time, "message": record.fault}
-        metrics["status"], metrics["reasons"] = "failed", [record.fault]
-        metrics["reason_codes"] = [
-            {"segment": None, "code": record.fault_kind.replace(" ", "_"), "message": record.fault}
-        ]
-    block = link_block(session, settings, handshake_s)
-    if record.fault is not None:
-        block["hold"] = hold_report(result.series, record.fault_time, n)
-    metrics["hardware"] = block
-    run_json = run_metrics(hw, metrics, figures=False)
+    run_json = run_metrics(hw, link_metrics(result, session, settings, n), figures=False)
     with staged_output(out) as stage:
         save_series(stage / SERIES, result.series)
         write_json_atomic(stage / METRICS, run_json)

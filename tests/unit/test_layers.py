@@ -54,3 +54,18 @@ def test_design_md_draws_the_same_layers():
     done = subprocess.run([sys.executable, str(ROOT / "scripts" / "layers_doc.py"), "--check"], cwd=ROOT,
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, "docs/design.md's layers differ: run scripts/layers_doc.py"
+
+
+def test_the_hardware_path_names_no_world():
+    """Issue 43: no line of ``ptint_drake/hardware/`` or ``cli/hardware.py`` names a world; what
+    a world adds to the link comes from its protocol (``World.link_ports``, ``own_plant_step``,
+    ``controller_side``, ``report``)."""
+    import re  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    root = Path(__file__).resolve().parents[2] / "ptint_drake"
+    files = sorted((root / "hardware").glob("*.py")) + [root / "cli" / "hardware.py"]
+    named = [f"{f.name}:{i}: {line.strip()}" for f in files
+             for i, line in enumerate(f.read_text().splitlines(), 1)
+             if re.search(r"\bpick|\binterception", line, re.IGNORECASE)]
+    assert named == []

@@ -1,4 +1,6 @@
-"""Real-time scheduling for the two link processes, where the system permits it.
+"""What the two link processes ask of their own process: real-time scheduling where the system
+permits it (``request_realtime``), a garbage collector that leaves the start-up's objects alone
+(``quiet_collector``), and SIGINT / SIGTERM as a stop that holds the arm (``stop_on_signals``).
 
 A control loop at 1 kHz answers each status within a period; the hardware side holds the arm
 after ``LinkSettings.silent_periods`` ticks (5 ms at 1 kHz) without a command.  Under Linux's
@@ -15,7 +17,11 @@ machine 5 % in any case.
 
 from __future__ import annotations
 
+import gc
 import os
+import signal
+import threading
+from contextlib import contextmanager
 from typing import Optional
 
 DEFAULT_PRIORITY = 10  # SCHED_FIFO priority (1-99); low enough to leave the kernel's threads above it
@@ -42,3 +48,41 @@ def scheduler_name() -> str:
     if os.sched_getscheduler(0) == os.SCHED_FIFO:
         return f"SCHED_FIFO {os.sched_getparam(0).sched_priority}"
     return "default"
+
+
+def quiet_collector() -> None:
+    """Before a real-time loop: collect once, then move every object alive into the collector's
+    permanent generation (``gc.freeze``), so that a later full collection does not walk the
+    interpreter's, pydrake's and numba's hundreds of thousands of start-up objects: such a pass
+    takes milliseconds, several control periods of an arm's link.  The collector stays on for
+    what the loop itself allocates."""
+    gc.collect()
+    gc.freeze()
+
+
+@contextmanager
+def stop_on_signals(session):
+    """While the block runs, SIGINT and SIGTERM ask ``session`` (a ``session.HardwareSession``) to
+    stop (``request_stop``): the arm
+    is held for ``hold_time`` and the run ends with its metrics written, as after any fault.  The
+    first signal puts the previous handlers back, so a second one acts as it did before (Ctrl-C
+    twice: ``KeyboardInterrupt``).  Outside the main thread (``in_memory``'s hardware thread)
+    nothing is installed: Python delivers signals to the main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {}
+
+    def handler(signum, _frame):
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+        session.request_stop(signum)
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        previous[sig] = signal.signal(sig, handler)
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            if signal.getsignal(sig) is handler:
+                signal.signal(sig, old)
