@@ -43,18 +43,16 @@ from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, TargetView
 from ptint_drake.hardware.link import (
     COMMAND_CHANNEL,
-    PARTS_CHANNEL,
     STATUS_CHANNEL,
     WSG_COMMAND_CHANNEL,
-    WSG_STATUS_CHANNEL,
     Endpoint,
     pack_command,
     pack_wsg_command,
-    unpack_parts,
-    unpack_wsg_status,
     unpack_status,
     url_warning,
 )
+from ptint_drake.hardware.camera_link import with_receive_buffer
+from ptint_drake.hardware.companions import CompanionFault, CompanionInbox, companion_channels
 from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.hardware.sim_hardware import link_period
@@ -142,13 +140,18 @@ class _DriveLoop:
         self.config = config
         self.context = self.simulator.get_mutable_context()
         self.state_in, self.out = diagram.GetInputPort("state"), diagram.GetOutputPort("actuation")
-        also = (WSG_STATUS_CHANNEL, PARTS_CHANNEL) if side is not None else ()
+        self.ports = ports = world_of(scenario).link_ports(scenario) if side is not None else None
+        also = companion_channels(ports)
+        if ports is not None and ports.camera and lcm is None:  # a depth frame is hundreds of kB
+            url = with_receive_buffer(url)
         self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also, lcm=lcm)
+        record.channels = [STATUS_CHANNEL, *also]
         if side is not None:
-            self.parts_in, self.gripper_in = diagram.GetInputPort("parts"), diagram.GetInputPort("gripper")
+            self.gripper_in = diagram.GetInputPort("gripper")
+            self.parts_in = diagram.GetInputPort("parts") if ports.objects else None
+            self.depth_in = diagram.GetInputPort("depth_image") if ports.camera else None
             self.grasp_out = diagram.GetOutputPort("grasp_state")
-            self.companions: dict[int, dict] = {}  # utime → {"gripper": [fingers; forces], "parts": motion}
-            self.last_companion: Optional[dict] = None
+            self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout)
             self.checks = side.reads
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
@@ -218,42 +221,12 @@ class _DriveLoop:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
         self.respond(t_recv, utime, q, v, self.companion(utime) if self.side is not None else None)
 
-    def _collect(self) -> None:
-        """File the gripper statuses and parts messages received by their ``utime``."""
-        for data in self.endpoint.take_side(WSG_STATUS_CHANNEL):
-            try:
-                utime, fingers, force = unpack_wsg_status(data)
-            except ValueError as exc:
-                raise DriveFault(f"gripper status rejected: {exc}; stopped commanding") from None
-            self.companions.setdefault(utime, {})["gripper"] = np.concatenate([fingers, force])
-        for data in self.endpoint.take_side(PARTS_CHANNEL):
-            try:
-                utime, motion = unpack_parts(data, self.side.parts)
-            except ValueError as exc:
-                raise DriveFault(f"parts message rejected: {exc}; stopped commanding") from None
-            self.companions.setdefault(utime, {})["parts"] = motion
-
     def companion(self, utime: int) -> dict:
-        """The gripper status and the parts' motion of the tick ``utime`` (the hardware sends them
-        before the arm's status; a lost one comes again with the status's re-send); ``DriveFault``
-        after the status timeout without them."""
-        deadline = time.perf_counter() + self.settings.status_timeout
-        while True:
-            self._collect()
-            got = self.companions.get(utime, {})
-            if "gripper" in got and "parts" in got:
-                # taken: the next status of this time (the first tick after the hand-shake's)
-                # waits for its own
-                for old in [u for u in self.companions if u <= utime]:
-                    del self.companions[old]
-                return got
-            if time.perf_counter() >= deadline:
-                missing = " and ".join(k for k in ("gripper", "parts") if k not in got)
-                raise DriveFault(
-                    f"no {missing} message for the status of t = {utime / 1e6:.3f} s within "
-                    f"{self.settings.status_timeout:g} s: stopped commanding"
-                )
-            self.endpoint.pump(0.005)  # the arm's statuses stay in the inbox
+        """The station's companions of the status of ``utime`` (``companions.CompanionInbox``)."""
+        try:
+            return self.inbox.take(utime, handshake=self.answered is None)
+        except CompanionFault as exc:
+            raise DriveFault(str(exc)) from None
 
     def check_grasp(self, utime: int) -> None:
         """At a grasp check of the plan (and, from a close command on, every ``SENSE_PERIOD``):
@@ -291,6 +264,8 @@ class _DriveLoop:
             self.simulator.AdvanceTo(t)
             self.check_grasp(int(round(t * 1e6)))
             self.gripper_in.FixValue(self.context, companion["gripper"])
+            if "image" in companion:  # this period's frame, before the perception's event in it
+                self.depth_in.FixValue(self.context, companion["image"])
             self.simulator.AdvanceTo(t)
         elif t > self.context.get_time():
             # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
@@ -309,7 +284,10 @@ class _DriveLoop:
         """The diagram's inputs: a status's [q; v] and, with a controller side, its companions."""
         self.state_in.FixValue(self.context, np.concatenate([q, v]))
         if companion is not None:
-            self.parts_in.FixValue(self.context, companion["parts"])
+            if "parts" in companion:
+                self.parts_in.FixValue(self.context, companion["parts"])
+            if "image" in companion:
+                self.depth_in.FixValue(self.context, companion["image"])
             self.gripper_in.FixValue(self.context, companion["gripper"])
 
     def respond(

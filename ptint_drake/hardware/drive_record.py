@@ -35,6 +35,7 @@ class DriveRecord:
     compute: list = field(default_factory=list)  # s wall: status received → command sent
     clipped: int = 0  # commands clipped to the actuators' effort limits
     url: Optional[str] = None  # the LCM URL in use
+    channels: list = field(default_factory=list)  # the channels subscribed to
     first_t: Optional[float] = None
     last_t: Optional[float] = None
     t: list = field(default_factory=list)
@@ -48,6 +49,7 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
     return {
         "url": url,
         "status_channel": STATUS_CHANNEL,
+        "subscribed_channels": list(record.channels),
         "command_channel": COMMAND_CHANNEL,
         "period": settings.period,
         "statuses_received": record.statuses,

@@ -28,6 +28,7 @@ from typing import Optional
 
 import numpy as np
 
+from ptint_drake.hardware.camera_link import image_channel, pack_depth_image
 from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
@@ -256,11 +257,14 @@ class HardwareSession:
         if extras is None or self.ports is None:
             self._companions = []
             return
-        fingers, force, parts = extras
-        self._companions = [
-            (WSG_STATUS_CHANNEL, pack_wsg_status(t, fingers, force)),
-            (PARTS_CHANNEL, pack_parts(t, parts)),
-        ]
+        fingers, force, parts, image = extras
+        self._companions = [(WSG_STATUS_CHANNEL, pack_wsg_status(t, fingers, force))]
+        if parts is not None:
+            self._companions.append((PARTS_CHANNEL, pack_parts(t, parts)))
+        if image is not None:  # the camera's frame of this tick's period: before the status too
+            camera = self.ports.camera
+            self._companions.append((image_channel(camera), pack_depth_image(t, image, camera)))
+            self.record.frames_sent += 1
 
     def handshake(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None) -> None:
         """Before the simulation starts: the status of the start pose at t = 0 until its command

@@ -23,6 +23,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
+from ptint_drake.hardware.camera_link import image_channel, with_receive_buffer
 from ptint_drake.hardware.process import scheduler_name, stop_on_signals
 from ptint_drake.hardware.session import (
     ACTIVE,
@@ -58,13 +59,17 @@ def link_period(scenario: Scenario) -> float:
 
 
 def check_link_scenario(scenario: Scenario) -> None:
-    """What the LCM path does not carry yet (ScenarioError, one line): a camera.  (An arm whose
-    joints are not one actuator each is refused by ``run_hardware``, which has the model.)"""
-    world_of(scenario)  # a plugin world that cannot be had is a one-line error here
-    if scenario.measurement is not None and scenario.measurement.estimator != "none":
+    """What the LCM path does not carry yet (ScenarioError, one line): a camera that is not a
+    station's rendered depth camera (a pose sensor's samples are the true pose plus noise: no
+    message carries truth).  (An arm whose joints are not one actuator each is refused by
+    ``run_hardware``, which has the model.)"""
+    ports = world_of(scenario).link_ports(scenario)  # (a plugin world that cannot be had: one line)
+    m = scenario.measurement
+    if m is not None and m.estimator != "none" and (ports is None or ports.camera is None):
         raise ScenarioError(
-            "measurement: a camera over LCM is not supported yet (the drive side sees no "
-            "objects); run a scenario with analytic targets"
+            "measurement: a camera over LCM is supported for a station's rendered depth camera "
+            "(sensor: rgbd in a world that sends its frames); this one is not: run a scenario with "
+            "analytic targets"
         )
 
 
@@ -154,13 +159,16 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "stop_signal": None if r.stop_signal is None else signal.Signals(r.stop_signal).name,
         "last_command_t": r.last_command_t,
     }
-    if session.ports is not None:
+    ports = session.ports
+    if ports is not None:
         block |= {
             "gripper_status_channel": WSG_STATUS_CHANNEL,
             "gripper_command_channel": WSG_COMMAND_CHANNEL,
-            "parts_channel": PARTS_CHANNEL,
+            "parts_channel": PARTS_CHANNEL if ports.objects else None,
             "gripper_commands_taken": r.gripper_commands,
         }
+        if ports.camera:
+            block |= {"image_channel": image_channel(ports.camera), "frames_sent": r.frames_sent}
     if not settings.lockstep and r.tick_wall:
         wall = np.asarray(r.tick_wall) - r.tick_wall[0]
         sim = (np.asarray(r.tick_time) - r.tick_time[0]) / settings.realtime_rate
@@ -208,6 +216,8 @@ def run_hardware(
         )
     hw = hardware_scenario(scenario, settings)
     ports = world_of(scenario).link_ports(scenario)
+    if ports is not None and ports.camera and lcm is None:  # its own frames come back on the group
+        url = with_receive_buffer(url)
     endpoint = Endpoint(
         url,
         lcm=lcm,

@@ -56,11 +56,15 @@ class RunResult:
 @dataclass(frozen=True)
 class LinkPorts:
     """A station's ports that cross ``ptint hardware``'s link beside the arm's (``World.link_ports``):
-    a gripper (status out, command in; ``gripper_max_force`` N, the commands' limit) and the
-    motion of ``objects`` bodies, in the station's order (``link.PART_SIZE`` doubles each)."""
+    a gripper (status out, command in; ``gripper_max_force`` N, the commands' limit); the motion
+    of ``objects`` bodies, in the station's order (``link.PART_SIZE`` doubles each: what a pose
+    tracker would report; 0 where a camera sees them); and a depth camera (``camera``: its name,
+    the station's ``depth_image`` port, one frame every 1 / ``camera_rate_hz`` s)."""
 
     gripper_max_force: float
     objects: int
+    camera: Optional[str] = None
+    camera_rate_hz: float = 0.0
 
 
 class WorldRun:

@@ -12,7 +12,9 @@ built once for its geometry: no state of it is read).
 port (export)   size        meaning
 ==============  ==========  ================================================================
 ``parts``       24 a part   input: per part (scenario order) [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15),
-                            ``pick.part_pose``'s ports
+                            ``pick.part_pose``'s ports (without an rgbd camera)
+``depth_image`` image       input (an rgbd camera): the station's depth frame; the perception,
+                            the estimators and ``EstimatedParts`` run here (``camera``)
 ``gripper``     6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each finger
                             drive's force (N, − squeezes): ``GraspObserver``'s inputs
 ``grasp_state`` 1           output: the observer's state (``systems.gripper.GRASP_STATES``)
@@ -26,17 +28,33 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.sensors import ImageDepth32F
 from pydrake.systems.primitives import Demultiplexer, PassThrough
 
 from ptint_drake.config.schema import Scenario
+from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.systems.gripper import GraspObserver
+from ptint_drake.worlds.pick.camera import AddPartEstimates
 from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
 from ptint_drake.worlds.pick.route import routed_plan
 
 PART_MOTION = (9, 15)  # a part's [x, ẋ, ẍ] and [R, ω, ω̇]
+CAMERA_NAME = "camera"  # the station's rgbd camera over LCM: DRAKE_RGBD_CAMERA_IMAGES_camera
+
+
+def pick_link_ports(scenario: Scenario) -> LinkPorts:
+    """What crosses ``ptint hardware``'s link beside the arm (``World.link_ports``): the gripper
+    (its force limit) and every part's motion, or with an rgbd camera its depth frames instead
+    (the drive runs the perception: no part's motion crosses the link)."""
+    force, m = scenario.pick.gripper.max_force, scenario.measurement
+    if m is not None and m.sensor == "rgbd":
+        return LinkPorts(gripper_max_force=force, objects=0, camera=CAMERA_NAME,
+                         camera_rate_hz=float(m.rate_hz))
+    return LinkPorts(gripper_max_force=force, objects=len(scenario.pick.parts))
 
 
 @dataclass
@@ -74,13 +92,24 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     plan = routed_plan(scenario)
     places = place_positions(MakePickStation(world_config(scenario)), plan)
     count = len(pick.parts)
-    parts = builder.AddNamedSystem("status_parts", PassThrough(sum(PART_MOTION) * count))
-    split = builder.AddNamedSystem("parts_split", Demultiplexer(list(PART_MOTION) * count))
-    builder.Connect(parts.get_output_port(), split.get_input_port(0))
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, count, places))
-    for k in range(count):
-        builder.Connect(split.get_output_port(2 * k), targets.GetInputPort(f"part_{k}_pose"))
-        builder.Connect(split.get_output_port(2 * k + 1), targets.GetInputPort(f"part_{k}_rotation"))
+    m = scenario.measurement
+    if m is not None and m.sensor == "rgbd":  # the camera's frames in, the perception here
+        depth = builder.AddNamedSystem("status_depth_image",
+                                       PassThrough(AbstractValue.Make(ImageDepth32F())))
+        seen = AddPartEstimates(builder, depth.get_output_port(), scenario).parts
+        for k in range(count):
+            for what in (f"part_{k}_pose", f"part_{k}_rotation"):
+                builder.Connect(seen.GetOutputPort(what), targets.GetInputPort(what))
+        builder.ExportInput(depth.get_input_port(), "depth_image")
+    else:  # the parts' motion in, as a pose tracker reports it
+        parts = builder.AddNamedSystem("status_parts", PassThrough(sum(PART_MOTION) * count))
+        split = builder.AddNamedSystem("parts_split", Demultiplexer(list(PART_MOTION) * count))
+        builder.Connect(parts.get_output_port(), split.get_input_port(0))
+        for k in range(count):
+            builder.Connect(split.get_output_port(2 * k), targets.GetInputPort(f"part_{k}_pose"))
+            builder.Connect(split.get_output_port(2 * k + 1), targets.GetInputPort(f"part_{k}_rotation"))
+        builder.ExportInput(parts.get_input_port(), "parts")
     sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
     gripper = builder.AddNamedSystem("status_gripper", PassThrough(6))
     fingers = builder.AddNamedSystem("gripper_split", Demultiplexer([4, 2]))
@@ -91,7 +120,6 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     builder.Connect(fingers.get_output_port(1), observer.GetInputPort("drive_force"))
     builder.Connect(sequence.GetOutputPort("command"), observer.GetInputPort("command"))
     builder.Connect(sequence.GetOutputPort("part_width"), observer.GetInputPort("part_width"))
-    builder.ExportInput(parts.get_input_port(), "parts")
     builder.ExportInput(gripper.get_input_port(), "gripper")
     builder.ExportOutput(observer.GetOutputPort("grasp_state"), "grasp_state")
     target = PortTargets(targets.GetOutputPort("target"), targets.GetOutputPort("target_rotation"))

@@ -351,8 +351,9 @@ class PickWorld(World):
         return world_config(scenario).time_step if scenario.multibody is None else None
 
     def link_ports(self, scenario: Scenario) -> LinkPorts:
-        """The gripper (its force limit) and every part's motion."""
-        return LinkPorts(gripper_max_force=scenario.pick.gripper.max_force, objects=len(scenario.pick.parts))
+        """The gripper, and the parts' motion or the camera's frames (``controller_side``)."""
+        from ptint_drake.worlds.pick.controller_side import pick_link_ports  # noqa: PLC0415
+        return pick_link_ports(scenario)
 
     def controller_side(self, builder, scenario: Scenario, period: float):
         """The targets, gripper sequence and grasp observer (``controller_side``)."""

@@ -1,0 +1,92 @@
+"""The companions of a status as ``ptint drive`` receives them: what a station with a gripper
+sends before each status of the arm (``World.link_ports``) — the gripper's status, the parts'
+motion where the station sends it (a pose tracker's report), a depth frame where one falls in the
+tick's period (``camera_link.frame_due``) — filed by their time stamp until the status of that
+time takes them."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ptint_drake.hardware.camera_link import frame_due, image_channel, unpack_depth_image
+from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_STATUS_CHANNEL, Endpoint, unpack_parts,
+                                       unpack_wsg_status)
+
+
+class CompanionFault(Exception):
+    """A companion rejected or missing (the message is the one-line reason)."""
+
+
+def companion_channels(ports) -> tuple:
+    """The channels a station's companions of a status arrive on (``World.link_ports``): the
+    gripper's status, the parts' motion where the station sends it, the camera's frames."""
+    if ports is None:
+        return ()
+    return ((WSG_STATUS_CHANNEL,) + ((PARTS_CHANNEL,) if ports.objects else ())
+            + ((image_channel(ports.camera),) if ports.camera else ()))
+
+
+class CompanionInbox:
+    """The companions received, by ``utime`` (module docstring); ``ports``: the station's
+    ``LinkPorts``, ``period``: T (s), ``timeout``: s to wait for a status's companions."""
+
+    def __init__(self, endpoint: Endpoint, ports, period: float, timeout: float):
+        self.endpoint, self.ports, self.period, self.timeout = endpoint, ports, period, timeout
+        # utime → {"gripper": [fingers; forces], "parts": motion, "image": a depth frame}
+        self.companions: dict[int, dict] = {}
+
+    def collect(self) -> None:
+        """File the gripper statuses, parts messages and depth frames received by their ``utime``."""
+        for data in self.endpoint.take_side(WSG_STATUS_CHANNEL):
+            try:
+                utime, fingers, force = unpack_wsg_status(data)
+            except ValueError as exc:
+                raise CompanionFault(f"gripper status rejected: {exc}; stopped commanding") from None
+            self.companions.setdefault(utime, {})["gripper"] = np.concatenate([fingers, force])
+        if self.ports.objects:
+            for data in self.endpoint.take_side(PARTS_CHANNEL):
+                try:
+                    utime, motion = unpack_parts(data, self.ports.objects)
+                except ValueError as exc:
+                    raise CompanionFault(f"parts message rejected: {exc}; stopped commanding") from None
+                self.companions.setdefault(utime, {})["parts"] = motion
+        if self.ports.camera:
+            for data in self.endpoint.take_side(image_channel(self.ports.camera)):
+                try:
+                    utime, image = unpack_depth_image(data)
+                except ValueError as exc:
+                    raise CompanionFault(f"camera frame rejected: {exc}; stopped commanding") from None
+                self.companions.setdefault(utime, {})["image"] = image
+
+    def expected(self, utime: int, handshake: bool = False) -> tuple:
+        """The companions a status of ``utime`` brings: the gripper's, the parts' motion where the
+        station sends it, and a depth frame where one falls in the tick's period (``frame_due``)."""
+        ports = self.ports
+        frame = bool(ports.camera) and frame_due(utime * 1e-6, self.period, ports.camera_rate_hz, handshake)
+        return ("gripper",) + (("parts",) if ports.objects else ()) + (("image",) if frame else ())
+
+    def take(self, utime: int, handshake: bool = False) -> dict:
+        """The companions of the tick ``utime`` (``_expected``; the hardware sends them before the
+        arm's status; a lost one comes again with the status's re-send); ``DriveFault`` after the
+        status timeout without them."""
+        deadline = time.perf_counter() + self.timeout
+        expected = self.expected(utime, handshake)
+        while True:
+            self.collect()
+            got = self.companions.get(utime, {})
+            if all(k in got for k in expected):
+                # taken: the next status of this time (the first tick after the hand-shake's)
+                # waits for its own
+                for old in [u for u in self.companions if u <= utime]:
+                    del self.companions[old]
+                return got
+            if time.perf_counter() >= deadline:
+                missing = " and ".join(k for k in expected if k not in got)
+                raise CompanionFault(
+                    f"no {missing} message for the status of t = {utime / 1e6:.3f} s within "
+                    f"{self.timeout:g} s: stopped commanding"
+                )
+            self.endpoint.pump(0.005)  # the arm's statuses stay in the inbox
+
