@@ -205,6 +205,8 @@ UNIT_SECONDS = {
     "test_sweep.py": 60,
     "test_tune.py::test_tune_on_the_paper_robot_says_how_it_compares": 57,
     "test_lcm_two_processes.py::test_pick_lockstep_places_like_one_process": 53,
+    "test_lcm_two_processes.py::test_camera_pick_lockstep_places_like_one_process": 45,
+    "test_world_plugin.py": 30,
     "test_filter_floor.py": 46,
     "test_plugin.py": 45,
     "test_benchmark.py": 43,

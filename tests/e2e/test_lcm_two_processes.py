@@ -213,7 +213,7 @@ def test_hardware_killed_stops_the_drive(tmp_path):
     """The hardware SIGKILLed mid-run: the drive exits 1 with one line within its status timeout."""
     out = run_plan(
         [
-            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT), "kill_when": ["hw", " 30 %"]},
+            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT, *SLACK), "kill_when": ["hw", " 30 %"]},
             {"name": "drive", "argv": ptint("drive", CURVE, *PATIENT, "--out", str(tmp_path / "dr"))},
         ],
         tmp_path,
