@@ -39,6 +39,7 @@ say() { echo "setup: $*" >&2; }
 # holding the terminal or a pipe open, no zombie).
 heartbeat() {
   local sleeper=""
+  trap '' INT  # Ctrl-C is the script's: its EXIT trap stops this loop with TERM, sleep reaped
   trap '[ -z "$sleeper" ] || { kill "$sleeper" 2>/dev/null; wait "$sleeper" 2>/dev/null; }; exit 0' TERM
   while :; do
     sleep "$HEARTBEAT_S" & sleeper=$!
@@ -75,6 +76,7 @@ step_end() {
 on_exit() {
   local rc=$?
   trap - EXIT
+  trap '' INT TERM  # a second Ctrl-C must not cut the clean-up short (the heartbeat left running)
   stop_heartbeat
   if [ "$rc" = 130 ] || [ "$rc" = 143 ]; then
     say "interrupted${step_name:+ during $step_name} (exit $rc after $SECONDS s in all)"

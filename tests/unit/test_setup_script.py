@@ -39,6 +39,21 @@ def _stand_ins(tmp_path) -> dict:
                 VENV=str(tmp_path / "venv"), HEARTBEAT_S="1")
 
 
+def _running_in_group(pgid: int) -> list:
+    """The processes of process group ``pgid`` that are not zombies (/proc).  A zombie is not
+    counted: a child the script's stand-ins left unreaped when Ctrl-C killed them is handed to
+    PID 1, which reaps it when it gets round to it (lazily in some sandboxes)."""
+    running = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:  # ended meanwhile
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":  # state, ppid, pgrp, ...
+            running.append((stat.parent.name, fields[0]))
+    return running
+
+
 def _run_setup(env: dict, on_line=None) -> tuple[int, list]:
     """Run setup.sh in a session of its own; (exit code, [(seconds since the start, line)]).
     ``on_line(proc, line)`` sees each line as it comes.  Fails if anything of the script is still
@@ -61,17 +76,27 @@ def _run_setup(env: dict, on_line=None) -> tuple[int, list]:
         reader.join(timeout=3.0)
         time.sleep(0.3)
         assert not reader.is_alive(), "a process of the script still holds its output open"
-        with pytest.raises(ProcessLookupError):  # nothing of the script is left: no heartbeat
-            os.killpg(proc.pid, 0)
+        assert _running_in_group(proc.pid) == [], "a process of the script is still running"
     finally:
         try:
             os.killpg(proc.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
+        reader.join(timeout=3.0)
+        proc.stdout.close()
     return code, stamped
 
 
-@pytest.mark.skipif(shutil.which("bash") is None, reason="no bash")
+def _interrupt(proc) -> None:
+    """Ctrl-C as a terminal sends it: to the script's whole process group (if still there)."""
+    try:
+        os.killpg(proc.pid, signal.SIGINT)
+    except ProcessLookupError:
+        pass
+
+
+@pytest.mark.skipif(shutil.which("bash") is None or not Path("/proc/self/stat").exists(),
+                    reason="no bash or no /proc")
 def test_steps_are_timed_the_heartbeat_ticks_and_a_failing_step_fails_the_script(tmp_path):
     code, stamped = _run_setup(_stand_ins(tmp_path))
     lines = [line for _, line in stamped]
@@ -87,13 +112,31 @@ def test_steps_are_timed_the_heartbeat_ticks_and_a_failing_step_fails_the_script
     assert max(b - a for a, b in zip(times, times[1:])) < 3.0, stamped
 
 
-@pytest.mark.skipif(shutil.which("bash") is None, reason="no bash")
+@pytest.mark.skipif(shutil.which("bash") is None or not Path("/proc/self/stat").exists(),
+                    reason="no bash or no /proc")
 def test_ctrl_c_during_a_step_exits_130_and_leaves_nothing_running(tmp_path):
+    sent = []
+
     def interrupt(proc, line):
-        if line.startswith("setup: venv: still running"):
-            os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
+        if line.startswith("setup: venv: still running") and not sent:
+            _interrupt(proc)
+            sent.append(line)
 
     code, stamped = _run_setup(_stand_ins(tmp_path), interrupt)
     lines = [line for _, line in stamped]
     assert code == 130, lines
     assert lines[-1].startswith("setup: interrupted during venv (exit 130"), lines
+
+
+@pytest.mark.skipif(shutil.which("bash") is None or not Path("/proc/self/stat").exists(),
+                    reason="no bash or no /proc")
+def test_a_second_ctrl_c_does_not_cut_the_clean_up_short(tmp_path):
+    """Ctrl-C pressed again while the script stops its heartbeat: still nothing left running."""
+    def interrupt(proc, line):
+        if line.startswith(("setup: venv: still running", "setup: interrupted")):
+            _interrupt(proc)
+            time.sleep(0.05)
+            _interrupt(proc)
+
+    code, stamped = _run_setup(_stand_ins(tmp_path), interrupt)
+    assert code == 130, stamped

@@ -26,6 +26,7 @@ pytestmark = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_meth
 FORKED = r'''
 import json, os, sys, types
 from ptint_drake.report import run_outputs
+from ptint_drake.scenario import ScenarioError
 
 parent = os.getpid()
 
@@ -100,11 +101,17 @@ def test_beside_another_python_thread_it_runs_here(monkeypatch, start):
     """A thread of ``threading`` or one started with ``_thread`` (as pytest-xdist's I/O thread
     is, unseen by ``threading.active_count``): no fork, the simulation runs in this process."""
     _here(monkeypatch)
-    stop = threading.Event()
+    started, stop = threading.Event(), threading.Event()
+
+    def wait():
+        started.set()
+        stop.wait()
+
     if start == "threading":
-        threading.Thread(target=stop.wait, daemon=True).start()
+        threading.Thread(target=wait, daemon=True).start()
     else:
-        _thread.start_new_thread(stop.wait, ())
+        _thread.start_new_thread(wait, ())
+    started.wait()
     try:
         assert not run_outputs.can_fork()
         assert run_outputs.simulate_beside("s", lambda: None)[0]["pid"] == os.getpid()
