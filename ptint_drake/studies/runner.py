@@ -316,7 +316,9 @@ class _LocalRun:
         if method == "forkserver":
             # the server imports fn's module (pydrake with it) once when it starts, and each
             # worker forked from it has it already: ~10 ms a worker instead of ~2 s
-            self.ctx.set_forkserver_preload([__name__, fn.__module__])
+            inner = fn.args[0] if isinstance(fn, functools.partial) else fn  # _with_plugin_folders
+            module = getattr(inner, "__module__", None)
+            self.ctx.set_forkserver_preload([__name__] + ([module] if module else []))
         self.fn, self.tasks, self.max_tasks, self.stats = fn, tasks, max_tasks_per_child, stats
         self.results = [None] * len(tasks)
         self.rss = [0.0] * len(tasks)
