@@ -189,10 +189,10 @@ step_begin "check" "the installed package finds its bundled model"
 (cd / && "$venv_abs/bin/python" -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
 step_end
 # Compile the controller's numba kernels once (into numba's cache), so the first `ptint run`
-# does not pay for it; the warm-up prints a line per run it compiles.  A cold cache took 58 s and
-# 96 s on a loaded 2-core x86_64 machine (2026-12-05, Python 3.13, Drake 1.58, two fresh-clone
-# trials) and 135 s / 182 s in CI (2026-12-03, the two Drake ends, .ci/run): 1-3 minutes; a warm
-# cache a few seconds.
+# does not pay for it; the warm-up prints a line per run it compiles.  A cold cache took 58 s,
+# 96 s and 122 s on a shared 2-core x86_64 machine at load averages of about 2.5 to 7 (2026-12-05,
+# Python 3.13, Drake 1.58) and 135 s / 182 s in CI (2026-12-03, the two Drake ends, .ci/run):
+# 1-3 minutes; a warm cache a few seconds.
 step_begin "compile" "the controller's numba kernels, once (1-3 min when numba's cache is cold, seconds when warm)"
 (cd / && "$venv_abs/bin/python" -m ptint_drake.warm_up)
 step_end
