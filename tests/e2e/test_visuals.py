@@ -26,6 +26,10 @@ def paper_dir(tmp_path_factory):
                           capture_output=True, text=True, timeout=900,
                           cwd=Path(__file__).parent)
     assert done.returncode == 0, done.stderr
+    # its last line counts the paper's scenarios reproduced against docs/results.md's criteria
+    assert done.stdout.splitlines()[-1] == (
+        f"paper: 6/6 scenarios reproduced (every segment: |e(tf)| <= 1 mm, not early, hold <= 3 mm; "
+        f"docs/results.md); open {out / 'index.html'} in a browser"), done.stdout
     return out
 
 
