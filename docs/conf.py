@@ -10,6 +10,7 @@ reference and the scenario schema are generated from the code at every build
 copied into ``tutorials/`` and rendered with their committed outputs, not executed.
 """
 
+import logging
 import shutil
 import sys
 from pathlib import Path
@@ -45,3 +46,30 @@ autodoc_default_options = {"members": True, "show-inheritance": False}
 autodoc_typehints = "description"
 napoleon_numpy_docstring = False
 suppress_warnings = ["mystnb.unknown_mime_type"]
+
+
+class _NoConfigurationDump(logging.Filter):
+    """myst-parser and myst-nb log their whole configuration objects (``MdParserConfig(...)``,
+    ``NbParserConfig(...)``, each one line of ~1,500 characters) and the jupyter-cache path at
+    the info level of every build, unconditionally; this site sets them here, so the dump says
+    nothing a reader of this file does not know.  They are kept at ``-v`` (sphinx-build's
+    verbose mode), dropped otherwise; every warning and error passes."""
+
+    def __init__(self, verbose: bool):
+        super().__init__()
+        self.verbose = verbose
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.levelno > logging.INFO or self.verbose:
+            return True
+        message = str(record.msg)  # the format string, before its arguments are put in
+        return not ("myst v%s:" in message or "myst-nb v%s:" in message
+                    or message.startswith("Using jupyter-cache at"))
+
+
+def setup(app):
+    """The filter above on the loggers of myst-parser and myst-nb, before their
+    ``builder-inited`` handlers log the configuration."""
+    quiet = _NoConfigurationDump(verbose=app.verbosity > 0)
+    for name in ("sphinx.myst_parser.sphinx_ext.main", "sphinx.myst_nb.sphinx_ext"):
+        logging.getLogger(name).addFilter(quiet)

@@ -58,7 +58,7 @@ __all__ = ["TARGET_KINDS", "BallisticConfig", "ControllerConfig", "Criteria", "D
            "ParamValue", "PlantConfig", "RobotConfig", "Scenario", "ScenarioError", "SinusoidConfig",
            "TargetConfig", "WaypointsConfig", "apply_variant", "bundled_scenarios", "check_variants",
            "default_simulator", "dump_dataclass", "dump_yaml", "load_scenario", "parse_scenario",
-           "parse_with_overrides", "scenario_folders", "scenario_text", "validate"]
+           "parse_with_overrides", "scenario_folders", "scenario_summary", "scenario_text", "validate"]
 
 
 def bundled_scenarios() -> "list[str]":
@@ -78,6 +78,14 @@ def scenario_text(name_or_file: str) -> "tuple[str, str]":
             f"scenario: {name_or_file!r} is neither a bundled scenario "
             f"({', '.join(bundled_scenarios())}) nor a file")
     return path.stem, path.read_text()
+
+
+def scenario_summary(text: str) -> str:
+    """A scenario file's one-line summary (``ptint list``): its first line when that is a
+    comment, without the ``#`` (empty otherwise).  The bundled files keep it one whole
+    sentence, with the details in the comment paragraphs below it."""
+    first = text.splitlines()[0] if text else ""
+    return first.lstrip("#").strip() if first.startswith("#") else ""
 
 
 def scenario_folders(name_or_file: str) -> tuple:

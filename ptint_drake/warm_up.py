@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import sys
 import time
+from typing import Callable
 
 import numpy as np
 
@@ -35,15 +36,19 @@ _RUNS = (
 )
 
 
-def warm_up(duration: float = 0.05) -> float:
+def warm_up(duration: float = 0.05, report: Callable[[str], None] | None = None) -> float:
     """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
-    telemetry of the last state, as a run's outputs do); the wall time in s."""
+    telemetry of the last state, as a run's outputs do); the wall time in s.  ``report(line)``
+    gets a line as each run and the last kernels are done (what compiled, how long it took)."""
     from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
     from ptint_drake.simulation import build, make_simulator  # noqa: PLC0415
     from ptint_drake.systems.tbg import alpha_gain, alpha_peak, tbg_profile  # noqa: PLC0415
 
+    say = report or (lambda line: None)
     t0 = time.perf_counter()
-    for name, overrides in _RUNS:
+    steps = len(_RUNS) + 1
+    for i, (name, overrides) in enumerate(_RUNS, start=1):
+        t_run = time.perf_counter()
         _, text = scenario_text(name)
         scenario = parse_with_overrides(text, overrides, name)
         built = build(scenario, log=False)
@@ -57,12 +62,16 @@ def warm_up(duration: float = 0.05) -> float:
             context = law.GetMyContextFromRoot(simulator.get_context())
             qv, sigma, captured, _ = law.loop_values(context)
             system.telemetry_at([duration], qv[None], sigma[None], captured[None])
+        say(f"[{i}/{steps}] {name}{' ' + ' '.join(overrides) if overrides else ''}: "
+            f"{time.perf_counter() - t_run:.1f} s")
+    t_rest = time.perf_counter()
     alpha_peak(1.5, 0.75)
     tbg_profile(0.5, 1.5, 0.75)
     xi, xi_dot, _, _ = tbg_profile(np.linspace(0.0, 1.5, 5), 1.5, 0.75)
     alpha_gain(xi, xi_dot)  # arrays, as ``figures.tbg_family_figure`` (``ptint paper``) calls it
     _orientation_kernels()
     _imm_kernels()
+    say(f"[{steps}/{steps}] TBG, orientation and IMM kernels: {time.perf_counter() - t_rest:.1f} s")
     return time.perf_counter() - t0
 
 
@@ -92,5 +101,11 @@ def _imm_kernels() -> None:
         X, Ps, mu = imm_cycle(X, Ps, mu, 1.0 / 30.0, sample, 4.0e-6)
 
 
+def _report(line: str) -> None:
+    print(f"warm-up: {line}", file=sys.stderr, flush=True)
+
+
 if __name__ == "__main__":
-    print(f"warm-up: compiled kernels ready in {warm_up():.1f} s", file=sys.stderr)
+    _report(f"compiling (or loading from numba's cache) the kernels of {len(_RUNS)} short runs, then "
+            f"the rest; a few seconds when the cache is warm")
+    print(f"warm-up: compiled kernels ready in {warm_up(report=_report):.1f} s", file=sys.stderr)

@@ -12,9 +12,82 @@
 #   VENV=dir                 the environment to create or update (default .venv)
 #   DRAKE='drake==1.51.1'    a pip requirement for Drake (default: the newest the Python admits)
 #   PTINT_EDITABLE=1         install the package in editable mode (for development)
+#   HEARTBEAT_S=6            seconds between the "still running" lines of a long step
 # An existing environment built on another Python version than the one chosen is rebuilt.
+#
+# Progress: every step prints what it does when it starts and how long it took when it ends
+# ("setup: <step> ...", "setup: <step>: done in N s"), and while a step runs a background
+# heartbeat prints "setup: <step>: still running, N s" every HEARTBEAT_S seconds, so the script
+# is never silent for more than ~HEARTBEAT_S seconds (apt-get, pip and the compile are otherwise
+# silent for minutes).  A failing step ends the script with that step's exit code and the line
+# "setup: FAILED: <step> (exit N after M s)" (Ctrl-C: "setup: interrupted during <step>", exit
+# 130); the heartbeat is stopped on every way out (the EXIT trap: success, a failure under
+# `set -e`, Ctrl-C, SIGTERM).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+HEARTBEAT_S=${HEARTBEAT_S:-6}
+step_name=""
+step_t0=$SECONDS
+heartbeat_pid=""
+
+say() { echo "setup: $*" >&2; }
+
+# The background loop of step_begin: a line every HEARTBEAT_S s until it is sent SIGTERM.  Its
+# sleep runs in the background and is waited for, so that the TERM trap runs at once (bash
+# defers a trap until a foreground child ends) and kills and reaps the sleep too (no orphan left
+# holding the terminal or a pipe open, no zombie).
+heartbeat() {
+  local sleeper=""
+  trap '' INT  # Ctrl-C is the script's: its EXIT trap stops this loop with TERM, sleep reaped
+  trap '[ -z "$sleeper" ] || { kill "$sleeper" 2>/dev/null; wait "$sleeper" 2>/dev/null; }; exit 0' TERM
+  while :; do
+    sleep "$HEARTBEAT_S" & sleeper=$!
+    wait "$sleeper" || true
+    echo "setup: $1: still running, $((SECONDS - $2)) s" >&2
+  done
+}
+
+stop_heartbeat() {
+  if [ -n "$heartbeat_pid" ]; then
+    kill "$heartbeat_pid" 2>/dev/null || true
+    wait "$heartbeat_pid" 2>/dev/null || true
+    heartbeat_pid=""
+  fi
+}
+
+# step_begin NAME "what it does": the start line ("setup: NAME: what it does ...") and the
+# heartbeat ("setup: NAME: still running, N s"); step_end: "setup: NAME: done in N s".
+step_begin() {
+  stop_heartbeat
+  step_name=$1
+  step_t0=$SECONDS
+  say "$1: $2 ..."
+  heartbeat "$step_name" "$step_t0" >/dev/null &
+  heartbeat_pid=$!
+}
+
+step_end() {
+  stop_heartbeat
+  say "$step_name: done in $((SECONDS - step_t0)) s"
+  step_name=""
+}
+
+on_exit() {
+  local rc=$?
+  trap - EXIT
+  trap '' INT TERM  # a second Ctrl-C must not cut the clean-up short (the heartbeat left running)
+  stop_heartbeat
+  if [ "$rc" = 130 ] || [ "$rc" = 143 ]; then
+    say "interrupted${step_name:+ during $step_name} (exit $rc after $SECONDS s in all)"
+  elif [ "$rc" != 0 ] && [ -n "$step_name" ]; then
+    say "FAILED: $step_name (exit $rc after $((SECONDS - step_t0)) s)"
+  fi
+  exit "$rc"
+}
+trap on_exit EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
 
 need=()
 command -v dot >/dev/null 2>&1 || need+=(graphviz)
@@ -22,12 +95,17 @@ command -v chromium >/dev/null 2>&1 || need+=(chromium)
 if [ ${#need[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ]; then SUDO=""; elif command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else SUDO="none"; fi
   if [ "$SUDO" = none ]; then
-    echo "setup: cannot install ${need[*]} (not root, no sudo); the tests that need them will fail" >&2
+    say "cannot install ${need[*]} (not root, no sudo); the tests that need them will fail"
   else
-    echo "setup: apt-get install ${need[*]}" >&2
+    step_begin "apt-get update" "the package lists, to install ${need[*]}"
     $SUDO apt-get update -qq >/dev/null
+    step_end
+    step_begin "apt-get install" "${need[*]}"
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
+    step_end
   fi
+else
+  say "graphviz and chromium are installed"
 fi
 
 VENV=${VENV:-.venv}
@@ -60,33 +138,65 @@ choose_python() {
   echo "${found[0]#* }"
 }
 
-PY=${PYTHON:-$(choose_python)}
+if [ -n "${PYTHON:-}" ]; then
+  PY=$PYTHON
+else
+  step_begin "python" "choosing the newest Python >= 3.10 that has a Drake wheel (asks the package index)"
+  PY=$(choose_python)
+  step_end
+fi
 want=$("$PY" -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+say "Python $want: $PY"
 if [ -x "$VENV/bin/python" ]; then
   have=$("$VENV/bin/python" -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null || echo none)
   if [ "$have" != "$want" ]; then
-    echo "setup: $VENV has Python $have, rebuilding it with $want" >&2
+    say "$VENV has Python $have, rebuilding it with $want"
     rm -rf "$VENV"
   fi
 fi
-[ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV"
+if [ -x "$VENV/bin/python" ]; then
+  say "$VENV exists (Python $want): updating it"
+else
+  step_begin "venv" "creating $VENV"
+  "$PY" -m venv "$VENV"
+  step_end
+fi
+step_begin "pip upgrade" "pip itself, in $VENV"
 "$VENV/bin/python" -m pip install -q --upgrade pip 2>&1 | quiet_pip
+step_end
 drake=${DRAKE:-drake}
 if [ "${PTINT_EDITABLE:-0}" = 1 ]; then
+  step_begin "pip install" "ptint_drake (editable) with $drake, numba and the test, docs and cluster extras"
   "$VENV/bin/python" -m pip install -q -e ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
+  step_end
 else
+  step_begin "pip install ptint_drake" "the package, from this tree"
   "$VENV/bin/python" -m pip install -q --force-reinstall --no-deps . 2>&1 | quiet_pip
+  step_end
+  step_begin "pip install dependencies" "$drake, numba, the test, docs and cluster extras (a first install downloads ~0.5 GB)"
   "$VENV/bin/python" -m pip install -q ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
+  step_end
 fi
 # without DRAKE=, bring an existing environment up to the newest Drake its Python admits
-[ -n "${DRAKE:-}" ] || "$VENV/bin/python" -m pip install -q --upgrade --upgrade-strategy only-if-needed \
-  "drake" 2>&1 | quiet_pip
+if [ -z "${DRAKE:-}" ]; then
+  step_begin "pip upgrade drake" "Drake up to the newest release this Python admits"
+  "$VENV/bin/python" -m pip install -q --upgrade --upgrade-strategy only-if-needed "drake" 2>&1 | quiet_pip
+  step_end
+fi
 # check the installed package (from outside the source tree) finds its bundled model
 venv_abs=$(cd "$VENV" && pwd)
+step_begin "check" "the installed package finds its bundled model"
 (cd / && "$venv_abs/bin/python" -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
-# compile the controller's numba kernels once (into numba's cache), so the first `ptint run`
-# does not pay for it (about 30-70 s of CPU on a cold cache; a few seconds when already warm)
+step_end
+# Compile the controller's numba kernels once (into numba's cache), so the first `ptint run`
+# does not pay for it; the warm-up prints a line per run it compiles.  A cold cache took 58 s,
+# 96 s and 122 s on a shared 2-core x86_64 machine at load averages of about 2.5 to 7 (2026-12-05,
+# Python 3.13, Drake 1.58) and 135 s / 182 s in CI (2026-12-03, the two Drake ends, .ci/run):
+# 1-3 minutes; a warm cache a few seconds.
+step_begin "compile" "the controller's numba kernels, once (1-3 min when numba's cache is cold, seconds when warm)"
 (cd / && "$venv_abs/bin/python" -m ptint_drake.warm_up)
+step_end
 info=$("$venv_abs/bin/python" -c 'import sys, importlib.metadata as m
 print("Python %s, Drake %s" % (sys.version.split()[0], m.version("drake")))')
-echo "setup: ready ($VENV/bin/ptint): $info (from $PY)" >&2
+say "ready in $SECONDS s ($VENV/bin/ptint): $info (from $PY)"
+say "next: $VENV/bin/ptint paper   (then open out/paper/index.html in a browser)"

@@ -11,6 +11,7 @@
     ptint bench [SCENARIO ...]              speed and accuracy benchmark, JSON on stdout
     ptint hardware NAME_OR_FILE [--lockstep]  the simulated world as hardware over LCM
     ptint drive NAME_OR_FILE                the controller alone over LCM (docs/hardware.md)
+    ptint --version                         this package's version and Drake's
 
 ``--set key=value`` (repeatable) overrides any scenario field, list items
 included, e.g. ``--set controller.switching=sign --set 'interceptions[0].tf=1.2'``;
@@ -21,7 +22,9 @@ from __future__ import annotations
 
 import argparse
 import gc
+import importlib.metadata
 import os
+import platform
 import sys
 
 from ptint_drake.cli import options as opt
@@ -48,6 +51,19 @@ def _study_arguments(parser, default_out: str, workers_default: str = "CPU count
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
 
 
+def version_text() -> str:
+    """``ptint --version``: this package's version, Drake's and Python's, read from the installed
+    distributions' metadata (no pydrake import, so it answers at once)."""
+    def installed(name: str) -> str:
+        try:
+            return importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            return "not installed"
+
+    return (f"ptint (ptint_drake) {installed('ptint_drake')}, Drake {installed('drake')}, "
+            f"Python {platform.python_version()}")
+
+
 def make_parser() -> argparse.ArgumentParser:
     """``ptint``'s parser: each subcommand with its options, each option value checked by its
     type (``cli.options``), ``func`` the command (``cli.runs``, ``cli.studies``)."""
@@ -55,6 +71,8 @@ def make_parser() -> argparse.ArgumentParser:
         prog="ptint", description=__doc__.split("\n")[0],
         epilog="Paper: Flores-Campos et al., Robotics 2024, 13(10), 145. "
                "Documentation: docs/cli.md, docs/scenarios.md.")
+    parser.add_argument("--version", action="version", version=version_text(),
+                        help="print the package's, Drake's and Python's versions and exit")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_run_parsers(sub)
     _add_grid_parsers(sub)
@@ -85,6 +103,8 @@ def _add_run_parsers(sub) -> None:
     run.add_argument("--no-figures", action="store_true", help="skip the figures")
     run.add_argument("--svg", action="store_true", help="the figures as SVG too (PNG always)")
     run.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    run.add_argument("--verbose", action="store_true",
+                     help="print the controller's settings (gains, switching law, sampling)")
     run.set_defaults(func=cmd_run)
 
     diagram = sub.add_parser(

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ptint_drake.cli.options import out_folder, scenario_and_out
 from ptint_drake.worlds.registry import world_of
-from ptint_drake.scenario import LoadedScenario, bundled_scenarios, scenario_text
+from ptint_drake.scenario import LoadedScenario, bundled_scenarios, scenario_summary, scenario_text
 
 
 def progress(label: str):
@@ -41,11 +41,11 @@ def progress(label: str):
 
 
 def cmd_list(args: argparse.Namespace) -> int:
-    """Each bundled scenario's name and the first line of its comment."""
-    for name in bundled_scenarios():
-        _, text = scenario_text(name)
-        first = text.splitlines()[0].lstrip("# ").strip() if text.startswith("#") else ""
-        print(f"{name:<18} {first}")
+    """Each bundled scenario's name and its one-line summary (``scenario_summary``)."""
+    names = bundled_scenarios()
+    width = max(len(name) for name in names)
+    for name in names:
+        print(f"{name:<{width}}  {scenario_summary(scenario_text(name)[1])}")
     return 0
 
 
@@ -82,18 +82,28 @@ def _sim_line(metrics: dict, out) -> str:
     return ", ".join(parts) + f"; wrote {out}/"
 
 
+def opening_line(name: str, world: str, duration: float, controller: str, out: Path) -> str:
+    """The first line of ``ptint run``: what is run, for how long, by which controller, and
+    where its outputs go."""
+    return (f"running {name}: the {world} world, {duration:g} s simulated, controller {controller} "
+            f"(its settings: --verbose); outputs in {out}/")
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     """One scenario: its outputs, a line per segment; exit 1 when a segment missed or the run failed."""
     from ptint_drake.report.run_outputs import run_and_write  # noqa: PLC0415
 
     loaded, out = scenario_and_out(args)
     scenario = loaded.scenario
+    print(opening_line(scenario.name, world_of(scenario).name, scenario.duration,
+                       scenario.controller.type, out), flush=True)
     warn = lambda message: print(f"ptint: warning: {message}", file=sys.stderr)  # noqa: E731
     metrics = run_and_write(scenario, out, replay=not args.no_replay,
                             figures=not args.no_figures, svg=args.svg,
                             progress=None if args.quiet else progress(scenario.name), warn=warn)
     for note in metrics["controller"]["notes"]:
-        print(note)
+        if args.verbose or ": warning: " in note:  # the settings on request, a warning always
+            print(note)
     own = world_of(scenario).report(scenario, metrics, out)  # a world's own lines, if it has them
     if own is not None:
         return own
@@ -126,10 +136,16 @@ def cmd_diagram(args: argparse.Namespace) -> int:
 
 
 def cmd_paper(args: argparse.Namespace) -> int:
-    """Every paper scenario, the TBG figures and index.html."""
-    from ptint_drake.report.paper_report import write_paper  # noqa: PLC0415
+    """Every paper scenario, the TBG figures and index.html; the last line counts the scenarios
+    reproduced (``paper_report.summary_line``)."""
+    from ptint_drake.report.paper_report import summary_line, write_paper  # noqa: PLC0415
 
-    index = write_paper(out_folder(args.out, Path("out/paper")),
-                        progress_factory=None if args.quiet else progress, svg=args.svg)
+    def notify(message: str) -> None:
+        print(f"paper: {message}", file=sys.stderr, flush=True)
+
+    index, metrics = write_paper(out_folder(args.out, Path("out/paper")),
+                                 progress_factory=None if args.quiet else progress, svg=args.svg,
+                                 notify=None if args.quiet else notify)
     print(f"wrote {index}")
+    print(summary_line(metrics, index))
     return 0

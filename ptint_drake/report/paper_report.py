@@ -5,6 +5,7 @@ controller comparisons, the TBG family figures and the camera figure, on one pag
 from __future__ import annotations
 
 import html
+import os
 import time
 from pathlib import Path
 
@@ -72,13 +73,52 @@ def paper_task(kind: str, name: str, *args):
     return [seg["e_hold_max_norm"] for seg in simulate(scenario, check=False).metrics["segments"]]
 
 
+def task_label(task: tuple) -> str:
+    """What one ``paper_task`` job is, for the progress lines."""
+    kind, name, *args = task
+    if kind == "compare":
+        return f"comparison on {name}: {args[0]}, {args[1]}"
+    if kind == "hold":
+        return f"the paper's hold formula (k_hold = k) on {name}"
+    if kind == "tbg":
+        return f"TBG figure {name}"
+    if kind == "camera":
+        return f"camera figure ({name})"
+    return f"{kind} {name}"
+
+
+def _task_reporter(runs: list, tasks: list, progress_factory, notify, every_s: float = 3.0):
+    """``run_tasks``' progress callback of ``ptint paper``: a paper scenario's run through
+    ``progress_factory`` (its "NAME: 100 %" line), any other job through ``notify`` as
+    "[done/total] label", at most one line per ``every_s`` seconds except the last job of
+    each kind (so a stage of many short jobs, the comparisons, shows without flooding)."""
+    last = {"t": -float("inf")}
+    remaining = {}
+    for task in tasks[len(runs):]:
+        remaining[task[0]] = remaining.get(task[0], 0) + 1
+
+    def report(done, total, index, result):
+        if index < len(runs):
+            if progress_factory is not None:
+                progress_factory(runs[index])(result["duration"], result["duration"])
+            return
+        kind = tasks[index][0]
+        remaining[kind] -= 1
+        now = time.monotonic()
+        if notify is not None and (now - last["t"] >= every_s or remaining[kind] == 0 or done == total):
+            last["t"] = now
+            notify(f"[{done}/{total}] {task_label(tasks[index])} done")
+    return report
+
+
 def _parallel_part(out_dir: Path, tbg_stage: Path, svg: bool, workers=None,
-                   progress_factory=None) -> tuple[dict, dict, dict]:
+                   progress_factory=None, notify=None) -> tuple[dict, dict, dict]:
     """Every simulation of the paper on worker processes, each writing what it shows as
     soon as it is done: the paper scenarios' folders (simulation, figures, replay), the TBG
     figures, the camera figure, the comparisons of ``COMPARED`` and the paper-formula holds,
     the longest first; then the comparisons' files.  Returns (metrics.json of each paper
-    scenario, comparisons, holds)."""
+    scenario, comparisons, holds).  ``notify(message)`` gets a line per stage and, as the
+    jobs finish, how many are done (``_task_reporter``)."""
     from ptint_drake.studies import compare  # noqa: PLC0415
     from ptint_drake.studies.runner import run_tasks  # noqa: PLC0415
 
@@ -91,10 +131,12 @@ def _parallel_part(out_dir: Path, tbg_stage: Path, svg: bool, workers=None,
     tasks += [("compare", name, c, v) for name in COMPARED for c, v in pairs]
     tasks += [("hold", name) for name in PAPER_SCENARIOS]
 
-    def report(done, total, index, result):
-        if progress_factory is not None and index < len(runs):
-            progress_factory(runs[index])(result["duration"], result["duration"])
-
+    say = notify or (lambda message: None)
+    say(f"{len(tasks)} jobs on {workers or os.cpu_count() or 1} worker processes: the {len(runs)} paper "
+        f"scenarios (each written as `ptint run` writes it), the camera and TBG figures, "
+        f"{len(tasks) - first - len(PAPER_SCENARIOS)} comparison runs, {len(PAPER_SCENARIOS)} runs "
+        f"of the paper's hold formula")
+    report = _task_reporter(runs, tasks, progress_factory, notify)
     t0 = time.perf_counter()
     with frozen_heap():  # every worker is forked from here
         results = run_tasks(paper_task, tasks, workers=workers, progress=report)
@@ -103,6 +145,7 @@ def _parallel_part(out_dir: Path, tbg_stage: Path, svg: bool, workers=None,
     comparisons = {name: compare.comparison(load_scenario(name), name, controllers, variants,
                                             compared[k * len(pairs):(k + 1) * len(pairs)], wall)
                    for k, name in enumerate(COMPARED)}
+    say(f"writing the comparisons' tables and figures ({', '.join(f'compare_{n}/' for n in COMPARED)})")
     run_tasks(paper_task, [("compare_files", name, result, out_dir / f"compare_{name}")
                            for name, result in comparisons.items()], workers=workers)
     holds = dict(zip(PAPER_SCENARIOS, compared[len(COMPARED) * len(pairs):]))
@@ -159,9 +202,27 @@ def _camera_figure(out_dir: Path) -> None:
         estimate_figure(scenario_text(CAMERA_SCENARIO)[1], CAMERA_SCENARIO, stage)
 
 
-def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = False) -> Path:
+def summary_line(metrics: dict, index: Path) -> str:
+    """``ptint paper``'s last line: how many of the paper's scenarios reproduced, n/N, by
+    their verdict (metrics.json ``status`` "ok": every segment meets docs/results.md's
+    criteria: |e(tf)| <= 1 mm, not early (|e(tf/2)| >= |e0|/4), |e| <= 3 mm while holding),
+    the reasons of those that did not, and the page to open.  ``metrics``: metrics.json of
+    each paper scenario, by name."""
+    ok = [name for name, m in metrics.items() if m["status"] == "ok"]
+    missed = [f"{name}: {m['status']}" + (f" ({'; '.join(m['reasons'])})" if m.get("reasons") else "")
+              for name, m in metrics.items() if m["status"] != "ok"]
+    return (f"paper: {len(ok)}/{len(metrics)} scenarios reproduced (every segment: |e(tf)| <= 1 mm, "
+            f"not early, hold <= 3 mm; docs/results.md)"
+            + (f"; not reproduced: {', '.join(missed)}" if missed else "")
+            + f"; open {index} in a browser")
+
+
+def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = False,
+                notify=None) -> tuple[Path, dict]:
     """Run every paper scenario and the controller comparisons; write ``out_dir/index.html``
-    (``svg``: the run figures as SVG too).
+    (``svg``: the run figures as SVG too); returns its path and metrics.json of each paper
+    scenario (``summary_line``).  ``progress_factory(name)``: a paper scenario's progress;
+    ``notify(message)``: one line per stage and on the other jobs' progress.
 
     Everything runs on worker processes forked after this one imported matplotlib
     (``figures.preload``): each paper scenario's run writes its folder as ``ptint run``
@@ -174,7 +235,9 @@ def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = 
     preload(studies=True)  # once, before the workers fork: none imports matplotlib again
     with staged_output(out_dir / "tbg") as stage:
         metrics, comparisons, paper_holds = _parallel_part(out_dir, stage, svg, workers,
-                                                           progress_factory)
+                                                           progress_factory, notify)
+    if notify is not None:
+        notify(f"writing {out_dir / 'index.html'}")
     rows, sections = [], []
     for name, (figs, claim) in PAPER_SCENARIOS.items():
         m = metrics[name]
@@ -188,7 +251,7 @@ def write_paper(out_dir: Path, progress_factory=None, workers=None, svg: bool = 
     compared = "".join(_compare_section(name, result) for name, result in comparisons.items())
     page = _page(rows, sections, compared, time.perf_counter() - t_start)
     write_text_atomic(out_dir / "index.html", page)
-    return out_dir / "index.html"
+    return out_dir / "index.html", {name: metrics[name] for name in PAPER_SCENARIOS}
 
 
 def _page(rows, sections, compared: str, elapsed: float) -> str:

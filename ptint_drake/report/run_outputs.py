@@ -13,7 +13,6 @@ import re
 import shutil
 import subprocess
 import sys
-import threading
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from pathlib import Path
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
 from ptint_drake.simulation import build, simulate
+from ptint_drake.studies.runner import fork_is_safe
 from ptint_drake.worlds.registry import world_key, world_named, world_of
 
 
@@ -70,6 +70,8 @@ def simulate_beside(scenario: Scenario, prepare=None, **kwargs) -> tuple[dict, d
     if prepare is None or not can_fork():
         result = simulate(scenario, **kwargs)
         return result.metrics, result.series
+    # fork, not forkserver: the child needs the scenario and this process's imports at no cost,
+    # and the fork is safe (can_fork: no other Python thread, hence no lock held by one)
     ctx = multiprocessing.get_context("fork")
     conn, child_conn = ctx.Pipe(duplex=False)
     child = ctx.Process(target=_simulate_child, args=(child_conn, scenario, kwargs.get("progress"),
@@ -132,12 +134,13 @@ def frozen_heap():
 
 
 def can_fork() -> bool:
-    """Whether a forked worker is safe: this process runs one Python thread and holds no
-    Meshcat (its server threads are C++ threads: a fork would copy the ``Meshcat`` object
-    without them, and a replay drawn in the child would wait on them forever)."""
+    """Whether a forked worker is safe: this process runs one Python thread (``fork_is_safe``:
+    no other thread can hold a lock the child would inherit locked; the command line's case,
+    not a notebook's or a pytest-xdist worker's) and holds no Meshcat (its server threads are
+    C++ threads: a fork would copy the ``Meshcat`` object without them, and a replay drawn in
+    the child would wait on them forever).  Otherwise the caller works in this process."""
     replay = sys.modules.get("ptint_drake.replay")
-    return ("fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
-            and getattr(replay, "_MESHCAT", None) is None)
+    return fork_is_safe() and getattr(replay, "_MESHCAT", None) is None
 
 
 def draw_views(tasks: list[tuple], workers: int | None = None) -> None:

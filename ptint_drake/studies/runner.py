@@ -12,11 +12,12 @@ same numbers with 1 worker, N workers or on a cluster.
 Local workers (the default) are this module's own small pool, not a
 ``ProcessPoolExecutor``:
 
-- forked on Linux when the calling process has a single thread, as the command line
-  has (a fork from a parent that has imported Drake starts in ~10 ms), from a
-  forkserver when it has more (e.g. a Jupyter kernel or a Dask client: a forked child
-  would inherit their locks held; a forkserver worker re-imports pydrake, ~2 s
-  each) unless ``fn`` is defined in ``__main__`` (a notebook cell), spawned elsewhere;
+- forked on Linux when the calling process runs no Python thread but its own, as the
+  command line does (``fork_is_safe``; a fork from a parent that has imported Drake starts
+  in ~10 ms), from a forkserver when it runs more (a Jupyter kernel, a Dask client,
+  pytest-xdist's I/O thread: a forked child would inherit their locks held; the forkserver
+  imports ``fn``'s module, pydrake with it, once, ~2 s, and forks each worker from
+  itself) unless ``fn`` is defined in ``__main__`` (a notebook cell), spawned elsewhere;
 - one task in flight per worker (dispatch on completion: a pipe round trip costs
   ~0.1 ms against ≥ 0.1 s per simulation), so nothing is submitted up front;
 - recycled after ``max_tasks_per_child`` tasks (default ``MAX_TASKS_PER_CHILD``):
@@ -55,6 +56,7 @@ workers, ``start_method``.
 
 from __future__ import annotations
 
+import _thread
 import concurrent.futures as cf
 import functools
 import multiprocessing
@@ -270,17 +272,32 @@ class _Worker:
             self.process.terminate()
 
 
+def fork_is_safe() -> bool:
+    """Whether a ``fork`` of this process is provably safe: no Python thread runs but the
+    calling one, so no lock can be held by a thread the child would not have.  Both counts
+    matter: ``threading.active_count`` sees the threads of ``threading`` (a Dask client's
+    event loop, a Jupyter kernel's), ``_thread._count`` also those started with ``_thread``
+    (pytest-xdist's execnet I/O thread, which ``threading`` never sees).  They are what
+    Python >= 3.12 counts when it warns that a fork "may lead to deadlocks in the child".
+    Native threads are not Python threads and do not count: OpenBLAS's pool (started by
+    ``import numpy``) re-arms itself across a fork (``pthread_atfork``), and Drake's Meshcat
+    server threads are checked for separately (``report.run_outputs.can_fork``)."""
+    count = getattr(_thread, "_count", lambda: 0)  # threads started here, the main one not counted
+    return ("fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
+            and count() == 0)
+
+
 def _start_method(fn) -> str:
-    """``fork`` when this process runs one Python thread (the command line), else
-    ``forkserver``: a fork copies only the calling thread, so a lock another thread holds
-    (a Dask client's event loop, a Jupyter kernel's) stays locked in the child forever; the
-    forkserver's workers re-import pydrake instead (~2 s each).  ``spawn`` where neither
-    exists.  (OpenBLAS's own threads do not count: it re-arms them across a fork, and
-    Python does not warn about them.)  A ``fn`` defined in ``__main__`` (a notebook cell, a
-    script) is forked whatever the threads: a forkserver child could not import it."""
+    """``fork`` when the fork is safe (``fork_is_safe``: this process runs one Python thread,
+    the command line's case), else ``forkserver``: a fork copies only the calling thread, so
+    a lock another thread holds (a Dask client's event loop, a Jupyter kernel's, pytest-xdist's
+    I/O thread) stays locked in the child forever; the forkserver is a fresh single-threaded
+    process that forks the workers instead.  ``spawn`` where neither exists.  A ``fn`` defined
+    in ``__main__`` (a notebook cell, a script) is forked whatever the threads: a forkserver
+    child could not import it (Python warns about that fork, rightly)."""
     methods = multiprocessing.get_all_start_methods()
     in_main = getattr(fn, "__module__", None) == "__main__"
-    if "fork" in methods and (threading.active_count() == 1 or in_main):
+    if "fork" in methods and (fork_is_safe() or in_main):
         return "fork"
     return "forkserver" if "forkserver" in methods else "spawn"
 
@@ -296,6 +313,12 @@ class _LocalRun:
         method = _start_method(fn)
         stats["start_method"] = method
         self.ctx = multiprocessing.get_context(method)
+        if method == "forkserver":
+            # the server imports fn's module (pydrake with it) once when it starts, and each
+            # worker forked from it has it already: ~10 ms a worker instead of ~2 s
+            inner = fn.args[0] if isinstance(fn, functools.partial) else fn  # _with_plugin_folders
+            module = getattr(inner, "__module__", None)
+            self.ctx.set_forkserver_preload([__name__] + ([module] if module else []))
         self.fn, self.tasks, self.max_tasks, self.stats = fn, tasks, max_tasks_per_child, stats
         self.results = [None] * len(tasks)
         self.rss = [0.0] * len(tasks)

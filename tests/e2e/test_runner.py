@@ -88,12 +88,13 @@ def _comparable(row):
 def _new_children(before):
     """Child processes of this process that were not there ``before`` (a set of pids): other
     tests may leave helpers of their own (e.g. Dask's resource tracker) that are not ours, and
-    the multiprocessing forkserver (started once per process, when a test before this one left
-    threads behind, e.g. a Dask client) is not a worker."""
-    from multiprocessing import forkserver  # noqa: PLC0415
+    the multiprocessing forkserver and its resource tracker (started once per process, when this
+    process runs other threads: a Dask client, pytest-xdist's I/O thread) are not workers."""
+    from multiprocessing import forkserver, resource_tracker  # noqa: PLC0415
 
     server = getattr(getattr(forkserver, "_forkserver", None), "_forkserver_pid", None)
-    return set(_children(os.getpid())) - before - {server}
+    tracker = getattr(getattr(resource_tracker, "_resource_tracker", None), "_pid", None)
+    return set(_children(os.getpid())) - before - {server, tracker}
 
 
 def _children(pid):

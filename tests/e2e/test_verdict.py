@@ -30,12 +30,15 @@ def test_a_tf_the_actuators_cannot_do_is_a_miss(tmp_path):
     segment = [i for i, line in enumerate(lines) if line.startswith("curve_b075_tf15 segment 0:")]
     assert len(segment) == 1 and "MISSED (late" in lines[segment[0]], text
     assert "ptint tune" in lines[-1], text
-    # the feasibility warning (known before the simulation) is printed once, before every line
-    # of the run's own (controller note, segment line, realtime factor, verdict) ...
+    # the run opens with what it runs; the feasibility warning (known before the simulation) is
+    # printed once, after that line and before every other line of the run's own (segment
+    # line, realtime factor, verdict) ...
+    assert lines[0].startswith("running curve_b075_tf15: the interception world, 3 s simulated, "
+                               "controller ptsmc"), text
     feasibility = [i for i, line in enumerate(lines) if "looks too short for the actuators" in line]
     assert len(feasibility) == 1, text
     assert lines[feasibility[0]].startswith("ptint: warning: interceptions[0].tf = 0.03 s"), text
-    own = [i for i, line in enumerate(lines) if not line.startswith("ptint: warning: ")]
+    own = [i for i, line in enumerate(lines[1:], start=1) if not line.startswith("ptint: warning: ")]
     assert feasibility[0] < min(own), text
     # ... and the warnings known only after it (joint speeds beyond the model's) after its lines
     realtime = [i for i, line in enumerate(lines) if line.startswith("realtime factor ")]

@@ -26,6 +26,10 @@ def paper_dir(tmp_path_factory):
                           capture_output=True, text=True, timeout=900,
                           cwd=Path(__file__).parent)
     assert done.returncode == 0, done.stderr
+    # its last line counts the paper's scenarios reproduced against docs/results.md's criteria
+    assert done.stdout.splitlines()[-1] == (
+        f"paper: 6/6 scenarios reproduced (every segment: |e(tf)| <= 1 mm, not early, hold <= 3 mm; "
+        f"docs/results.md); open {out / 'index.html'} in a browser"), done.stdout
     return out
 
 
@@ -152,23 +156,40 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
     assert red.sum() > 150
 
 
+FORKED_VIEWS = r"""
+import sys
+from pathlib import Path
+from ptint_drake.report.run_outputs import can_fork, write_views
+from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation import simulate
+
+scenario = load_scenario("curve_b075_tf15")
+scenario.duration = 0.6
+result = simulate(scenario)
+assert can_fork(), "a fresh process runs one Python thread"
+write_views(scenario, result.series, result.metrics, Path(sys.argv[1]), workers=2)
+assert can_fork(), "the replay's Meshcat was made in a worker"
+"""
+
+
 def test_views_in_workers_equal_views_drawn_here(tmp_path):
     """Figures drawn by forked workers are byte for byte those drawn in this process; the
-    default is PNG only, ``svg=True`` adds the SVGs; the replay is written either way."""
+    default is PNG only, ``svg=True`` adds the SVGs; the replay is written either way.  The
+    forked workers are drawn from a fresh single-threaded process (as ``ptint run`` is): this
+    one, a pytest-xdist worker with its I/O thread, does not fork (``can_fork``)."""
     from ptint_drake.report.run_outputs import can_fork, write_views
     from ptint_drake.scenario import load_scenario
     from ptint_drake.simulation import simulate
 
-    scenario = load_scenario("curve_b075_tf15")
-    scenario.duration = 0.6
-    result = simulate(scenario)
     here, there = tmp_path / "here", tmp_path / "there"
     here.mkdir()
     there.mkdir()
-    if not can_fork():
-        pytest.skip("this test process already holds a Meshcat: views are drawn here only")
-    write_views(scenario, result.series, result.metrics, there, workers=2)
-    assert can_fork()  # the replay's Meshcat was made in a worker
+    forked = subprocess.run([sys.executable, "-c", FORKED_VIEWS, str(there)], capture_output=True,
+                            text=True, timeout=600, cwd=tmp_path)
+    assert forked.returncode == 0, forked.stderr
+    scenario = load_scenario("curve_b075_tf15")
+    scenario.duration = 0.6
+    result = simulate(scenario)
     stems = write_views(scenario, result.series, result.metrics, here, workers=1, svg=True)
     assert stems == ["axes", "errors", "joints", "paths3d"]
     assert not can_fork()  # ... and now here: no more forks from this process
