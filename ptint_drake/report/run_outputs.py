@@ -20,7 +20,7 @@ from pathlib import Path
 from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
 from ptint_drake.simulation import build, simulate
-from ptint_drake.studies.runner import fork_is_safe
+from ptint_drake.studies.workers import fork_is_safe
 from ptint_drake.worlds.registry import world_key, world_named, world_of
 
 
