@@ -25,8 +25,28 @@ mixing c_j = Σᵢ Πᵢⱼ μᵢ, μᵢ|ⱼ = Πᵢⱼ μᵢ / c_j, χ⁰ⱼ = 
 P⁰ⱼ = Σᵢ μᵢ|ⱼ (Pᵢ + (χᵢ − χ⁰ⱼ)(χᵢ − χ⁰ⱼ)ᵀ); each model predicts and corrects (Joseph form),
 its likelihood is N(y; 0, S); μⱼ ∝ c_j N(y; 0, S) (in logs).  Π: stay with probability
 exp(−Δ/SOJOURN), else switch to either other model.  A dropout (no new sample at an
-update) mixes and predicts only (μⱼ = c_j).  The timing (latency compensation, priming
-with pre-run samples, update instants) is ``sampled_estimator.SampledEstimator``'s.
+update) *coasts*: each model predicts its own χⱼ, Pⱼ, unmixed, and μ is held (below).  The
+timing (latency compensation, priming with pre-run samples, update instants) is
+``sampled_estimator.SampledEstimator``'s.
+
+Through a gap (the arm hiding the object for its last frames, a dropout window) the
+estimate is the filter's prediction conditioned on no switch since the last sample:
+Σ μⱼ χⱼ with each χⱼ predicted by its own model and μ as the last sample left it.  The
+textbook cycle without a sample (mixing, then μ ← Πᵀμ; Blom & Bar-Shalom 1988, Bar-Shalom,
+Li & Kirubarajan 2001 §11.6) applies the switching prior with nothing to test it: repeated
+over a gap it moves μ toward Π's stationary distribution (uniform) by about Δ/(3·SOJOURN)
+per cycle, and the combined mean then weighs in models whose predictions leave the data
+quadratically — ``fall`` drops ½gT², 1.08 m after T = 0.47 s.  On conveyor_pair_rgbd (seed 0;
+the tool hides box 1 from 1.73 s to its tf at 2.2 s) μ_fall rose from 2e-5 to 0.008 and
+the combined estimate sank with −0.08 m/s² (g·μ_fall): 3.8 mm low at tf, 10 mm at 2.37 s
+(segment 1: e(tf) 4.6 mm, hold 66 mm).  SOJOURN is a tracking rate (how fast samples may
+re-weigh the models, chosen by measurement below), not a measured switching rate of the
+objects, so its drift carries no information about the hidden motion; a motion that did
+change in the gap shows at the next sample as an innovation of many σ (a belt that stopped
+for 0.5 s: 40 mm against σ ≈ 0.5 mm), whose likelihoods re-weigh μ at once, and the
+switching resumes with that sample.  Nothing here is a constant: with one model dominant,
+coasting is that model's own prediction, and a real acceleration (a throw: ``fall``; a belt
+speeding up: ``ca``) is extrapolated through the gap exactly as far as its model carries it.
 
 Output ``target`` (9) = [p̂ + v̂Δt + âΔt²/2, v̂ + âΔt, â] of the combined estimate
 χ̂ = Σ μⱼ χⱼ, Δt = t − t_est (the same layout as the Kalman filter); ``probabilities`` (4, μ of ``MODELS``).

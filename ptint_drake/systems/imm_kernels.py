@@ -212,17 +212,29 @@ def mix(X: np.ndarray, Ps: np.ndarray, mu: np.ndarray, dt: float) -> tuple:
 @njit(cache=True)
 def imm_cycle(X: np.ndarray, Ps: np.ndarray, mu: np.ndarray, dt: float, z: np.ndarray,
               R: float) -> tuple:
-    """One IMM cycle over dt, correcting with the position z (3; ``NO_SAMPLE``, empty: predict
-    only): (X, Ps, μ) after it, μⱼ ∝ c_j N(y; 0, S) (in logs; μⱼ = c_j without a sample)."""
+    """One IMM cycle over dt, correcting with the position z (3): (X, Ps, μ) after it, μⱼ ∝
+    c_j N(y; 0, S) (in logs).  Without a sample (z = ``NO_SAMPLE``, empty) ``coast``."""
+    if len(z) == 0:
+        return coast(X, Ps, mu, dt)
     X0, P0, c = mix(X, Ps, mu, dt)
     logs = np.zeros(len(MODELS))
     for j in range(len(MODELS)):
         X0[j], P0[j] = predict_model(j, X0[j], P0[j], dt)
-        if len(z) != 0:
-            X0[j], P0[j], logs[j] = correct(X0[j], P0[j], z, R)
+        X0[j], P0[j], logs[j] = correct(X0[j], P0[j], z, R)
     logw = np.log(np.maximum(c, 1e-300)) + logs
     w = np.exp(logw - logw.max())
     return X0, P0, w / w.sum()
+
+
+@njit(cache=True)
+def coast(X: np.ndarray, Ps: np.ndarray, mu: np.ndarray, dt: float) -> tuple:
+    """A cycle without a sample: each model predicts its own (χⱼ, Pⱼ) over dt, unmixed, and μ
+    is held — the filter's prediction conditioned on no switch since the last sample (``imm``'s
+    docstring, "Through a gap", has why: Πᵀμ would leak the other models in)."""
+    X1, P1 = np.empty_like(X), np.empty_like(Ps)
+    for j in range(len(MODELS)):
+        X1[j], P1[j] = predict_model(j, X[j], Ps[j], dt)
+    return X1, P1, mu.copy()
 
 
 @njit(cache=True)

@@ -271,6 +271,9 @@ class _ReferenceIMM:
 
     @classmethod
     def imm_cycle(cls, X, Ps, mu, dt, z, R):
+        if z is None:  # the coast: each model alone, μ held
+            pairs = [cls.predict(model, X[j], Ps[j], dt) for j, model in enumerate(MODELS)]
+            return np.array([x for x, _ in pairs]), np.array([P for _, P in pairs]), mu.copy()
         X0, P0, c = cls.mix(X, Ps, mu, dt)
         logs = np.zeros(4)
         for j, model in enumerate(MODELS):
