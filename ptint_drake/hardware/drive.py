@@ -35,7 +35,7 @@ import time
 from typing import Callable, Optional
 
 import numpy as np
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.analysis import ApplySimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import PassThrough
 
@@ -57,7 +57,8 @@ from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
-from ptint_drake.systems.gripper import EMPTY, GRASP_STATES, HOLDING, LOST
+from ptint_drake.systems.gripper import GRASP_STATES
+from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.registry import objects_of, schedule_of, world_of
 
 
@@ -130,7 +131,7 @@ class _DriveLoop:
         # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
         # the hardware side rejects a torque beyond an effort limit as a fault
         self.limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
-        self.simulator = Simulator(diagram)
+        self.simulator = new_simulator(diagram)
         config = copy.copy(scenario.simulator)
         own = world_of(scenario).simulator_config(scenario)
         if own is not None:  # the world's own integrator settings, as in ``ptint run``
@@ -229,14 +230,13 @@ class _DriveLoop:
             raise DriveFault(str(exc)) from None
 
     def check_grasp(self, utime: int) -> None:
-        """At a grasp check of the plan (and, from a close command on, every ``SENSE_PERIOD``):
-        ``DriveFault`` when the gripper is not holding there (``empty`` or ``lost`` at a sense
-        time) — a retry or abort would plan anew, which is not supported across processes."""
-        what = self.checks.get(utime)
-        if what is None:
+        """At a grasp read of the plan (its checks, and from a close command on every
+        ``SENSE_PERIOD``): ``DriveFault`` when the world's rule would plan anew there (the controller
+        side's ``stands``) — a retry or abort is not supported across processes."""
+        if utime not in self.checks:
             return
         state = int(self.grasp_out.Eval(self.context)[0])
-        if state == HOLDING or (what == "sense" and state not in (EMPTY, LOST)):
+        if self.side.stands(utime, state):  # the world's own rule (``World.controller_side``)
             return
         raise DriveFault(
             f"the grasp check at t = {utime / 1e6:.3f} s read {GRASP_STATES[state]!r}: a retry "
@@ -328,8 +328,7 @@ class _DriveLoop:
         integration and the events call is loaded before the first tick, which must be answered
         within a period (measured: the first real-time ticks answered 1-2 ms late without it,
         five in a row, a hold).  The hardware waits ``session.QUIET`` s after the hand-shake."""
-        scratch = Simulator(self.simulator.get_system(), self.context.Clone())
-        ApplySimulatorConfig(self.config, scratch)
+        scratch = new_simulator(self.simulator.get_system(), self.context.Clone(), self.config)
         scratch.Initialize()
         scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
         self.out.Eval(scratch.get_context())

@@ -32,6 +32,7 @@ from ptint_drake.outputs import staged_output, write_json_atomic
 from ptint_drake.scenario import LoadedScenario, Scenario, ScenarioError
 from ptint_drake.studies.camera import DEFAULT_SEEDS, with_measurement
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.registry import schedule_of, world_of
 
 # scenario, process noises q (m²/s⁵ for kalman_ca) and output read rate (Hz)
@@ -100,7 +101,6 @@ def _read_filters(scenario: Scenario, times: np.ndarray) -> dict:
     """Simulate the true objects → cameras → filters → selector and read, at each of
     ``times``: ``objects`` (every true position), ``filters`` (every filter's position),
     ``truth`` (the active true target) and ``estimate`` (the selector's output)."""
-    from pydrake.systems.analysis import Simulator  # noqa: PLC0415
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
     from ptint_drake.systems.kalman import AddCameraEstimators  # noqa: PLC0415
@@ -113,7 +113,7 @@ def _read_filters(scenario: Scenario, times: np.ndarray) -> dict:
                                      schedule=schedule_of(scenario), config=scenario.measurement,
                                      histories=world_of(scenario).objects(scenario))  # in view before t = 0
     diagram = builder.Build()
-    simulator = Simulator(diagram)
+    simulator = new_simulator(diagram)
     context = simulator.get_mutable_context()
     truth_context = truth.GetMyContextFromRoot(context)
     filters = [(kf, kf.GetMyContextFromRoot(context)) for kf in estimators.filters]

@@ -28,12 +28,26 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.metrics import Reason
 from ptint_drake.systems.schedule import Schedule
 
 Progress = Optional[Callable[[float, float, int], None]]
+
+
+def new_simulator(diagram, context=None, config=None) -> Simulator:
+    """The package's one construction of a Drake ``Simulator``: of ``diagram`` (from ``context``,
+    else the diagram's default context), with ``config`` (a ``SimulatorConfig``) applied when
+    given.  Every run, study, floor and the drive's controller loop start here, so that what a
+    simulator is set up with is decided in one place (``worlds.runner.make_simulator`` adds a
+    world's own settings)."""
+    simulator = Simulator(diagram) if context is None else Simulator(diagram, context)
+    if config is not None:
+        ApplySimulatorConfig(config, simulator)
+    return simulator
 
 
 @dataclass

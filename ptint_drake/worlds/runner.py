@@ -17,11 +17,11 @@ import dataclasses
 import time
 from typing import Callable, Optional
 
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.analysis import Simulator
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.jit_notice import compile_notice
-from ptint_drake.worlds.base import Progress, RunResult, WorldRun
+from ptint_drake.worlds.base import Progress, RunResult, WorldRun, new_simulator
 from ptint_drake.worlds.registry import world_of
 
 __all__ = ["RunResult", "make_simulator", "simulate"]
@@ -30,9 +30,7 @@ __all__ = ["RunResult", "make_simulator", "simulate"]
 def make_simulator(run: WorldRun) -> Simulator:
     """A simulator of the run's diagram with the world's integrator settings, from the diagram's
     default context (the station's defaults are the scenario's start)."""
-    simulator = Simulator(run.diagram)
-    ApplySimulatorConfig(run.simulator_config, simulator)
-    return simulator
+    return new_simulator(run.diagram, config=run.simulator_config)
 
 
 def _failure(t: float, what: str, exc: BaseException) -> dict:

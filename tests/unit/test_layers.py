@@ -69,3 +69,15 @@ def test_the_hardware_path_names_no_world():
              for i, line in enumerate(f.read_text().splitlines(), 1)
              if re.search(r"\bpick|\binterception", line, re.IGNORECASE)]
     assert named == []
+
+
+def test_one_module_constructs_the_simulator():
+    """Issue 43: ``Simulator(`` appears in one module (``worlds.base.new_simulator``); every run,
+    study, floor and the drive start there."""
+    import re  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    root = Path(__file__).resolve().parents[2] / "ptint_drake"
+    found = sorted({str(f.relative_to(root)) for f in root.rglob("*.py")
+                    if re.search(r"(?<![_\w])Simulator\(", f.read_text())})
+    assert found == ["worlds/base.py"]

@@ -35,7 +35,7 @@ from pydrake.systems.primitives import Demultiplexer, PassThrough
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.worlds.base import LinkPorts
-from ptint_drake.systems.gripper import GraspObserver
+from ptint_drake.systems.gripper import EMPTY, HOLDING, LOST, GraspObserver
 from ptint_drake.worlds.pick.camera import AddPartEstimates
 from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
 from ptint_drake.worlds.pick.station import MakePickStation
@@ -57,6 +57,15 @@ def pick_link_ports(scenario: Scenario) -> LinkPorts:
     return LinkPorts(gripper_max_force=force, objects=len(scenario.pick.parts))
 
 
+def plan_stands(state: int, read: str) -> bool:
+    """The pick's grasp rule, the one ``ptint run`` (``world.PickRun``) and ``ptint drive``
+    apply: at a grasp check (``read`` = "check") the plan stands when the gripper is ``holding``;
+    at a read between the close command and the check ("sense") unless the fingers closed on
+    nothing (``empty``) or lost the part (``lost``).  Otherwise the world plans anew (a retry, an
+    abort, or at a check still ``closing``, a longer wait)."""
+    return state == HOLDING if read == "check" else state not in (EMPTY, LOST)
+
+
 @dataclass
 class PickControllerSide:
     """What ``AddPickControllerSide`` added: the plan, the gripper sequence and observer, the parts'
@@ -69,6 +78,12 @@ class PickControllerSide:
     max_force: float
     reads: dict
     target: PortTargets
+
+    def stands(self, utime: int, state: int) -> bool:
+        """Whether the plan stands at the status of ``utime`` with the observer's ``state``
+        (``plan_stands``; a time that is no grasp read: it stands)."""
+        read = self.reads.get(utime)
+        return read is None or plan_stands(state, read)
 
 
 def grasp_reads(plan, period: float, sense: float) -> dict:

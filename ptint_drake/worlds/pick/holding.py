@@ -14,11 +14,11 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from pydrake.systems.analysis import Simulator
 from pydrake.systems.controllers import PidController
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
+from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.pick.config import PickWorldConfig
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 
@@ -55,7 +55,7 @@ def measure_hold(config: PickWorldConfig, duration: float = 2.0, settle: float =
         X_WT = tip.CalcPoseInWorld(pc)
         return X_WT.inverse().multiply(plant.EvalBodyPoseInWorld(pc, station.parts[0])).translation()
 
-    simulator = Simulator(diagram, context)
+    simulator = new_simulator(diagram, context)
     simulator.AdvanceTo(settle)
     start, drift, belt_error = relative(), 0.0, 0.0
     belts = {b.name: b for b in config.belts}

@@ -11,12 +11,12 @@ import sys
 from collections import Counter
 
 import numpy as np
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.controllers import PidController
 from pydrake.systems.framework import DiagramBuilder, EventStatus
 from pydrake.systems.primitives import Adder, LogVectorOutput, Saturation, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
+from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.config.pick import PHASES
 from ptint_drake.mass_scaling import scale_in_context
@@ -324,8 +324,7 @@ class FloorReplay:
             taus.append(saturation.get_output_port().Eval(saturation.GetMyContextFromRoot(context)).copy())
             return EventStatus.Succeeded()
 
-        simulator = Simulator(run.diagram)
-        ApplySimulatorConfig(run.simulator_config, simulator)
+        simulator = new_simulator(run.diagram, config=run.simulator_config)
         context = simulator.get_mutable_context()
         run.initialize(context)
         simulator.set_monitor(keep)

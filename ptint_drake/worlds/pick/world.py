@@ -49,7 +49,8 @@ from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
                                          pick_logs, pick_simulator, segment_aims, world_config)
 from ptint_drake.reachability import inverse_kinematics
-from ptint_drake.systems.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST
+from ptint_drake.systems.gripper import CLOSING, GRASP_STATES, HOLDING
+from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.route import routed_plan
 from ptint_drake.worlds.pick.tasks import Replan, check_tasks, pick_plan
 
@@ -125,7 +126,7 @@ class PickRun(WorldRun):
                 self._check(context, k, t, self._grasp_state(context))
             elif any(abs(s - t) < 1e-12 for s in self._sense_times(k)):
                 state = self._grasp_state(context)
-                if state in (EMPTY, LOST):  # nothing between the fingers: no need to wait for the check
+                if not plan_stands(state, "sense"):  # nothing between the fingers: no need to wait
                     self._check(context, k, t, state)
 
     def _unseen(self, context, k: int, t: float) -> bool:
@@ -352,7 +353,6 @@ class PickWorld(World):
 
     def link_ports(self, scenario: Scenario) -> LinkPorts:
         """The gripper, and the parts' motion or the camera's frames (``controller_side``)."""
-        from ptint_drake.worlds.pick.controller_side import pick_link_ports  # noqa: PLC0415
         return pick_link_ports(scenario)
 
     def controller_side(self, builder, scenario: Scenario, period: float):
