@@ -1,12 +1,13 @@
 """Regenerate the tables of the README and the documentation pages from the commands behind them.
 
-    .venv/bin/python scripts/readme_tables.py            # results + controllers compared (~1 min)
+    .venv/bin/python scripts/readme_tables.py            # controllers compared (~1 min)
     .venv/bin/python scripts/readme_tables.py --all      # also tuning and the camera study (~8 min)
 
+The results table (and every block a test checks) is written by ``scripts/doc_blocks.py``.
 Each table sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->`` in README.md and/or
-the pages of docs/ (``results`` in both; the others in docs/results.md, controllers.md,
-own_controller.md, own_arm.md, camera.md) and is replaced in place in every file that has it,
-with the command and the machine it was measured on.  Timings (realtime
+the pages of docs/ (controllers.md, own_controller.md, own_arm.md, camera.md) and is
+replaced in place in every file that has it, with the command and the machine it was
+measured on.  Timings (realtime
 factors, study wall times) depend on the machine; errors and verdicts do not (the runs are
 deterministic).
 """
@@ -39,35 +40,6 @@ def machine() -> str:
 
 def mm(v, digits: int = 4) -> str:
     return "–" if v is None else f"{v * 1e3:.{digits}g}"
-
-
-def results_table() -> str:
-    """The paper scenarios: both hold columns and the torque peaks with and without start-up."""
-    from ptint_drake.report.paper_report import paper_task  # noqa: PLC0415
-    from ptint_drake.scenario import load_scenario  # noqa: PLC0415
-    from ptint_drake.simulation import simulate  # noqa: PLC0415
-
-    lines = ["| scenario | β | tf [s] | e0 | e(tf/2) | e(tf) | ė(tf) [mm/s] | hold max (k_hold = 50) "
-             "| hold max (paper: k_hold = k) | peak τ [N·m] | peak τ after start-up [N·m] | verdict | RTF |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for name in PAPER:
-        m = simulate(load_scenario(name)).metrics
-        paper_holds = paper_task("hold", name)  # the paper's s_d after tf (k_hold = k)
-        rtf = f"{m['sim']['realtime_factor']:.1f}"
-        for i, seg in enumerate(m["segments"]):
-            first = i == 0
-            label = name if len(m["segments"]) == 1 else f"{name} #{i + 1}"
-            lines.append(
-                f"| {label} | {seg['beta']:g} | {seg['tf']:g} | {mm(seg['e0_norm'])} "
-                f"| {mm(seg['e_half_norm'])} | {mm(seg['e_tf_norm'], 3)} | {mm(seg['edot_tf_norm'], 3)} "
-                f"| {mm(seg['e_hold_max_norm'], 3)} "
-                f"| {mm(paper_holds[i], 3)} "
-                f"| {', '.join(f'{v:.2f}' for v in m['torque_peak']) if first else ''} "
-                f"| {', '.join(f'{v:.2f}' for v in m['torque_peak_after_startup']) if first else ''} "
-                f"| {m['status'] if first else ''} | {rtf if first else ''} |")
-    return "\n".join(lines) + "\n\n`ptint run NAME` for each (and `--set controller.k_hold=3` for the " \
-        f"paper's hold), measured by `scripts/readme_tables.py` on {machine()}; " \
-        "RTF (end-to-end realtime factor) depends on the machine.\n"
 
 
 def compare_table(name: str, workers: int, controllers=None, folders: tuple = ()) -> str:
@@ -153,7 +125,6 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     text = {path: path.read_text() for path in PAGES}
-    text = replace(text, "results", results_table())
     for name in ("curve_b075_tf15", "assembly"):
         text = replace(text, f"compare_{name}", compare_table(name, args.workers))
     text = replace(text, "compare_plugin", compare_table(  # docs/own_controller.md's plugin example
