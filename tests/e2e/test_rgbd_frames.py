@@ -80,7 +80,7 @@ def _truth_at(series: dict, part: int, t: float) -> tuple[np.ndarray, np.ndarray
 
 def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_beside_the_part(tmp_path):
     from ptint_drake.worlds.pick.camera_frames import pick_instants
-    from ptint_drake.worlds.pick.views import CLOUD_HOLD, GRASP_TAIL
+    from ptint_drake.worlds.pick.views import GRASP_TAIL
     from ptint_drake.worlds.registry import world_of
 
     result = run_cached("conveyor_pick_place_rgbd")
@@ -96,6 +96,12 @@ def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_
     half = 0.5 * np.asarray(result.scenario.pick.parts[0].size)
     instants = pick_instants(series, metrics)
     assert [label for label, _, _ in instants] == ["pick0_first_fit", "pick0_grasp"]
+    frame_of = {label: float(replay_t[np.argmin(np.abs(replay_t - t))]) for label, _, t in instants}
+    # each cloud stays until the next drawn for its pick (the first fit's until the grasp's frame),
+    # the grasp's as long as the estimate (GRASP_TAIL)
+    shown_for = {"pick0_first_fit": frame_of["pick0_grasp"] - frame_of["pick0_first_fit"],
+                 "pick0_grasp": GRASP_TAIL}
+    assert shown_for["pick0_first_fit"] > 1.0  # most of the approach, not a quarter second
     for label, part, t in instants:
         path = f"/drake/camera/clouds/{label}"
         cloud = next(c for c in commands if c.get("type") == "set_object" and c["path"] == path)
@@ -114,7 +120,7 @@ def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_
         on = [f for f in range(len(replay_t)) if _visible_at(tracks[path], f)]
         assert on and on[0] == int(np.floor(t_frame * fps + 1e-9)), (label, on[:3])
         assert on == list(range(on[0], on[-1] + 1))  # one stretch
-        assert len(on) / fps == pytest.approx(CLOUD_HOLD, abs=1.5 / fps)
+        assert len(on) / fps == pytest.approx(shown_for[label], abs=1.5 / fps)
     # the estimate: a track over the run, what the series logged, near the part until the grasp
     track = tracks["/drake/estimates/part_0"]
     assert len(track[".position"]) >= 0.9 * len(replay_t)

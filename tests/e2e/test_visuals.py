@@ -138,7 +138,10 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
         browser = p.chromium.launch(executable_path=CHROMIUM, args=BROWSER_ARGS)
         page = browser.new_page(viewport={"width": 1000, "height": 700})
         page.goto((paper_dir / "curve_b075_tf15" / "replay.html").as_uri())
-        page.wait_for_timeout(5000)  # past tf = 1.5 s: the object is held
+        page.wait_for_function("viewer.animator.actions.length > 0", timeout=60_000)
+        page.click("#ptint-play")  # paused (the replay loops) at 2.5 s, past tf = 1.5 s: the object is held
+        page.evaluate("viewer.animator.seek(2.5)")
+        page.wait_for_timeout(1000)
         shot = tmp_path / "held.png"
         page.screenshot(path=str(shot))
         browser.close()

@@ -20,10 +20,13 @@ from the scenario and replayed from its logged [q; v] at 30 frames per second in
 recording, saved standalone with ``StaticHtml()`` (``replay``).  With an RGB-D camera it also shows
 what the perception had (issue 34): the point cloud of each pick's first fit (magenta) and of its
 grasp (violet) — the frame re-rendered, cropped and downsampled as the perception did
-(``camera_frames.camera_views``) — from the frame's time for ``CLOUD_HOLD``, and per part its
+(``camera_frames.camera_views``) — from the frame's time until the pick's next cloud's frame (the
+grasp's: ``GRASP_TAIL``; ``cloud_intervals``), and per part its
 estimate (series ``part_estimate_k``, what the approach and the grasp aimed at) as a yellow outline
 of its known shape with a frame triad, beside the simulated part, until ``GRASP_TAIL`` past its
 pick's prescribed grasp (the part is in the hand then; the estimate runs on along the belt).
+The floor is drawn under the whole scene (``draw_pick_floor``), Meshcat's grid and axes hidden, and
+the page loops with the time, a pause / play button and a legend (``replay.finish_page``).
 """
 
 from __future__ import annotations
@@ -181,8 +184,7 @@ def replay_world(scenario):
     return plant, viz, meshcat, builder.Build().CreateDefaultContext()
 
 
-CLOUD_HOLD = 0.25  # s, a frame's cloud stays shown after the frame (one replay frame is 33 ms; the
-# part moves on meanwhile: 25 mm at 0.1 m/s — paused at the frame's time the cloud sits on it)
+CLOUD_HOLD = 0.25  # s, the least a frame's cloud stays shown after its frame (one replay frame is 33 ms)
 CLOUD_POINT_SIZE = 0.002  # m (the cloud's voxel is 1.5 mm)
 CLOUD_RGBA = {"first_fit": (1.0, 0.1, 0.8, 1.0), "grasp": (0.55, 0.25, 1.0, 1.0)}  # magenta, violet
 ESTIMATE_RGBA = (1.0, 0.85, 0.0, 1.0)  # yellow: seen on the blue parts and the black belts
@@ -208,6 +210,51 @@ def draw_camera_clouds(meshcat, scenario, series: dict, metrics: dict) -> list[t
         meshcat.SetProperty(path, "visible", False)
         shown.append((path, view.t))
     return shown
+
+
+def cloud_intervals(clouds: list) -> list[tuple[str, float, float]]:
+    """(path, on, off) of each cloud of ``draw_camera_clouds`` ([(path, frame time)]): shown from
+    its frame until the next cloud drawn for the same pick (the first fit's until the grasp's),
+    the last of a pick for ``GRASP_TAIL`` (as long as the estimate stays drawn), at least
+    ``CLOUD_HOLD``.  The cloud stays where the part was at its frame; the part moves on."""
+    out = []
+    for path, t in clouds:
+        pick = path.rsplit("/", 1)[-1].split("_", 1)[0]
+        later = [u for p, u in clouds if p.rsplit("/", 1)[-1].split("_", 1)[0] == pick and u > t]
+        off = min(later) if later else t + GRASP_TAIL
+        out.append((path, t, max(off, t + CLOUD_HOLD)))
+    return out
+
+
+def pick_legend(scenario, camera: bool) -> list:
+    """The legend of a pick replay (``replay.finish_page``)."""
+    from ptint_drake.replay import FLOOR_COLOR, css_color  # noqa: PLC0415
+
+    legend = [("rgba(40, 90, 200, 1)", "the parts, on their belts (dark), to the tray"),
+              ("rgba(150, 150, 150, 1)", "the arm and its two-finger gripper")]
+    if camera:
+        rgba = {k: "rgba({}, {}, {}, 1)".format(*(round(255 * c) for c in v[:3]))
+                for k, v in CLOUD_RGBA.items()}
+        legend += [(rgba["first_fit"], "magenta points: the depth camera's point cloud at the pick's "
+                    "first fit (shown until the grasp's frame; it stays where the part was)"),
+                   (rgba["grasp"], "violet points: the cloud at the prescribed grasp"),
+                   ("rgba(255, 217, 0, 1)", "yellow outline and axes: the part's estimate, what the arm aims "
+                    f"at (until {GRASP_TAIL:g} s past the grasp)")]
+    legend.append((css_color(FLOOR_COLOR), "floor, 10 cm grid"))
+    return legend
+
+
+def draw_pick_floor(meshcat, plant, context) -> None:
+    """The floor (``replay.draw_floor``: the plate, a 10 cm grid, Meshcat's grid hidden) under every
+    body of the plant at its posed state, with a margin."""
+    from pydrake.multibody.tree import BodyIndex  # noqa: PLC0415
+
+    from ptint_drake.replay import draw_floor, floor_extent  # noqa: PLC0415
+
+    plant_context = plant.GetMyContextFromRoot(context)
+    points = np.array([plant.EvalBodyPoseInWorld(plant_context, plant.get_body(BodyIndex(i))).translation()
+                       for i in range(1, plant.num_bodies())])
+    draw_floor(meshcat, floor_extent(points, margin=0.2))
 
 
 def draw_estimates(meshcat, scenario) -> None:
@@ -243,15 +290,18 @@ def estimate_pose(series: dict, part: int, t: float):
     return RigidTransform(RotationMatrix.ProjectToRotationMatrix(np.reshape(row[3:12], (3, 3))), row[0:3])
 
 
-def write_pick_replay(scenario, series: dict, metrics: dict, path: Path) -> int:
+def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: str = "") -> int:
     """Write ``replay.html`` (module docstring); returns its size in bytes."""
-    from ptint_drake.replay import CAMERA, with_camera  # noqa: PLC0415
+    from ptint_drake.replay import finish_page  # noqa: PLC0415
     plant, viz, meshcat, context = replay_world(scenario)
     plant_context = plant.GetMyMutableContextFromRoot(context)
     times, states = series["replay_t"], series["plant_state"]
+    plant.SetPositions(plant_context, states[0][:plant.num_positions()])
+    draw_pick_floor(meshcat, plant, context)
     clouds, until, visible = [], [], {}
-    if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
-        clouds = draw_camera_clouds(meshcat, scenario, series, metrics)
+    camera = scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
+    if camera:
+        clouds = cloud_intervals(draw_camera_clouds(meshcat, scenario, series, metrics))
         draw_estimates(meshcat, scenario)
         until = estimate_shown_until(scenario, metrics)
     meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
@@ -259,7 +309,7 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path) -> int:
         plant.SetPositions(plant_context, x[:plant.num_positions()])
         context.SetTime(float(t))
         viz.ForcedPublish(viz.GetMyContextFromRoot(context))
-        shown = [(cloud, t_frame - 1e-6 <= t < t_frame + CLOUD_HOLD) for cloud, t_frame in clouds]
+        shown = [(cloud, on - 1e-6 <= t < off) for cloud, on, off in clouds]
         shown += [(f"estimates/part_{k}", t <= end) for k, end in enumerate(until)]
         for name, on in shown:  # a key where it changes (a visibility track holds its last key)
             if visible.get(name) != on:
@@ -268,8 +318,11 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path) -> int:
         for k in range(len(until)):
             meshcat.SetTransform(f"estimates/part_{k}", estimate_pose(series, k, float(t)),
                                  time_in_recording=float(t))
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
-    html = with_camera(meshcat.StaticHtml(), CAMERA)
+    for name, on in visible.items():  # every track to the last frame: the clips loop together
+        meshcat.SetProperty(name, "visible", bool(on), time_in_recording=float(times[-1]))
+    placed = sum(bool(p["placed"]) for p in metrics["picks"])
+    heading = (f"{title or scenario.name}: {metrics.get('status', '')}, "
+               f"{placed} of {len(metrics['picks'])} placed")
+    html = finish_page(meshcat, heading, pick_legend(scenario, camera))
     Path(path).write_text(html, encoding="utf-8")
     return len(html.encode("utf-8"))

@@ -339,7 +339,7 @@ class PickWorld(World):
             write_pick_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics, stage)
         else:
             write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics,
-                              stage / "replay.html")
+                              stage / "replay.html", title=title)
         return name
 
     def simulator_config(self, scenario: Scenario):
