@@ -8,6 +8,8 @@ Each page is opened, its animation paused (the overlay's button) and sought to t
 (``viewer.animator.seek``), and the page photographed with its overlay: the time, the legend.
 The interception replay is ``assembly`` (three objects, prescribed 0.5, 2.2 and 4.3 s), the pick
 replay ``conveyor_pick_place_rgbd`` (the depth camera's point cloud and the part's estimate).
+The same pick run's figures are copied beside them (``FIGURES``: picks.png, estimates.png and the
+camera's frames at the first fit), as the documentation's stills of each.
 """
 
 from __future__ import annotations
@@ -29,6 +31,10 @@ BROWSER_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swif
 # cloud interval (shown from the first fit, ~0.03 s, until the grasp's frame, 1.7 s)
 SHOTS = {"assembly": ("replay_assembly", (0.3, 2.2, 4.6)),
          "conveyor_pick_place_rgbd": ("replay_pick_rgbd", (0.2, 1.0, 3.0))}
+# a run's file → the still in docs/_static
+FIGURES = {"conveyor_pick_place_rgbd": {"picks.png": "picks_rgbd.png", "estimates.png": "estimates_rgbd.png",
+                                        "frames/pick0_first_fit_color.png": "frame_first_fit_color.png",
+                                        "frames/pick0_first_fit_depth.png": "frame_first_fit_depth.png"}}
 
 
 def shoot(page_file: Path, times: tuple, stem: str, folder: Path, size: tuple = (1000, 650)) -> list[Path]:
@@ -65,10 +71,14 @@ def main() -> int:
         base = args.runs or Path(tmp)
         for name, (stem, times) in SHOTS.items():
             if not args.runs:
-                subprocess.run([sys.executable, "-m", "ptint_drake", "run", name, "--quiet", "--no-figures",
+                figures = [] if name in FIGURES else ["--no-figures"]
+                subprocess.run([sys.executable, "-m", "ptint_drake", "run", name, "--quiet", *figures,
                                 "--out", str(base / name)], check=True, capture_output=True)
             for path in shoot(base / name / "replay.html", times, stem, STATIC):
                 print(f"wrote {path.relative_to(ROOT)}")
+            for source, still in FIGURES.get(name, {}).items():
+                shutil.copyfile(base / name / source, STATIC / still)
+                print(f"wrote docs/_static/{still}")
     return 0
 
 

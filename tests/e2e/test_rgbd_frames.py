@@ -14,10 +14,20 @@ def test_frames_show_the_belts_and_a_good_fit_at_every_instant(tmp_path):
     camera = result.scenario.measurement.camera
     segments = len(result.scenario.interceptions)
     assert len(names) == 2 * 3 * segments  # colour + depth at start, half-way and tf of each segment
+    from ptint_drake.systems.perception.frame_images import CAPTION_HEIGHT, SCALE_WIDTH
+
     for name in names:
-        image = np.asarray(Image.open(tmp_path / name))
-        assert image.shape[:2] == (camera.height, camera.width), name
-        if name.endswith("_depth.png"):
+        whole = np.asarray(Image.open(tmp_path / name))
+        depth = name.endswith("_depth.png")
+        width = camera.width + (SCALE_WIDTH if depth else 0)
+        assert whole.shape[:2] == (CAPTION_HEIGHT + camera.height, width), name
+        caption = whole[:CAPTION_HEIGHT, :, :3]
+        assert np.count_nonzero(np.all(caption < 100, axis=-1)) > 200, f"{name}: no caption text"
+        if depth:  # the scale's ramp: bright at its top, dark at its bottom
+            ramp = whole[CAPTION_HEIGHT + 20: -36, camera.width + 12, 0].astype(int)
+            assert ramp[0] > 200 and ramp[-1] < 50 and np.all(np.diff(ramp) <= 0), name
+        image = whole[CAPTION_HEIGHT:, :camera.width]  # the camera's own pixels
+        if depth:
             # belts, parts and arm (~20 % of the frame; the sky beyond them has no depth)
             seen = np.count_nonzero(image) / image.size
             assert seen > 0.1, f"{name}: only {seen:.0%} of the depth pixels are valid"
