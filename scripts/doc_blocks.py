@@ -50,7 +50,9 @@ POSE_SCENARIOS = {"conveyor_yaw": ("part (yaw)", ("0 (0°)", "1 (30°)", "2 (−
 
 EXEMPT_COLUMNS = ("RTF", "realtime factor")
 ABS_TOL, REL_TOL = 0.01, 0.02
-STAMP = re.compile(r"measured \d{4}-\d\d-\d\d on [^,]+, Python [\d.]+, Drake [\d.]+, commit [0-9a-f]{7,}")
+# a stamp line, and after "; " the machine's timings measured then
+STAMP = re.compile(r"measured \d{4}-\d\d-\d\d on [^,]+, Python [\d.]+, Drake [\d.]+, "
+                   r"commit [0-9a-f]{7,}(; .*)?")
 
 
 def paper_hold_overrides(name: str) -> str:
@@ -245,13 +247,65 @@ def store_robust(folders: list) -> None:
     (DATA / "pick_robust.json").write_text(text + "\n")
 
 
+# block → (scenario, controllers (None: the registry's), folders with plugins); the first two are
+# what ``ptint paper`` compares (its compare_NAME/compare.json feeds tests/e2e/test_visuals.py)
+COMPARES = {"compare_curve_b075_tf15": ("curve_b075_tf15", None, ()),
+            "compare_assembly": ("assembly", None, ()),
+            "compare_plugin": ("curve_b075_tf15", ("ptsmc", "task_space_pd:TaskSpacePD"), ("examples",))}
+
+
+def compare(result: dict, controllers: Optional[tuple], when: str) -> str:
+    """A compare study condensed (docs/controllers.md, own_controller.md): e(tf), t_arrive and the
+    verdict per controller, segment and variant; ``result``: compare.json's content."""
+    from ptint_drake.studies.compare import table_rows  # noqa: PLC0415
+
+    variants = result["variants"]
+    header = " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants)
+    lines = ["| controller | seg | " + header + " |", "|---|---|" + "---|" * len(variants)]
+    rows = table_rows(result)
+    keys = sorted({(r["controller"], r["segment"]) for r in rows},
+                  key=lambda k: (result["controllers"].index(k[0]), k[1]))
+    for controller, seg in keys:
+        cells = []
+        for v in variants:
+            r = next(x for x in rows if (x["controller"], x["segment"], x["variant"]) == (controller, seg, v))
+            arrive = "never" if r["t_arrive"] is None else f"{r['t_arrive']:.2f} s"
+            cells.append(f"{mm(r['e_tf_norm'], 3)} mm / {arrive} / {'ok' if r['ok'] else r['reasons']}")
+        lines.append(f"| {controller} | {seg} | " + " | ".join(cells) + " |")
+    prescribed = ", ".join(f"{s['start'] + s['tf']:g} s" for s in result["segments"])
+    option = f" --controllers {','.join(controllers)}" if controllers else ""
+    return "\n".join(lines) + (
+        f"\n\n`ptint compare {result['scenario']}{option}` (prescribed interception at {prescribed}), "
+        "written by `scripts/doc_blocks.py` and checked by the tests against the runs of the same comparison "
+        f"(t_arrive: the first time |e| ≤ 1 mm); its wall time depends on the machine:\n{when}; "
+        f"{result['wall_time_s']:.0f} s.")
+
+
+def run_compare_study(block: str, workers: int = 2) -> dict:
+    """The comparison of ``COMPARES[block]`` run now (compare.json's content, without curves)."""
+    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
+    from ptint_drake.studies.compare import DEFAULT_CONTROLLERS, run_compare  # noqa: PLC0415
+
+    name, controllers, folders = COMPARES[block]
+    loaded = LoadedScenario.parse(scenario_text(name)[1], name, (), tuple(str(ROOT / f) for f in folders))
+    result = run_compare(loaded, list(controllers or DEFAULT_CONTROLLERS), workers=workers)
+    return dict(result, rows=[{k: v for k, v in r.items() if k != "curve"} for r in result["rows"]])
+
+
+def store_compare(block: str) -> None:
+    """docs/_data/BLOCK.json: the comparison run now, with the stamp."""
+    DATA.mkdir(exist_ok=True)
+    text = json.dumps({"result": run_compare_study(block), "stamp": stamp()}, indent=1)
+    (DATA / f"{block}.json").write_text(text + "\n")
+
+
 @dataclass(frozen=True)
 class Block:
     """A generated block: its marker ``name``, the files that hold it, and its source."""
 
     name: str
     files: tuple
-    source: str  # "runs", "json" or "tests"
+    source: str  # "runs", "json", "tests" or "paper" (a comparison ``ptint paper`` makes)
 
 
 BLOCKS = (
@@ -262,15 +316,24 @@ BLOCKS = (
     Block("rgbd_picks", ("docs/camera.md",), "json"),
     Block("pick_robust", ("docs/pick_place.md",), "json"),
     Block("speed", ("docs/speed.md",), "json"),
+    Block("compare_curve_b075_tf15", ("docs/controllers.md",), "paper"),
+    Block("compare_assembly", ("docs/controllers.md",), "paper"),
+    Block("compare_plugin", ("docs/own_controller.md",), "json"),
 )
 BY_NAME = {b.name: b for b in BLOCKS}
 
 
 def render(name: str, runs: Optional[Callable[[str, str], dict]] = None, when: Optional[str] = None,
-           counts: Optional[dict] = None) -> str:
+           counts: Optional[dict] = None, compared: Optional[dict] = None) -> str:
     """Block ``name``'s text: ``runs(scenario, overrides)`` gives a run's metrics (``runs``
-    blocks), ``when`` their stamp (default: this machine, today), ``counts`` pytest's counts."""
+    blocks), ``when`` their stamp (default: this machine, today), ``counts`` pytest's counts,
+    ``compared`` a comparison's compare.json (``paper`` blocks; default: run now)."""
     when = when or stamp()
+    if name in COMPARES and BY_NAME[name].source == "paper":
+        return compare(compared or run_compare_study(name), COMPARES[name][1], when)
+    if name == "compare_plugin":
+        data = json.loads((DATA / f"{name}.json").read_text())
+        return compare(data["result"], COMPARES[name][1], data["stamp"])
     if name == "results":
         return results({n: runs(n, "") for n in PAPER}, {n: runs(n, paper_hold_overrides(n)) for n in PAPER},
                        when)
@@ -384,6 +447,8 @@ def main(argv: Optional[list] = None) -> int:
     parser.add_argument("blocks", nargs="*", help=f"the blocks (default: all of {', '.join(BY_NAME)})")
     parser.add_argument("--check", action="store_true", help="exit 1 when a block differs from its generator")
     parser.add_argument("--measure-speed", action="store_true", help="first time docs/speed.md's commands")
+    parser.add_argument("--store-compare", action="store_true",
+                        help="first run the plugin comparison into docs/_data/compare_plugin.json")
     parser.add_argument("--store-robust", nargs="+", metavar="FOLDER",
                         help="first store these `ptint robust` output folders as docs/_data/pick_robust.json")
     args = parser.parse_args(argv)
@@ -391,6 +456,8 @@ def main(argv: Optional[list] = None) -> int:
         measure_speed()
     if args.store_robust:
         store_robust(args.store_robust)
+    if args.store_compare:
+        store_compare("compare_plugin")
     stale = []
     for name in args.blocks or list(BY_NAME):
         text = render(name, runs=run_metrics)

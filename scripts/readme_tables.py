@@ -1,9 +1,9 @@
 """Regenerate the tables of the README and the documentation pages from the commands behind them.
 
-    .venv/bin/python scripts/readme_tables.py            # controllers compared (~1 min)
-    .venv/bin/python scripts/readme_tables.py --all      # also tuning and the camera study (~8 min)
+    .venv/bin/python scripts/readme_tables.py            # tuning and the camera study (~30 min)
 
-The results table (and every block a test checks) is written by ``scripts/doc_blocks.py``.
+The results table, the comparisons and every other block a test checks are written by
+``scripts/doc_blocks.py``; these two (``tune``, ``camera``) are not checked by a test yet.
 Each table sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->`` in README.md and/or
 the pages of docs/ (controllers.md, own_controller.md, own_arm.md, camera.md) and is
 replaced in place in every file that has it, with the command and the machine it was
@@ -40,35 +40,6 @@ def machine() -> str:
 
 def mm(v, digits: int = 4) -> str:
     return "–" if v is None else f"{v * 1e3:.{digits}g}"
-
-
-def compare_table(name: str, workers: int, controllers=None, folders: tuple = ()) -> str:
-    """The compare study of ``name`` condensed: e(tf), t_arrive and the verdict per variant
-    (``controllers``: the registry's by default; ``folders``: where a plugin's module is)."""
-    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
-    from ptint_drake.studies.compare import DEFAULT_CONTROLLERS, run_compare, table_rows  # noqa: PLC0415
-
-    loaded = LoadedScenario.parse(scenario_text(name)[1], name, (), folders)
-    result = run_compare(loaded, controllers or DEFAULT_CONTROLLERS, workers=workers)
-    variants = result["variants"]
-    header = " | ".join(f"{v}: e(tf) / t_arrive / verdict" for v in variants)
-    lines = ["| controller | seg | " + header + " |",
-             "|---|---|" + "---|" * len(variants)]
-    rows = table_rows(result)
-    keys = sorted({(r["controller"], r["segment"]) for r in rows},
-                  key=lambda k: (result["controllers"].index(k[0]), k[1]))
-    for controller, seg in keys:
-        cells = []
-        for v in variants:
-            r = next(x for x in rows if (x["controller"], x["segment"], x["variant"]) == (controller, seg, v))
-            arrive = "never" if r["t_arrive"] is None else f"{r['t_arrive']:.2f} s"
-            cells.append(f"{mm(r['e_tf_norm'], 3)} mm / {arrive} / {'ok' if r['ok'] else r['reasons']}")
-        lines.append(f"| {controller} | {seg} | " + " | ".join(cells) + " |")
-    prescribed = ", ".join(f"{s['start'] + s['tf']:g} s" for s in result["segments"])
-    option = f" --controllers {','.join(controllers)}" if controllers else ""
-    return ("\n".join(lines) + f"\n\n`ptint compare {name}{option}` (prescribed interception at "
-            f"{prescribed}; "
-            f"{result['wall_time_s']:.0f} s with {workers} workers on {machine()}).\n")
 
 
 def tune_table(workers: int) -> str:
@@ -121,17 +92,11 @@ def replace(texts: dict, name: str, table: str) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--all", action="store_true", help="also the tuning and camera tables (slow)")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     text = {path: path.read_text() for path in PAGES}
-    for name in ("curve_b075_tf15", "assembly"):
-        text = replace(text, f"compare_{name}", compare_table(name, args.workers))
-    text = replace(text, "compare_plugin", compare_table(  # docs/own_controller.md's plugin example
-        "curve_b075_tf15", args.workers, ["ptsmc", "task_space_pd:TaskSpacePD"], (str(ROOT / "examples"),)))
-    if args.all:
-        text = replace(text, "tune", tune_table(args.workers))
-        text = replace(text, "camera", camera_table(args.workers))
+    text = replace(text, "tune", tune_table(args.workers))
+    text = replace(text, "camera", camera_table(args.workers))
     for path, content in text.items():
         if content != path.read_text():
             path.write_text(content)
