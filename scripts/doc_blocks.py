@@ -7,19 +7,25 @@
 A block sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->``.  Its generator is a
 function of its inputs, never of the files it is written into:
 
-* ``runs``: metrics of scenario runs (``RUNS[name]``: (scenario, YAML overrides) pairs).  The
+* ``runs``: metrics of scenario runs (``runs_of(name)``: (scenario, YAML overrides) pairs).  The
   script simulates them; ``tests/e2e/test_doc_blocks.py`` feeds the generators the suite's
-  session-cached runs (``conftest.run_cached``) instead, so no run is made twice.
+  session-cached runs (``conftest.run_cached``) instead, so a run another test made is not made
+  again.
+* ``paper``: a comparison ``ptint paper`` makes (compare_NAME/compare.json); the script runs the
+  comparison, ``tests/e2e/test_visuals.py`` feeds the one its shared ``ptint paper`` run wrote.
 * ``json``: the committed output of a study too long for a test (``docs/_data/NAME.json``,
-  written by the study's script); the block is the rendering of that file.
-* ``tests``: the counts ``pytest --collect-only -q`` reports.
+  written by the study's own script or ``--store-*`` here, with its stamp); the block is the
+  rendering of that file and ``tests/unit/test_doc_blocks.py`` checks it is.
+* ``tests``: the counts ``pytest --collect-only -q`` reports (checked by the unit test).
 
-``matches(old, new)`` is the comparison the check and the test use: the text must be equal
-except (a) table columns and lines that are timings of the machine (``EXEMPT_COLUMNS``; a line
-starting with "measured"), which must instead carry a stamp (date, machine, commit: ``STAMP``),
-and (b) numbers, which may differ by ``ABS_TOL + REL_TOL·|x|`` in the printed unit (mm, N·m,
-s, °): the runs are deterministic on one Drake, but Drake 1.51.1 and 1.58 integrate the
-last digits of a near-zero error differently, and CI checks the blocks on both.
+``differences(old, new)`` is the comparison the check and the tests use: the text must be equal
+except (a) table columns that are timings of the machine (``EXEMPT_COLUMNS``) and stamp lines
+(``STAMP``: "measured DATE on MACHINE, Python X, Drake Y, commit Z", and after "; " the timings
+measured then), which any other stamp replaces, and (b) numbers, which may differ by
+``ABS_TOL + REL_TOL·|x|`` in the printed unit (mm, N·m, s, °): the runs are deterministic on one
+Drake, but CI checks the blocks on Drake 1.51.1 and the newest, which integrate the last digits
+of a near-zero error differently (0.01 mm is 1 % of the 1 mm criterion; the tutorial notebooks'
+tables agree across both to 3 significant digits, tests/e2e/test_notebooks.py).
 """
 
 from __future__ import annotations
@@ -299,6 +305,81 @@ def store_compare(block: str) -> None:
     (DATA / f"{block}.json").write_text(text + "\n")
 
 
+TUNED = (*PAPER, "conveyor_pair")  # and the heavy 6-joint arm of tests/heavy_arm.py
+
+
+def store_tune(workers: int = 2) -> None:
+    """docs/_data/tune.json: ``ptint tune`` on each of TUNED and the heavy 6-joint arm, each
+    result's gains, per-variant e(tf), runs and wall time, with the stamp."""
+    import tempfile  # noqa: PLC0415
+
+    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
+    from ptint_drake.studies.tune import TuneSettings, run_tune  # noqa: PLC0415
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from heavy_arm import heavy_arm_scenario, heavy_arm_urdf  # noqa: PLC0415
+
+    folder = Path(tempfile.mkdtemp())
+    (folder / "heavy6.urdf").write_text(heavy_arm_urdf())
+    cases = [(n, scenario_text(n)[1]) for n in TUNED]
+    cases.append(("heavy 6-joint arm (tests/heavy_arm.py)", heavy_arm_scenario(folder / "heavy6.urdf")))
+    rows = []
+    for name, text in cases:
+        r = run_tune(LoadedScenario.parse(text, name.split()[0]), TuneSettings(), workers=workers,
+                     say=lambda m: None)
+        per = (r.get("smallest_working") or {}).get("per_variant", {})
+        rows.append({"name": name, "K": None if r["gains"] is None else r["gains"]["K"],
+                     "paper_value": r["paper_value"], "reasons": r.get("reasons", []), "runs": r["runs"],
+                     "wall_time_s": r["wall_time_s"], "variants": r["variants"],
+                     "e_tf_norm": {v: per[v]["e_tf_norm"] for v in per}})
+    DATA.mkdir(exist_ok=True)
+    text = json.dumps({"rows": rows, "command": f"ptint tune NAME --workers {workers}", "stamp": stamp()},
+                      indent=1)
+    (DATA / "tune.json").write_text(text + "\n")
+
+
+def tune(data: dict) -> str:
+    """docs/own_arm.md's tuning table (docs/_data/tune.json, ``--store-tune``)."""
+    lines = ["| scenario | tuned K (margin 2) | paper's K | e(tf) nominal / ×0.7 / ×1.5 [mm] | runs "
+             "| time [s] |", "|---|---|---|---|---|---|"]
+    for r in data["rows"]:
+        if r["K"] is None:
+            lines.append(f"| {r['name']} | none works ({', '.join(r['reasons'])}) | {r['paper_value']:g} | – "
+                         f"| {r['runs']} | {r['wall_time_s']:.0f} |")
+            continue
+        errors = " / ".join(mm(r["e_tf_norm"][v], 3) for v in r["variants"])
+        lines.append(f"| {r['name']} | {r['K']:.3g} | {r['paper_value']:g} | {errors} | {r['runs']} "
+                     f"| {r['wall_time_s']:.0f} |")
+    return "\n".join(lines) + (
+        f"\n\n`{data['command']}`; the rendering of `docs/_data/tune.json` by `scripts/doc_blocks.py`, "
+        f"which the tests check this table against; the times depend on the machine:\n{data['stamp']}.")
+
+
+def store_camera(folder: Path) -> None:
+    """docs/_data/camera.json: a ``ptint study camera`` output folder's camera_study.json without
+    its per-run rows (the summary the table shows), with the stamp."""
+    result = json.loads((Path(folder) / "camera_study.json").read_text())
+    result.pop("runs", None)
+    DATA.mkdir(exist_ok=True)
+    text = json.dumps({"result": result, "command": f"ptint study camera --workers {result['workers']}",
+                       "stamp": stamp()}, indent=1)
+    (DATA / "camera.json").write_text(text + "\n")
+
+
+def camera(data: dict) -> str:
+    """docs/camera.md's camera study (docs/_data/camera.json, ``--store-camera``)."""
+    from ptint_drake.studies.camera import markdown  # noqa: PLC0415
+
+    r = data["result"]
+    text = "\n".join(f"**{line[2:]}**" if line.startswith("# ") else line
+                     for line in markdown(r["table"], r["seeds"], r["scenario"]).splitlines())
+    return text + (
+        f"\n\n`{data['command']}`; the rendering of `docs/_data/camera.json` (the study's "
+        "camera_study.json without its per-run rows) by `scripts/doc_blocks.py`, which the tests check "
+        f"this table against; the wall time depends on the machine:\n{data['stamp']}; "
+        f"{r['wall_time_s']:.0f} s with {r['workers']} worker{'s' if r['workers'] > 1 else ''}.")
+
+
 @dataclass(frozen=True)
 class Block:
     """A generated block: its marker ``name``, the files that hold it, and its source."""
@@ -319,6 +400,8 @@ BLOCKS = (
     Block("compare_curve_b075_tf15", ("docs/controllers.md",), "paper"),
     Block("compare_assembly", ("docs/controllers.md",), "paper"),
     Block("compare_plugin", ("docs/own_controller.md",), "json"),
+    Block("tune", ("docs/own_arm.md",), "json"),
+    Block("camera", ("docs/camera.md",), "json"),
 )
 BY_NAME = {b.name: b for b in BLOCKS}
 
@@ -343,7 +426,8 @@ def render(name: str, runs: Optional[Callable[[str, str], dict]] = None, when: O
         return pose({key: runs(*key) for key in runs_of("pose")})
     if name == "tests":
         return test_counts(counts or collect_counts())
-    generator = {"rgbd_picks": rgbd_picks, "pick_robust": robust, "speed": speed}[name]
+    generator = {"rgbd_picks": rgbd_picks, "pick_robust": robust, "speed": speed, "tune": tune,
+                 "camera": camera}[name]
     return generator(json.loads((DATA / f"{name}.json").read_text()))
 
 
@@ -449,6 +533,9 @@ def main(argv: Optional[list] = None) -> int:
     parser.add_argument("--measure-speed", action="store_true", help="first time docs/speed.md's commands")
     parser.add_argument("--store-compare", action="store_true",
                         help="first run the plugin comparison into docs/_data/compare_plugin.json")
+    parser.add_argument("--store-tune", action="store_true", help="first run the tuning table's studies")
+    parser.add_argument("--store-camera", type=Path, metavar="FOLDER",
+                        help="first store a `ptint study camera` output folder as docs/_data/camera.json")
     parser.add_argument("--store-robust", nargs="+", metavar="FOLDER",
                         help="first store these `ptint robust` output folders as docs/_data/pick_robust.json")
     args = parser.parse_args(argv)
@@ -458,6 +545,10 @@ def main(argv: Optional[list] = None) -> int:
         store_robust(args.store_robust)
     if args.store_compare:
         store_compare("compare_plugin")
+    if args.store_tune:
+        store_tune()
+    if args.store_camera:
+        store_camera(args.store_camera)
     stale = []
     for name in args.blocks or list(BY_NAME):
         text = render(name, runs=run_metrics)

@@ -14,9 +14,6 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 import doc_blocks  # noqa: E402
 
-# blocks written by a study's script (scripts/readme_tables.py) and not yet checked by a test: the
-# studies (tune, the camera grid) take many minutes and commit no output to render the block from
-UNCHECKED = {"camera", "tune"}
 OTHER_TESTS = {"layers (scripts/layers_doc.py)": "tests/unit/test_layers.py"}
 
 
@@ -31,7 +28,7 @@ def _markers() -> set:
 def test_every_block_in_the_docs_has_a_generator_and_every_generator_a_block():
     known = {(b.name, f) for b in doc_blocks.BLOCKS for f in b.files}
     found = _markers()
-    assert {m for m in found if m[0] not in UNCHECKED and m[0] not in OTHER_TESTS} == known
+    assert {m for m in found if m[0] not in OTHER_TESTS} == known
 
 
 @pytest.mark.parametrize("block", [b for b in doc_blocks.BLOCKS if b.source == "json"], ids=lambda b: b.name)
