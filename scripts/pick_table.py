@@ -29,7 +29,7 @@ def still(path: Path) -> None:
     """The assembly's world at its second pick's prescribed grasp time, as a PNG."""
     import numpy as np  # noqa: PLC0415
 
-    from ptint_drake.worlds.pick.views import replay_world  # noqa: PLC0415
+    from ptint_drake.worlds.pick.views import draw_pick_floor, replay_world  # noqa: PLC0415
     from ptint_drake.replay import CAMERA, with_camera  # noqa: PLC0415
     from ptint_drake.scenario import load_scenario  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
@@ -41,6 +41,7 @@ def still(path: Path) -> None:
     j = int(np.argmin(np.abs(result.series["replay_t"] - t_grasp)))
     plant.SetPositions(plant.GetMyMutableContextFromRoot(context),
                        result.series["plant_state"][j, :plant.num_positions()])
+    draw_pick_floor(meshcat, plant, context)  # the floor, Meshcat's grid and axes hidden (as the replay)
     viz.ForcedPublish(viz.GetMyContextFromRoot(context))
     html = with_camera(meshcat.StaticHtml(), (0.55, -0.35, 0.45))
     browser = shutil.which("chromium") or shutil.which("chromium-browser")

@@ -49,7 +49,9 @@ def pick_outcome(row: int, pick: dict) -> str:
              f"grasped at {pick['t_grasp']:.3f} s (prescribed {pick['t_grasp_prescribed']:.3f} s)")
     place = (f"placed {pick['place_error_mm']:.2f} mm, {pick['place_error_deg']:.2f}° from its slot"
              if pick["placed"] else "NOT placed")
-    return f"pick {row} ({pick['part']} → slot {pick['slot']}): {grasp}, {place}"
+    attempts = len(pick.get("attempt_details") or [pick])
+    retried = f" after {attempts} attempts" if attempts > 1 else ""
+    return f"pick {row} ({pick['part']} → slot {pick['slot']}): {grasp}{retried}, {place}"
 
 
 def _mark_attempts(ax, pick: dict) -> None:
@@ -133,7 +135,7 @@ def pick_figure(series: dict, metrics: dict, path: Path, title: str = "") -> Pat
             ax.set_ylabel("force (N)")
             _mark_attempts(ax, pick)
             ax.set_title(f"pick {row} ({pick['part']}): contact grip force (N)")
-            _legend(ax, loc="upper right")
+            _legend(ax, loc="center left")
 
             ax = axes[3]  # the part's height
             ax.plot(t, 1e3 * block[:, 2], lw=1.3, label="part's height")
