@@ -8,7 +8,7 @@ A block sits between ``<!-- BEGIN name -->`` and ``<!-- END name -->``.  Its gen
 function of its inputs, never of the files it is written into:
 
 * ``runs``: metrics of scenario runs (``runs_of(name)``: (scenario, YAML overrides) pairs).  The
-  script simulates them; ``tests/e2e/test_doc_blocks.py`` feeds the generators the suite's
+  script simulates them; ``tests/e2e/test_doc_blocks_runs.py`` feeds the generators the suite's
   session-cached runs (``conftest.run_cached``) instead, so a run another test made is not made
   again.
 * ``paper``: a comparison ``ptint paper`` makes (compare_NAME/compare.json); the script runs the
@@ -125,7 +125,8 @@ def results(metrics: dict, paper_holds: dict, when: str) -> str:
                 f"| {m['status'] if first else ''} | {rtf if first else ''} |")
     return "\n".join(lines) + (
         "\n\n`ptint run NAME` for each (and `--set controller.k_hold=3` for the paper's hold), written by "
-        "`scripts/doc_blocks.py` and checked against the test suite's runs (`tests/e2e/test_doc_blocks.py`); "
+        "`scripts/doc_blocks.py` and checked against the test suite's runs "
+        "(`tests/e2e/test_doc_blocks_runs.py`); "
         f"RTF (end-to-end realtime factor) depends on the machine:\n{when}.")
 
 
@@ -183,7 +184,7 @@ def collect_counts() -> dict:
         done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-n", "0", where],
                               cwd=ROOT, capture_output=True, text=True, check=False)
         found = re.search(r"(\d+) tests? collected", done.stdout)
-        if found is None:
+        if found is None or done.returncode != 0:  # a collection error is not a count
             raise RuntimeError(f"pytest --collect-only {where}: {done.stdout[-500:]}{done.stderr[-500:]}")
         counts[key] = int(found.group(1))
     return counts

@@ -5,7 +5,7 @@ run with ``ptint run``; one row per pick, and each run's realtime factor.
     .venv/bin/python scripts/pick_table.py --still      # also docs/_static/pick_grasp.png
 
 The table (the block ``picks`` of README.md and docs/pick_place.md) is written by
-``scripts/doc_blocks.py picks``, which this calls; tests/e2e/test_doc_blocks.py checks it.
+``scripts/doc_blocks.py picks``, which this calls; tests/e2e/test_doc_blocks_runs.py checks it.
 The still is the world at the second
 pick's prescribed grasp time of ``assembly_pick_place`` (the run's logged plant state drawn by
 Meshcat, saved as a page, photographed by headless Chromium).

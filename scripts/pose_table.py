@@ -5,7 +5,7 @@
     .venv/bin/python scripts/pose_table.py      # the six runs; the same as scripts/doc_blocks.py pose
 
 The block ``pose`` of docs/pose.md is written by ``scripts/doc_blocks.py`` (its generator and
-its runs are there; tests/e2e/test_doc_blocks.py checks it against the suite's runs).
+its runs are there; tests/e2e/test_doc_blocks_runs.py checks it against the suite's runs).
 """
 
 from __future__ import annotations
