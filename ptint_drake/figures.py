@@ -235,9 +235,11 @@ def run_figures(series: dict, metrics: dict, out_dir: Path, title: str, formats=
 def run_figure(stem: str, series: dict, metrics: dict, out_dir: Path, title: str,
                formats=("png",)) -> str:
     """The run figure ``stem`` (of ``RUN_FIGURES`` or ``ORIENTATION_FIGURES``) written in
-    ``out_dir``; returns ``stem``.  Module-level, so that a worker process can draw one figure
-    while another draws the next."""
+    ``out_dir``, its title ``title (verdict)``; returns ``stem``.  Module-level, so that a worker
+    process can draw one figure while another draws the next."""
     tfs = [s["start"] + s["tf"] for s in metrics["segments"]]
+    if metrics.get("status"):  # every run figure's title carries the run's verdict
+        title = f"{title} ({metrics['status']})"
     (RUN_FIGURES | ORIENTATION_FIGURES)[stem](series, metrics, tfs, out_dir, title, formats)
     return stem
 

@@ -15,6 +15,10 @@ moves with the gripper point for the rest of the run (the arm carries it).
 The floor is a light plate at z = 0 with a 10 cm grid under the working area
 (meshcat's own grid is hidden: in a recorded page it is drawn edge-on).
 
+Every replay page (``finish_page``, also the pick world's) loops its recording and carries an
+overlay: the run's name, the replay's time (``t = … s``, read from the animation each frame), a
+pause / play button and a legend of what each colour is.
+
 A task with orientation (``controller.task`` pose or top_down, issue 19) adds two frame
 triads (x red, y green, z blue): a thin one on the gripper's tool frame (``triads/gripper``,
 forward kinematics of the replayed q) and a thicker, translucent one on the active object
@@ -28,7 +32,9 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from pydrake.geometry import (Box, Cylinder, Meshcat, MeshcatParams, MeshcatVisualizer,
+import html as html_text
+
+from pydrake.geometry import (Box, Cylinder, Meshcat, MeshcatAnimation, MeshcatParams, MeshcatVisualizer,
                               MeshcatVisualizerParams, Rgba, Role, Sphere)
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
@@ -121,9 +127,10 @@ def floor_extent(points: np.ndarray, margin: float = 0.15, step: float = 0.1):
 
 def draw_floor(meshcat: Meshcat, extent, step: float = 0.1) -> None:
     """A floor plate over ``extent`` (x0, x1, y0, y1, m) just below z = 0 with grid lines every
-    ``step`` m, in place of Meshcat's own grid."""
+    ``step`` m, in place of Meshcat's own grid and axes (both hidden)."""
     x0, x1, y0, y1 = extent
     meshcat.SetProperty("/Grid", "visible", False)
+    meshcat.SetProperty("/Axes", "visible", False)  # the world axes at the base: not in the legend
     meshcat.SetObject("floor/plate", Box(x1 - x0, y1 - y0, 0.004), FLOOR_COLOR)
     meshcat.SetTransform("floor/plate", RigidTransform([0.5 * (x0 + x1), 0.5 * (y0 + y1), -0.0025]))
     xs = np.arange(x0, x1 + 0.5 * step, step)
@@ -134,6 +141,86 @@ def draw_floor(meshcat: Meshcat, extent, step: float = 0.1) -> None:
     ends = np.hstack([np.array([xs, np.full_like(xs, y1), np.full_like(xs, z)]),
                       np.array([np.full_like(ys, x1), ys, np.full_like(ys, z)])])
     meshcat.SetLineSegments("floor/grid", starts, ends, 1.0, FLOOR_LINES)
+
+
+LOOP_REPETITIONS = 1_000_000  # the recording replays this many times (three.js: LoopRepeat)
+OVERLAY_ID = "ptint-overlay"
+TIME_ID = "ptint-time"
+
+
+def css_color(rgba: Rgba) -> str:
+    """``rgba`` as a CSS colour."""
+    return f"rgba({round(255 * rgba.r())}, {round(255 * rgba.g())}, {round(255 * rgba.b())}, {rgba.a():g})"
+
+
+def overlay_html(title: str, legend: list, note: str = "") -> str:
+    """The page's overlay: ``title``, the time display (``TIME_ID``, updated by its script from
+    the animation's clip time), a pause / play button and ``legend`` [(CSS colour, text)] as
+    swatches; ``note`` under them."""
+    rows = "".join(
+        f'<div><span style="display:inline-block;width:12px;height:12px;margin-right:6px;'
+        f'vertical-align:middle;background:{color};border:1px solid #555"></span>'
+        f'{html_text.escape(text)}</div>'
+        for color, text in legend)
+    extra = f'<div style="margin-top:4px;color:#444">{html_text.escape(note)}</div>' if note else ""
+    return (f'<div id="{OVERLAY_ID}" style="position:fixed;left:8px;top:8px;z-index:20;max-width:380px;'
+            'background:rgba(255,255,255,0.88);border:1px solid #999;border-radius:4px;padding:6px 8px;'
+            'font:13px/1.35 sans-serif;color:#111">'
+            f'<div style="font-weight:bold">{html_text.escape(title)}</div>'
+            f'<div><span id="{TIME_ID}" style="font:bold 16px monospace">t = 0.00 s</span> '
+            '<button id="ptint-play" style="margin-left:8px">pause</button> '
+            '<span style="color:#444">(loops)</span></div>'
+            f'<div style="margin-top:4px">{rows}</div>{extra}</div>'
+            '<script>(function () {'
+            f'  var label = document.getElementById("{TIME_ID}");'
+            '  var button = document.getElementById("ptint-play");'
+            '  button.onclick = function () {'
+            '    var a = viewer.animator;'
+            '    if (a.playing) { a.pause(); button.textContent = "play"; }'
+            '    else { a.play(); button.textContent = "pause"; }'
+            '  };'
+            '  function tick() {'  # the longest track's time (a track ends at its last key)
+            '    var longest = null;'
+            '    (viewer.animator ? viewer.animator.actions : []).forEach(function (action) {'
+            '      if (!longest || action.getClip().duration > longest.getClip().duration) {'
+            '        longest = action;'
+            '      }'
+            '    });'
+            '    if (longest) { label.textContent = "t = " + longest.time.toFixed(2) + " s"; }'
+            '    requestAnimationFrame(tick);'
+            '  }'
+            '  tick();'
+            '})();</script>')
+
+
+def finish_page(meshcat: Meshcat, title: str, legend: list, note: str = "") -> str:
+    """Stop the recording, make it loop, publish it and return the standalone page with the
+    camera (``CAMERA``) and the overlay (``overlay_html``)."""
+    meshcat.StopRecording()
+    recording = meshcat.get_mutable_recording()
+    recording.set_loop_mode(MeshcatAnimation.LoopMode.kLoopRepeat)
+    recording.set_repetitions(LOOP_REPETITIONS)
+    recording.set_clamp_when_finished(False)
+    meshcat.PublishRecording()
+    page = with_camera(meshcat.StaticHtml(), CAMERA)
+    return page.replace("</body>", overlay_html(title, legend, note) + "\n</body>", 1)
+
+
+def interception_legend(n_objects: int, ends, belts: bool, triads: bool) -> list:
+    """The legend of an interception replay: each object's colour, the markers, the trail."""
+    legend = [(css_color(COLORS[i % len(COLORS)]),
+               f"object {i}: the target of segment {i}, caught at its prescribed time {end:g} s "
+               "(a faint line of its colour: its path)") for i, end in enumerate(ends[:n_objects])]
+    legend += [("rgba(255, 230, 0, 1)", "yellow marker: where the gripper is at the prescribed time "
+                "(shown from then on)"),
+               ("rgba(26, 26, 26, 0.9)", "black line: the gripper's trail")]
+    if belts:
+        legend.append(("rgba(77, 77, 77, 1)", "grey boxes: the conveyor belts"))
+    if triads:
+        legend.append(("rgba(255, 0, 0, 0.45)", "axes (x red, y green, z blue): thin, the tool frame; "
+                       "thick and faint, the orientation the task asks for at the object"))
+    legend.append((css_color(FLOOR_COLOR), "floor, 10 cm grid"))
+    return legend
 
 
 def held_object_index(t: float, starts, ends) -> int:
@@ -293,14 +380,15 @@ def _draw_scene(meshcat: Meshcat, series: dict, raw: np.ndarray, ends, radius: f
 
 
 def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float = 30.0,
-                 conveyors=None, end_effector: str | None = None, orientation=None) -> int:
+                 conveyors=None, end_effector: str | None = None, orientation=None,
+                 title: str = "") -> int:
     """Write a standalone replay HTML to ``path``; returns its size in bytes.
 
     ``conveyors``: optional list of (start_xyz, end_xyz) belts to draw as boxes.
     ``end_effector``: the frame whose body's size sets the objects' size (see module doc).
     ``orientation``: (task, rotations) of a task with orientation — rotations (N × objects × 9)
     each object's true R_r (row-major) at ``series["t"]`` — to draw the frame triads on
-    ``end_effector`` and the active object.
+    ``end_effector`` and the active object.  ``title``: the overlay's first line (``finish_page``).
     """
     meshcat = shared_meshcat()
     meshcat.Delete()
@@ -318,9 +406,8 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
         draw_triads(meshcat)
         triads = (plant.GetFrameByName(end_effector), starts, orientation)
     _record(meshcat, viz, plant, context, series, objs, ends, fps, triads)
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
-    html = with_camera(meshcat.StaticHtml(), CAMERA)
+    legend = interception_legend(objs.shape[1], ends, bool(belts), triads is not None)
+    html = finish_page(meshcat, title or "replay", legend)
     with open(path, "w", encoding="utf-8") as f:
         f.write(html)
     meshcat.DeleteRecording()

@@ -2,12 +2,18 @@
 estimate's error at the grasp (median / p90 / max), as JSON on stdout.
 
     python scripts/rgbd_pick_table.py --seeds 1-10 [--scenarios conveyor_pick_place_rgbd,...]
+    python scripts/rgbd_pick_table.py --seeds 1-10 --write   # also docs/_data/rgbd_picks.json
+
+``--write`` stores the output with its stamp as docs/_data/rgbd_picks.json, which
+``scripts/doc_blocks.py`` renders into docs/camera.md's ``rgbd_picks`` block.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -41,11 +47,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", default="1-10")
     parser.add_argument("--scenarios", default="conveyor_pick_place_rgbd,assembly_pick_place_rgbd")
+    parser.add_argument("--write", action="store_true", help="also write docs/_data/rgbd_picks.json")
     args = parser.parse_args()
     lo, _, hi = args.seeds.partition("-")
     seeds = list(range(int(lo), int(hi or lo) + 1))
     load_scenario("conveyor_pick_place_rgbd")  # fail early on a broken install
-    print(json.dumps([gate(n, seeds) for n in args.scenarios.split(",")], indent=1))
+    gates = [gate(n, seeds) for n in args.scenarios.split(",")]
+    print(json.dumps(gates, indent=1))
+    if args.write:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_blocks import DATA, stamp  # noqa: PLC0415
+
+        (DATA / "rgbd_picks.json").write_text(json.dumps(
+            {"source": f"`scripts/rgbd_pick_table.py --seeds {args.seeds}`, {stamp()}", "gates": gates},
+            indent=1) + "\n")
 
 
 if __name__ == "__main__":

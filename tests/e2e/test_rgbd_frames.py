@@ -14,10 +14,20 @@ def test_frames_show_the_belts_and_a_good_fit_at_every_instant(tmp_path):
     camera = result.scenario.measurement.camera
     segments = len(result.scenario.interceptions)
     assert len(names) == 2 * 3 * segments  # colour + depth at start, half-way and tf of each segment
+    from ptint_drake.systems.perception.frame_images import CAPTION_HEIGHT, SCALE_WIDTH
+
     for name in names:
-        image = np.asarray(Image.open(tmp_path / name))
-        assert image.shape[:2] == (camera.height, camera.width), name
-        if name.endswith("_depth.png"):
+        whole = np.asarray(Image.open(tmp_path / name))
+        depth = name.endswith("_depth.png")
+        width = camera.width + (SCALE_WIDTH if depth else 0)
+        assert whole.shape[:2] == (CAPTION_HEIGHT + camera.height, width), name
+        caption = whole[:CAPTION_HEIGHT, :, :3]
+        assert np.count_nonzero(np.all(caption < 100, axis=-1)) > 200, f"{name}: no caption text"
+        if depth:  # the scale's ramp: bright at its top, dark at its bottom
+            ramp = whole[CAPTION_HEIGHT + 20: -36, camera.width + 12, 0].astype(int)
+            assert ramp[0] > 200 and ramp[-1] < 50 and np.all(np.diff(ramp) <= 0), name
+        image = whole[CAPTION_HEIGHT:, :camera.width]  # the camera's own pixels
+        if depth:
             # belts, parts and arm (~20 % of the frame; the sky beyond them has no depth)
             seen = np.count_nonzero(image) / image.size
             assert seen > 0.1, f"{name}: only {seen:.0%} of the depth pixels are valid"
@@ -80,7 +90,7 @@ def _truth_at(series: dict, part: int, t: float) -> tuple[np.ndarray, np.ndarray
 
 def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_beside_the_part(tmp_path):
     from ptint_drake.worlds.pick.camera_frames import pick_instants
-    from ptint_drake.worlds.pick.views import CLOUD_HOLD, GRASP_TAIL
+    from ptint_drake.worlds.pick.views import GRASP_TAIL
     from ptint_drake.worlds.registry import world_of
 
     result = run_cached("conveyor_pick_place_rgbd")
@@ -96,6 +106,12 @@ def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_
     half = 0.5 * np.asarray(result.scenario.pick.parts[0].size)
     instants = pick_instants(series, metrics)
     assert [label for label, _, _ in instants] == ["pick0_first_fit", "pick0_grasp"]
+    frame_of = {label: float(replay_t[np.argmin(np.abs(replay_t - t))]) for label, _, t in instants}
+    # each cloud stays until the next drawn for its pick (the first fit's until the grasp's frame),
+    # the grasp's as long as the estimate (GRASP_TAIL)
+    shown_for = {"pick0_first_fit": frame_of["pick0_grasp"] - frame_of["pick0_first_fit"],
+                 "pick0_grasp": GRASP_TAIL}
+    assert shown_for["pick0_first_fit"] > 1.0  # most of the approach, not a quarter second
     for label, part, t in instants:
         path = f"/drake/camera/clouds/{label}"
         cloud = next(c for c in commands if c.get("type") == "set_object" and c["path"] == path)
@@ -114,7 +130,7 @@ def test_a_camera_pick_replay_shows_the_clouds_at_their_frames_and_the_estimate_
         on = [f for f in range(len(replay_t)) if _visible_at(tracks[path], f)]
         assert on and on[0] == int(np.floor(t_frame * fps + 1e-9)), (label, on[:3])
         assert on == list(range(on[0], on[-1] + 1))  # one stretch
-        assert len(on) / fps == pytest.approx(CLOUD_HOLD, abs=1.5 / fps)
+        assert len(on) / fps == pytest.approx(shown_for[label], abs=1.5 / fps)
     # the estimate: a track over the run, what the series logged, near the part until the grasp
     track = tracks["/drake/estimates/part_0"]
     assert len(track[".position"]) >= 0.9 * len(replay_t)

@@ -70,6 +70,25 @@ def test_replay_renders_in_headless_chromium(paper_dir, tmp_path):
     assert np.sum(diff > 0.1) > 500
 
 
+def test_the_docs_comparisons_are_what_the_papers_comparisons_write(paper_dir):
+    """docs/controllers.md's compare blocks against the comparisons ``ptint paper`` ran above
+    (scripts/doc_blocks.py: the numbers within its tolerance, the wall time exempt)."""
+    import json
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+    import doc_blocks
+
+    blocks = [b for b in doc_blocks.BLOCKS if b.source == "paper"]
+    assert [b.name for b in blocks] == ["compare_curve_b075_tf15", "compare_assembly"]
+    for block in blocks:
+        scenario = doc_blocks.COMPARES[block.name][0]
+        result = json.loads((paper_dir / f"compare_{scenario}" / "compare.json").read_text())
+        text = doc_blocks.render(block.name, compared=result)
+        for file in block.files:
+            found = doc_blocks.differences(doc_blocks.current(block.name, file), text)
+            assert not found, f"{file}'s {block.name} is stale:\n" + "\n".join(found)
+
+
 def test_paper_report_has_every_scenario(paper_dir):
     index = (paper_dir / "index.html").read_text()
     names = ["curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12",
@@ -142,7 +161,10 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
         browser = p.chromium.launch(executable_path=CHROMIUM, args=BROWSER_ARGS)
         page = browser.new_page(viewport={"width": 1000, "height": 700})
         page.goto((paper_dir / "curve_b075_tf15" / "replay.html").as_uri())
-        page.wait_for_timeout(5000)  # past tf = 1.5 s: the object is held
+        page.wait_for_function("viewer.animator.actions.length > 0", timeout=60_000)
+        page.click("#ptint-play")  # paused (the replay loops) at 2.5 s, past tf = 1.5 s: the object is held
+        page.evaluate("viewer.animator.seek(2.5)")
+        page.wait_for_timeout(1000)
         shot = tmp_path / "held.png"
         page.screenshot(path=str(shot))
         browser.close()

@@ -50,3 +50,18 @@ def test_the_angle_figure_draws_each_objects_window(tmp_path):
                "criteria": {"e_rot_tf_deg": 2.0, "rot_hold_deg": 5.0}}
     assert run_figure("angle", {"t": t, "rot_angle_deg": angle}, metrics, tmp_path, "two parts") == "angle"
     assert (tmp_path / "angle.png").stat().st_size > 10_000
+
+
+def test_a_run_figure_title_carries_the_runs_verdict(tmp_path, monkeypatch):
+    import matplotlib.figure
+
+    titles = []
+    suptitle = matplotlib.figure.FigureBase.suptitle
+    monkeypatch.setattr(matplotlib.figure.FigureBase, "suptitle",
+                        lambda fig, text, **kw: titles.append(text) or suptitle(fig, text, **kw))
+    t = np.linspace(0.0, 2.0, 201)
+    angle = 60.0 * np.exp(-5.0 * t)[:, None]
+    metrics = {"segments": [{"start": 0.0, "tf": 0.5, "e_rot_tf_deg": 0.01}], "status": "missed",
+               "criteria": {"e_rot_tf_deg": 2.0, "rot_hold_deg": 5.0}}
+    run_figure("angle", {"t": t, "rot_angle_deg": angle}, metrics, tmp_path, "one part")
+    assert titles and titles[-1].startswith("one part (missed): ")

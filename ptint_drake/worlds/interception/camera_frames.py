@@ -74,5 +74,8 @@ def write_camera_frames(scenario: Scenario, series: dict, stage: Path) -> list[s
         depth = np.array(system.GetOutputPort("depth_image").Eval(station_context).data)[:, :, 0]
         fits = estimator.fit_frame(estimator.GetInputPort("point_cloud").Eval(
             estimator.GetMyContextFromRoot(context)))
-        names += write_frame(folder, label, color, depth, fits, X_WC, info)
+        segment, instant = label.split("_", 1)
+        when = {"start": "start", "half": "tf/2", "tf": "tf"}[instant]
+        title = f"{scenario.name}: segment {segment[3:]} at its {when}, t = {times[k]:.3f} s"
+        names += write_frame(folder, label, color, depth, fits, X_WC, info, title=title)
     return names

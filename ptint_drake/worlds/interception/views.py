@@ -79,7 +79,8 @@ def draw_view(name: str, series: dict, metrics: dict, stage: Path, title: str, a
 
         model_file, belts, end_effector, orientation = args
         write_replay(series, metrics, model_file, stage / "replay.html", conveyors=belts,
-                     end_effector=end_effector, orientation=orientation)
+                     end_effector=end_effector, orientation=orientation,
+                     title=f"{title}: {metrics.get('status', '')}")
         return name
     from ptint_drake.figures import run_figure  # noqa: PLC0415
 

@@ -100,6 +100,10 @@ def write_pick_camera_frames(scenario: Scenario, series: dict, metrics: dict, st
     names = []
     for view in camera_views(scenario, series, metrics):
         yaw = float(np.arctan2(view.estimate[6], view.estimate[3]))  # R[1, 0], R[0, 0] of the row-major R
+        pick, instant = view.label.split("_", 1)
+        title = (f"{scenario.name}: {pick.replace('pick', 'pick ')} ({scenario.pick.parts[view.part].name}), "
+                 f"{instant.replace('_', ' ')}, t = {view.t:.3f} s")
         names += write_frame(folder, view.label, view.color, view.depth, view.fits, X_WC, info,
-                             [(view.estimate[0:3], yaw, ESTIMATE)])
+                             [(view.estimate[0:3], yaw, ESTIMATE)], title=title,
+                             marks="crosses: green = good fit, red = rejected, blue = the estimate aimed at")
     return names

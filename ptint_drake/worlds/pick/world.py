@@ -331,17 +331,17 @@ class PickWorld(World):
         from ptint_drake.worlds.pick.views import estimate_figure, pick_figure, write_pick_replay  # noqa: PLC0415
 
         if name == "picks":
-            pick_figure(series, metrics, stage / "picks.png")
+            pick_figure(series, metrics, stage / "picks.png", title)
         elif name == "estimates":
             scenario = yaml_load_typed(schema=Scenario, data=args[0])
-            estimate_figure(series, metrics, *belt_frames(scenario), stage / "estimates.png")
+            estimate_figure(series, metrics, *belt_frames(scenario), stage / "estimates.png", title)
         elif name == "camera_frames":
             from ptint_drake.worlds.pick.camera_frames import write_pick_camera_frames  # noqa: PLC0415
 
             write_pick_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics, stage)
         else:
             write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics,
-                              stage / "replay.html")
+                              stage / "replay.html", title=title)
         return name
 
     def simulator_config(self, scenario: Scenario):
