@@ -48,4 +48,4 @@ def test_own_diagram_page_names_every_field_of_the_handles():
     names = [f.name for f in dataclasses.fields(InterceptorHandles)]
     assert paragraph.startswith(f"{words[len(names)]} fields"), paragraph[:40]
     assert all(f"`{name}`" in paragraph for name in names), names
-    assert "For your own arm, load its URDF instead" in page
+    assert "For your own arm, load\nits URDF instead" in page
