@@ -5,47 +5,14 @@ world as the hardware, ``hardware.sim_hardware``) and ``ptint drive`` (the contr
 from __future__ import annotations
 
 import argparse
-import math
 import signal
 import sys
 from pathlib import Path
-from typing import Callable
 
-from ptint_drake.cli.options import OptionError, scenario_and_out
+from ptint_drake.cli.options import count, fraction, integer_in, scenario_and_out, seconds
 from ptint_drake.cli.runs import progress
 
 SET_HELP = "override a scenario field (repeatable), as for ptint run; use the same on both sides"
-
-
-def seconds(flag: str, allow_zero: bool = False) -> Callable[[str], float]:
-    """An argparse type: a finite time in s, > 0 (or >= 0 with ``allow_zero``)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise OptionError(f"{flag}: expected a number of seconds, got {text!r}") from None
-        if not (math.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
-            raise OptionError(f"{flag}: must be {'>= 0' if allow_zero else '> 0'} and finite, got {text}")
-        return value
-
-    return parse
-
-
-def fraction(flag: str, top_open: bool = True) -> Callable[[str], float]:
-    """An argparse type: a number in [0, 1) (``top_open``) or (0, 1]."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise OptionError(f"{flag}: expected a number, got {text!r}") from None
-        ok = 0.0 <= value < 1.0 if top_open else 0.0 < value <= 1.0
-        if not ok:
-            raise OptionError(f"{flag}: must be in {'[0, 1)' if top_open else '(0, 1]'}, got {text}")
-        return value
-
-    return parse
 
 
 def add_hardware_parsers(sub) -> None:
@@ -112,7 +79,7 @@ def _add_hardware_link_options(hw: argparse.ArgumentParser) -> None:
     )
     hw.add_argument(
         "--silent-periods",
-        type=_periods,
+        type=count("--silent-periods"),
         default=5,
         help="without --lockstep: control periods in a row without a command before the arm is held "
         "(default 5; a loaded virtual machine may stall a process longer: see docs/hardware.md)",
@@ -157,35 +124,13 @@ def _add_drive_parser(sub) -> None:
     dr.set_defaults(func=cmd_drive)
 
 
-def _periods(text: str) -> int:
-    """An argparse type: a count of control periods, >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise OptionError(f"--silent-periods: expected an integer >= 1, got {text!r}") from None
-    if value < 1:
-        raise OptionError(f"--silent-periods: must be >= 1, got {text}")
-    return value
-
-
-def _priority(text: str) -> int:
-    """An argparse type: a SCHED_FIFO priority, 0 (none) to 99."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise OptionError(f"--priority: expected an integer 0-99, got {text!r}") from None
-    if not 0 <= value <= 99:
-        raise OptionError(f"--priority: must be in 0-99, got {text}")
-    return value
-
-
 def _add_priority_option(parser: argparse.ArgumentParser, when: str) -> None:
     """``--priority``: the loop's real-time scheduling (``hardware.priority``)."""
     from ptint_drake.hardware.process import DEFAULT_PRIORITY  # noqa: PLC0415
 
     parser.add_argument(
         "--priority",
-        type=_priority,
+        type=integer_in("--priority", 0, 99),
         default=DEFAULT_PRIORITY,
         help=f"{when}SCHED_FIFO priority of the control loop where the system permits it (root or "
         f"an rtprio limit; else a warning), 0 for the default scheduler (default {DEFAULT_PRIORITY})",

@@ -123,6 +123,46 @@ def count(flag: str) -> Callable[[str], int]:
     return parse
 
 
+def seconds(flag: str, allow_zero: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite time in s, > 0 (or >= 0 with ``allow_zero``)."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise OptionError(f"{flag}: expected a number of seconds, got {text!r}") from None
+        if not (math.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
+            raise OptionError(f"{flag}: must be {'>= 0' if allow_zero else '> 0'} and finite, got {text}")
+        return value
+    return parse
+
+
+def fraction(flag: str, top_open: bool = True) -> Callable[[str], float]:
+    """An argparse type: a number in [0, 1) (``top_open``) or (0, 1]."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise OptionError(f"{flag}: expected a number, got {text!r}") from None
+        ok = 0.0 <= value < 1.0 if top_open else 0.0 < value <= 1.0
+        if not ok:
+            raise OptionError(f"{flag}: must be in {'[0, 1)' if top_open else '(0, 1]'}, got {text}")
+        return value
+    return parse
+
+
+def integer_in(flag: str, low: int, high: int) -> Callable[[str], int]:
+    """An argparse type: an integer in [``low``, ``high``] (e.g. ``--priority``, 0-99)."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise OptionError(f"{flag}: expected an integer {low}-{high}, got {text!r}") from None
+        if not low <= value <= high:
+            raise OptionError(f"{flag}: must be in {low}-{high}, got {text}")
+        return value
+    return parse
+
+
 @_option
 def robust_range(pair: str) -> tuple[str, tuple[float, float]]:
     """``--range NAME=LOW,HIGH`` of ``robust``: (NAME, (LOW, HIGH)) with 0 <= LOW <= HIGH (LOW < 0

@@ -12,8 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ptint_drake.cli.options import out_folder, scenario_and_out
-from ptint_drake.scenario import ScenarioError
+from ptint_drake.cli.options import OptionError, out_folder, scenario_and_out
 
 
 def _where(args: argparse.Namespace) -> dict:
@@ -42,7 +41,7 @@ def _dask_errors(call):
     try:
         return call()
     except SchedulerUnreachable as exc:  # bad input: one line, exit 2
-        raise ScenarioError(f"--dask: {exc}") from None
+        raise OptionError(f"--dask: {exc}") from None
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
@@ -131,7 +130,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     for flag, value in (("--scenario", args.scenario), ("--process-noise", args.process_noise),
                         ("--set", args.set)):
         if value is not None:
-            raise ScenarioError(f"{flag}: only with --filter-floor")
+            raise OptionError(f"{flag}: only with --filter-floor")
     out = out_folder(args.out, Path("out") / f"study_{args.study}")
     result = camera.run_study(seeds=args.seeds, workers=args.workers, out=out, progress=report)
     runs = sum(row["summary"]["runs"] for row in result["table"])
