@@ -163,7 +163,9 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                      workers=workers or (None if executor or dask else 1), dask=dask,
                      executor=executor, progress=report, stats=stats, folders=loaded.folders)
     wall = time.perf_counter() - t0
-    finished = [r for r in rows if r.get("e_tf_max") is not None]
+    # the rows of a world whose samples keep the segment row (``World.robust_row``'s default; a
+    # pick's rows keep its picks instead and have no torque_peak key)
+    finished = [r for r in rows if r.get("e_tf_max") is not None and "torque_peak" in r]
     torqued = [r for r in finished if r.get("torque_peak") is not None]  # a world that logs torques
     failed_first = sorted(rows, key=lambda r: (r["ok"], -(r.get("e_tf_max") or np.inf)))
     worst = failed_first[0]
@@ -203,7 +205,7 @@ def histogram(result: dict, out_dir: Path) -> None:
 
     if "pick_success_rate" in result:
         return _pick_histogram(result, out_dir)
-    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None]
+    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None and "torque_peak" in r]
     n, n_ok = result["samples"], sum(1 for r in result["rows"] if r["ok"])
     n_failed = n - len(rows)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
