@@ -21,6 +21,7 @@ from pydrake.geometry import Box
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.feasibility import feasibility_warnings
 from ptint_drake.worlds.pick.grippers import payload_warnings
 from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
@@ -120,10 +121,11 @@ def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float,
 def arm_warnings(scenario, built) -> list[str]:
     """Warnings before a pick run about the arm: the gripper plus a part beyond the arm's rated
     payload (``grippers.payload_warnings``), a path past a singularity or near the inner edge of a
-    5-joint arm's top-down workspace (``singularity``)."""
+    5-joint arm's top-down workspace (``singularity``), a segment too short for a joint's speed or
+    effort limit along its planned profile (``feasibility``)."""
     station = built.station
     plant = station.plant
     gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
     return (payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
                              station.config.parts) + singularity_warnings(scenario, built)
-            + inner_reach_warnings(scenario, built))
+            + inner_reach_warnings(scenario, built) + feasibility_warnings(scenario, built))
