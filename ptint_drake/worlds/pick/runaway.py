@@ -1,0 +1,58 @@
+"""During a pick run: did the arm run away?  Measured per task from the run's series.
+
+A runaway — the controller commanding torques far beyond what the drives give, the joints far
+beyond their speed limits — ends in its consequences (a collision, a part knocked off its belt,
+``missed after retry``); the verdict names the runaway itself too.  Per task, over its window
+(``collisions.task_window``: from its first approach to the next task's), two measured tests:
+
+- ``saturated``: the commanded torque of some joint beyond its effort limit for at least
+  ``SATURATED_FRACTION`` (50 %) of the window's time (``saturated_fraction`` of the task);
+- ``joint speed beyond limit``: some joint faster than ``SPEED_RUNAWAY`` (3) times its model's
+  velocity limit (``joint_speed_ratio``: the largest |q̇ⱼ| / limitⱼ, ``joint_speed_joint`` its
+  joint, 1-based).
+
+Thresholds, measured (rvm1_5dof, docs/pick_place.md): runs that place every part saturate
+4-9 % of the time (assembly_pick_place 4.1 %, ``tests/two_belt_pick.yaml`` 8.7 %) and reach
+1.7-1.9 times the model's speed limits (their planned profiles ask for as much: the feasibility
+warnings before the run); ``tests/two_belt_pick.yaml`` with pick 1's approach cut to 0.3 s runs
+away: 59 % of the run saturated, joint 3 at 37.5 rad/s against its 3 rad/s limit (12.5 times).
+A joint beyond 1-3 times its limit is warned about after the run (``run_warnings
+.joint_limit_warnings``), not a verdict.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ptint_drake.worlds.pick.collisions import task_window
+
+SATURATED_FRACTION = 0.5  # of a task's window with a commanded torque beyond its limit
+SPEED_RUNAWAY = 3.0  # times a joint's velocity limit
+
+
+def runaway_metrics(built, metrics: dict, series: dict) -> None:
+    """Add to each of ``metrics["picks"]`` its window's ``saturated_fraction``, ``joint_speed_ratio``
+    and ``joint_speed_joint`` (module docstring), from ``series`` (``run.pick_series``: t, v, tau)."""
+    t, v, tau = series["t"], series["v"], series["tau"]
+    limits = np.asarray(built.arm.GetVelocityUpperLimits(), float)
+    over = np.any(np.abs(tau) > built.limits * (1.0 + 1e-9), axis=1)
+    dt = np.diff(t, append=t[-1]) if len(t) else np.zeros(0)
+    for k, pick in enumerate(metrics["picks"]):
+        start, end = task_window(built.plan, k)
+        inside = (t >= start) & (t < end)
+        span = float(np.sum(dt[inside]))
+        pick["saturated_fraction"] = float(np.sum(dt[inside & over]) / span) if span > 0 else 0.0
+        ratio = np.abs(v[inside]) / np.where(limits > 0, limits, np.inf)
+        peak = np.max(ratio, axis=0) if np.any(inside) else np.zeros(1)
+        pick["joint_speed_ratio"] = float(np.max(peak))
+        pick["joint_speed_joint"] = int(np.argmax(peak)) + 1
+
+
+def runaway_reasons(pick: dict) -> list[str]:
+    """The runaway codes of one pick's metrics: ``saturated``, ``joint speed beyond limit``."""
+    out = []
+    if pick.get("saturated_fraction", 0.0) >= SATURATED_FRACTION:
+        out.append("saturated")
+    if pick.get("joint_speed_ratio", 0.0) > SPEED_RUNAWAY:
+        out.append("joint speed beyond limit")
+    return out
