@@ -27,10 +27,11 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list,
     a(t) = ẍ_r(t) + e0 ξ̈(t).  ξ̈ is unbounded for β < 1/2; there the closed loop
     cannot follow it anyway and the β = 1/2 profile's bound is used.  The joint
     torque estimate is |M(q) J⁻¹ a| + |g(q)| at the segment's start and
-    interception configurations.  The acceleration part scales as 1/tf², which
-    gives the suggested tf (``targets``: the interception world's objects).  e0 is taken from
-    the start pose for the first
-    segment and from the previous target for later ones.
+    interception configurations and at every posture along its profile (``_profile``).  The
+    acceleration part scales as 1/tf², which gives the suggested tf (``targets``: the
+    interception world's objects).  e0 is taken from the start pose for the first segment and
+    from the previous target for later ones.  The joint-speed term: |J⁺ẋ| along the same profile
+    against the model's velocity limits (``feasibility_warning``, its own line).
     """
     from ptint_drake.systems.tbg import tbg_profile  # noqa: PLC0415
 
@@ -48,24 +49,20 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list,
         accelerations = [targets[i].evaluate(ic.start + s)[6:9] + e0 * xi_dd[k] for k, s in enumerate(tau)]
         x_end = targets[i].evaluate(ic.start + ic.tf)[0:3]
         q_end = inverse_kinematics(plant, frame, x_end, q_prev)
-        configs = [q_prev] + ([q_end] if q_end is not None else [])
+        profile = _profile(plant, frame, ic, targets[i], e0, q_prev)
+        configs = [q_prev] + ([q_end] if q_end is not None else []) + (list(profile.q) if profile else [])
         need_acc, need_g = _torque_needed(plant, context, frame, configs, accelerations)
-        warning = _too_short(i, ic.tf, need_acc, need_g, limits)
-        if warning:
-            warnings.append(warning)
-        warning = _speed_too_short(plant, frame, i, ic, targets[i], e0, q_prev)
-        if warning:
-            warnings.append(warning)
+        warnings += [w for w in (_too_short(i, ic.tf, need_acc, need_g, limits),
+                                 _speed_too_short(plant, frame, i, ic.tf, profile)) if w]
         if q_end is not None:
             q_prev, x_prev = q_end, x_end
     return warnings
 
 
-def _speed_too_short(plant: MultibodyPlant, frame, i: int, ic, target, e0: np.ndarray,
-                     q: np.ndarray) -> Optional[str]:
-    """The joint-speed term of interception i: |J⁺ẋ| (``joint_demand``) along its whole profile
-    x = x_r + ξ e0, ẋ = ẋ_r + ξ̇ e0, the postures by inverse kinematics from sample to sample
-    (none found: no warning, ``check_reachable`` names an unreachable target)."""
+def _profile(plant: MultibodyPlant, frame, ic, target, e0: np.ndarray, q: np.ndarray) -> Optional[Profile]:
+    """Interception ``ic``'s planned profile (position task): x = x_r + ξ e0, ẋ = ẋ_r + ξ̇ e0, the
+    postures by inverse kinematics from sample to sample; None where one is not found
+    (``check_reachable`` names an unreachable target)."""
     tau = profile_times(ic.tf)
     xi, xi_d = _xi_profile(tau, ic.tf, ic.beta)
     states = np.array([target.evaluate(ic.start + s) for s in tau])
@@ -77,10 +74,17 @@ def _speed_too_short(plant: MultibodyPlant, frame, i: int, ic, target, e0: np.nd
             return None
         postures.append(q)
     velocity = states[:, 3:6] + np.outer(xi_d, e0)
-    profile = Profile(ic.start + tau, np.array(postures), velocity, np.zeros_like(velocity))
+    return Profile(ic.start + tau, np.array(postures), velocity, np.zeros_like(velocity))
+
+
+def _speed_too_short(plant: MultibodyPlant, frame, i: int, tf: float,
+                     profile: Optional[Profile]) -> Optional[str]:
+    """The joint-speed term of interception i: |J⁺ẋ| (``joint_demand``) along its ``profile``."""
+    if profile is None:
+        return None
     speeds = joint_demand(plant, frame, profile)[0]
     none = np.zeros(plant.num_velocities())
-    return feasibility_warning(f"interceptions[{i}].tf", ic.tf, f"segment {i}", profile, speeds,
+    return feasibility_warning(f"interceptions[{i}].tf", tf, f"segment {i}", profile, speeds,
                                np.zeros_like(speeds), plant.GetVelocityUpperLimits(), none)
 
 
