@@ -12,7 +12,8 @@ beyond their speed limits — ends in its consequences (a collision, a part knoc
   joint, 1-based).
 
 Thresholds, measured (rvm1_5dof, docs/pick_place.md): runs that place every part saturate
-4-9 % of the time (assembly_pick_place 4.1 %, ``tests/two_belt_pick.yaml`` 8.7 %) and reach
+4-13 % of a task's window (assembly_pick_place 4.1 % of its run, ``tests/two_belt_pick.yaml``'s
+pick 0 12.8 %) and reach
 1.7-1.9 times the model's speed limits (their planned profiles ask for as much: the feasibility
 warnings before the run); ``tests/two_belt_pick.yaml`` with pick 1's approach cut to 0.3 s runs
 away: 59 % of the run saturated, joint 3 at 37.5 rad/s against its 3 rad/s limit (12.5 times).
