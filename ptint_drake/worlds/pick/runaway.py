@@ -11,12 +11,12 @@ beyond their speed limits — ends in its consequences (a collision, a part knoc
   velocity limit (``joint_speed_ratio``: the largest |q̇ⱼ| / limitⱼ, ``joint_speed_joint`` its
   joint, 1-based).
 
-Thresholds, measured (rvm1_5dof, docs/pick_place.md): runs that place every part saturate
-4-13 % of a task's window (assembly_pick_place 4.1 % of its run, ``tests/two_belt_pick.yaml``'s
-pick 0 12.8 %) and reach
-1.7-1.9 times the model's speed limits (their planned profiles ask for as much: the feasibility
-warnings before the run); ``tests/two_belt_pick.yaml`` with pick 1's approach cut to 0.3 s runs
-away: 59 % of the run saturated, joint 3 at 37.5 rad/s against its 3 rad/s limit (12.5 times).
+Thresholds, measured (rvm1_5dof, docs/pick_place.md): runs that place every part saturate at
+most 12.8 % of a task's window (the four bundled picks 0.2-11.8 %, ``tests/two_belt_pick.yaml``'s
+pick 0 12.8 %) and reach up to 2.24 times the model's speed limits (assembly_pick_place_rgbd; their
+planned profiles ask for as much: the feasibility warnings before the run).
+``tests/two_belt_pick.yaml`` with pick 1's approach cut to 0.3 s runs away: 99.5 % of pick 1's
+window saturated, joint 3 at 37.5 rad/s against its 3 rad/s limit (12.5 times).
 A joint beyond 1-3 times its limit is warned about after the run (``run_warnings
 .joint_limit_warnings``), not a verdict.
 """
