@@ -53,7 +53,8 @@ def torque_feasibility(plant: MultibodyPlant, scenario: Scenario, targets: list,
         configs = [q_prev] + ([q_end] if q_end is not None else []) + (list(profile.q) if profile else [])
         need_acc, need_g = _torque_needed(plant, context, frame, configs, accelerations)
         warnings += [w for w in (_too_short(i, ic.tf, need_acc, need_g, limits),
-                                 _speed_too_short(plant, frame, i, ic.tf, profile)) if w]
+                                 _speed_too_short(plant, frame, i, ic.tf, profile,
+                                                  scenario.controller.pinv_damping)) if w]
         if q_end is not None:
             q_prev, x_prev = q_end, x_end
     return warnings
@@ -77,12 +78,12 @@ def _profile(plant: MultibodyPlant, frame, ic, target, e0: np.ndarray, q: np.nda
     return Profile(ic.start + tau, np.array(postures), velocity, np.zeros_like(velocity))
 
 
-def _speed_too_short(plant: MultibodyPlant, frame, i: int, tf: float,
-                     profile: Optional[Profile]) -> Optional[str]:
+def _speed_too_short(plant: MultibodyPlant, frame, i: int, tf: float, profile: Optional[Profile],
+                     damping: float) -> Optional[str]:
     """The joint-speed term of interception i: |J⁺ẋ| (``joint_demand``) along its ``profile``."""
     if profile is None:
         return None
-    speeds = joint_demand(plant, frame, profile)[0]
+    speeds = joint_demand(plant, frame, profile, damping=damping)[0]
     none = np.zeros(plant.num_velocities())
     return feasibility_warning(f"interceptions[{i}].tf", tf, f"segment {i}", profile, speeds,
                                np.zeros_like(speeds), plant.GetVelocityUpperLimits(), none)
@@ -214,13 +215,16 @@ class Profile:
     payload: float = 0.0
 
 
-def joint_demand(plant: MultibodyPlant, frame, profile: Profile,
-                 instance=None) -> tuple[np.ndarray, np.ndarray]:
+def joint_demand(plant: MultibodyPlant, frame, profile: Profile, instance=None, rot_scale: float = 1.0,
+                 damping: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """(speeds, torques), each samples × joints of ``instance`` (default: all of ``plant``):
     q̇ = J⁺ ẋ and q̈ = J⁺ (ẍ − J̇q̇) of the task's Jacobian (spatial for a 6-D task, translational
     for a 3-D one) at each posture, and τ = M q̈ + C q̇ − g (Drake's inverse dynamics, every body of
     ``plant``, e.g. a gripper welded to the arm) + Jᵥᵀ m (a − g) for a payload m held at the
-    tool.  A planning estimate from the model: the controller never sees it."""
+    tool.  A 6-D task is weighed as the controller weighs it, [c ω; v] with c = ``rot_scale`` (m/rad),
+    and inverted as it inverts it: J⁺, or Jᵀ(JJᵀ + λ²I)⁻¹ with λ = ``damping``
+    (``controller.pinv_damping``: near a singularity the exact J⁺ would ask for speeds the damped
+    controller never commands).  A planning estimate from the model: the controller never sees it."""
     context = plant.CreateDefaultContext()
     nv = plant.num_velocities()
     cols = (np.arange(nv) if instance is None
@@ -239,8 +243,11 @@ def joint_demand(plant: MultibodyPlant, frame, profile: Profile,
         else:
             J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3),
                                                         world, world)[:, cols]
-        Jp = np.linalg.pinv(J)
-        v[cols] = Jp @ xd
+        weight = np.r_[np.full(3, rot_scale), np.ones(3)] if six else np.ones(3)
+        J = weight[:, None] * J
+        Jp = (np.linalg.pinv(J) if damping <= 0.0
+              else J.T @ np.linalg.inv(J @ J.T + damping ** 2 * np.eye(len(J))))
+        v[cols] = Jp @ (weight * xd)
         plant.SetVelocities(context, v)
         if six:
             bias = plant.CalcBiasSpatialAcceleration(context, JacobianWrtVariable.kV, frame, np.zeros(3),
@@ -250,11 +257,11 @@ def joint_demand(plant: MultibodyPlant, frame, profile: Profile,
             bias = plant.CalcBiasTranslationalAcceleration(context, JacobianWrtVariable.kV, frame,
                                                            np.zeros(3), world, world)[:, 0]
         vdot = np.zeros(nv)
-        vdot[cols] = Jp @ (xdd - bias)
+        vdot[cols] = Jp @ (weight * (xdd - bias))
         forces.SetZero()
         tau = plant.CalcInverseDynamics(context, vdot, forces)[cols]
         if profile.payload > 0.0:
-            Jv = J[3:] if six else J
+            Jv = J[3:] if six else J  # (the translational rows: weight 1)
             tau = tau + Jv.T @ (profile.payload * (xdd[-3:] - gravity))
         speeds.append(np.abs(v[cols]))
         torques.append(np.abs(tau))

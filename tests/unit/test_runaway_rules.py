@@ -6,16 +6,17 @@ from types import SimpleNamespace
 import numpy as np
 
 from ptint_drake.run_warnings import Profile, feasibility_warning
-from ptint_drake.worlds.pick.runaway import SATURATED_FRACTION, SPEED_RUNAWAY, runaway_reasons
+from ptint_drake.worlds.pick.runaway import SATURATED_FRACTION, SPEED_RUNAWAY_S, runaway_reasons
 from ptint_drake.worlds.pick.collisions import touched_before_close
 
 
 def test_the_thresholds_name_a_runaway_and_nothing_below_them():
-    assert runaway_reasons({"saturated_fraction": 0.087, "joint_speed_ratio": 1.9}) == []
-    at = {"saturated_fraction": SATURATED_FRACTION, "joint_speed_ratio": SPEED_RUNAWAY}
-    assert runaway_reasons(at) == ["saturated"]
-    assert runaway_reasons({"saturated_fraction": 0.99, "joint_speed_ratio": 12.5}) == [
-        "saturated", "joint speed beyond limit"]
+    # rvm1_6dof's wrist flipping by its singularity for 156 ms beyond 3 times its limit: no runaway
+    flip = {"saturated_fraction": 0.156, "joint_speed_ratio": 5.18, "joint_speed_over_s": 0.156}
+    assert runaway_reasons(flip) == []
+    at = {"saturated_fraction": SATURATED_FRACTION, "joint_speed_over_s": SPEED_RUNAWAY_S}
+    assert runaway_reasons(at) == ["saturated", "joint speed beyond limit"]
+    assert runaway_reasons({"saturated_fraction": 0.49, "joint_speed_over_s": 0.29}) == []
     assert runaway_reasons({}) == []  # metrics of before issue 44
 
 

@@ -12,8 +12,9 @@ to the target's top-down branch (``route.tool_yaws``) on the same ξ; the postur
 comes from Drake's ``InverseKinematics`` (the top-down orientation, from the previous sample's
 posture).  The first 5 % of each segment are left out (``run_warnings.PROFILE_START``: the ideal
 profile starts at the target's velocity while the arm is at rest).  The task velocity is the 6-D
-[ω; v]; the torques are those of the station's plant (the arm with its gripper) plus, from the
-lift to the place, the part's mass held at the tool.
+[ω; v], weighed and inverted as the controller does (``controller.rot_scale``, its damped
+pseudoinverse with ``controller.pinv_damping``); the torques are those of the station's plant
+(the arm with its gripper) plus, from the lift to the place, the part's mass held at the tool.
 
 A planning estimate from the model (the controller never sees it): one warning line per segment
 that asks a joint for more than its limit, naming the pick, the phase, the segment, the joint and
@@ -93,7 +94,8 @@ def feasibility_warnings(scenario, built) -> list[str]:
         if profile is None:
             continue
         seg = plan.segments[i]
-        speeds, torques = joint_demand(plant, frame, profile, station.arm)
+        speeds, torques = joint_demand(plant, frame, profile, station.arm, scenario.controller.rot_scale,
+                                       scenario.controller.pinv_damping)
         phase = seg.phase if seg.phase != "via" else ("approach" if seg.kind == VIA_PART else "carry")
         field = f"pick.tasks[{seg.task}].{phase}.tf"
         what = f"pick {seg.task}'s {seg.phase} (segment {i})"

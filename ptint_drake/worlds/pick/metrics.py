@@ -36,8 +36,9 @@ observer's log (``systems.gripper.GraspObserver``: what the gripper sensed):
   (``collisions.pick_collisions``), and every body touched during an approach or a descend before
   its close command (``collisions.touched_before_close``: the own part too, fingers or not), so a
   ``collision`` always names its bodies;
-- ``saturated_fraction``, ``joint_speed_ratio``, ``joint_speed_joint``: the runaway tests of the
-  task's window (``runaway.runaway_metrics``, added by the world after the series are made).
+- ``saturated_fraction``, ``joint_speed_ratio``, ``joint_speed_joint``, ``joint_speed_over_s``: the
+  runaway tests of the task's window (``runaway.runaway_metrics``, added by the world after the
+  series are made).
 
 ``pick_reasons`` — the verdict's reasons: first a runaway in the task's window, ``pick k:
 saturated`` and ``pick k: joint speed beyond limit`` (``runaway``); ``pick k: collision with
