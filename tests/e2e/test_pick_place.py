@@ -42,7 +42,7 @@ def test_assembly_pick_place_places_three_turned_parts(run):
 
 @pytest.mark.parametrize("override, field", [
     ("pick.parts[0].offset=0.9", "pick.parts[0].offset"),  # starts off its belt
-    ("pick.tray.center=[0.5,0.4,0.1]", "pick.tasks[0].slot"),  # a slot the arm cannot reach
+    ("pick.tray.center=[0.5,0.4,0.1]", "pick.tray.slots[0]"),  # a slot the arm cannot reach
     ("pick.parts[0].size=[0.07,0.03,0.03]", "pick.parts[0].size"),  # wider than the gripper opens
     ("controller.control_period=0", "controller.control_period"),
     ("controller.control_period=-0.001", "controller.control_period"),

@@ -10,7 +10,8 @@ part's centre) and checks the fingers' vertical
 extent (from the pads' lower edge to the fingers' top, read from the gripper's collision geometry)
 against each belt's slab wherever the open fingers (a disc of half the opening plus the finger's
 thickness) are over it.  A pass into a belt, or less than ``MIN_CLEARANCE`` above it, is a
-one-line ScenarioError naming the field to change (exit 2).  The links above the hand are not
+one-line ScenarioError naming the field to change (exit 2), as is a part wider than the gripper's
+stroke less its task's margin (``check_pick_opening``).  The links above the hand are not
 checked here: their contacts are found during the run (``collisions``).
 """
 
@@ -21,6 +22,7 @@ from pydrake.geometry import Box
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.feasibility import feasibility_warnings
 from ptint_drake.worlds.pick.grippers import payload_warnings
 from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
@@ -65,6 +67,7 @@ def check_pick_clearance(scenario, built) -> None:
     reach, top, thickness = finger_extent(station)
     stroke = sum(station.plant.GetJointByName(n, station.gripper).position_upper_limits()[0]
                  for n in FINGER_JOINTS)
+    check_pick_opening(scenario, stroke)
     for k, task in enumerate(scenario.pick.tasks):
         i_part = plan.segments[plan.segment_index(k, "approach")].index
         part = config.parts[i_part]
@@ -99,6 +102,22 @@ def check_pick_clearance(scenario, built) -> None:
         x0 = place + [0.0, 0.0, task.clearance]
 
 
+def check_pick_opening(scenario, stroke: float) -> None:
+    """ScenarioError naming ``pick.parts[i].size`` when a task's part is wider than the gripper's
+    ``stroke`` (m) less the task's ``margin``: the fingers cannot open the margin around it, so they
+    would reach it before the prescribed time (an early grasp), or land on it."""
+    names = [p.name for p in scenario.pick.parts]
+    for k, task in enumerate(scenario.pick.tasks):
+        i = names.index(task.part)
+        width = grasp_width(scenario.pick.parts[i])
+        if width + task.margin > stroke + 1e-12:
+            need, most = width + task.margin, stroke - task.margin
+            raise ScenarioError(f"pick.parts[{i}].size: {width:g} m across the fingers plus "
+                                f"pick.tasks[{k}].margin {task.margin:g} m needs an opening of {need:.4g} m, "
+                                f"beyond the gripper's {stroke:g} m stroke (a part at most {most:.4g} m "
+                                f"wide, or a smaller margin)")
+
+
 def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float, radius: float,
                 field: str, k: int, phase: str) -> None:
     X = belt_frame(belt)
@@ -120,10 +139,11 @@ def _check_belt(belt, path: np.ndarray, t: np.ndarray, reach: float, top: float,
 def arm_warnings(scenario, built) -> list[str]:
     """Warnings before a pick run about the arm: the gripper plus a part beyond the arm's rated
     payload (``grippers.payload_warnings``), a path past a singularity or near the inner edge of a
-    5-joint arm's top-down workspace (``singularity``)."""
+    5-joint arm's top-down workspace (``singularity``), a segment too short for a joint's speed or
+    effort limit along its planned profile (``feasibility``)."""
     station = built.station
     plant = station.plant
     gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
     return (payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
                              station.config.parts) + singularity_warnings(scenario, built)
-            + inner_reach_warnings(scenario, built))
+            + inner_reach_warnings(scenario, built) + feasibility_warnings(scenario, built))

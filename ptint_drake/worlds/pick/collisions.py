@@ -76,7 +76,25 @@ def pick_collisions(built, logs: dict, k: int) -> list:
         return []
     t, flags = logs["collisions"]
     plan = built.plan
-    starts = [plan.attempts[j][0].start for j in range(len(plan.close_times))]  # (a via's start, if any)
-    window = (0.0 if k == 0 else starts[k], starts[k + 1] if k + 1 < len(starts) else np.inf)
+    window = task_window(plan, k)
     own = built.station.config.parts[plan.segments[plan.segment_index(k, "approach")].index].name
     return collision_bodies(built.station.obstacles, t, flags, window, own)
+
+
+def task_window(plan, k: int) -> tuple:
+    """(start, end) of task k's window in a ``tasks.PickPlan``: from its first approach's start (or
+    that of the via before it; 0 for the first task) to the next task's (``inf`` for the last)."""
+    starts = [plan.attempts[j][0].start for j in range(len(plan.close_times))]  # (a via's start, if any)
+    return (0.0 if k == 0 else starts[k], starts[k + 1] if k + 1 < len(starts) else np.inf)
+
+
+def touched_before_close(built, logs: dict, mask: np.ndarray) -> list:
+    """The obstacles (names, the station's order) the arm or the gripper touched at the samples
+    ``mask`` of the logged ``collisions`` — every body, the task's own part included and touched by
+    the fingers too: ``mask`` is a task's approaches and descends before their close commands,
+    where the open fingers must touch nothing (the metrics' ``collision``)."""
+    if "collisions" not in logs:
+        return []
+    flags = logs["collisions"][1][mask]
+    return [name for k, name in enumerate(built.station.obstacles)
+            if np.any(flags[:, [2 * k + FINGER, 2 * k + OTHER]] > 0)]

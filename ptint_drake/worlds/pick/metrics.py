@@ -33,9 +33,16 @@ observer's log (``systems.gripper.GraspObserver``: what the gripper sensed):
   a descend before its close command, or any in ``collision_with``;
 - ``collision_with``: the obstacles (belts, ``tray``, ``floor``, other parts; the own part touched
   by anything but the fingers) the arm or the gripper touched in the task's window
-  (``collisions.pick_collisions``).
+  (``collisions.pick_collisions``), and every body touched during an approach or a descend before
+  its close command (``collisions.touched_before_close``: the own part too, fingers or not), so a
+  ``collision`` always names its bodies;
+- ``saturated_fraction``, ``joint_speed_ratio``, ``joint_speed_joint``, ``joint_speed_over_s``: the
+  runaway tests of the task's window (``runaway.runaway_metrics``, added by the world after the
+  series are made).
 
-``pick_reasons`` — the verdict's reasons: ``pick k: collision with <body>`` (or ``collision``);
+``pick_reasons`` — the verdict's reasons: first a runaway in the task's window, ``pick k:
+saturated`` and ``pick k: joint speed beyond limit`` (``runaway``); ``pick k: collision with
+<body>``;
 ``pick k: empty grasp`` (the grasp never confirmed, no retry allowed: ``pick.retries: 0``) or
 ``pick k: missed after retry`` (retries spent, or the retry out of reach); otherwise ``pick k:
 late grasp`` (t_grasp more than ``LATE_GRASP`` after the prescribed grasp time, or never),
@@ -49,8 +56,9 @@ import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
 
-from ptint_drake.worlds.pick.collisions import pick_collisions
+from ptint_drake.worlds.pick.collisions import pick_collisions, touched_before_close
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
+from ptint_drake.worlds.pick.runaway import runaway_reasons
 from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_reference
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time
@@ -156,6 +164,7 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
     for a in attempts:  # each approach and descend until its close command
         before |= (t >= a.start) & (t < a.close)
     collision = bool(np.any(robot_flags[before] > 0))
+    early = touched_before_close(built, logs, before) if collision else []
     i_lift, i_place = _at(t, lift_start), _at(t, place_end)
     checks = outcome["checks"][k]
     confirmed = bool(checks and checks[-1]["state"] == "holding")
@@ -192,7 +201,7 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
             "peak_grip_force_N": float(np.max(grip[in_carry])) if np.any(in_carry) else 0.0,
             "place_error_mm": float(1e3 * np.linalg.norm(block[-1, 0:3] - place)),
             "place_error_deg": _place_angle(R_end, place_yaw, part.shape, part.size),
-            "collision": collision}
+            "collision": collision, "collision_before_close": early}
 
 
 def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> dict:
@@ -201,7 +210,9 @@ def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> 
     picks = []
     for k in range(len(scenario.pick.tasks)):
         pick = _one_pick(built, k, logs, outcome)
-        pick["collision_with"] = pick_collisions(built, logs, k)  # arm/gripper vs belts, tray, floor, parts
+        touched = set(pick_collisions(built, logs, k)) | set(pick.pop("collision_before_close"))
+        # arm/gripper vs belts, tray, floor, parts; and whatever the open fingers touched before the close
+        pick["collision_with"] = [name for name in built.station.obstacles if name in touched]
         pick["collision"] = bool(pick["collision"] or pick["collision_with"])
         pick["placed"] = bool(pick["grasped"] and pick["held_at_place"]
                               and pick["place_error_mm"] <= scenario.criteria.place_mm
@@ -214,6 +225,7 @@ def pick_reasons(picks: list) -> list:
     """(task, code) of every pick that failed (module docstring)."""
     out = []
     for k, p in enumerate(picks):
+        out += [(k, code) for code in runaway_reasons(p)]  # the runaway first: its consequences follow
         if p["collision"]:
             out.append((k, "collision with " + ", ".join(p["collision_with"]) if p.get("collision_with")
                         else "collision"))

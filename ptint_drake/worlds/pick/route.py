@@ -117,7 +117,7 @@ def nominal(scenario, arm) -> Nominal:
     return Nominal(parts, yaws, places, start, waist_axis(arm), arm, frame, q0)
 
 
-def _target(world: Nominal, plan: PickPlan, i: int, t) -> np.ndarray:
+def segment_target(world: Nominal, plan: PickPlan, i: int, t) -> np.ndarray:
     """Where segment i aims at time(s) t (rows), nominally."""
     seg, s = plan.segments[i], plan.schedule.segments[i]
     t = np.atleast_1d(np.asarray(t, float))
@@ -139,9 +139,9 @@ def nominal_paths(world: Nominal, plan: PickPlan) -> list:
     out, x0 = [], world.start
     for i, s in enumerate(plan.schedule.segments):
         if i > 0:
-            x0 = _target(world, plan, i - 1, s.start)[0]
+            x0 = segment_target(world, plan, i - 1, s.start)[0]
         tau = np.linspace(0.0, s.tf, SAMPLES)
-        target = _target(world, plan, i, s.start + tau)
+        target = segment_target(world, plan, i, s.start + tau)
         out.append(target + np.outer(xi(tau, s.tf, s.beta), x0 - target[0]))
     return out
 
@@ -228,7 +228,7 @@ def _via_for(world: Nominal, pick, replans: tuple, vias: tuple, k: int, phase: s
     return None
 
 
-def _yaws(world: Nominal, plan: PickPlan) -> list:
+def tool_yaws(world: Nominal, plan: PickPlan) -> list:
     """Per segment: the tool's yaw (rad, unwrapped) at its start and at its end, as the top-down
     task turns it: to the branch (modulo π) of the target's yaw nearest the tool's yaw
     (``orientation.top_down_of``), from the start posture's, with the parts at their nominal yaws."""
@@ -266,7 +266,7 @@ def _carry_turn(world: Nominal, plan: PickPlan, pick, replans: tuple, vias: tupl
     i = plan.segment_index(k, "carry")
     if plan.segments[i - 1].phase == "via":
         return None
-    yaws, path = _yaws(world, plan)[i], nominal_paths(world, plan)[i]
+    yaws, path = tool_yaws(world, plan)[i], nominal_paths(world, plan)[i]
     start, end = path[0], path[-1]
     q = _down(world, start)
     if q is None:

@@ -244,14 +244,17 @@ def check_pick_plant(scenario: Scenario) -> None:
 
 def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
     """Before a run: every task's grasp (the part's nominal place on its belt at the prescribed grasp
-    time), its lift point and its slot (and the carry above it) must be reachable from above
-    (Drake's InverseKinematics, the model's joint limits); a ScenarioError naming the field."""
+    time), its lift point and its slot (and the carry above it), solved from one to the next, then
+    every slot no task uses (``_check_slots``) must be reachable from above (Drake's
+    InverseKinematics, the model's joint limits); a ScenarioError naming the field: a slot out of
+    reach is ``pick.tray.slots[j]`` (the tray's centre and the slot's offset put it there)."""
     arm = built.arm
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     plan, config = built.plan, built.station.config
     belts = {b.name: b for b in config.belts}
     guess = np.radians(scenario.robot.initial_q_deg)
     context = built.station.plant.CreateDefaultContext()
+    guesses = [guess]
     for k, task in enumerate(scenario.pick.tasks):
         part_index = [p.name for p in config.parts].index(task.part)
         belt = belts[config.parts[part_index].belt]
@@ -260,13 +263,36 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
         place = built.targets.places[plan.segment_index(k, "place")]
         for where, x in ((f"pick.tasks[{k}].part", grasp), (f"pick.tasks[{k}].lift_height",
                                                            grasp + [0, 0, task.lift_height]),
-                         (f"pick.tasks[{k}].slot", place), (f"pick.tasks[{k}].lift_height",
+                         (_slot_field(task.slot), place), (f"pick.tasks[{k}].lift_height",
                                                            place + [0, 0, task.lift_height])):
             solution = inverse_kinematics(arm, frame, np.asarray(x), guess, down=True)
             if solution is None:
                 raise ScenarioError(f"{where}: {np.round(x, 3).tolist()} m is outside what the arm reaches "
                                     f"from above")
             guess = solution
+        guesses.append(guess)
+    _check_slots(scenario, built, frame, guesses, context)
+
+
+def _slot_field(j: int) -> str:
+    return f"pick.tray.slots[{j}] (pick.tray.center and the slot's offset)"
+
+
+def _check_slots(scenario: Scenario, built: PickBuilt, frame, guesses: list, context) -> None:
+    """ScenarioError naming ``pick.tray.slots[j]`` when slot j, one no task uses, is outside what
+    the arm reaches from above (solved from each of ``guesses``: the start posture and the tasks'
+    carries): at half the lowest part's height above the tray and ``lift_height`` above that."""
+    tasks, used = scenario.pick.tasks, {t.slot for t in scenario.pick.tasks}
+    height = min(p.size[2] if p.shape == "box" else p.size[1] for p in built.station.config.parts)
+    lift = max(t.lift_height for t in tasks)
+    for j, slot in enumerate(built.station.slots):
+        if j in used:
+            continue
+        x = slot.CalcPoseInWorld(context).translation() + [0.0, 0.0, height / 2]
+        for where in (x, x + [0.0, 0.0, lift]):
+            if all(inverse_kinematics(built.arm, frame, where, q, down=True) is None for q in guesses):
+                raise ScenarioError(f"{_slot_field(j)}: {np.round(where, 3).tolist()} m is outside what "
+                                    f"the arm reaches from above")
 
 
 def pick_series(built: PickBuilt, logs: dict) -> dict:

@@ -37,7 +37,7 @@ from ptint_drake.config.schema import Scenario
 from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.mass_scaling import scale_in_context
 from ptint_drake.metrics import Reason, drive_metrics
-from ptint_drake.run_warnings import sampled_control_warnings
+from ptint_drake.run_warnings import joint_limit_warnings, sampled_control_warnings
 from ptint_drake.worlds.base import LinkPorts, World, WorldRun
 from ptint_drake.worlds.pick import studies
 from ptint_drake.worlds.pick.camera import MIN_FITS, check_pick_camera, estimate_metrics
@@ -52,6 +52,7 @@ from ptint_drake.reachability import inverse_kinematics
 from ptint_drake.systems.gripper import CLOSING, GRASP_STATES, HOLDING
 from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.runaway import runaway_metrics
 from ptint_drake.worlds.pick.tasks import Replan, check_tasks, pick_plan
 
 GRASP_WAIT = 0.05  # s, the lift's wait for ``holding`` while the fingers are still closing
@@ -220,7 +221,7 @@ class PickRun(WorldRun):
         if not self._rebuilt:
             return False
         self._rebuilt = False
-        self._pieces.append(self._logs(context))  # the old diagram's loggers, up to now
+        self._pieces.append(pick_logs(self.built, context))  # the old diagram's loggers, up to now
         self.built = build_pick(self.scenario, tuple(self.replans))
         self.diagram, self.controller = self.built.diagram, self.built.controller
         self.end = max(self.scenario.duration, self.built.plan.end + self._tail)
@@ -246,12 +247,9 @@ class PickRun(WorldRun):
             if value is not None:  # the backoff's latch, before the controller captures its start
                 tc.SetDiscreteState(0, value)
 
-    def _logs(self, context) -> dict:
-        return pick_logs(self.built, context)
-
     def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
         built = self.built
-        logs = self._logs(context)
+        logs = pick_logs(built, context)
         for name in logs:  # the pieces of the replaced diagrams, each up to where the next began
             t, data = logs[name]
             for t_piece, data_piece in reversed([piece[name] for piece in self._pieces]):
@@ -264,7 +262,8 @@ class PickRun(WorldRun):
         estimate_metrics(self.scenario, metrics["picks"], self.estimates)
         metrics |= drive_metrics(built.plan.schedule, series["t"], series["tau"], series["tau_applied"],
                                  series["v"], built.limits)
-        return metrics, series, []
+        runaway_metrics(built, metrics, series)  # per pick: saturated, joint speed beyond limit
+        return metrics, series, joint_limit_warnings(built.arm, series)
 
     def sim_info(self, integrator) -> dict:
         config = self.built.station.config
