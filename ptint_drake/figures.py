@@ -21,6 +21,7 @@ import numpy as np
 
 from ptint_drake.derivatives import uniform_derivatives
 from ptint_drake.figure_grid import place_grid
+from ptint_drake.figure_marks import mark_peak, peak_label, peak_of, robust_limit
 from ptint_drake.systems.tbg import alpha_gain, tbg_profile
 
 AXES = ("X", "Y", "Z")
@@ -135,40 +136,6 @@ def _save_laid_out(fig, paths) -> None:
 def _mark_times(ax, times):
     for i, t in enumerate(times):
         ax.axvline(t, color="k", ls="--", lw=0.8, label="prescribed time $t_f$" if i == 0 else None)
-
-
-def peak_of(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
-    """(time, value) of the largest |y|."""
-    k = int(np.argmax(np.abs(y)))
-    return float(t[k]), float(y[k])
-
-
-def peak_label(name: str, t_peak: float, value: float, unit: str) -> str:
-    """``"τ1: peak −5.89 N·m at t = 0.178 s"`` (with a true minus sign, as on the axes)."""
-    return f"{name}peak {value:.3g} {unit} at t = {t_peak:.3f} s".replace("-", "−")
-
-
-def robust_limit(robot: np.ndarray, target: np.ndarray, spread: float = 3.0) -> float:
-    """A symmetric y limit that shows the curves, not one start-up spike.
-
-    The whole range when the robot's peak is within ``spread`` × its 99th percentile
-    (and the target's range); otherwise the latter, and the peak is marked off scale.
-    """
-    robot, target = np.abs(robot), np.abs(target)
-    whole = max(float(np.max(robot)), float(np.max(target)), 1e-12)
-    body = max(float(np.percentile(robot, 99)), float(np.max(target)), 1e-12)
-    return 1.08 * (whole if whole <= spread * body else body)
-
-
-def mark_peak(ax, t_peak: float, value: float, limit: float | None = None, **style):
-    """A marker at the peak; at the axis edge (pointing out) when it lies beyond ``limit``.
-    Returns the marker's handle, for a legend."""
-    off = limit is not None and abs(value) > limit
-    y = np.sign(value) * limit if off else value
-    marker = ("^" if value > 0 else "v") if off else "o"
-    (h,) = ax.plot([t_peak], [y], ls="none", marker=marker, ms=6, mfc="none", mew=1.5,
-                   clip_on=False, zorder=5, **style)
-    return h
 
 
 def tbg_family_figure(settings, out_dir: Path, stem: str, title: str, n: int = 2000,
