@@ -21,6 +21,7 @@ from ptint_drake.config.yaml_io import drake_version
 from ptint_drake.controllers.slot import uses_analytic_targets
 from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenario_text
 from ptint_drake.simulation import build, make_simulator, simulate
+from ptint_drake.worlds.base import advance_over_stops
 from ptint_drake.worlds.registry import world_of
 
 CONFIGS = {
@@ -254,15 +255,11 @@ def _cpu_per_simulated_s(run) -> dict:
     runner drives it — ``Initialize`` and ``AdvanceTo`` over its stops, ``at_stop`` after each —
     per simulated second; the build and the metrics are not counted."""
     simulator = make_simulator(run)
-    context = simulator.get_mutable_context()
-    run.initialize(context)
+    run.initialize(simulator.get_mutable_context())
     cpu0, wall0 = time.process_time(), time.perf_counter()
-    simulator.Initialize()
-    for t_stop in run.stops():
-        if t_stop > context.get_time() or run.advance_at_reached_stops:
-            simulator.AdvanceTo(t_stop)
-        run.at_stop(context, t_stop)
-    cpu, wall, t = time.process_time() - cpu0, time.perf_counter() - wall0, context.get_time()
+    _, _, simulator, _ = advance_over_stops(simulator, run, run.scenario)  # the runner's own loop
+    t = simulator.get_context().get_time()
+    cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
     return {"cpu_per_s": cpu / t, "wall_per_s": wall / t,
             "steps": int(simulator.get_integrator().get_num_steps_taken())}
 

@@ -22,6 +22,8 @@ Adding a world = one package under ``worlds/`` with a ``World`` subclass, plus o
 
 from __future__ import annotations
 
+import time
+
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
@@ -284,3 +286,59 @@ def segment_row(seed: int, params: dict, m: dict) -> dict:
         "realtime_factor": m["sim"]["realtime_factor"],
         "warnings": m.get("warnings", []),
     }
+
+
+def _failure(t: float, what: str, exc: BaseException) -> dict:
+    detail = " ".join(str(exc).split())[:300]
+    return {"time": t, "message": f"{what} at t = {t:.4f} s: {detail}"}
+
+
+def advance_over_stops(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: Progress = None,
+                       monitor=None):
+    """The one stop loop (the runner's, the benchmark's CPU timing, the pick floor's recording):
+    ``Initialize``, then ``AdvanceTo`` every exact stop of ``run`` with ``at_stop`` after each;
+    returns (failure or None, wall s of ``AdvanceTo``, the simulator of the end, steps taken by the
+    simulators a replan replaced).  ``run.stops()`` is read again
+    after each stop: a world that plans anew at a stop (``WorldRun.replan``) hands over a new
+    diagram, which goes on from the old context's state in a new simulator."""
+    context = simulator.get_mutable_context()
+    failure, wall, done, steps_before = None, 0.0, None, 0
+    simulator.Initialize()
+    while True:
+        upcoming = [t for t in run.stops() if done is None or t > done]
+        if not upcoming:
+            break
+        t_stop = upcoming[0]
+        if t_stop > context.get_time() or run.advance_at_reached_stops:
+            t0 = time.perf_counter()
+            try:
+                simulator.AdvanceTo(t_stop)
+            except RuntimeError as exc:  # e.g. a step-size collapse on a non-finite state
+                failure = _failure(context.get_time(), "integration failed", exc)
+            except Exception as exc:  # noqa: BLE001  (only a plugin's: the package's own are bugs)
+                if not run.controller.plugin:
+                    raise
+                detail = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+                t = context.get_time()
+                failure = {"time": t, "message": f"controller {scenario.controller.type} raised at "
+                                                 f"t = {t:.4f} s: {detail}"}
+            wall += time.perf_counter() - t0
+        failure = failure or run.watchdog_failure()
+        if failure is not None:
+            break
+        run.at_stop(context, t_stop)
+        done = t_stop
+        if run.replan(context, t_stop):
+            steps_before += int(simulator.get_integrator().get_num_steps_taken())
+            t0 = time.perf_counter()
+            simulator = new_simulator(run.diagram, config=run.simulator_config)
+            run.resume(simulator.get_mutable_context(), context)
+            context = simulator.get_mutable_context()
+            if monitor is not None:
+                simulator.set_monitor(monitor)
+            simulator.Initialize()
+            wall += time.perf_counter() - t0
+        if progress is not None:
+            steps = steps_before + int(simulator.get_integrator().get_num_steps_taken())
+            progress(context.get_time(), scenario.duration, steps)
+    return failure, wall, simulator, steps_before

@@ -21,7 +21,7 @@ from pydrake.systems.analysis import Simulator
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.jit_notice import compile_notice
-from ptint_drake.worlds.base import Progress, RunResult, WorldRun, new_simulator
+from ptint_drake.worlds.base import Progress, RunResult, WorldRun, advance_over_stops, new_simulator
 from ptint_drake.worlds.registry import world_of
 
 __all__ = ["RunResult", "make_simulator", "simulate"]
@@ -31,59 +31,6 @@ def make_simulator(run: WorldRun) -> Simulator:
     """A simulator of the run's diagram with the world's integrator settings, from the diagram's
     default context (the station's defaults are the scenario's start)."""
     return new_simulator(run.diagram, config=run.simulator_config)
-
-
-def _failure(t: float, what: str, exc: BaseException) -> dict:
-    detail = " ".join(str(exc).split())[:300]
-    return {"time": t, "message": f"{what} at t = {t:.4f} s: {detail}"}
-
-
-def _advance(simulator: Simulator, run: WorldRun, scenario: Scenario, progress: Progress, monitor=None):
-    """Run to every exact stop; returns (failure or None, wall s of ``AdvanceTo``, the simulator
-    of the end, steps taken by the simulators a replan replaced).  ``run.stops()`` is read again
-    after each stop: a world that plans anew at a stop (``WorldRun.replan``) hands over a new
-    diagram, which goes on from the old context's state in a new simulator."""
-    context = simulator.get_mutable_context()
-    failure, wall, done, steps_before = None, 0.0, None, 0
-    simulator.Initialize()
-    while True:
-        upcoming = [t for t in run.stops() if done is None or t > done]
-        if not upcoming:
-            break
-        t_stop = upcoming[0]
-        if t_stop > context.get_time() or run.advance_at_reached_stops:
-            t0 = time.perf_counter()
-            try:
-                simulator.AdvanceTo(t_stop)
-            except RuntimeError as exc:  # e.g. a step-size collapse on a non-finite state
-                failure = _failure(context.get_time(), "integration failed", exc)
-            except Exception as exc:  # noqa: BLE001  (only a plugin's: the package's own are bugs)
-                if not run.controller.plugin:
-                    raise
-                detail = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
-                t = context.get_time()
-                failure = {"time": t, "message": f"controller {scenario.controller.type} raised at "
-                                                 f"t = {t:.4f} s: {detail}"}
-            wall += time.perf_counter() - t0
-        failure = failure or run.watchdog_failure()
-        if failure is not None:
-            break
-        run.at_stop(context, t_stop)
-        done = t_stop
-        if run.replan(context, t_stop):
-            steps_before += int(simulator.get_integrator().get_num_steps_taken())
-            t0 = time.perf_counter()
-            simulator = make_simulator(run)
-            run.resume(simulator.get_mutable_context(), context)
-            context = simulator.get_mutable_context()
-            if monitor is not None:
-                simulator.set_monitor(monitor)
-            simulator.Initialize()
-            wall += time.perf_counter() - t0
-        if progress is not None:
-            steps = steps_before + int(simulator.get_integrator().get_num_steps_taken())
-            progress(context.get_time(), scenario.duration, steps)
-    return failure, wall, simulator, steps_before
 
 
 def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
@@ -109,7 +56,7 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
     monitor = run.monitor(progress)
     if monitor is not None:
         simulator.set_monitor(monitor)
-    failure, wall, simulator, steps_before = _advance(simulator, run, scenario, progress, monitor)
+    failure, wall, simulator, steps_before = advance_over_stops(simulator, run, scenario, progress, monitor)
     context, integrator = simulator.get_context(), simulator.get_integrator()
     if progress is not None:
         progress(context.get_time(), scenario.duration, steps_before + int(integrator.get_num_steps_taken()))

@@ -16,7 +16,7 @@ from pydrake.systems.framework import DiagramBuilder, EventStatus
 from pydrake.systems.primitives import Adder, LogVectorOutput, Saturation, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from ptint_drake.worlds.base import new_simulator
+from ptint_drake.worlds.base import advance_over_stops, new_simulator
 from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.config.pick import PHASES
 from ptint_drake.mass_scaling import scale_in_context
@@ -325,12 +325,9 @@ class FloorReplay:
             return EventStatus.Succeeded()
 
         simulator = new_simulator(run.diagram, config=run.simulator_config)
-        context = simulator.get_mutable_context()
-        run.initialize(context)
+        run.initialize(simulator.get_mutable_context())
         simulator.set_monitor(keep)
-        simulator.Initialize()
-        for t_stop in run.stops():
-            simulator.AdvanceTo(t_stop)
+        advance_over_stops(simulator, run, self.scenario, monitor=keep)  # the runner's own loop
         self.recording = {"t": np.array(ts), "state": np.array(xs), "torque": np.array(taus),
                           "commands": list(built.plan.commands), "limits": np.asarray(built.limits),
                           "stops": run.stops()}
