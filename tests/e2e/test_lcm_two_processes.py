@@ -27,9 +27,10 @@ PERIOD = 1e-3
 PATIENT = ("--startup-timeout", "60")
 # real time on the loaded 2-core virtual machine of CI: a process (or the machine's virtual CPU)
 # may stall for several milliseconds (measured: sleeps overshooting by up to 8 ms at load 4.5 even
-# under SCHED_FIFO), so the real-time tests that are not about the hold's reaction give a slack
-# of 50 periods; the default 5 is measured by scripts/link_faults.py and tests/unit/test_lcm_checks.py
-SLACK = ("--silent-periods", "50")
+# under SCHED_FIFO; 20 ms once in the whole suite), so the real-time tests give a slack of 100
+# periods (the kill test checks the reaction is exactly that); the default 5 is measured by
+# scripts/link_faults.py and tests/unit/test_lcm_checks.py
+SLACK = ("--silent-periods", "100")
 
 
 def ptint(*args: str) -> list[str]:
@@ -166,13 +167,12 @@ def test_pick_replan_is_refused_in_one_line(tmp_path):
 
 def test_drive_killed_holds_the_arm(tmp_path):
     """The drive SIGKILLed mid-run (real time, at 30 % of the run): the hardware holds the arm
-    after exactly its silent periods without a command (here 20: a loaded CI machine stalls a
+    after exactly its silent periods without a command (here 100: a loaded CI machine stalls a
     process for several ms, ``SLACK``; the default 5 is scripts/link_faults.py's row), joint
     speeds below 0.05 rad/s within 0.2 s, and exits 1 with the reason."""
     out = run_plan(
         [
-            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT, "--silent-periods", "20",
-                                         "--out", str(tmp_path / "hw"))},
+            {"name": "hw", "argv": ptint("hardware", CURVE, *PATIENT, *SLACK, "--out", str(tmp_path / "hw"))},
             {"name": "drive", "argv": ptint("drive", CURVE, *PATIENT), "kill_when": ["hw", " 30 %"]},
         ],
         tmp_path,
@@ -181,9 +181,9 @@ def test_drive_killed_holds_the_arm(tmp_path):
     assert "command timeout at t" in one_line(out["hw"]["stderr"])
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     assert link["fault_kind"] == "command timeout" and 0.8 < link["fault_time"] < 2.5
-    assert "no command for 20 periods" in link["fault"]
-    # from the last command taken to the hold: 20 ticks (the last command's own tick is not silent)
-    assert abs(link["fault_time"] - link["last_command_t"] - 20 * PERIOD) < 1e-9, link
+    assert "no command for 100 periods" in link["fault"]
+    # from the last command taken to the hold: 100 ticks (the last command's own tick is not silent)
+    assert abs(link["fault_time"] - link["last_command_t"] - 100 * PERIOD) < 1e-9, link
     assert link["hold"]["settled_s_after_fault"] <= 0.2 and link["hold"]["speed_at_end"] < 0.05
 
 
