@@ -1,4 +1,5 @@
-"""Issue 45, every world on each bundled industrial arm: a pose task per arm (``pose_ARM``)."""
+"""Issue 45, every world on each bundled industrial arm: a pose task (``pose_ARM``) and a pick with a
+real-size gripper (``pick_ARM``) per arm."""
 
 import numpy as np
 import pytest
@@ -33,3 +34,39 @@ def test_pose_meets_criteria(run, arm):
     assert seg["e_half_norm"] >= 0.25 * seg["e0_norm"] and seg["e_rot_half_deg"] >= 0.25 * seg["e_rot0_deg"]
     assert seg["e_hold_max_norm"] <= 3e-3 and seg["e_rot_hold_max_deg"] <= 5.0
     assert _inside_limits(arm, np.asarray(result.series["q"]))
+
+
+@pytest.mark.parametrize("arm", ARMS)
+def test_pick_places_every_yawed_part(run, arm):
+    """``pick_ARM``: three parts, each turned, riding a belt at ≥ 0.1 m/s, grasped by the arm's
+    real-size gripper and placed within 3 mm and 3° of their slots, with no collision, no joint out
+    of its range."""
+    result = run(f"pick_{arm}")
+    m, pick = result.metrics, result.scenario.pick
+    assert len(pick.parts) >= 3 and all(abs(p.yaw_deg) >= 10.0 for p in pick.parts)
+    assert all(b.speed >= 0.1 for b in pick.belts)
+    assert pick.gripper.model in ("schunk_wsg_50_110_full", "robotiq_2f_85_full", "panda_hand")
+    assert m["status"] == "ok", m.get("reasons")
+    assert len(m["picks"]) == len(pick.parts)
+    for p in m["picks"]:
+        assert p["placed"] and not p["collision"], p
+        assert p["place_error_mm"] <= 3.0 and p["place_error_deg"] <= 3.0, p
+    assert _inside_limits(arm, np.asarray(result.series["q"]))
+
+
+def test_list_names_a_curve_a_pose_and_a_pick_per_arm(ptint_here):
+    names = {line.split()[0] for line in ptint_here("list").stdout.splitlines() if line.strip()}
+    assert {f"{w}_{arm}" for w in ("curve", "pose", "pick") for arm in ARMS} <= names
+
+
+def test_hand_and_part_over_the_panda_payload_is_warned_before_the_run():
+    """The Panda hand (0.73 kg) with a 2.5 kg part is over the Panda's 3 kg: warned before the run,
+    naming both masses; the bundled 0.1 kg parts are not."""
+    from ptint_drake.scenario import parse_with_overrides, scenario_text
+    from ptint_drake.simulation import build
+
+    name, text = scenario_text("pick_panda")
+    assert not build(parse_with_overrides(text, (), name), log=False).pre_run_warnings()
+    heavy = parse_with_overrides(text, ("pick.parts[1].mass=2.5",), name)
+    (warning,) = build(heavy, log=False).pre_run_warnings()
+    assert "0.73 kg" in warning and "2.50 kg" in warning and "3 kg" in warning, warning
