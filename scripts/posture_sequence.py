@@ -3,13 +3,15 @@ rotation, run with the null-space posture task and without it (``null_space_damp
 
     .venv/bin/python scripts/posture_sequence.py iiwa14 [--out DIR]   # two runs of ~60 s simulated
     .venv/bin/python scripts/posture_sequence.py panda --write-only    # only the scenario file
+    .venv/bin/python scripts/posture_sequence.py panda --report-only   # the report of runs in DIR
 
 The world: two belts at 0.1 m/s on either side of the arm (base azimuths −60° and +60°, running
 across the arm's reach), each with ten parts, and a tray beside each (−30° and +30°); the first ten
 tasks pick from the first belt into the first tray, the last ten from the second into the second,
 so the base turns through 120° and back.  Every task's segments are shortened (``TFS``) to fit 20
-picks in the time.  The arm's start posture is its rest posture (``null_space_posture_deg``); the
-posture task also pushes joints back from their limits (``null_space_limit_margin_deg``).
+picks in the time.  The rest posture (``null_space_posture_deg``) faces the tray (joint 1 at 0); the
+arm starts from it turned to the first belt; the posture task also pushes joints back from their
+limits (``null_space_limit_margin_deg``).
 
 Writes ``DIR/sequence_ARM.yaml`` and, per variant, ``DIR/<variant>/metrics.json``, then
 ``DIR/posture.png`` (the posture error |q − q_rest| over time of both runs beside each other, and
@@ -29,10 +31,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-# per arm: (start = rest posture [deg], K, gripper, belt radius, belt height, tray radius, tray height)
-ARMS = {"iiwa14": ([-60.0, 30.0, 0.0, -80.0, 0.0, 60.0, 0.0], 150.0, "schunk_wsg_50_110_full", 0.6, 0.20, 0.5,
+# per arm: (rest posture [deg], K, gripper, belt radius, belt height, tray radius, tray height)
+ARMS = {"iiwa14": ([0.0, 30.0, 0.0, -80.0, 0.0, 60.0, 0.0], 150.0, "schunk_wsg_50_110_full", 0.6, 0.20, 0.6,
                    0.22),
-        "panda": ([-60.0, -20.0, 0.0, -120.0, 0.0, 100.0, 45.0], 100.0, "panda_hand", 0.5, 0.20, 0.42, 0.22)}
+        "panda": ([0.0, -20.0, 0.0, -120.0, 0.0, 100.0, 45.0], 100.0, "panda_hand", 0.5, 0.20, 0.5, 0.22)}
+START_J1 = -60.0  # deg: the start posture is the rest posture turned to the first belt
 TFS = {"approach": 0.8, "descend": 0.3, "lift": 0.25, "carry": 0.8, "place": 0.3, "retreat": 0.25}
 DWELL = 0.1  # s (default 0.15; the grip builds up within 30 ms)
 SWITCH_APPROACH = 1.6  # s: the approach that crosses from one side to the other
@@ -80,7 +83,7 @@ def scenario(arm: str) -> str:
         f"# Issue 45: {2 * PER_SIDE} picks in {duration:g} s spanning {SIDES[1] - SIDES[0]:g}° of base "
         f"rotation on {arm} (scripts/posture_sequence.py writes this file).",
         f"duration: {duration}", "robot:", f"  model: {arm}", f"  end_effector: {gripper}_tip",
-        f"  initial_q_deg: {_v(q0)}",
+        f"  initial_q_deg: {_v([START_J1] + q0[1:])}",
         f"controller: {{K: {K}, task: top_down, rot_scale: 0.1, control_period: 0.001,",
         f"             null_space_damping: 10.0, null_space_posture_deg: {_v(q0)},",
         f"             null_space_limit_margin_deg: {LIMIT_MARGIN_DEG}}}",
@@ -160,6 +163,8 @@ def report(arm: str, out: Path) -> dict:
         err = posture_error(series["q"], q_rest)
         t = series["t"] if "t" in series else np.linspace(0.0, m["duration"], err.size)
         rows[name] = _row(m, err, limit_margin(arm, series["q"]))
+        q = series["q"] if series["q"].shape[-1] == q_rest.size else series["q"].T
+        rows[name]["base_rotation_span_deg"] = float(np.degrees(q[:, 0].max() - q[:, 0].min()))
         picks = m["picks"]
         ax.plot(t[: err.size], err)
         ax.set_title(f"{arm}, {name.replace('_', ' ')}: max {err.max():.1f}°, "
@@ -177,6 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("arm", choices=sorted(ARMS))
     parser.add_argument("--out", type=Path)
     parser.add_argument("--write-only", action="store_true")
+    parser.add_argument("--report-only", action="store_true", help="only read DIR/<variant>/ and report")
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     args = parser.parse_args(argv)
     out = args.out or ROOT / "out" / f"sequence_{args.arm}"
@@ -186,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.write_only:
         print(path)
         return 0
-    for name in args.variants:
+    for name in [] if args.report_only else args.variants:
         run_variant(path, out / name, VARIANTS[name])
     print(json.dumps(report(args.arm, out), indent=1))
     return 0
