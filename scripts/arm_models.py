@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ptint_drake.worlds.pick.grippers import FULL_SIZE
+
 MODELS = Path(__file__).resolve().parent.parent / "models"
 PI = math.pi
 
@@ -347,6 +349,10 @@ def urdf(arm: Arm) -> str:
     out += ['  <link name="tool"/>', '  <joint name="tool_weld" type="fixed">',
             f'    <parent link="{parent}"/>', '    <child link="tool"/>',
             f'    <origin xyz="{_vec(tool_p)}" rpy="{_vec(tool_rpy)}"/>', "  </joint>"]
+    out.append("  <!-- fingertip centres of the real-size grippers mounted on the flange (the pick world "
+               "welds their fingertip_center here; scripts/gripper_models.py) -->")
+    out += [f'  <frame name="{g.name}_tip" link="tool" xyz="0 0 {_fmt(g.tip_depth)}" '
+            f'rpy="0 0 {_fmt(g.yaw_rad)}"/>' for g in FULL_SIZE.values()]
     out.append(f"  <!-- transmissions: gear ratio {GEAR_RATIO:g}, rotor inertia = reflected inertia / "
                "ratio^2 (assumptions) -->")
     for i, joint in enumerate(arm.joints, start=1):

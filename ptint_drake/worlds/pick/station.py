@@ -58,6 +58,7 @@ from ptint_drake.worlds.pick.camera import AddPickCamera
 from ptint_drake.worlds.pick.collisions import CollisionProbe
 from ptint_drake.worlds.pick.contact_pairs import ContactPairs
 from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
+from ptint_drake.worlds.pick.grippers import check_mount
 from ptint_drake.worlds.pick.part_pose import PartPoses
 from ptint_drake.worlds.pick.scene import AddBelt, AddFloor, AddGripper, AddPart, AddTray, gripper_stroke
 from ptint_drake.robot import resolve_model
@@ -111,6 +112,7 @@ def _parse_arm(plant: MultibodyPlant, config: PickWorldConfig) -> ModelInstanceI
         raise ScenarioError(f"pick.model: cannot parse {str(path)!r}: {detail}") from None
     if not plant.HasFrameNamed(config.end_effector, arm):
         raise ScenarioError(f"pick.end_effector: the arm has no frame named {config.end_effector!r}")
+    check_mount(config.gripper.model, config.end_effector, lambda name: plant.HasFrameNamed(name, arm))
     return arm
 
 
