@@ -14,7 +14,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 import doc_blocks  # noqa: E402
 
-OTHER_TESTS = {"layers (scripts/layers_doc.py)": "tests/unit/test_layers.py"}
+OTHER_TESTS = {"layers (scripts/layers_doc.py)": "tests/unit/test_layers.py",
+               "arms": "tests/unit/test_arm_table.py"}  # scripts/arm_table.py --check: its gains exactly
 
 
 def _markers() -> set:
