@@ -126,6 +126,7 @@ class _DriveLoop:
         lcm=None,
     ) -> None:
         diagram, _, n, side = DriveDiagram(scenario)
+        self.warn, self.in_memory = warn, lcm is not None  # (memq: both sides in one process)
         self.n, self.settings, self.record, self.side = n, settings, record, side
         self.period_us = int(round(settings.period * 1e6))
         # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
@@ -311,6 +312,7 @@ class _DriveLoop:
         sent = self.endpoint.publish(self.answer)
         if first:
             self.warm_up(t)
+            self.go_realtime()
         self.answered = utime
         record = self.record
         record.commands += 1
@@ -333,6 +335,17 @@ class _DriveLoop:
         scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
         self.out.Eval(scratch.get_context())
 
+    def go_realtime(self) -> None:
+        """After the first answer and the warm-up: the collector's start-up objects frozen, then
+        SCHED_FIFO (``process``) for the loop alone.  Not before: the build, the first answer and
+        the warm-up take hundreds of milliseconds of CPU, which at a real-time priority would
+        queue a running drive behind this one (a second drive started mid-run held the arm as
+        a silent controller that way, instead of being named as the second sender)."""
+        quiet_collector()
+        refused = request_realtime(self.settings.priority) if not self.in_memory else None
+        if refused:
+            self.warn(refused)
+
     def finished(self) -> bool:
         """Whether the last tick (t >= duration - 1.5 T) has been answered."""
         return self.quiet_end or (self.answered is not None and self.answered * 1e-6 >= self.end)
@@ -350,10 +363,6 @@ def run_drive(
     into ``record``; returns the URL used.  ``lcm``: a ``DrakeLcm`` to use instead of one of
     ``url`` (``in_memory``)."""
     loop = _DriveLoop(scenario, settings, record, url, warn, lcm)
-    quiet_collector()
-    refused = request_realtime(settings.priority) if lcm is None else None  # (memq: one process)
-    if refused:
-        warn(refused)
     while True:
         for t_recv, data in loop.wait():
             loop.take(t_recv, data)
