@@ -299,6 +299,9 @@ class _DriveLoop:
         t = utime / 1e6
         first = self.answered is None
         tau = self.torque(t, q, v, companion)
+        if first:  # before the hand-shake's answer: the hardware waits for it up to its start-up
+            self.warm_up(t)  # timeout, while a tick waits only its command timeout (0.25 s)
+            self.go_realtime()
         self.last_q, self.last_v = q, v
         self.answer = pack_command(utime, tau)
         if self.side is not None:
@@ -310,9 +313,6 @@ class _DriveLoop:
             )
             self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
         sent = self.endpoint.publish(self.answer)
-        if first:
-            self.warm_up(t)
-            self.go_realtime()
         self.answered = utime
         record = self.record
         record.commands += 1
@@ -325,22 +325,25 @@ class _DriveLoop:
         record.tau.append(tau)
 
     def warm_up(self, t: float) -> None:
-        """After answering the hand-shake: a throwaway run of the controller over a few periods
+        """Before answering the hand-shake: a throwaway run of the controller over a few periods
         from a copy of its context (the hand-shake's inputs), so that every compiled kernel the
         integration and the events call is loaded before the first tick, which must be answered
         within a period (measured: the first real-time ticks answered 1-2 ms late without it,
-        five in a row, a hold).  The hardware waits ``session.QUIET`` s after the hand-shake."""
+        five in a row, a hold).  The hardware waits for the hand-shake's answer up to its
+        start-up timeout; a later tick only its command timeout (lockstep, 0.25 s: a camera pick's
+        warm-up and collection took longer than that in a loaded CI run)."""
         scratch = new_simulator(self.simulator.get_system(), self.context.Clone(), self.config)
         scratch.Initialize()
         scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
         self.out.Eval(scratch.get_context())
 
     def go_realtime(self) -> None:
-        """After the first answer and the warm-up: the collector's start-up objects frozen, then
-        SCHED_FIFO (``process``) for the loop alone.  Not before: the build, the first answer and
-        the warm-up take hundreds of milliseconds of CPU, which at a real-time priority would
-        queue a running drive behind this one (a second drive started mid-run held the arm as
-        a silent controller that way, instead of being named as the second sender)."""
+        """After the hand-shake's command and the warm-up, before the answer goes out: the
+        collector's start-up objects frozen, then SCHED_FIFO (``process``) for the loop alone.
+        Not before: the build, the first command and the warm-up take hundreds of milliseconds of
+        CPU, which at a real-time priority would queue a running drive behind this one (a second
+        drive started mid-run held the arm as a silent controller that way, instead of being
+        named as the second sender)."""
         quiet_collector()
         refused = request_realtime(self.settings.priority) if not self.in_memory else None
         if refused:
