@@ -5,10 +5,12 @@ permits it (``request_realtime``), a garbage collector that leaves the start-up'
 A control loop at 1 kHz answers each status within a period; the hardware side holds the arm
 after ``LinkSettings.silent_periods`` ticks (5 ms at 1 kHz) without a command.  Under Linux's
 default scheduler a process that wakes on a busy machine may wait several milliseconds for a
-core (measured on the 2-core machine at load 3.6: 4 of 5 clean real-time runs had 5 ticks in a
-row without a command, each a spurious hold), so ``ptint drive`` and the real-time ``ptint
-hardware`` ask for ``SCHED_FIFO`` (``os.sched_setscheduler``), as a robot's control PC runs its
-loop.  That needs ``CAP_SYS_NICE`` (root, or an ``rtprio`` entry in
+core, so ``ptint drive`` and the real-time ``ptint hardware`` ask for ``SCHED_FIFO``
+(``os.sched_setscheduler``), as a robot's control PC runs its loop (measured on the 2-core
+virtual machine, curve_b075_tf15: with neither this nor the drive's warm-up, 4 of 5 clean
+real-time runs at load 3.6 held on 5 late ticks; with both, 0 of 10 at load 0.5 and 0 of 3 at
+load 3.9 — a sleep under SCHED_FIFO still overshoots by up to 8 ms there, when the host pauses
+the virtual CPU).  That needs ``CAP_SYS_NICE`` (root, or an ``rtprio`` entry in
 ``/etc/security/limits.conf``); without it the process keeps the default scheduler and says so
 in one warning.  Both loops sleep in ``select`` between messages, so a FIFO priority never spins
 a core; the kernel's real-time throttling (``sched_rt_runtime_us``) leaves the rest of the
@@ -63,8 +65,8 @@ def quiet_collector() -> None:
 @contextmanager
 def stop_on_signals(session):
     """While the block runs, SIGINT and SIGTERM ask ``session`` (a ``session.HardwareSession``) to
-    stop (``request_stop``): the arm
-    is held for ``hold_time`` and the run ends with its metrics written, as after any fault.  The
+    stop (``request_stop``): the arm is held for ``hold_time`` and the run ends with its metrics
+    written, as after any fault.  The
     first signal puts the previous handlers back, so a second one acts as it did before (Ctrl-C
     twice: ``KeyboardInterrupt``).  Outside the main thread (``in_memory``'s hardware thread)
     nothing is installed: Python delivers signals to the main thread only."""
