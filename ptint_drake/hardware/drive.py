@@ -330,8 +330,8 @@ class _DriveLoop:
         integration and the events call is loaded before the first tick, which must be answered
         within a period (measured: the first real-time ticks answered 1-2 ms late without it,
         five in a row, a hold).  The hardware waits for the hand-shake's answer up to its
-        start-up timeout; a later tick only its command timeout (lockstep, 0.25 s: a camera pick's
-        warm-up and collection took longer than that in a loaded CI run)."""
+        start-up timeout; a later tick only its command timeout (lockstep, 0.25 s: with a
+        camera's frames the warm-up and collection took longer than that in a loaded CI run)."""
         scratch = new_simulator(self.simulator.get_system(), self.context.Clone(), self.config)
         scratch.Initialize()
         scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
