@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from generated_files import write_or_check  # (scripts/ is on sys.path when a script runs)
 from ptint_drake.worlds.pick.grippers import FULL_SIZE
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
@@ -370,18 +371,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="compare instead of writing")
     args = parser.parse_args(argv)
-    status = 0
-    for arm in ARMS:
-        path = MODELS / f"{arm.name}.urdf"
-        text = urdf(arm)
-        if args.check:
-            if not path.is_file() or path.read_text() != text:
-                print(f"{path.name}: differs from scripts/arm_models.py")
-                status = 1
-        else:
-            path.write_text(text)
-            print(f"wrote {path}")
-    return status
+    files = {MODELS / f"{arm.name}.urdf": urdf(arm) for arm in ARMS}
+    return write_or_check(files, args.check, "scripts/arm_models.py")
 
 
 if __name__ == "__main__":

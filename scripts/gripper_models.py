@@ -20,6 +20,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from generated_files import write_or_check  # (scripts/ is on sys.path when a script runs)
 from ptint_drake.worlds.pick.grippers import FULL_SIZE, FullSizeGripper
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
@@ -88,17 +89,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="compare instead of writing")
     args = parser.parse_args(argv)
-    status = 0
-    for g in FULL_SIZE.values():
-        path, text = MODELS / f"{g.name}.sdf", sdf(g)
-        if args.check:
-            if not path.is_file() or path.read_text() != text:
-                print(f"{path.name}: differs from scripts/gripper_models.py")
-                status = 1
-        else:
-            path.write_text(text)
-            print(f"wrote {path}")
-    return status
+    files = {MODELS / f"{g.name}.sdf": sdf(g) for g in FULL_SIZE.values()}
+    return write_or_check(files, args.check, "scripts/gripper_models.py")
 
 
 if __name__ == "__main__":

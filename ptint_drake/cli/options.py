@@ -123,13 +123,18 @@ def count(flag: str) -> Callable[[str], int]:
     return parse
 
 
+def _converted(kind, text: str, flag: str, expected: str):
+    """``kind(text)``, or OptionError naming ``flag`` and what it ``expected``."""
+    try:
+        return kind(text)
+    except ValueError:
+        raise OptionError(f"{flag}: expected {expected}, got {text!r}") from None
+
+
 def seconds(flag: str, allow_zero: bool = False) -> Callable[[str], float]:
     """An argparse type: a finite time in s, > 0 (or >= 0 with ``allow_zero``)."""
     def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise OptionError(f"{flag}: expected a number of seconds, got {text!r}") from None
+        value = _converted(float, text, flag, "a number of seconds")
         if not (math.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
             raise OptionError(f"{flag}: must be {'>= 0' if allow_zero else '> 0'} and finite, got {text}")
         return value
@@ -139,10 +144,7 @@ def seconds(flag: str, allow_zero: bool = False) -> Callable[[str], float]:
 def fraction(flag: str, top_open: bool = True) -> Callable[[str], float]:
     """An argparse type: a number in [0, 1) (``top_open``) or (0, 1]."""
     def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise OptionError(f"{flag}: expected a number, got {text!r}") from None
+        value = _converted(float, text, flag, "a number")
         ok = 0.0 <= value < 1.0 if top_open else 0.0 < value <= 1.0
         if not ok:
             raise OptionError(f"{flag}: must be in {'[0, 1)' if top_open else '(0, 1]'}, got {text}")
@@ -153,10 +155,7 @@ def fraction(flag: str, top_open: bool = True) -> Callable[[str], float]:
 def integer_in(flag: str, low: int, high: int) -> Callable[[str], int]:
     """An argparse type: an integer in [``low``, ``high``] (e.g. ``--priority``, 0-99)."""
     def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise OptionError(f"{flag}: expected an integer {low}-{high}, got {text!r}") from None
+        value = _converted(int, text, flag, f"an integer {low}-{high}")
         if not low <= value <= high:
             raise OptionError(f"{flag}: must be in {low}-{high}, got {text}")
         return value

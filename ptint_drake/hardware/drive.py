@@ -154,7 +154,6 @@ class _DriveLoop:
             self.depth_in = diagram.GetInputPort("depth_image") if ports.camera else None
             self.grasp_out = diagram.GetOutputPort("grasp_state")
             self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout)
-            self.checks = side.reads
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
         if risk:
@@ -234,7 +233,7 @@ class _DriveLoop:
         """At a grasp read of the plan (its checks, and from a close command on every
         ``SENSE_PERIOD``): ``DriveFault`` when the world's rule would plan anew there (the controller
         side's ``stands``) — a retry or abort is not supported across processes."""
-        if utime not in self.checks:
+        if utime not in self.side.reads:  # (no read here: the observer is not evaluated)
             return
         state = int(self.grasp_out.Eval(self.context)[0])
         if self.side.stands(utime, state):  # the world's own rule (``World.controller_side``)

@@ -139,6 +139,13 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
     return world_of(scenario).robust_row(seed, params, result.metrics)
 
 
+def segment_rows(rows: list) -> list:
+    """The finished samples of a world whose rows are segment rows (``World.robust_row``'s
+    default: e(tf) of every segment; a pick's rows keep its picks instead and have no
+    ``torque_peak`` key), which the summary's percentiles and the histogram read."""
+    return [r for r in rows if r.get("e_tf_max") is not None and "torque_peak" in r]
+
+
 def _percentiles(values) -> dict:
     values = np.asarray(values, dtype=float)
     if len(values) == 0:
@@ -163,9 +170,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                      workers=workers or (None if executor or dask else 1), dask=dask,
                      executor=executor, progress=report, stats=stats, folders=loaded.folders)
     wall = time.perf_counter() - t0
-    # the rows of a world whose samples keep the segment row (``World.robust_row``'s default; a
-    # pick's rows keep its picks instead and have no torque_peak key)
-    finished = [r for r in rows if r.get("e_tf_max") is not None and "torque_peak" in r]
+    finished = segment_rows(rows)
     torqued = [r for r in finished if r.get("torque_peak") is not None]  # a world that logs torques
     failed_first = sorted(rows, key=lambda r: (r["ok"], -(r.get("e_tf_max") or np.inf)))
     worst = failed_first[0]
@@ -205,7 +210,7 @@ def histogram(result: dict, out_dir: Path) -> None:
 
     if "pick_success_rate" in result:
         return _pick_histogram(result, out_dir)
-    rows = [r for r in result["rows"] if r.get("e_tf_max") is not None and "torque_peak" in r]
+    rows = segment_rows(result["rows"])
     n, n_ok = result["samples"], sum(1 for r in result["rows"] if r["ok"])
     n_failed = n - len(rows)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")

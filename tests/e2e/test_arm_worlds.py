@@ -77,17 +77,14 @@ def test_the_long_sequence_has_twenty_picks_in_sixty_seconds_over_120_degrees(ar
     """scripts/posture_sequence.py's scenario (issue 45's 60 s sequence) passes the pick world's checks
     before a run (reach, belt clearance) and is what the issue asks: ≥ 20 picks, ≤ 60 s, the parts
     taken at base azimuths ≥ 120° apart.  (The 60 s runs themselves are the script's, not a test's.)"""
-    import importlib.util
     import math
-    from pathlib import Path
+
+    from script_module import load_script
 
     from ptint_drake.scenario import parse_scenario
     from ptint_drake.simulation import build
 
-    path = Path(__file__).resolve().parents[2] / "scripts" / "posture_sequence.py"
-    spec = importlib.util.spec_from_file_location("posture_sequence", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script("posture_sequence")
     scenario = parse_scenario(module.scenario(arm), f"sequence_{arm}")
     assert len(scenario.pick.tasks) >= 20 and scenario.duration <= 60.0
     azimuths = [math.degrees(math.atan2(b.center[1], b.center[0])) for b in scenario.pick.belts]

@@ -1,18 +1,16 @@
 """Issue 45: docs/own_arm.md's per-arm block is scripts/arm_table.py's, and its check can fail."""
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
+
+from script_module import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location("arm_table", ROOT / "scripts" / "arm_table.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("arm_table")
 
 
 def test_the_page_block_is_current():

@@ -7,7 +7,6 @@ releases (Drake 1.58's MultibodyPlant has `surface_speeds` and `surface_displace
 1.51's lacks), so of those only the connected ports count.
 """
 
-import importlib.util
 import re
 import shutil
 from pathlib import Path
@@ -15,12 +14,11 @@ from pathlib import Path
 import pytest
 
 from ptint_drake.report.run_outputs import write_diagram
+from script_module import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 DIAGRAMS = ROOT / "diagrams"
-_spec = importlib.util.spec_from_file_location("export_diagrams", ROOT / "scripts" / "export_diagrams.py")
-export = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(export)
+export = load_script("export_diagrams")
 
 _NODE = re.compile(r"^(s\d+) \[shape=none.*?<B>(.*?)</B><BR/>\s*name=(.*?)\n(.*?)^>\];", re.S | re.M)
 _PORT = re.compile(r'<TD PORT="([uy]\d+)"[^>]*>(.*?)</TD>', re.S)

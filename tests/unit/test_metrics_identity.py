@@ -1,16 +1,14 @@
 """scripts/metrics_identity.py: the comparison of two metrics.json trees, and a bad argument."""
 
-import importlib.util
 import math
 import subprocess
 import sys
 from pathlib import Path
 
+from script_module import load_script
+
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "metrics_identity.py"
-_spec = importlib.util.spec_from_file_location("metrics_identity", SCRIPT)
-identity = importlib.util.module_from_spec(_spec)
-sys.modules["metrics_identity"] = identity  # its dataclasses look their module up there
-_spec.loader.exec_module(identity)
+identity = load_script("metrics_identity")  # (registered in sys.modules: its dataclasses look it up)
 
 
 def metrics(**sim):

@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
+
+from script_module import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _size_check():
-    spec = importlib.util.spec_from_file_location("size_check", ROOT / "scripts" / "size_check.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("size_check")
 
 
 def test_the_package_is_within_its_limits():
