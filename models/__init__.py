@@ -1,2 +1,2 @@
 """The bundled robot and gripper models (URDF/SDFormat) and their documented assumptions
-(``README.md`` beside them); ``ptint_drake.rvm1.bundled_models`` lists the arms."""
+(``README.md`` beside them); ``ptint_drake.robot.rvm1.bundled_models`` lists the arms."""

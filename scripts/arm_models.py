@@ -20,9 +20,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
 from generated_files import write_or_check  # (scripts/ is on sys.path when a script runs)
-from ptint_drake.worlds.pick.grippers import FULL_SIZE
+
+from ptint_drake.systems.hand.datasheets import FULL_SIZE
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 PI = math.pi

@@ -40,7 +40,7 @@ K_SOURCE = {"curve_iiwa14": "`ptint tune curve_iiwa14`",
 
 def gains_table() -> str:
     """Per arm and world: K, Λ, k, the null-space damping, rot_scale and the gripper (scenario files)."""
-    from ptint_drake.scenario import load_scenario  # noqa: PLC0415  (pydrake: only when needed)
+    from ptint_drake.simulation.scenario import load_scenario  # noqa: PLC0415  (pydrake: only when needed)
 
     rows = ["| scenario | K | K from | Λ, k | null-space D | task (rot_scale) | end effector / gripper |",
             "|---|---|---|---|---|---|---|"]

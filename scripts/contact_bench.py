@@ -19,7 +19,7 @@ from importlib.metadata import version
 from pydrake.multibody.plant import MultibodyPlantConfig
 
 from ptint_drake.worlds.pick.config import (BeltConfig, GripperConfig, PartConfig, PickWorldConfig,
-                                     contact_approximations)
+                                            contact_approximations)
 from ptint_drake.worlds.pick.holding import measure_hold
 
 CANDIDATES = ("sap", "tamsi", "lagged", "similar")

@@ -63,7 +63,7 @@ STAMP = re.compile(r"measured \d{4}-\d\d-\d\d on [^,]+, Python [\d.]+, Drake [\d
 
 def paper_hold_overrides(name: str) -> str:
     """The YAML override of the paper's own hold after tf (``k_hold = k``) for scenario ``name``."""
-    from ptint_drake.scenario import load_scenario  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import load_scenario  # noqa: PLC0415
 
     return f"controller: {{k_hold: {load_scenario(name).controller.k!r}}}"
 
@@ -289,7 +289,7 @@ def compare(result: dict, controllers: Optional[tuple], when: str) -> str:
 
 def run_compare_study(block: str, workers: int = 2) -> dict:
     """The comparison of ``COMPARES[block]`` run now (compare.json's content, without curves)."""
-    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
     from ptint_drake.studies.compare import DEFAULT_CONTROLLERS, run_compare  # noqa: PLC0415
 
     name, controllers, folders = COMPARES[block]
@@ -313,7 +313,7 @@ def store_tune(workers: int = 2) -> None:
     result's gains, per-variant e(tf), runs and wall time, with the stamp."""
     import tempfile  # noqa: PLC0415
 
-    from ptint_drake.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import LoadedScenario, scenario_text  # noqa: PLC0415
     from ptint_drake.studies.tune import TuneSettings, run_tune  # noqa: PLC0415
 
     sys.path.insert(0, str(ROOT / "tests"))
@@ -502,8 +502,8 @@ def differences(old: str, new: str) -> list[str]:
 
 def run_metrics(name: str, overrides: str) -> dict:
     """A run's metrics (the script's own runs: one simulation each)."""
-    from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
 
     _, text = scenario_text(name)
     return simulate(parse_with_overrides(text, overrides or "{}", name)).metrics

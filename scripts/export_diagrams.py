@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 from ptint_drake.report.run_outputs import write_diagram
-from ptint_drake.scenario import load_scenario, parse_with_overrides, scenario_text
+from ptint_drake.simulation.scenario import load_scenario, parse_with_overrides, scenario_text
 
 DIAGRAM_SCENARIOS = ("curve_b075_tf15", "assembly")
 OUT = Path(__file__).resolve().parent.parent / "diagrams"

@@ -1,6 +1,6 @@
 """Writes the real-size gripper models of issue 45 (models/schunk_wsg_50_110_full.sdf,
 models/robotiq_2f_85_full.sdf, models/panda_hand.sdf) from the table in
-``ptint_drake.worlds.pick.grippers.FULL_SIZE`` (every number cited in models/README.md, section
+``ptint_drake.systems.hand.datasheets.FULL_SIZE`` (every number cited in models/README.md, section
 "Real-size grippers").
 
 They follow ``rvm1_gripper.sdf``'s conventions (frame ``fingertip_center``, z = approach, x = across
@@ -21,7 +21,8 @@ import sys
 from pathlib import Path
 
 from generated_files import write_or_check  # (scripts/ is on sys.path when a script runs)
-from ptint_drake.worlds.pick.grippers import FULL_SIZE, FullSizeGripper
+
+from ptint_drake.systems.hand.datasheets import FULL_SIZE, FullSizeGripper
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 FINGER_MASS = 0.02  # kg each: this project's fingers (as rvm1_gripper's; models/README.md)
@@ -69,7 +70,7 @@ def sdf(g: FullSizeGripper) -> str:
     ixx, iyy, izz = (m * (ly ** 2 + h ** 2) / 12, m * (lx ** 2 + h ** 2) / 12, m * (lx ** 2 + ly ** 2) / 12)
     housing = f"{lx:g} {ly:g} {h:g}"
     return (f'<?xml version="1.0"?>\n<!--\n  {g.title}, at its real size (issue 45), written by\n'
-            "  scripts/gripper_models.py from ptint_drake.worlds.pick.grippers.FULL_SIZE; every number's\n"
+            "  scripts/gripper_models.py from ptint_drake.systems.hand.datasheets.FULL_SIZE; every number's\n"
             '  source is in models/README.md, section "Real-size grippers".  Model frame = the gripper\'s\n'
             f"  flange; fingertip_center {g.tip_depth:g} m beyond it, turned {g.yaw_deg:g} deg about the\n"
             "  approach.\n"

@@ -74,7 +74,7 @@ if problem is None:  # two processes in a private namespace: hardware first, the
 else:  # the same two sides as two threads over memq://
     from ptint_drake.hardware.session import LinkSettings
     from ptint_drake.hardware.in_memory import run_pair
-    from ptint_drake.scenario import parse_with_overrides, scenario_text
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 
     scenario = parse_with_overrides(scenario_text(SCENARIO)[1], SETS, SCENARIO)
     metrics, drive = run_pair(scenario, LinkSettings(period=0.001, duration=1.0), out / "hw")

@@ -22,8 +22,8 @@ from nbclient import NotebookClient
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 sys.path.insert(0, str(ROOT / "tests"))
-from notebook_kernel import kernel_env, kernel_name  # noqa: E402
 from hardware_notebook import hardware  # noqa: E402
+from notebook_kernel import kernel_env, kernel_name  # noqa: E402
 from task_notebooks import pick_and_place, pose  # noqa: E402
 
 SETUP = """\
@@ -89,9 +89,9 @@ print("joints:", plant.num_positions(), " hand at", np.round(x0, 3), "m")""",
     "generator, the target, the task-space kinematics, the sliding surface and the controller, "
     "wires them to the plant and returns their handles.",
     """\
-from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget
+from ptint_drake.controllers.ptsmc.builder import AddPrescribedTimeInterceptor, ControllerGains
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import LinearTarget
 
 tf = 1.0
 target = LinearTarget(start=x0 + [0.06, -0.08, -0.05], velocity=[0.0, 0.1, 0.0])
@@ -169,11 +169,11 @@ CAMERA = [
     "`AddPrescribedTimeInterceptor(..., targets=None)` leaves an input port for the estimate.",
     """\
 from pydrake.all import LogVectorOutput, Simulator
-from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
-from ptint_drake.systems.camera import MeasurementConfig
-from ptint_drake.systems.kalman import AddCameraEstimators
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget, TargetSource
+from ptint_drake.controllers.ptsmc.builder import AddPrescribedTimeInterceptor, ControllerGains
+from ptint_drake.systems.perception.camera import MeasurementConfig
+from ptint_drake.systems.estimation.kalman import AddCameraEstimators
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import LinearTarget, TargetSource
 
 tf = 1.0
 
@@ -241,7 +241,7 @@ for latency, compensate, e_tf, hold in rows:
     "and what the approach aims at against the simulated part.",
     """\
 import matplotlib.pyplot as plt
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, project
 from ptint_drake.worlds.pick.run import build_pick
 
@@ -278,7 +278,7 @@ WHICH_CONTROLLER = [
     "lines add the ×0.7 and ×1.5 mass variants).",
     SETUP,
     """\
-from ptint_drake.scenario import LoadedScenario
+from ptint_drake.simulation.scenario import LoadedScenario
 from ptint_drake.studies.compare import run_compare, table_rows
 
 # a bundled name or a YAML file, with --set-style overrides: here the hold after tf shortened

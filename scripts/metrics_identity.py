@@ -12,9 +12,9 @@ Each scenario runs with that tree's own command line, ``python -m ptint_drake ru
 metrics.json matters), on the Python running this script, with the tree first on ``sys.path``
 and setuptools' editable-install finder removed, so an editable install of another checkout
 cannot shadow it (each child checks that ``ptint_drake`` was imported from its tree).  Before its
-scenarios, each tree compiles its numba kernels once (``python -m ptint_drake.systems.warm_up``
-when the tree has that module; ``--no-warm-up`` to skip), so the runs' wall times are comparable
-and two runs do not compile the same kernels at once.
+scenarios, each tree compiles its numba kernels once with its own warm-up module (``python -m
+ptint_drake.cli.warm_up``, or ``ptint_drake.warm_up`` in older trees; ``--no-warm-up`` to skip),
+so the runs' wall times are comparable and two runs do not compile the same kernels at once.
 
 ``--scenarios``: default every bundled scenario of either side (``ptint_drake/scenarios/*.yaml``);
 a scenario bundled on one side only is reported (``only_in``) and counts as a difference; a name
@@ -425,10 +425,12 @@ def _sigterm(signum, frame):
 
 
 def warm_up(runner: Runner, side: Side, log: Callable[[str], None]) -> None:
-    """Compile the tree's numba kernels (``ptint_drake.systems.warm_up``, when it has one)."""
-    if (side.tree / "ptint_drake" / "systems" / "warm_up.py").is_file():
-        code, tail, side.warm_up_s = runner.run(side.tree, [], "ptint_drake.systems.warm_up")
-        log(f"{side.label}: warm-up {side.warm_up_s:.1f} s (exit code {code})")
+    """Compile the tree's numba kernels with its own warm-up module (where the tree has one)."""
+    for module in ("cli.warm_up", "warm_up", "systems.warm_up"):
+        if (side.tree / "ptint_drake" / f"{module.replace('.', '/')}.py").is_file():
+            code, tail, side.warm_up_s = runner.run(side.tree, [], f"ptint_drake.{module}")
+            log(f"{side.label}: warm-up {side.warm_up_s:.1f} s (exit code {code})")
+            return
 
 
 def identity(args: argparse.Namespace, log: Callable[[str], None]) -> dict:

@@ -22,9 +22,9 @@ import time
 GROUPS = {
     "controller": ("ptint_drake/systems/", "ptint_drake/controllers/"),
     "pick systems": ("ptint_drake/pick/targets.py", "ptint_drake/pick/part_pose.py",
-                     "ptint_drake/pick/probe.py", "ptint_drake/systems/gripper.py"),
+                     "ptint_drake/pick/probe.py", "ptint_drake/systems/hand/gripper.py"),
     "post-processing": ("ptint_drake/pick/metrics.py", "ptint_drake/pick/run.py:pick_series",
-                        "ptint_drake/metrics.py"),
+                        "ptint_drake/verdict/metrics.py"),
 }
 
 
@@ -55,8 +55,8 @@ def main() -> None:
     parser.add_argument("scenario", nargs="?", default="assembly_pick_place")
     parser.add_argument("--profile", action="store_true")
     args = parser.parse_args()
-    from ptint_drake.scenario import load_scenario  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import load_scenario  # noqa: PLC0415
 
     scenario = load_scenario(args.scenario)
     t0 = time.perf_counter()

@@ -29,10 +29,10 @@ def still(path: Path) -> None:
     """The assembly's world at its second pick's prescribed grasp time, as a PNG."""
     import numpy as np  # noqa: PLC0415
 
-    from ptint_drake.worlds.pick.views import draw_pick_floor, replay_world  # noqa: PLC0415
-    from ptint_drake.replay import CAMERA, with_camera  # noqa: PLC0415
-    from ptint_drake.scenario import load_scenario  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import load_scenario  # noqa: PLC0415
+    from ptint_drake.views.replay import CAMERA, with_camera  # noqa: PLC0415
+    from ptint_drake.worlds.pick.views import draw_pick_floor, replay_world  # noqa: PLC0415
 
     scenario = load_scenario("assembly_pick_place")
     result = simulate(scenario)

@@ -122,7 +122,7 @@ def limit_margin(arm: str, q: np.ndarray) -> np.ndarray:
     from pydrake.multibody.parsing import Parser  # noqa: PLC0415
     from pydrake.multibody.plant import MultibodyPlant  # noqa: PLC0415
 
-    from ptint_drake.rvm1 import model_path  # noqa: PLC0415
+    from ptint_drake.robot.rvm1 import model_path  # noqa: PLC0415
 
     plant = MultibodyPlant(0.0)
     Parser(plant).AddModels(str(model_path(arm)))

@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 from ptint_drake.config.yaml_io import drake_version
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.interception.camera_frames import build_rgbd_view
 
 

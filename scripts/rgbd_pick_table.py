@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.scenario import load_scenario, parse_with_overrides, scenario_text
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import load_scenario, parse_with_overrides, scenario_text
 
 FIELDS = ("place_error_mm", "place_error_deg", "estimate_error_mm", "estimate_error_deg")
 

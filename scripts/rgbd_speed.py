@@ -23,8 +23,8 @@ def main() -> None:
     parser.add_argument("scenario", nargs="?", default="assembly_pick_place_rgbd")
     args = parser.parse_args()
     from ptint_drake.config.yaml_io import drake_version  # noqa: PLC0415
-    from ptint_drake.scenario import load_scenario  # noqa: PLC0415
     from ptint_drake.simulation import simulate  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import load_scenario  # noqa: PLC0415
 
     scenario = load_scenario(args.scenario)
     before, start = resource.getrusage(resource.RUSAGE_SELF), time.perf_counter()

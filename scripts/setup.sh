@@ -186,7 +186,7 @@ fi
 # check the installed package (from outside the source tree) finds its bundled model
 venv_abs=$(cd "$VENV" && pwd)
 step_begin "check" "the installed package finds its bundled model"
-(cd / && "$venv_abs/bin/python" -c "import ptint_drake.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
+(cd / && "$venv_abs/bin/python" -c "import ptint_drake.robot.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
 step_end
 # Compile the controller's numba kernels once (into numba's cache), so the first `ptint run`
 # does not pay for it; the warm-up prints a line per run it compiles.  A cold cache took 58 s,
@@ -194,7 +194,7 @@ step_end
 # Python 3.13, Drake 1.58) and 135 s / 182 s in CI (2026-12-03, the two Drake ends, .ci/run):
 # 1-3 minutes; a warm cache a few seconds.
 step_begin "compile" "the controller's numba kernels, once (1-3 min when numba's cache is cold, seconds when warm)"
-(cd / && "$venv_abs/bin/python" -m ptint_drake.warm_up)
+(cd / && "$venv_abs/bin/python" -m ptint_drake.cli.warm_up)
 step_end
 info=$("$venv_abs/bin/python" -c 'import sys, importlib.metadata as m
 print("Python %s, Drake %s" % (sys.version.split()[0], m.version("drake")))')

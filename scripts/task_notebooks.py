@@ -21,7 +21,7 @@ def pose(setup: str) -> list:
         "weighs like 10 cm) weights orientation against position where J⁺ is not an inverse and in "
         "the boundary layer. The same TBG, surface and τ = −K J⁺ s_x; still model-free.",
         """\
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.simulation import simulate
 
 scenario = load_scenario("curve_pose")  # a bundled name or a YAML file
@@ -71,7 +71,7 @@ def pick_and_place(setup: str) -> list:
         "pose as it rides the belt, not the belt's formula, so a belt that runs fast is a real "
         "disturbance; the payload is unknown to the controller.",
         """\
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.simulation import simulate
 
 result = simulate(load_scenario("conveyor_pick_place"))  # 5 s simulated

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from ptint_drake.scenario import load_scenario, parse_with_overrides, scenario_text
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import load_scenario, parse_with_overrides, scenario_text
 
 CURVES = ["curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12",
           "curve_b075_tf19"]

@@ -159,7 +159,7 @@ def _default(cls, name: str):
 def schema_fields(cls=None, prefix: str = "") -> list:
     """Every field of the scenario schema, depth first: (path, type, default, comment).  A list of
     mappings is written ``interceptions[]``; Drake's ``SimulatorConfig`` through its ``__fields__``."""
-    from ptint_drake.scenario import Scenario
+    from ptint_drake.simulation.scenario import Scenario
 
     cls = Scenario if cls is None else cls
     rows = []

@@ -32,7 +32,7 @@ from ptint_drake.cli.hardware import add_hardware_parsers
 from ptint_drake.cli.runs import cmd_diagram, cmd_list, cmd_paper, cmd_run
 from ptint_drake.cli.studies import cmd_bench, cmd_compare, cmd_robust, cmd_study, cmd_sweep, cmd_tune
 from ptint_drake.controllers import CONTROLLERS, describe
-from ptint_drake.scenario import ScenarioError
+from ptint_drake.simulation.scenario import ScenarioError
 
 SET_HELP = ("override a scenario field (repeatable); KEY is a path with dots and list "
             "indices, VALUE is YAML, e.g. controller.K=40 or 'interceptions[0].tf=1.2' "

@@ -256,7 +256,7 @@ def cmd_drive(args: argparse.Namespace) -> int:
         run_drive,
     )
     from ptint_drake.hardware.sim_hardware import check_link_scenario, link_period  # noqa: PLC0415
-    from ptint_drake.outputs import save_series, staged_output, write_json_atomic  # noqa: PLC0415
+    from ptint_drake.outputs.folder import save_series, staged_output, write_json_atomic  # noqa: PLC0415
 
     loaded, out = scenario_and_out(args, prefix="drive_")
     scenario = loaded.scenario

@@ -17,7 +17,7 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
-from ptint_drake.scenario import ScenarioError
+from ptint_drake.simulation.scenario import ScenarioError
 
 
 class OptionError(Exception):
@@ -249,7 +249,7 @@ def saturation_fraction(text: str) -> float:
 @_option
 def scenario_source(text: str) -> str:
     """A scenario argument checked when parsed (``bench``'s list): a bundled name or a file."""
-    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import scenario_text  # noqa: PLC0415
 
     scenario_text(text)  # ScenarioError: "scenario: 'x' is neither a bundled scenario ... nor a file"
     return text
@@ -311,7 +311,7 @@ def scenario_and_out(args: argparse.Namespace, prefix: str = "", name_or_file: s
     """(``LoadedScenario``, output folder) of a command: the scenario argument (or
     ``name_or_file``) with its ``--set`` overrides, parsed once, and ``--out`` or
     out/PREFIXNAME.  An ``--out`` that is a file fails before the scenario is read."""
-    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import LoadedScenario  # noqa: PLC0415
 
     out_folder(args.out, Path("out"))
     loaded = LoadedScenario.load(name_or_file or args.scenario, args.set)

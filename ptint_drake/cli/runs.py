@@ -8,8 +8,8 @@ import sys
 from pathlib import Path
 
 from ptint_drake.cli.options import out_folder, scenario_and_out
+from ptint_drake.simulation.scenario import LoadedScenario, bundled_scenarios, scenario_summary, scenario_text
 from ptint_drake.worlds.registry import world_of
-from ptint_drake.scenario import LoadedScenario, bundled_scenarios, scenario_summary, scenario_text
 
 
 def progress(label: str):
@@ -60,7 +60,7 @@ def _mm_deg(seg: dict, distance: str, angle: str) -> str:
 
 
 def _segment_line(name: str, i: int, seg: dict, criteria) -> str:
-    from ptint_drake.metrics import segment_reasons  # noqa: PLC0415
+    from ptint_drake.verdict.metrics import segment_reasons  # noqa: PLC0415
 
     reasons = segment_reasons(seg, criteria)
     return (f"{name} segment {i}: e0 = {_mm_deg(seg, 'e0_norm', 'e_rot0_deg')}, "

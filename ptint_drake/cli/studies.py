@@ -46,7 +46,7 @@ def _dask_errors(call):
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     """The β × tf grid: sweep.csv and heat maps."""
-    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+    from ptint_drake.outputs.folder import staged_output  # noqa: PLC0415
     from ptint_drake.studies import sweep  # noqa: PLC0415
 
     loaded, out = scenario_and_out(args, "sweep_")
@@ -85,7 +85,7 @@ def cmd_robust(args: argparse.Namespace) -> int:
 def cmd_compare(args: argparse.Namespace) -> int:
     """Every controller × plant variant: compare.json/.csv/.md/.png and the table on stdout."""
     from ptint_drake.controllers import check_controller  # noqa: PLC0415
-    from ptint_drake.scenario import check_variants  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import check_variants  # noqa: PLC0415
     from ptint_drake.studies import compare  # noqa: PLC0415
 
     loaded, out = scenario_and_out(args, "compare_")

@@ -39,11 +39,11 @@ class ControllerGains:
     # Issue 45, the null-space posture task: the rest posture q_rest that replaces q_start above
     # (degrees, one per joint; empty = the start posture), and a joint-limit term: within this many
     # degrees of a joint's position limit (the model's kinematic limits) the reference is pushed
-    # back from the limit, ``systems.controller.LIMIT_WEIGHT`` times harder per radian than toward
+    # back from the limit, ``controllers.ptsmc.law.LIMIT_WEIGHT`` times harder per radian than toward
     # q_rest (0 = off).  Both act through D, in the null space only.
     null_space_posture_deg: List[float] = field(default_factory=list)
     null_space_limit_margin_deg: float = 0.0
-    # Issue 19: which error the surface drives to zero (``systems.task``): ``position`` (the
+    # Issue 19: which error the surface drives to zero (``systems.task.error``): ``position`` (the
     # paper's), ``pose`` (position and orientation, ≥ 6 joints) or ``top_down`` (position, approach
     # axis down, yaw matched to the object's modulo 180°, ≥ 5 joints); and how a radian of
     # orientation error weighs against a metre of position error.

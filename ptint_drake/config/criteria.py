@@ -3,6 +3,7 @@ compares against.  (No postponed annotations: Drake's ``yaml_load_typed`` reads 
 
 from dataclasses import dataclass
 
+
 @dataclass
 class Criteria:
     """Pass criteria of a scenario (defaults: the paper's property as this project states it)."""

@@ -1,5 +1,6 @@
 """How the target is observed (the scenario's ``measurement`` block); the camera and the
-estimators that read it live in ``systems.camera``, ``systems.kalman`` and ``systems.imm``.
+estimators that read it live in ``systems.perception.camera``, ``systems.estimation.kalman``
+and ``systems.estimation.imm``.
 (No postponed annotations: Drake's ``yaml_load_typed`` reads the types.)"""
 
 from dataclasses import dataclass, field

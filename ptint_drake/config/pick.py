@@ -12,6 +12,7 @@ task becomes six prescribed-time segments (``worlds.pick.tasks`` has the plan).
 from dataclasses import dataclass, field
 from typing import List, Union
 
+
 @dataclass
 class GripperConfig:
     """A parallel two-finger gripper welded at the arm's end-effector frame (defaults: the
@@ -147,7 +148,7 @@ class PickConfig:
     parts: List[PartConfig] = field(default_factory=list)
     tray: TrayConfig = field(default_factory=TrayConfig)
     tasks: List[PickTaskConfig] = field(default_factory=list)
-    # the confirmed grasp (``systems.gripper.GraspObserver``, docs/pick_place.md "Grasp states"):
+    # the confirmed grasp (``systems.hand.gripper.GraspObserver``, docs/pick_place.md "Grasp states"):
     retries: int = 1  # new approach + descend after an empty grasp or a timeout (0: none)
     grasp_window: float = 0.3  # s after the prescribed grasp time: the latest the lift waits for ``holding``
     width_tolerance: float = 0.003  # m, ``holding``: the opening within the part's width ± this

@@ -1,12 +1,13 @@
 """The scenario schema (docs/scenarios.md): plain dataclasses that Drake's ``yaml_load_typed``
 fills from a scenario's YAML mapping, unknown keys rejected.  Nothing here loads, checks or
-runs anything: loading and validation are ``ptint_drake.scenario`` and ``ptint_drake.validation``,
+runs anything: loading and validation are ``ptint_drake.simulation.scenario`` and
+``ptint_drake.simulation.validation``,
 the worlds that run a scenario are ``ptint_drake.worlds``.  ``simulator`` is Drake's own
 ``SimulatorConfig``, ``multibody`` Drake's ``MultibodyPlantConfig``.
 
 Defaults are the paper's: gains K = 50, Λ = 5, k = 3, ϵ = δ = 1e-6 (section 3.1), the RV-M1
 start pose θ = (22.5°, 45°, 30°).  Choices the paper leaves open are listed in
-``ptint_drake.scenario``'s docstring.  (No postponed annotations: ``yaml_load_typed`` reads
+``ptint_drake.simulation.scenario``'s docstring.  (No postponed annotations: ``yaml_load_typed`` reads
 the field types.)
 """
 

@@ -11,7 +11,7 @@
 
 with input ports ``state`` (the arm's [q; v]) and ``target`` ([x_r, ẋ_r, ẍ_r] of the active
 segment, ``signals.TARGET``, 9 values), optionally an input ``segment`` ([index, start, tf] of
-the active segment, ``systems.active_segment``) and an input ``target_rotation`` ([R_r row-major,
+the active segment, ``systems.task.active_segment``) and an input ``target_rotation`` ([R_r row-major,
 ω_r, ω̇_r], 15 values: the object's orientation, or with a camera the rotation estimator's
 estimate of it, as the paper's controller gets it), and an output ``actuation`` (one torque per
 actuator of the arm, in the plant's actuator order).  ``plant`` is for the plugin's
@@ -38,10 +38,10 @@ from typing import Sequence
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.controllers.slot import ControllerHandles, ControllerSlot, TargetView, target_columns
-from ptint_drake.robot import nominal_plant
-from ptint_drake.systems.active_segment import SIZE as SEGMENT_SIZE
-from ptint_drake.systems.active_segment import ActiveSegment
-from ptint_drake.systems.signals import TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
+from ptint_drake.robot.plant import nominal_plant
+from ptint_drake.systems.task.active_segment import SIZE as SEGMENT_SIZE
+from ptint_drake.systems.task.active_segment import ActiveSegment
+from ptint_drake.systems.task.signals import TARGET_PORT_SIZE, TARGET_ROTATION_SIZE
 
 PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*$")
 FORM = "'module:Class' (a LeafSystem in your own file)"

@@ -24,7 +24,6 @@ least ``tau``), lines for the run's output, and whether the controller used the 
 from __future__ import annotations
 
 import dataclasses
-
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Callable, Optional
 
@@ -33,14 +32,14 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Frame
 from pydrake.systems.framework import DiagramBuilder, InputPort, OutputPort
 
-from ptint_drake.robot import nominal_plant
-from ptint_drake.systems.kalman import AddCameraEstimators, CameraEstimators
+from ptint_drake.robot.plant import nominal_plant
+from ptint_drake.systems.estimation.kalman import AddCameraEstimators, CameraEstimators
+from ptint_drake.systems.estimation.rotation_estimator import AddRotationEstimators
 from ptint_drake.systems.perception.part_pose_estimator import FIT_NOISE_STD, AddRgbdPerception
-from ptint_drake.systems.orientation import has_orientation
-from ptint_drake.systems.rotation_estimator import AddRotationEstimators
-from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.signals import TARGET
-from ptint_drake.systems.targets import TargetSource
+from ptint_drake.systems.task.orientation import has_orientation
+from ptint_drake.systems.task.schedule import Schedule
+from ptint_drake.systems.task.signals import TARGET
+from ptint_drake.systems.task.targets import TargetSource
 
 if TYPE_CHECKING:
     from ptint_drake.config.schema import Scenario

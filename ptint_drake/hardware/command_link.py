@@ -28,13 +28,13 @@ from __future__ import annotations
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
-from pydrake.systems.sensors import ImageDepth32F
 from pydrake.systems.primitives import Multiplexer
+from pydrake.systems.sensors import ImageDepth32F
 
 from ptint_drake.hardware.camera_link import frame_due
 from ptint_drake.hardware.link import PART_SIZE, utime_of
 from ptint_drake.hardware.session import ACTIVE, LinkFault
-from ptint_drake.robot import actuator_effort_limits
+from ptint_drake.robot.plant import actuator_effort_limits
 
 HOLD_OMEGA = 40.0  # rad/s: the hold's natural frequency (critically damped); settles in ~0.15 s
 

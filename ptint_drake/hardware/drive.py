@@ -41,26 +41,17 @@ from pydrake.systems.primitives import PassThrough
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, TargetView
-from ptint_drake.hardware.link import (
-    COMMAND_CHANNEL,
-    STATUS_CHANNEL,
-    WSG_COMMAND_CHANNEL,
-    Endpoint,
-    pack_command,
-    pack_wsg_command,
-    unpack_status,
-    url_warning,
-)
 from ptint_drake.hardware.camera_link import with_receive_buffer
 from ptint_drake.hardware.companions import CompanionFault, CompanionInbox, companion_channels
 from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
+from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL, Endpoint,
+                                       pack_command, pack_wsg_command, unpack_status, url_warning)
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.hardware.sim_hardware import link_period
-from ptint_drake.robot import actuator_effort_limits, nominal_plant
-from ptint_drake.systems.gripper import GRASP_STATES
+from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
+from ptint_drake.systems.hand.gripper import GRASP_STATES
 from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.registry import objects_of, schedule_of, world_of
-
 
 # s: after integrating σ to a status's time t, a step this short takes the controller's events at t
 # (a segment's start stores s(t0)) with that status's state, as the one-process run's do

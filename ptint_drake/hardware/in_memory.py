@@ -17,8 +17,8 @@ from pathlib import Path
 from pydrake.lcm import DrakeLcm
 
 from ptint_drake.config.schema import Scenario
-from ptint_drake.hardware.session import LinkSettings
 from ptint_drake.hardware.drive import DriveRecord, DriveSettings, drive_summary, run_drive
+from ptint_drake.hardware.session import LinkSettings
 from ptint_drake.hardware.sim_hardware import run_hardware
 
 SWITCH_INTERVAL = 1e-4  # s: the interpreter's thread switch interval while both sides run

@@ -19,7 +19,7 @@ of its objects' motion:
 - ``lcmt_schunk_wsg_status`` (hardware → drive, channel ``SCHUNK_WSG_STATUS``, Drake's
   ``hardware_sim`` name), one per tick, before the arm's status: ``utime`` as the arm's,
   ``actual_position_mm`` = the opening between the pads (mm), ``actual_speed_mm_per_s`` = the faster
-  finger's speed (mm/s, ≥ 0: what ``systems.gripper.GraspObserver`` takes as the fingers' speed),
+  finger's speed (mm/s, ≥ 0: what ``systems.hand.gripper.GraspObserver`` takes as the fingers' speed),
   ``actual_force`` = the grip force, the smaller squeeze of the two finger drives (N, + squeezing).
 - ``lcmt_schunk_wsg_command`` (drive → hardware, ``SCHUNK_WSG_COMMAND``), one per status, before the
   arm's command: ``utime`` = the tick at which the gripper's driver takes it (the answered status's
@@ -47,13 +47,8 @@ import urllib.parse
 from typing import Optional
 
 import numpy as np
-from drake import (
-    lcmt_iiwa_command,
-    lcmt_iiwa_status,
-    lcmt_schunk_wsg_command,
-    lcmt_schunk_wsg_status,
-    lcmt_scope,
-)
+from drake import (lcmt_iiwa_command, lcmt_iiwa_status, lcmt_schunk_wsg_command, lcmt_schunk_wsg_status,
+                   lcmt_scope)
 from pydrake.lcm import DrakeLcm
 
 STATUS_CHANNEL = "IIWA_STATUS"  # Drake's iiwa driver's channel names

@@ -29,21 +29,12 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.hardware.camera_link import image_channel, pack_depth_image
+from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
+                                       pack_parts, pack_status, pack_wsg_status, unpack_command,
+                                       unpack_wsg_command, utime_of)
 from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
-from ptint_drake.hardware.link import (
-    PARTS_CHANNEL,
-    WSG_COMMAND_CHANNEL,
-    WSG_STATUS_CHANNEL,
-    Endpoint,
-    pack_parts,
-    pack_status,
-    pack_wsg_status,
-    unpack_command,
-    unpack_wsg_command,
-    utime_of,
-)
 
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)

@@ -24,28 +24,13 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.hardware.camera_link import image_channel, with_receive_buffer
+from ptint_drake.hardware.link import (COMMAND_CHANNEL, PARTS_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL,
+                                       WSG_STATUS_CHANNEL, Endpoint, SenderWatch, spread, url_warning)
 from ptint_drake.hardware.process import scheduler_name, stop_on_signals
-from ptint_drake.hardware.session import (
-    ACTIVE,
-    SETTLED_SPEED,
-    HardwareSession,
-    LinkFault,
-    LinkSettings,
-)
-from ptint_drake.hardware.link import (
-    COMMAND_CHANNEL,
-    PARTS_CHANNEL,
-    STATUS_CHANNEL,
-    WSG_COMMAND_CHANNEL,
-    WSG_STATUS_CHANNEL,
-    Endpoint,
-    SenderWatch,
-    spread,
-    url_warning,
-)
-from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
+from ptint_drake.hardware.session import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
+from ptint_drake.outputs.folder import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.report.run_outputs import run_metrics
-from ptint_drake.robot import actuator_effort_limits, nominal_plant
+from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
 from ptint_drake.simulation import simulate
 from ptint_drake.worlds.registry import world_of
 

@@ -9,12 +9,12 @@ import os
 import time
 from pathlib import Path
 
-from ptint_drake.figures import preload, tbg_family_figure
-from ptint_drake.metrics import segment_reasons
-from ptint_drake.outputs import staged_output, write_text_atomic
+from ptint_drake.outputs.folder import staged_output, write_text_atomic
 from ptint_drake.report.run_outputs import frozen_heap, run_and_write
-from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.verdict.metrics import segment_reasons
+from ptint_drake.views.plots import preload, tbg_family_figure
 
 PAPER_SCENARIOS = {
     "curve_b025_tf15": ("Figs. 6-7", "β = 0.25: intercepts almost linearly; discontinuous velocity, "
@@ -52,7 +52,7 @@ def paper_task(kind: str, name: str, *args):
     metrics.json), a TBG family figure, the camera figure, a compare row, a compare
     result's files (args: the result, its folder), or the hold of a paper scenario with the
     paper's own s_d formula after tf (``k_hold = k``)."""
-    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import scenario_text  # noqa: PLC0415
     from ptint_drake.studies import compare  # noqa: PLC0415
 
     if kind == "run":
@@ -196,7 +196,7 @@ CAMERA_SCENARIO = "conveyor_pair_camera"
 
 def _camera_figure(out_dir: Path) -> None:
     """Beyond the paper: the estimate a camera-fed run chases, against the truth, around tf."""
-    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import scenario_text  # noqa: PLC0415
     from ptint_drake.studies.camera import estimate_figure  # noqa: PLC0415
 
     with staged_output(out_dir) as stage:

@@ -16,10 +16,9 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-
-from ptint_drake.outputs import METRICS, SERIES, save_series, staged_output, write_json_atomic
-from ptint_drake.scenario import Scenario, ScenarioError, dump_dataclass
+from ptint_drake.outputs.folder import METRICS, SERIES, save_series, staged_output, write_json_atomic
 from ptint_drake.simulation import build, simulate
+from ptint_drake.simulation.scenario import Scenario, ScenarioError, dump_dataclass
 from ptint_drake.studies.workers import fork_is_safe
 from ptint_drake.worlds.registry import world_key, world_named, world_of
 
@@ -34,7 +33,7 @@ def run_and_write(scenario: Scenario, out_dir: Path, replay: bool = True, figure
     (``simulate_beside``)."""
     prepare = None
     if figures and (workers or os.cpu_count() or 1) > 1:
-        from ptint_drake.figures import preload as prepare  # noqa: PLC0415
+        from ptint_drake.views.plots import preload as prepare  # noqa: PLC0415
     metrics, series = simulate_beside(scenario, prepare, progress=progress, warn=warn)
     run_json = run_metrics(scenario, metrics, figures)
     with staged_output(out_dir) as stage:
@@ -139,7 +138,7 @@ def can_fork() -> bool:
     not a notebook's or a pytest-xdist worker's) and holds no Meshcat (its server threads are
     C++ threads: a fork would copy the ``Meshcat`` object without them, and a replay drawn in
     the child would wait on them forever).  Otherwise the caller works in this process."""
-    replay = sys.modules.get("ptint_drake.replay")
+    replay = sys.modules.get("ptint_drake.views.replay")
     return fork_is_safe() and getattr(replay, "_MESHCAT", None) is None
 
 
@@ -154,7 +153,7 @@ def draw_views(tasks: list[tuple], workers: int | None = None) -> None:
     process stays fit to fork.
     """
     if any(not task[1].endswith("replay") for task in tasks):
-        from ptint_drake.figures import preload  # noqa: PLC0415
+        from ptint_drake.views.plots import preload  # noqa: PLC0415
 
         preload()  # once here, not in every worker
     workers = min(len(tasks), workers or os.cpu_count() or 1)

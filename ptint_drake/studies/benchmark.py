@@ -16,11 +16,10 @@ import time
 from argparse import Namespace
 from collections.abc import Callable
 
-
 from ptint_drake.config.yaml_io import drake_version
 from ptint_drake.controllers.slot import uses_analytic_targets
-from ptint_drake.scenario import bundled_scenarios, parse_with_overrides, scenario_text
 from ptint_drake.simulation import build, make_simulator, simulate
+from ptint_drake.simulation.scenario import bundled_scenarios, parse_with_overrides, scenario_text
 from ptint_drake.worlds.base import advance_over_stops
 from ptint_drake.worlds.registry import world_of
 

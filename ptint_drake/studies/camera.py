@@ -31,15 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.figures import plt, save
-from ptint_drake.metrics import segment_reasons
-from ptint_drake.outputs import staged_output, write_json_atomic
-from ptint_drake.studies.runner import run_tasks
-from ptint_drake.worlds.registry import schedule_of
-from ptint_drake.scenario import Scenario, ScenarioError, parse_scenario, scenario_text, validate
+from ptint_drake.outputs.folder import staged_output, write_json_atomic
 from ptint_drake.simulation import simulate
-from ptint_drake.systems.camera import MeasurementConfig
-
+from ptint_drake.simulation.scenario import Scenario, ScenarioError, parse_scenario, scenario_text, validate
+from ptint_drake.studies.runner import run_tasks
+from ptint_drake.systems.perception.camera import MeasurementConfig
+from ptint_drake.verdict.metrics import segment_reasons
+from ptint_drake.views.plots import plt, save
+from ptint_drake.worlds.registry import schedule_of
 
 SCENARIO = "conveyor_pair_camera"
 NOISES = (0.0005, 0.001, 0.002, 0.005)  # m

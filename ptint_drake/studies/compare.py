@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from ptint_drake.controllers import CONTROLLERS
-from ptint_drake.figures import plt, save
-from ptint_drake.metrics import ROTATION_KEYS, Reason
-from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, apply_variant, parse_scenario
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.verdict.metrics import ROTATION_KEYS, Reason
+from ptint_drake.views.plots import plt, save
 
 DEFAULT_CONTROLLERS = CONTROLLERS  # every registered controller
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
@@ -189,7 +189,7 @@ def figure(result: dict, out_dir: Path) -> None:
 
 def write_compare(result: dict, out_dir: Path) -> None:
     """compare.json (without the curves), compare.csv, compare.md and compare.png, staged."""
-    from ptint_drake.outputs import staged_output, write_json_atomic  # noqa: PLC0415
+    from ptint_drake.outputs.folder import staged_output, write_json_atomic  # noqa: PLC0415
 
     with staged_output(out_dir) as stage:
         (stage / "compare.csv").write_text(to_csv(result))

@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.outputs import staged_output, write_json_atomic
-from ptint_drake.scenario import LoadedScenario, Scenario, ScenarioError
+from ptint_drake.outputs.folder import staged_output, write_json_atomic
+from ptint_drake.simulation.scenario import LoadedScenario, Scenario, ScenarioError
 from ptint_drake.studies.camera import DEFAULT_SEEDS, with_measurement
 from ptint_drake.studies.runner import run_tasks
 from ptint_drake.worlds.base import new_simulator
@@ -103,8 +103,8 @@ def _read_filters(scenario: Scenario, times: np.ndarray) -> dict:
     ``truth`` (the active true target) and ``estimate`` (the selector's output)."""
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
-    from ptint_drake.systems.kalman import AddCameraEstimators  # noqa: PLC0415
-    from ptint_drake.systems.targets import TargetSource  # noqa: PLC0415
+    from ptint_drake.systems.estimation.kalman import AddCameraEstimators  # noqa: PLC0415
+    from ptint_drake.systems.task.targets import TargetSource  # noqa: PLC0415
 
     builder = DiagramBuilder()
     truth = builder.AddNamedSystem("objects", TargetSource(schedule_of(scenario),

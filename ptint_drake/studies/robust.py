@@ -58,10 +58,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.figures import plt, save
-from ptint_drake.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.views.plots import plt, save
 from ptint_drake.worlds.registry import world_of
 
 RANGES = {
@@ -263,7 +263,7 @@ def _pick_histogram(result: dict, out_dir: Path) -> None:
 
 def write_robust(result: dict, out_dir: Path) -> None:
     """robust.json, samples.json, worst.yaml and the histogram, staged then moved in."""
-    from ptint_drake.outputs import staged_output, write_json_atomic  # noqa: PLC0415
+    from ptint_drake.outputs.folder import staged_output, write_json_atomic  # noqa: PLC0415
 
     with staged_output(out_dir) as stage:
         summary = {k: v for k, v in result.items() if k not in ("rows", "worst_yaml")}

@@ -22,7 +22,7 @@ Local workers (the default) are this module's own small pool, not a
   ~0.1 ms against ≥ 0.1 s per simulation), so nothing is submitted up front;
 - recycled after ``max_tasks_per_child`` tasks (default ``MAX_TASKS_PER_CHILD``):
   the diagram of a simulation (and the plant in it) is never freed, on Drake 1.51.1 and
-  1.58.0 alike: its LeafSystems that hold a Drake cache entry (``systems.cache``) are in a
+  1.58.0 alike: its LeafSystems that hold a Drake cache entry (``systems.task.cache``) are in a
   reference cycle through C++ that Python's garbage collector cannot see (1.51.1 keeps
   every Python LeafSystem alive, 1.58.0 only those).  Measured over 120 runs in one process:
   ≈ 1.05 MB per simulation of ``curve_b075_tf15``, ≈ 1.55 MB per ``ptint robust`` sample

@@ -23,12 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
-# Imported here, not in the worker function: forked workers then inherit them ready.
-from ptint_drake.figures import plt, save
-from ptint_drake.outputs import write_text_atomic
-from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, validate
+from ptint_drake.outputs.folder import write_text_atomic
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, parse_scenario, validate
 from ptint_drake.studies.runner import run_tasks
+
+# Imported here, not in the worker function: forked workers then inherit them ready.
+from ptint_drake.views.plots import plt, save
 from ptint_drake.worlds.registry import world_of
 
 COLUMNS = ("beta", "tf", "e0", "e_tf", "e_half", "hold", "peak_torque", "peak_torque_after_startup",

@@ -32,10 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.metrics import segment_reasons
-from ptint_drake.scenario import LoadedScenario, ScenarioError, apply_variant, check_variants, parse_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import (LoadedScenario, ScenarioError, apply_variant, check_variants,
+                                             parse_scenario)
 from ptint_drake.studies.runner import run_tasks
+from ptint_drake.verdict.metrics import segment_reasons
 from ptint_drake.worlds.registry import world_of
 
 GAINS = ("K", "Lambda", "phi", "rot_scale")
@@ -138,7 +139,7 @@ def model_bracket(scenario, gain: str) -> tuple[float, float]:
         return current / 30.0, current * 30.0
     from pydrake.multibody.tree import JacobianWrtVariable  # noqa: PLC0415
 
-    from ptint_drake.robot import actuator_effort_limits, make_plant  # noqa: PLC0415
+    from ptint_drake.robot.plant import actuator_effort_limits, make_plant  # noqa: PLC0415
 
     plant = make_plant(scenario)
     context = plant.CreateDefaultContext()
@@ -240,8 +241,8 @@ def run_tune(loaded: LoadedScenario, settings: TuneSettings, workers=None, dask=
 def _portable(scenario):
     """The scenario with its model file written as an absolute path (bundled names stay),
     so that tuned.yaml runs from any folder."""
-    from ptint_drake.rvm1 import bundled_models  # noqa: PLC0415
-    from ptint_drake.robot import resolve_model  # noqa: PLC0415
+    from ptint_drake.robot.plant import resolve_model  # noqa: PLC0415
+    from ptint_drake.robot.rvm1 import bundled_models  # noqa: PLC0415
 
     if scenario.robot.model not in bundled_models():
         scenario.robot.model = str(resolve_model(scenario.robot.model).resolve())
@@ -279,7 +280,7 @@ def summary_line(result: dict) -> str:
 
 def figure(result: dict, out_dir: Path) -> None:
     """e(tf) and hold max against the gain, one line per variant, criteria and choice marked."""
-    from ptint_drake.figures import plt, save  # noqa: PLC0415
+    from ptint_drake.views.plots import plt, save  # noqa: PLC0415
 
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), layout="constrained", sharex=True)
     gain = result["gain"]
@@ -305,8 +306,8 @@ def figure(result: dict, out_dir: Path) -> None:
 
 def write_tune(result: dict, out_dir: Path) -> None:
     """tune.json, tune.png and (only when a value works) tuned.yaml, staged then moved in."""
-    from ptint_drake.outputs import staged_output, write_json_atomic  # noqa: PLC0415
-    from ptint_drake.scenario import dump_yaml  # noqa: PLC0415
+    from ptint_drake.outputs.folder import staged_output, write_json_atomic  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import dump_yaml  # noqa: PLC0415
 
     with staged_output(out_dir) as stage:
         scenario = result.get("scenario_obj")

@@ -13,7 +13,7 @@ import sys
 import threading
 import traceback
 
-from ptint_drake.outputs import remove_live_stages
+from ptint_drake.outputs.folder import remove_live_stages
 
 
 def rss_mb() -> float:

@@ -23,19 +23,17 @@ Adding a world = one package under ``worlds/`` with a ``World`` subclass, plus o
 from __future__ import annotations
 
 import time
-
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
 import numpy as np
-
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
-from ptint_drake.metrics import Reason
-from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.task.schedule import Schedule
+from ptint_drake.verdict.metrics import Reason
 
 Progress = Optional[Callable[[float, float, int], None]]
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers.plugin import is_plugin, load_class, search_folders
-from ptint_drake.systems.schedule import Schedule
+from ptint_drake.systems.task.schedule import Schedule
 from ptint_drake.worlds.base import RunResult, World
 from ptint_drake.worlds.interception.checks import TARGET_KINDS
 from ptint_drake.worlds.interception.world import InterceptionWorld

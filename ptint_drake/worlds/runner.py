@@ -20,7 +20,7 @@ from typing import Callable, Optional
 from pydrake.systems.analysis import Simulator
 
 from ptint_drake.config.schema import Scenario
-from ptint_drake.systems.jit_notice import compile_notice
+from ptint_drake.controllers.ptsmc.jit_notice import compile_notice
 from ptint_drake.worlds.base import Progress, RunResult, WorldRun, advance_over_stops, new_simulator
 from ptint_drake.worlds.registry import world_of
 
@@ -40,7 +40,7 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
     ``progress(t, duration, steps)`` is called while it runs; ``warn(message)`` for each warning
     known before the simulation starts, as soon as it is known; with ``progress``, one line on
     stderr while numba compiles the controller's equations (an empty JIT cache,
-    ``systems.jit_notice``).  A run stopped by the watchdog or an integrator failure returns
+    ``controllers.ptsmc.jit_notice``).  A run stopped by the watchdog or an integrator failure returns
     normally with ``status == "failed"``.
     """
     world = world_of(scenario)
@@ -79,7 +79,7 @@ def simulate(scenario: Scenario, check: bool = True, progress: Progress = None,
 
 
 def _verdict(world, metrics: dict, criteria) -> list:
-    from ptint_drake.metrics import Reason  # noqa: PLC0415
+    from ptint_drake.verdict.metrics import Reason  # noqa: PLC0415
 
     if metrics.get("failure"):
         return [Reason(None, "failed", metrics["failure"]["message"])]

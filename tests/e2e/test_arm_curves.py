@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import assert_prescribed_time
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from conftest import assert_prescribed_time
-from ptint_drake.rvm1 import model_path
+from ptint_drake.robot.rvm1 import model_path
 
 ARMS = ("iiwa14", "panda", "ur5e")
 

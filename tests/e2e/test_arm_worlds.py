@@ -3,11 +3,11 @@ real-size gripper (``pick_ARM``) per arm."""
 
 import numpy as np
 import pytest
+from conftest import assert_prescribed_time
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from conftest import assert_prescribed_time
-from ptint_drake.rvm1 import model_path
+from ptint_drake.robot.rvm1 import model_path
 
 ARMS = ("iiwa14", "panda", "ur5e")
 
@@ -62,8 +62,8 @@ def test_list_names_a_curve_a_pose_and_a_pick_per_arm(ptint_here):
 def test_hand_and_part_over_the_panda_payload_is_warned_before_the_run():
     """The Panda hand (0.73 kg) with a 2.5 kg part is over the Panda's 3 kg: warned before the run,
     naming both masses; the bundled 0.1 kg parts are not."""
-    from ptint_drake.scenario import parse_with_overrides, scenario_text
     from ptint_drake.simulation import build
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 
     name, text = scenario_text("pick_panda")
     assert not build(parse_with_overrides(text, (), name), log=False).pre_run_warnings()
@@ -81,8 +81,8 @@ def test_the_long_sequence_has_twenty_picks_in_sixty_seconds_over_120_degrees(ar
 
     from script_module import load_script
 
-    from ptint_drake.scenario import parse_scenario
     from ptint_drake.simulation import build
+    from ptint_drake.simulation.scenario import parse_scenario
 
     module = load_script("posture_sequence")
     scenario = parse_scenario(module.scenario(arm), f"sequence_{arm}")

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-
 from conftest import assert_prescribed_time, run_cached
-from ptint_drake.replay import held_object_index, object_positions
+
+from ptint_drake.views.replay import held_object_index, object_positions
 
 
 def _velocity_error_converges(result):

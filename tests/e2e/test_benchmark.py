@@ -93,7 +93,7 @@ def test_kernel_cost_takes_the_law_inputs_as_the_simulation_does(name):
     """``kernels_us`` of ``bench --floors`` for a pose task fed by a camera (target and
     target_rotation on ports) and the other paths; it failed on conveyor_yaw_camera when the
     benchmark dropped the rotation input."""
-    from ptint_drake.scenario import parse_with_overrides, scenario_text
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 
     scenario = parse_with_overrides(scenario_text(name)[1], "{}", name)
     assert benchmark.kernel_cost(scenario, calls=50) > 0

@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 from ptint_drake import cli
-from ptint_drake.scenario import load_scenario
+from ptint_drake.controllers.ptsmc.interceptor import PrescribedTimeInterceptor
 from ptint_drake.simulation import build, simulate
-from ptint_drake.systems.camera import Camera, MeasurementConfig
-from ptint_drake.systems.interceptor import PrescribedTimeInterceptor
-from ptint_drake.systems.kalman import TargetKalmanFilter
-from ptint_drake.systems.targets import LinearTarget, TargetSource
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.systems.estimation.kalman import TargetKalmanFilter
+from ptint_drake.systems.perception.camera import Camera, MeasurementConfig
+from ptint_drake.systems.task.targets import LinearTarget, TargetSource
 from ptint_drake.worlds.registry import objects_of
 
 CAMERA_SCENARIOS = ("conveyor_pair_camera", "curve_camera", "conveyor_speedup_camera",
@@ -118,7 +118,7 @@ def test_bad_measurement_value_is_one_line_exit_2(setting, field, capsys, tmp_pa
 
 
 def test_bad_measurement_in_a_scenario_file(capsys, tmp_path):
-    from ptint_drake.scenario import scenario_text
+    from ptint_drake.simulation.scenario import scenario_text
 
     _, text = scenario_text("conveyor_pair_camera")
     bad = tmp_path / "bad.yaml"

@@ -3,9 +3,9 @@ camera also measures each part's orientation (1° noise) and the rotation estima
 
 import numpy as np
 
-from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
-from ptint_drake.systems.orientation import rotation_angle, target_rotation_values
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.systems.task.orientation import rotation_angle, target_rotation_values
 from ptint_drake.worlds.registry import objects_of, schedule_of
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptint_drake.scenario import scenario_text
+from ptint_drake.simulation.scenario import scenario_text
 
 PAPER = ["assembly", "curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf12", "curve_b075_tf15",
          "curve_b075_tf19"]

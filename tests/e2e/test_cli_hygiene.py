@@ -14,9 +14,9 @@ import pytest
 
 from ptint_drake import cli
 from ptint_drake.cli import runs as cli_runs
-from ptint_drake.outputs import staged_output, write_json_atomic
-from ptint_drake.scenario import LoadedScenario, ScenarioError, scenario_text
 from ptint_drake.config.yaml_io import override_text
+from ptint_drake.outputs.folder import staged_output, write_json_atomic
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, scenario_text
 
 TESTS = Path(__file__).parent
 

@@ -82,8 +82,8 @@ def test_bad_compare_input_is_one_line(tmp_path, args, message, ptint_here):
 def test_table_rows_read_the_structured_reasons():
     """The table's reasons come from ``reason_codes`` (segment, code), not from parsing the
     printed strings: a row's own codes on its segment, a failure's message on every segment."""
-    from ptint_drake.metrics import Reason  # noqa: PLC0415
     from ptint_drake.studies.compare import table_rows  # noqa: PLC0415
+    from ptint_drake.verdict.metrics import Reason  # noqa: PLC0415
 
     seg = dict.fromkeys(SEGMENT_KEYS, 0.001)
     missed = {"controller": "pd", "variant": "nominal", "status": "missed", "torque_peak_max": 1.0,

@@ -5,10 +5,10 @@ import pytest
 from arms import OFFSET_ARM
 from conftest import run_cached
 
-from ptint_drake.metrics import Criteria, Reason, segment_reasons, verdict
-from ptint_drake.robot import make_plant
-from ptint_drake.scenario import ScenarioError, apply_variant, load_scenario, parse_scenario
+from ptint_drake.robot.plant import make_plant
 from ptint_drake.simulation import build, simulate
+from ptint_drake.simulation.scenario import ScenarioError, apply_variant, load_scenario, parse_scenario
+from ptint_drake.verdict.metrics import Criteria, Reason, segment_reasons, verdict
 
 STATIC_ON_OFFSET_ARM = """
 duration: 2.5
@@ -56,7 +56,7 @@ def test_metrics_come_from_the_plant_state_not_the_controller():
     result = run_cached("curve_b075_tf15")  # the session's run of it (runs are deterministic)
     series = result.series
     # the error is against the true target, recomputed independently here
-    from ptint_drake.systems.targets import SinusoidTarget  # noqa: PLC0415
+    from ptint_drake.systems.task.targets import SinusoidTarget  # noqa: PLC0415
 
     truth = SinusoidTarget([0.24, 0.0, 0.3], [0.1, 0.1, 0.1], 1.5, [0.0, np.pi / 2, 0.0])
     expected = series["x"] - np.array([truth.evaluate(t)[0:3] for t in series["t"]])
@@ -108,7 +108,7 @@ def test_criteria_are_read_from_the_scenario():
 
 
 def load_scenario_text() -> str:
-    from ptint_drake.scenario import scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import scenario_text  # noqa: PLC0415
 
     return scenario_text("curve_b075_tf15")[1]
 

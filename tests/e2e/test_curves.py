@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from conftest import CURVES, assert_prescribed_time, run_cached
 
 

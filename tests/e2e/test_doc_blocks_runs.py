@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from conftest import run_cached
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ptint_drake.scenario import parse_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import parse_scenario
 
 X0 = np.array([0.20157919, 0.08349683, 0.32222856])  # the rvm1's tool at its default start pose
 GRAVITY = np.array([0.0, 0.0, -9.81])

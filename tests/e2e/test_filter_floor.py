@@ -6,8 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, parse_scenario, scenario_text
 from ptint_drake.studies import filter_floor as floor
 
 NAME, TEXT = scenario_text("curve_camera")

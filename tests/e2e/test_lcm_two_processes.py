@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import run_cached
 from lcm_link.netns import require_netns, run_in_netns
 
@@ -326,9 +325,9 @@ def test_in_memory_pair_matches_two_processes(tmp_path):
     """The fallback where no private namespace can be made: hardware and drive as two threads
     over one ``memq://`` LCM (``hardware.in_memory``), the same messages and checks; lockstep
     gives the one-process result (no network at all, so this runs everywhere)."""
-    from ptint_drake.hardware.session import LinkSettings  # noqa: PLC0415
     from ptint_drake.hardware.in_memory import run_pair  # noqa: PLC0415
-    from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
+    from ptint_drake.hardware.session import LinkSettings  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
 
     short = ["duration=1.0", "interceptions[0].tf=0.8", "controller.control_period=0.001",
              "multibody.time_step=0.001"]

@@ -13,7 +13,6 @@ import time
 import nbformat
 import pytest
 from nbclient import NotebookClient
-
 from notebook_kernel import EXAMPLES, NOTEBOOKS, kernel_env, kernel_name
 
 pytestmark = pytest.mark.e2e

@@ -7,7 +7,7 @@ matplotlib.use("Agg")
 import matplotlib.axes  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ptint_drake.systems.gripper import GRASP_STATES  # noqa: E402
+from ptint_drake.systems.hand.gripper import GRASP_STATES  # noqa: E402
 from ptint_drake.worlds.pick.views import pick_figure  # noqa: E402
 
 

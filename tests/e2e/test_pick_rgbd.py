@@ -3,8 +3,8 @@
 import numpy as np
 from conftest import run_cached
 
-from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.systems.perception import part_pose_estimator
 
 

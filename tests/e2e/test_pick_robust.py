@@ -7,7 +7,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from ptint_drake.config.errors import ScenarioError
-from ptint_drake.scenario import parse_with_overrides, scenario_text
+from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 from ptint_drake.studies import robust
 from ptint_drake.worlds.pick.config import check_pick_parts
 from ptint_drake.worlds.pick.run import world_config

@@ -13,11 +13,10 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from ptint_drake.scenario import ScenarioError, parse_scenario
-from ptint_drake.simulation import simulate
-
 from plugin_case import EXAMPLE, ROOT, SCENARIO, TYPE
+
+from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import ScenarioError, parse_scenario
 
 BROKEN = '''
 import numpy as np
@@ -161,7 +160,7 @@ def test_tune_takes_a_plugin_parameter_with_its_range(user_folder, ptint_here, m
 def test_dask_workers_find_the_plugin_beside_its_scenario_file(user_folder):
     """Dask worker processes start elsewhere: the runner hands them the scenario's folder."""
     distributed = pytest.importorskip("distributed", reason="install the [cluster] extra")
-    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import LoadedScenario  # noqa: PLC0415
     from ptint_drake.studies.compare import run_compare  # noqa: PLC0415
 
     assert Path.cwd() != user_folder
@@ -176,7 +175,7 @@ def test_dask_workers_find_the_plugin_beside_its_scenario_file(user_folder):
 def test_the_plugin_and_ptsmc_on_an_arm_the_package_has_never_seen(user_folder, monkeypatch):
     from arms import OFFSET_ARM  # noqa: PLC0415
 
-    from ptint_drake.scenario import LoadedScenario  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import LoadedScenario  # noqa: PLC0415
     from ptint_drake.studies.compare import run_compare  # noqa: PLC0415
 
     (user_folder / "offset_arm.urdf").write_text(OFFSET_ARM)

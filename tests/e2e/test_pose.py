@@ -6,20 +6,20 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from arms import _joint, _link
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ptint_drake.scenario import load_scenario
-from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
-from ptint_drake.systems.orientation import (OrientedTarget, SpinningOrientation, rotation_angle,
-                                             rotation_exp, rotation_log, rpy_matrix)
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.sliding_surface import SlidingSurface
-from ptint_drake.systems.targets import LinearTarget
-from ptint_drake.systems.tbg import alpha_gain, tbg_profile
-from arms import _joint, _link
+from ptint_drake.controllers.ptsmc.builder import AddPrescribedTimeInterceptor, ControllerGains
+from ptint_drake.controllers.ptsmc.sliding_surface import SlidingSurface
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.systems.task.orientation import (OrientedTarget, SpinningOrientation, rotation_angle,
+                                                  rotation_exp, rotation_log, rpy_matrix)
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import LinearTarget
+from ptint_drake.systems.task.tbg import alpha_gain, tbg_profile
 
 # A 6-joint arm (waist, shoulder, elbow, a roll-pitch-roll wrist) that is not the RV-M1.  The
 # wrist links' inertia sets the stiffness of the closed loop: at 0.002 kg m² RK3 needed 20,000
@@ -202,8 +202,8 @@ def test_bad_orientation_input_is_one_line_exit_2(tmp_path, overrides, field, pt
 
 
 def test_waypoint_orientation_is_slerped_and_checked():
+    from ptint_drake.simulation.scenario import TargetConfig, WaypointsConfig
     from ptint_drake.worlds.interception.objects import make_target
-    from ptint_drake.scenario import TargetConfig, WaypointsConfig
 
     target = make_target(TargetConfig(waypoints=WaypointsConfig(
         time=[0.0, 1.0, 2.0], position=[[0.3, 0, 0.2], [0.3, 0.1, 0.2], [0.3, 0.2, 0.2]],

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import run_cached
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -27,7 +26,7 @@ def _commands(html: str) -> list[dict]:
 
 
 def _check_page(html: str, legend_words: list) -> list[dict]:
-    from ptint_drake.replay import OVERLAY_ID, TIME_ID  # noqa: PLC0415
+    from ptint_drake.views.replay import OVERLAY_ID, TIME_ID  # noqa: PLC0415
 
     assert f'id="{OVERLAY_ID}"' in html and f'id="{TIME_ID}"' in html and 'id="ptint-play"' in html
     overlay = html[html.index(f'id="{OVERLAY_ID}"'):]
@@ -48,8 +47,8 @@ def _check_page(html: str, legend_words: list) -> list[dict]:
 
 
 def test_interception_replay_loops_with_time_legend_and_floor(tmp_path):
-    from ptint_drake.replay import write_replay  # noqa: PLC0415
-    from ptint_drake.robot import resolve_model  # noqa: PLC0415
+    from ptint_drake.robot.plant import resolve_model  # noqa: PLC0415
+    from ptint_drake.views.replay import write_replay  # noqa: PLC0415
 
     result = run_cached("curve_b075_tf15")
     path = tmp_path / "replay.html"

@@ -4,8 +4,8 @@ import pytest
 from conftest import run_cached
 
 from ptint_drake import cli
-from ptint_drake.scenario import load_scenario
 from ptint_drake.simulation import build
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.systems.perception.part_pose_estimator import PartPoseEstimator
 
 

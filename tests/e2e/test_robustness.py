@@ -9,13 +9,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import TOO_SHORT_TF, assert_prescribed_time, run_cached, sigint_default
-from ptint_drake.systems.disturbance import JointDisturbance
-from ptint_drake.systems.camera import MeasurementConfig
-from ptint_drake.studies.robust import RANGES, sample_scenario
-from ptint_drake.scenario import parse_scenario, scenario_text
+
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import parse_scenario, scenario_text
+from ptint_drake.studies.robust import RANGES, sample_scenario
+from ptint_drake.systems.perception.camera import MeasurementConfig
+from ptint_drake.worlds.interception.disturbance import JointDisturbance
 from ptint_drake.worlds.registry import objects_of
 
 HERE = Path(__file__).parent

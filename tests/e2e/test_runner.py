@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from conftest import sigint_default
 
-from ptint_drake.scenario import parse_with_overrides, scenario_text
+from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 from ptint_drake.studies.robust import robust_sample
 from ptint_drake.studies.runner import WorkerDied, run_tasks
 
@@ -38,7 +38,7 @@ def _die(i):
 
 def _stage_and_wait(out_dir):
     """Stage a file in ``out_dir`` and wait there until stopped."""
-    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+    from ptint_drake.outputs.folder import staged_output  # noqa: PLC0415
 
     with staged_output(out_dir) as stage:
         (stage / "half.txt").write_text("half")
@@ -52,7 +52,7 @@ def _stage_and_wait_in_c(out_dir):
     callback is printed and swallowed there."""
     import ctypes  # noqa: PLC0415
 
-    from ptint_drake.outputs import staged_output  # noqa: PLC0415
+    from ptint_drake.outputs.folder import staged_output  # noqa: PLC0415
 
     compare = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int))
 
@@ -232,7 +232,7 @@ def test_cli_ctrl_c_stops_robust_within_5_s(tmp_path):
 def test_why_workers_are_recycled_a_simulation_is_never_freed(monkeypatch):
     """Why ``max_tasks_per_child``: the diagram of a simulation is never freed, on both Drake
     ends (1.51.1 and 1.58.0).  A LeafSystem of this package that holds a Drake cache entry
-    (``systems.cache.DeclareVectorCache``: the entry's ``Eval`` kept on the system, a ``calc``
+    (``systems.task.cache.DeclareVectorCache``: the entry's ``Eval`` kept on the system, a ``calc``
     that captures the system; ``TargetSource``, the controller's blocks) is in a reference cycle
     through C++ that Python's garbage collector cannot see, and keeps its diagram alive.  Drake
     1.51.1 keeps every Python LeafSystem alive; Drake 1.58.0 frees one without a cache entry
@@ -246,8 +246,8 @@ def test_why_workers_are_recycled_a_simulation_is_never_freed(monkeypatch):
     from importlib.metadata import version
 
     from ptint_drake import simulation
-    from ptint_drake.systems.orientation import ObjectRotations
-    from ptint_drake.systems.targets import TargetSource
+    from ptint_drake.systems.task.orientation import ObjectRotations
+    from ptint_drake.systems.task.targets import TargetSource
     from ptint_drake.worlds import runner
     from ptint_drake.worlds.registry import objects_of, schedule_of
 

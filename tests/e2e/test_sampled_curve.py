@@ -4,7 +4,6 @@ plant (``multibody``); one run each."""
 
 import numpy as np
 import pytest
-
 from conftest import assert_prescribed_time, run_cached
 
 CASES = {"continuous plant": "controller: {control_period: 0.001}",

@@ -7,8 +7,8 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from ptint_drake.scenario import LoadedScenario, parse_scenario, scenario_text
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import LoadedScenario, parse_scenario, scenario_text
 from ptint_drake.studies.sweep import run_sweep, sweep_point
 
 NAME, TEXT = scenario_text("curve_b075_tf15")

@@ -6,7 +6,6 @@ averaged over 20 ms the torques agree within 0.075 N·m; 1,279 vs 27,030 integra
 """
 
 import numpy as np
-
 from conftest import assert_prescribed_time, run_cached
 
 

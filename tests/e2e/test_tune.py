@@ -9,8 +9,8 @@ from conftest import TOO_SHORT_TF
 from heavy_arm import heavy_arm_scenario, heavy_arm_urdf
 from test_cli import ptint
 
-from ptint_drake.scenario import apply_variant, parse_scenario
 from ptint_drake.simulation import simulate
+from ptint_drake.simulation.scenario import apply_variant, parse_scenario
 from ptint_drake.studies.runner import run_tasks
 from ptint_drake.studies.tune import tune_run
 

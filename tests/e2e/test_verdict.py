@@ -7,7 +7,7 @@ import contextlib
 import io
 import json
 
-from ptint_drake.metrics import Criteria, Reason, verdict
+from ptint_drake.verdict.metrics import Criteria, Reason, verdict
 
 
 def ptint_one_stream(*args) -> tuple[int, list[str]]:

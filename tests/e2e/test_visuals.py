@@ -10,7 +10,7 @@ import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
-from ptint_drake.figures import tbg_family_figure, uniform_derivatives
+from ptint_drake.views.plots import tbg_family_figure, uniform_derivatives
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 BROWSER_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
@@ -144,8 +144,8 @@ def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
     from pydrake.systems.framework import DiagramBuilder
 
-    from ptint_drake.replay import end_effector_radius, floor_extent, object_radius
-    from ptint_drake.robot import resolve_model
+    from ptint_drake.robot.plant import resolve_model
+    from ptint_drake.views.replay import end_effector_radius, floor_extent, object_radius
 
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
@@ -182,7 +182,7 @@ FORKED_VIEWS = r"""
 import sys
 from pathlib import Path
 from ptint_drake.report.run_outputs import can_fork, write_views
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.simulation import simulate
 
 scenario = load_scenario("curve_b075_tf15")
@@ -200,8 +200,8 @@ def test_views_in_workers_equal_views_drawn_here(tmp_path):
     forked workers are drawn from a fresh single-threaded process (as ``ptint run`` is): this
     one, a pytest-xdist worker with its I/O thread, does not fork (``can_fork``)."""
     from ptint_drake.report.run_outputs import can_fork, write_views
-    from ptint_drake.scenario import load_scenario
     from ptint_drake.simulation import simulate
+    from ptint_drake.simulation.scenario import load_scenario
 
     here, there = tmp_path / "here", tmp_path / "there"
     here.mkdir()

@@ -10,7 +10,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from lcm_link.netns import require_netns, run_in_netns
 
 pytestmark = pytest.mark.e2e

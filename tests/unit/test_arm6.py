@@ -8,7 +8,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from ptint_drake.rvm1 import FINGERTIP_OFFSET, bundled_models, model_path, paper_fk, q_from_theta
+from ptint_drake.robot.rvm1 import FINGERTIP_OFFSET, bundled_models, model_path, paper_fk, q_from_theta
 
 JOINTS = ["waist", "shoulder", "elbow", "forearm_roll", "wrist_pitch", "wrist_roll"]
 

@@ -18,8 +18,8 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.multibody.tree import RevoluteJoint
 from pydrake.systems.framework import DiagramBuilder
 
-from ptint_drake.rvm1 import bundled_models, model_path
-from ptint_drake.scenario import bundled_scenarios
+from ptint_drake.robot.rvm1 import bundled_models, model_path
+from ptint_drake.simulation.scenario import bundled_scenarios
 
 ROOT = Path(__file__).resolve().parents[2]
 D = math.pi / 180.0
@@ -206,8 +206,8 @@ def test_every_bundled_model_parses_with_an_empty_cache(tmp_path):
             "    Parser(plant).AddModels(path)\n"
             "    plant.Finalize()\n"
             "    print('ok', path)\n"
-            "from ptint_drake.robot import make_plant\n"
-            "from ptint_drake.scenario import bundled_scenarios, load_scenario\n"
+            "from ptint_drake.robot.plant import make_plant\n"
+            "from ptint_drake.simulation.scenario import bundled_scenarios, load_scenario\n"
             "for name in bundled_scenarios():\n"
             "    make_plant(load_scenario(name))\n"
             "    print('scenario', name)\n")
@@ -227,7 +227,7 @@ def test_null_space_term_at_a_singular_jacobian():
     made) is finite there and still leaves the tool point alone."""
     from pydrake.multibody.tree import JacobianWrtVariable  # noqa: PLC0415
 
-    from ptint_drake.systems.controller import null_space_torque  # noqa: PLC0415
+    from ptint_drake.controllers.ptsmc.law import null_space_torque  # noqa: PLC0415
 
     plant, _ = _plant("iiwa14")
     context = plant.CreateDefaultContext()
@@ -241,7 +241,7 @@ def test_null_space_term_at_a_singular_jacobian():
 
 
 def test_limit_push_is_zero_inside_and_grows_into_the_band():
-    from ptint_drake.systems.controller import limit_push  # noqa: PLC0415
+    from ptint_drake.controllers.ptsmc.law import limit_push  # noqa: PLC0415
 
     lower, upper = np.array([-1.0, -1.0, -np.inf]), np.array([1.0, 1.0, np.inf])
     push = limit_push(np.array([0.95, -0.85, 5.0]), lower, upper, 0.1)
@@ -256,7 +256,7 @@ def test_posture_task_pushes_a_joint_away_from_its_limit_in_the_null_space():
     from pydrake.multibody.tree import JacobianWrtVariable  # noqa: PLC0415
 
     from ptint_drake.config.controller import ControllerGains  # noqa: PLC0415
-    from ptint_drake.systems.controller import null_space_terms, null_space_torque  # noqa: PLC0415
+    from ptint_drake.controllers.ptsmc.law import null_space_terms, null_space_torque  # noqa: PLC0415
 
     plant, _ = _plant("iiwa14")
     q = np.radians([0.0, 30.0, 0.0, -119.0, 0.0, 60.0, 0.0])

@@ -10,19 +10,15 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from ptint_drake import rvm1
-from ptint_drake.systems.baseline_common import TaskSpaceBaseline
-from ptint_drake.systems.builder import ControllerGains
-from ptint_drake.systems.ct_quintic import (
-    CtQuinticConfig,
-    CtQuinticController,
-    quintic_eval,
-)
-from ptint_drake.systems.pd import PDConfig, PDController
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.signals import TARGET_PORT, TARGET_PORT_SIZE
-from ptint_drake.systems.smc import FirstOrderSMC, SMCConfig
-from ptint_drake.systems.targets import SinusoidTarget
+from ptint_drake.controllers.baseline import TaskSpaceBaseline
+from ptint_drake.controllers.ct_quintic import CtQuinticConfig, CtQuinticController, quintic_eval
+from ptint_drake.controllers.pd import PDConfig, PDController
+from ptint_drake.controllers.ptsmc.builder import ControllerGains
+from ptint_drake.controllers.smc import FirstOrderSMC, SMCConfig
+from ptint_drake.robot import rvm1
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.signals import TARGET_PORT, TARGET_PORT_SIZE
+from ptint_drake.systems.task.targets import SinusoidTarget
 
 THETA0 = np.radians(rvm1.START_THETA_DEG)
 CURVE = SinusoidTarget([0.24, 0.0, 0.3], [0.1] * 3, 1.5, [0.0, np.pi / 2, 0.0])
@@ -296,9 +292,9 @@ def test_configs_load_from_yaml():
 def test_every_target_port_has_the_one_width():
     """Baselines, the fused system, the blocks' target input and ``TargetSource`` all take
     ``signals.TARGET_PORT_SIZE`` values laid out as ``signals.TARGET`` slots."""
-    from ptint_drake.systems.builder import AddPrescribedTimeInterceptor
-    from ptint_drake.systems.signals import TARGET as SLOTS
-    from ptint_drake.systems.targets import TargetSource
+    from ptint_drake.controllers.ptsmc.builder import AddPrescribedTimeInterceptor
+    from ptint_drake.systems.task.signals import TARGET as SLOTS
+    from ptint_drake.systems.task.targets import TargetSource
 
     assert TARGET_PORT_SIZE == 9 and TARGET_PORT == slice(0, SLOTS.xddot.stop)
     schedule = Schedule([Segment(0.0, 1.5, 0.75)])
@@ -316,8 +312,8 @@ def test_every_target_port_has_the_one_width():
 
 def test_prediction_reads_the_named_slots():
     """ct_quintic's constant-acceleration prediction takes x_r, ẋ_r, ẍ_r from their slots."""
-    from ptint_drake.systems.ct_quintic import constant_acceleration_predict
-    from ptint_drake.systems.signals import TARGET as SLOTS
+    from ptint_drake.controllers.ct_quintic import constant_acceleration_predict
+    from ptint_drake.systems.task.signals import TARGET as SLOTS
 
     target = np.zeros(9)
     target[SLOTS.x], target[SLOTS.xdot], target[SLOTS.xddot] = [0.2, 0.1, 0.3], [0.1, -0.2, 0.0], [1, 2, 3]

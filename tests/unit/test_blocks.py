@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from ptint_drake.systems.controller import SlidingModeController
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.sliding_surface import SlidingSurface, SurfaceLaw, switching_law
-from ptint_drake.systems.targets import LinearTarget, SinusoidTarget, TargetSource
-from ptint_drake.systems.tbg import TimeBaseGenerator
+from ptint_drake.controllers.ptsmc.law import SlidingModeController
+from ptint_drake.controllers.ptsmc.sliding_surface import SlidingSurface, SurfaceLaw, switching_law
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import LinearTarget, SinusoidTarget, TargetSource
+from ptint_drake.systems.task.tbg import TimeBaseGenerator
 
 SCHED = Schedule([Segment(0.0, 1.5, 0.75), Segment(2.0, 1.0, 0.5)])
 
@@ -132,7 +132,7 @@ def test_schedule_validation():
 
 def test_square_solve_matches_numpy_and_survives_singular():
     """The compiled 3 × 3 solve (Cramer's rule) against numpy; least squares when singular."""
-    from ptint_drake.systems.controller import pinv_apply
+    from ptint_drake.controllers.ptsmc.law import pinv_apply
 
     rng = np.random.default_rng(5)
     for _ in range(200):
@@ -147,7 +147,7 @@ def test_square_solve_matches_numpy_and_survives_singular():
 @pytest.mark.parametrize("nv, damping", [(5, 0.0), (6, 0.0), (7, 0.0), (6, 0.05)])
 def test_six_row_pinv_is_numpys_least_squares(nv, damping):
     """6-row tasks: the minimum-norm least-squares solution (damped: Jᵀ(JJᵀ + λ²I)⁻¹ b)."""
-    from ptint_drake.systems.controller import pinv_apply
+    from ptint_drake.controllers.ptsmc.law import pinv_apply
 
     rng = np.random.default_rng(nv)
     J, b = rng.normal(size=(6, nv)), rng.normal(size=6)
@@ -161,7 +161,7 @@ def test_six_row_pinv_of_a_rank_deficient_jacobian_is_the_svds(nv):
     """A 6-row J with two equal columns (a wrist singularity) or a zero row: the Householder
     solve says rank-deficient and the SVD's minimum-norm least-squares solution is returned
     (not a huge or NaN one); a nearly singular J (condition ~1e8) still matches numpy."""
-    from ptint_drake.systems.controller import pinv_apply
+    from ptint_drake.controllers.ptsmc.law import pinv_apply
 
     rng = np.random.default_rng(10 + nv)
     b = rng.normal(size=6)
@@ -195,7 +195,7 @@ def test_surface_law_matches_the_paper_equations():
     """``SurfaceLaw.values`` (what the fused system and the block call) against eqs. 11, 16, 17
     written with numpy arrays: e, ė, s = ė + αe, s_d = s(t0) e^(−kτ) (hold: e^(−k tf − k_hold(τ − tf))),
     s_x = s − s_d + Λσ, σ̇ = tanh((s − s_d)/φ)."""
-    from ptint_drake.systems.task import task_error
+    from ptint_drake.systems.task.error import task_error
 
     law = SurfaceLaw(Lambda=5.0, k=3.0, switching="tanh", phi=0.01, k_hold=50.0)
     rng = np.random.default_rng(11)
@@ -218,7 +218,7 @@ def test_smc_torque_is_minus_K_pinv_J_s_x(nv, damping):
     """``smc_torque`` (fused system, block and SMC baseline) against τ = −K J⁺ s_x (eq. 18) with
     numpy: J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ (λ = 0: the inverse or the minimum-norm pseudoinverse); it takes
     lists and arrays alike and gives the same floats."""
-    from ptint_drake.systems.controller import smc_torque
+    from ptint_drake.controllers.ptsmc.law import smc_torque
 
     rng = np.random.default_rng(nv + int(100 * damping))
     K = rng.uniform(10.0, 60.0, nv)
@@ -233,7 +233,7 @@ def test_smc_torque_is_minus_K_pinv_J_s_x(nv, damping):
 
 def _lean_and_general(J, b, damping):
     """``pinv_solve_into`` without ``general`` (its return value, ``out`` after it) and with it."""
-    from ptint_drake.systems.controller import pinv_solve_into, pinv_work_size
+    from ptint_drake.controllers.ptsmc.law import pinv_solve_into, pinv_work_size
 
     J = np.ascontiguousarray(J, dtype=float)
     work = np.empty(pinv_work_size(*J.shape))
@@ -260,7 +260,7 @@ def test_the_lean_solve_leaves_what_needs_numpy_to_the_general_one():
     """A singular 3 × 3 J (Cramer's rule cannot), a rank-deficient 6-row J (Householder cannot),
     a damped 6-row solve and more than 8 joints: False and ``out`` untouched; the general solve
     gives ``pinv_solve``'s answer (numpy's least squares for the singular J)."""
-    from ptint_drake.systems.controller import pinv_solve
+    from ptint_drake.controllers.ptsmc.law import pinv_solve
 
     rng = np.random.default_rng(4)
     singular = np.array([[1.0, 2, 3], [2, 4, 6], [0, 1, 1]])

@@ -2,17 +2,16 @@
 
 import numpy as np
 import pytest
+from arms import OFFSET_ARM, REDUNDANT_ARM
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from ptint_drake.systems.builder import AddPrescribedTimeInterceptor, ControllerGains
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget, WaypointTarget
-
-from arms import OFFSET_ARM, REDUNDANT_ARM
+from ptint_drake.controllers.ptsmc.builder import AddPrescribedTimeInterceptor, ControllerGains
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import LinearTarget, WaypointTarget
 
 
 @pytest.mark.parametrize("urdf, q0", [(OFFSET_ARM, [0.3, 0.5, 1.2]),

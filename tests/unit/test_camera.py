@@ -1,4 +1,4 @@
-"""The camera: sample times, hold, delay, noise and dropouts (systems/camera.py)."""
+"""The camera: sample times, hold, delay, noise and dropouts (systems/perception/camera.py)."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from ptint_drake.systems.camera import Camera, MeasurementConfig, validate_measurement
+from ptint_drake.systems.perception.camera import Camera, MeasurementConfig, validate_measurement
 
 VELOCITY = np.array([1.0, -2.0, 0.5])
 

@@ -1,16 +1,16 @@
-"""The compiled kinematic chain (systems/chain.py) against Drake's kinematics, to 1e-12."""
+"""The compiled kinematic chain (systems/task/chain.py) against Drake's kinematics, to 1e-12."""
 
 import numpy as np
 import pytest
+from heavy_arm import heavy_arm_urdf
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from heavy_arm import heavy_arm_urdf
-from ptint_drake import rvm1
-from ptint_drake.robot import parse_model
-from ptint_drake.systems.chain import KinematicChain
-from ptint_drake.systems.kinematics import FrameKinematics
+from ptint_drake.robot import rvm1
+from ptint_drake.robot.plant import parse_model
+from ptint_drake.systems.task.chain import KinematicChain
+from ptint_drake.systems.task.kinematics import FrameKinematics
 
 # turned joint frames (rpy), an off-axis revolute axis, a prismatic joint and a turned tool
 TWISTED = """<?xml version="1.0"?><robot name="twisted">

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from ptint_drake.hardware.drive import DriveDiagram
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 
 
 def _leaves(system):

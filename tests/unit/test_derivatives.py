@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.signal import savgol_filter
 
-from ptint_drake.derivatives import savgol_derivative, uniform_derivatives
+from ptint_drake.views.derivatives import savgol_derivative, uniform_derivatives
 
 
 @pytest.mark.parametrize("shape", [(400,), (300, 3)])

@@ -12,9 +12,9 @@ import shutil
 from pathlib import Path
 
 import pytest
+from script_module import load_script
 
 from ptint_drake.report.run_outputs import write_diagram
-from script_module import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 DIAGRAMS = ROOT / "diagrams"
@@ -81,7 +81,7 @@ def test_structure_ignores_drake_version_details():
             'name=plant\n</TD></TR>\n<TR>\n<TD PORT="u0" BORDER="1" >actuation</TD>\n'
             '<TD PORT="y0" BORDER="1" >state</TD>\n</TR>\n' + extra_plant_port + '</TABLE>\n>];\n'
             's2 [shape=none, border=0, label=<\n<TABLE>\n<TR><TD COLSPAN="2">\n'
-            '<B>ptint_drake.systems.interceptor.PrescribedTimeInterceptor</B><BR/>\nname=interceptor\n'
+            '<B>ptint_drake.controllers.ptsmc.interceptor.PrescribedTimeInterceptor</B><BR/>\nname=interceptor\n'
             '</TD></TR>\n<TR>\n<TD PORT="u0" BORDER="1" ROWSPAN="2">state</TD>\n'
             '<TD PORT="y0" BORDER="1" >tau</TD>\n</TR>\n<TR>\n<TD PORT="y1" BORDER="1" >sigma</TD>\n'
             '</TR>\n</TABLE>\n>];\ns1:y0:e -> s2:u0:w\ns2:y0:e -> s1:u0:w\n')
@@ -95,7 +95,7 @@ def test_structure_ignores_drake_version_details():
 def test_diagrams_of_two_scenarios_share_a_folder(tmp_path):
     """`ptint diagram A` then `ptint diagram B --out` the same folder keeps A's files (each
     scenario's pair is named after it), and a diagram written again replaces its own pair."""
-    from ptint_drake.scenario import load_scenario
+    from ptint_drake.simulation.scenario import load_scenario
 
     if shutil.which("dot") is None:
         pytest.skip("Graphviz's dot is not installed")

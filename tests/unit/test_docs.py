@@ -88,7 +88,7 @@ def _fields(cls, prefix=""):
 def test_scenario_page_lists_every_field():
     from pydrake.systems.analysis import SimulatorConfig
 
-    from ptint_drake.scenario import Scenario
+    from ptint_drake.simulation.scenario import Scenario
 
     page = ptint_reference.schema_markdown()
     listed = set(re.findall(r"^\| `([^`]+)`", page, re.M))

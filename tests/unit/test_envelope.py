@@ -3,7 +3,7 @@ can show (the first and last point, each column's minimum and maximum)."""
 
 import numpy as np
 
-from ptint_drake.figures import envelope
+from ptint_drake.views.plots import envelope
 
 
 def _columns(x, x0, x1, n):

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ptint_drake.figure_grid import place_grid
-from ptint_drake.figures import new_figure
+from ptint_drake.views.plot_grid import place_grid
+from ptint_drake.views.plots import new_figure
 
 
 def _grid_figure():

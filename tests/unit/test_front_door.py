@@ -9,7 +9,7 @@ import pytest
 
 from ptint_drake import cli
 from ptint_drake.report import paper_report
-from ptint_drake.scenario import bundled_scenarios, scenario_text
+from ptint_drake.simulation.scenario import bundled_scenarios, scenario_text
 
 
 def test_version_names_the_package_and_drake(capsys):

@@ -14,8 +14,8 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.pick import GripperConfig
-from ptint_drake.rvm1 import model_path
-from ptint_drake.worlds.pick.grippers import check_mount, payload_warnings
+from ptint_drake.robot.rvm1 import model_path
+from ptint_drake.systems.hand.datasheets import check_mount, payload_warnings
 from ptint_drake.worlds.pick.scene import AddGripper, gripper_stroke
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -4,10 +4,10 @@ of a retry."""
 import numpy as np
 import pytest
 
-from ptint_drake.systems.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST, OPEN, GraspObserver
+from ptint_drake.simulation.validation import ScenarioError
+from ptint_drake.systems.hand.gripper import CLOSING, EMPTY, GRASP_STATES, HOLDING, LOST, OPEN, GraspObserver
 from ptint_drake.worlds.pick.config import BeltConfig, PartConfig, SlotConfig, TrayConfig
 from ptint_drake.worlds.pick.tasks import PickConfig, PickTaskConfig, Replan, check_tasks, pick_plan
-from ptint_drake.validation import ScenarioError
 
 WIDTH = 0.03  # m, the expected part
 

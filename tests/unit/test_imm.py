@@ -1,4 +1,4 @@
-"""estimator: auto — the IMM filter of systems/imm.py, and the retired measurement options."""
+"""estimator: auto — the IMM filter of systems/estimation/imm.py, and the retired measurement options."""
 
 import math
 
@@ -7,13 +7,13 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ptint_drake.scenario import ScenarioError, parse_scenario
-from ptint_drake.systems import imm_kernels as imm
-from ptint_drake.systems.camera import MeasurementConfig, validate_measurement
-from ptint_drake.systems.imm import MODELS, AdaptiveTargetEstimator
-from ptint_drake.systems.kalman import AddCameraEstimators
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import BallisticTarget, LinearTarget, SinusoidTarget, TargetSource
+from ptint_drake.simulation.scenario import ScenarioError, parse_scenario
+from ptint_drake.systems.estimation import imm_kernels as imm
+from ptint_drake.systems.estimation.imm import MODELS, AdaptiveTargetEstimator
+from ptint_drake.systems.estimation.kalman import AddCameraEstimators
+from ptint_drake.systems.perception.camera import MeasurementConfig, validate_measurement
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import BallisticTarget, LinearTarget, SinusoidTarget, TargetSource
 
 CURVE = SinusoidTarget([0.24, 0.0, 0.3], [0.1] * 3, 1.5, [0.0, np.pi / 2, 0.0])  # paper eq. 28
 TRACKS = {
@@ -179,7 +179,7 @@ def test_compiled_cycle_matches_the_numpy_reference():
 
 
 class _ReferenceIMM:
-    """The IMM cycle as plain numpy, as systems/imm.py had it before it was compiled (string
+    """The IMM cycle as plain numpy, as systems/estimation/imm.py had it before it was compiled (string
     model names, ``np.linalg.inv``/``slogdet``, ``einsum``): the yardstick of the kernels."""
 
     @staticmethod
@@ -324,7 +324,7 @@ def test_ballistic_target_is_held_before_release_and_unseen_by_the_camera():
     b = BallisticTarget([0.2, 0.0, 0.1], [0.0, 0.1, 2.0], [0.0, 0.0, -9.81], release=0.5)
     np.testing.assert_array_equal(b.evaluate(0.2), np.concatenate([[0.2, 0.0, 0.1], np.zeros(9)]))
     np.testing.assert_allclose(b.evaluate(0.7)[0:3], [0.2, 0.02, 0.1 + 0.4 - 0.5 * 9.81 * 0.04])
-    from ptint_drake.systems.camera import Camera  # noqa: PLC0415
+    from ptint_drake.systems.perception.camera import Camera  # noqa: PLC0415
     camera = Camera(config=MeasurementConfig(rate_hz=30.0), history=b)
     assert camera.dropped(0.4) and not camera.dropped(0.5) and camera.pre_run_samples() == []
 

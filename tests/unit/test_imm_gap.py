@@ -10,10 +10,10 @@ accelerates (ca: its acceleration must be kept) and a throw (fall: gravity must 
 import numpy as np
 import pytest
 
-from ptint_drake.systems import imm_kernels as imm
-from ptint_drake.systems.camera import MeasurementConfig
-from ptint_drake.systems.imm import MODELS, AdaptiveTargetEstimator
-from ptint_drake.systems.targets import BallisticTarget, LinearTarget
+from ptint_drake.systems.estimation import imm_kernels as imm
+from ptint_drake.systems.estimation.imm import MODELS, AdaptiveTargetEstimator
+from ptint_drake.systems.perception.camera import MeasurementConfig
+from ptint_drake.systems.task.targets import BallisticTarget, LinearTarget
 
 CHI2_3_999 = 16.27  # the 99.9 % quantile of χ² with 3 degrees of freedom
 RGBD = MeasurementConfig(noise_std=0.0005, rate_hz=30.0, latency=0.033)  # perception's fit noise

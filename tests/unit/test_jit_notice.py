@@ -1,11 +1,11 @@
-"""The compile notice (systems.jit_notice): one line while a kernel of the package compiles, and
+"""The compile notice (controllers.ptsmc.jit_notice): one line while a kernel of the package compiles, and
 its time once done; nothing when the kernel was compiled (or loaded from the cache) before."""
 
 from __future__ import annotations
 
 import numba
 
-from ptint_drake.systems.jit_notice import MESSAGE, compile_notice
+from ptint_drake.controllers.ptsmc.jit_notice import MESSAGE, compile_notice
 
 
 def _kernel(module: str):

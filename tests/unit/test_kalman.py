@@ -1,4 +1,4 @@
-"""Target estimation from camera samples (systems/kalman.py)."""
+"""Target estimation from camera samples (systems/estimation/kalman.py)."""
 
 import numpy as np
 import pytest
@@ -9,15 +9,11 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import Sine, TrajectorySource, VectorLogSink
 from pydrake.trajectories import PiecewisePolynomial
 
-from ptint_drake.systems.camera import Camera, MeasurementConfig
-from ptint_drake.systems.kalman import (
-    AddCameraEstimators,
-    TargetKalmanFilter,
-    process_covariance,
-    transition,
-)
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.target_prediction import ActiveTargetSelector
+from ptint_drake.systems.estimation.kalman import (AddCameraEstimators, TargetKalmanFilter,
+                                                   process_covariance, transition)
+from ptint_drake.systems.estimation.target_prediction import ActiveTargetSelector
+from ptint_drake.systems.perception.camera import Camera, MeasurementConfig
+from ptint_drake.systems.task.schedule import Schedule, Segment
 
 START = np.array([0.3, -0.15, 0.15])
 VELOCITY = np.array([0.05, 0.1, -0.02])

@@ -7,15 +7,15 @@ import numpy as np
 import pytest
 from pydrake.systems.framework import BasicVector
 
-from ptint_drake import rvm1
-from ptint_drake.robot import parse_model
-from ptint_drake.systems.chain import KinematicChain
-from ptint_drake.systems.controller import smc_torque
-from ptint_drake.systems.interceptor_row import GAINS_HEAD, borrow, pack_chain, pack_position, \
-    position_output
-from ptint_drake.systems.sliding_surface import SurfaceLaw
-from ptint_drake.systems.targets import SinusoidTarget
-from ptint_drake.systems.tbg import gamma_gain, tbg_row
+from ptint_drake.controllers.ptsmc.interceptor_row import (GAINS_HEAD, borrow, pack_chain, pack_position,
+                                                           position_output)
+from ptint_drake.controllers.ptsmc.law import smc_torque
+from ptint_drake.controllers.ptsmc.sliding_surface import SurfaceLaw
+from ptint_drake.robot import rvm1
+from ptint_drake.robot.plant import parse_model
+from ptint_drake.systems.task.chain import KinematicChain
+from ptint_drake.systems.task.targets import SinusoidTarget
+from ptint_drake.systems.task.tbg import gamma_gain, tbg_row
 
 EPS, DELTA, K_GAIN = 1e-6, 1e-6, 50.0
 
@@ -97,12 +97,12 @@ def test_pose_output_gives_the_allocating_kernels_bits(task, inputs):
     ``task_row`` in new arrays) at a sequence of times with repeats (the memo), with the
     system's own compiled target and orientation or with both as inputs (a filter's), with
     σ reset; ``rows`` (all samples in one call) gives the same bits again."""
-    from ptint_drake.systems.gains import ControllerGains
-    from ptint_drake.systems.interceptor import InterceptorLaw
-    from ptint_drake.systems.interceptor_row import pose_row
-    from ptint_drake.systems.orientation import OrientedTarget, SpinningOrientation
-    from ptint_drake.systems.schedule import Schedule, Segment
-    from ptint_drake.systems.task import TASKS
+    from ptint_drake.controllers.ptsmc.gains import ControllerGains
+    from ptint_drake.controllers.ptsmc.interceptor import InterceptorLaw
+    from ptint_drake.controllers.ptsmc.interceptor_row import pose_row
+    from ptint_drake.systems.task.error import TASKS
+    from ptint_drake.systems.task.orientation import OrientedTarget, SpinningOrientation
+    from ptint_drake.systems.task.schedule import Schedule, Segment
 
     plant = parse_model("rvm1_6dof" if task == "pose" else "rvm1_5dof")
     plant.Finalize()

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import pytest
 
-from ptint_drake.scenario import parse_with_overrides, scenario_text
+from ptint_drake.controllers.ptsmc.interceptor_row import pose_output, position_output
 from ptint_drake.simulation import build, make_simulator
-from ptint_drake.systems.interceptor_row import pose_output, position_output
+from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 
 
 @pytest.mark.parametrize("name, kernel", [("curve_b075_tf15", position_output), ("curve_pose", pose_output)])

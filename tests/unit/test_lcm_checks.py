@@ -8,18 +8,9 @@ import numpy as np
 import pytest
 from pydrake.lcm import DrakeLcm
 
+from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, Endpoint, pack_command, pack_status,
+                                       unpack_command, unpack_status, url_warning, utime_of)
 from ptint_drake.hardware.session import HardwareSession, LinkSettings
-from ptint_drake.hardware.link import (
-    COMMAND_CHANNEL,
-    STATUS_CHANNEL,
-    Endpoint,
-    pack_command,
-    pack_status,
-    unpack_command,
-    unpack_status,
-    url_warning,
-    utime_of,
-)
 
 N = 3
 LIMITS = np.array([5.0, 12.0, 12.0])

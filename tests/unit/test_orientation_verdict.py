@@ -6,7 +6,7 @@ on orientation: tests/e2e/test_verdict.py."""
 
 import pytest
 
-from ptint_drake.metrics import Criteria, Reason, segment_reasons, verdict
+from ptint_drake.verdict.metrics import Criteria, Reason, segment_reasons, verdict
 
 
 def _seg(rot0=60.0, rot_half=30.0, rot_tf=0.5, rot_hold=1.0, **position):

@@ -4,9 +4,9 @@ four they were and its replay gets no orientation."""
 
 import numpy as np
 
-from ptint_drake.figures import run_figure
 from ptint_drake.report.run_outputs import run_metrics, view_tasks
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.views.plots import run_figure
 
 POSITION_FIGURES = ["axes.png", "errors.png", "joints.png", "paths3d.png"]
 

@@ -3,9 +3,9 @@ parse_with_overrides): list items, nested keys, one-line errors naming the key o
 
 import pytest
 
-from ptint_drake.scenario import (LoadedScenario, ScenarioError, dump_yaml, parse_scenario,
-                                  parse_with_overrides, scenario_text)
 from ptint_drake.config.yaml_io import override_text, split_path
+from ptint_drake.simulation.scenario import (LoadedScenario, ScenarioError, dump_yaml, parse_scenario,
+                                             parse_with_overrides, scenario_text)
 
 NAME, TEXT = scenario_text("assembly")
 

@@ -10,16 +10,16 @@ from pydrake.perception import BaseField, DepthImageToPointCloud
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.sensors import PixelType
+from static_scene import StaticScene
 
 from ptint_drake.config.measurement import BeltRegionConfig, MeasurementConfig, RgbdCameraConfig
-from ptint_drake.systems.camera import validate_measurement
+from ptint_drake.systems.perception.camera import validate_measurement
 from ptint_drake.systems.perception.part_fit import fit_parts
 from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PartPoseEstimator,
-                                                                 PerceptionConfig, belt_regions,
-                                                                 belts_under_paths)
+                                                                PerceptionConfig, belt_regions,
+                                                                belts_under_paths)
 from ptint_drake.systems.perception.rgbd_camera import cloud_camera_info
-from ptint_drake.systems.perception.static_scene import StaticScene
-from ptint_drake.systems.targets import LinearTarget
+from ptint_drake.systems.task.targets import LinearTarget
 
 BELT = BeltRegionConfig(center=[0.3, 0.0, 0.1], direction=[0.0, 1.0, 0.0], length=0.4, width=0.08)
 TILT = math.radians(30.0)  # from vertical, 0.5 m from the belt

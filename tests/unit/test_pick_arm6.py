@@ -1,6 +1,6 @@
 """Issue 33: the 6-joint arm on pick scenarios — the singularity warning before the run."""
 
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.world import PickWorld
 
 # rvm1_6dof's start posture for the bundled pick scenarios: the tool at conveyor_pick_place's
@@ -33,7 +33,7 @@ def test_the_five_joint_arm_is_not_checked():
 def test_a_six_joint_top_down_task_is_damped_by_default_and_nothing_else_is():
     """controller.pinv_damping left out: 0.015 m/rad for top_down on 6 joints (docs/pick_place.md),
     the exact J⁺ for the 5-joint arm and the other tasks; a value written is kept."""
-    from ptint_drake.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
 
     _, text = scenario_text("conveyor_pick_place")
     six = ["robot.model=rvm1_6dof", f"robot.initial_q_deg={START_6DOF}"]

@@ -7,7 +7,7 @@ from pydrake.math import RotationMatrix
 
 from ptint_drake import cli
 from ptint_drake.config.pick import PartConfig
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.metrics import _place_angle
 from ptint_drake.worlds.pick.placement import nominal_parts, placed_parts
 from ptint_drake.worlds.pick.run import build_pick
@@ -99,7 +99,7 @@ def test_robust_draws_an_rgbd_picks_camera_errors_and_placement_from_its_preset(
     """The camera's calibration error and depth-noise scale come from the ``--ranges`` preset;
     every part is placed at any yaw and within ±15 mm across its belt (issue 34), whatever the
     scenario's own range."""
-    from ptint_drake.scenario import scenario_text
+    from ptint_drake.simulation.scenario import scenario_text
     from ptint_drake.studies import robust
     from ptint_drake.worlds.pick.placement import placed_parts
 
@@ -124,7 +124,7 @@ def test_robust_draws_an_rgbd_picks_camera_errors_and_placement_from_its_preset(
 
 
 def test_a_narrow_belt_clips_the_robust_lateral_range_to_its_half_width():
-    from ptint_drake.scenario import scenario_text
+    from ptint_drake.simulation.scenario import scenario_text
     from ptint_drake.studies import robust
 
     name, text = scenario_text("conveyor_pick_place_rgbd")

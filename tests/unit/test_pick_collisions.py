@@ -5,7 +5,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.analysis import Simulator
 
 from ptint_drake.cli import main
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.collisions import collision_bodies
 from ptint_drake.worlds.pick.metrics import pick_reasons
 from ptint_drake.worlds.pick.run import world_config

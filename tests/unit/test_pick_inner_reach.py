@@ -5,8 +5,8 @@ warned about before the run (``worlds.pick.singularity.inner_reach_warnings``)."
 from pathlib import Path
 from types import SimpleNamespace
 
-from ptint_drake.robot import nominal_plant
-from ptint_drake.scenario import load_scenario
+from ptint_drake.robot.plant import nominal_plant
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick import route
 from ptint_drake.worlds.pick.singularity import inner_reach_warnings
 

@@ -6,7 +6,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from ptint_drake.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.probe import PART_WIDTH
 from ptint_drake.worlds.pick.run import PROBE_PERIOD, AddPickProbe, world_config
 from ptint_drake.worlds.pick.station import MakePickStation

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.robot import nominal_plant
-from ptint_drake.scenario import load_scenario
+from ptint_drake.robot.plant import nominal_plant
+from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick import route
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, pick_plan
 

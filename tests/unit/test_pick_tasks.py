@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
+from ptint_drake.simulation.validation import ScenarioError
 from ptint_drake.worlds.pick.config import BeltConfig, PartConfig, SlotConfig, TrayConfig
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
 from ptint_drake.worlds.pick.tasks import (PHASES, MoveConfig, PickConfig, PickTaskConfig, check_tasks,
                                            pick_plan)
-from ptint_drake.validation import ScenarioError
 
 
 def _pick(**task) -> PickConfig:
@@ -72,7 +72,7 @@ def test_targets_follow_the_simulated_part_then_latch_and_place():
 
 
 def test_robust_samples_a_pick_scenario_within_its_ranges():
-    from ptint_drake.scenario import scenario_text
+    from ptint_drake.simulation.scenario import scenario_text
     from ptint_drake.studies.robust import RANGES, sample_scenario
     from ptint_drake.worlds.pick.studies import robust_summary
 

@@ -12,10 +12,10 @@ import pytest
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import Simulator
 
+from ptint_drake.simulation.validation import ScenarioError
+from ptint_drake.systems.hand.gripper import GripperDriver
 from ptint_drake.worlds.pick.config import BeltConfig, PartConfig, PickWorldConfig, SlotConfig, TrayConfig
 from ptint_drake.worlds.pick.station import MakePickStation
-from ptint_drake.systems.gripper import GripperDriver
-from ptint_drake.validation import ScenarioError
 
 
 def _world(**changes) -> PickWorldConfig:

@@ -5,10 +5,10 @@ nothing written; the bundled orientation scenarios pass it."""
 import pytest
 
 from ptint_drake import cli
+from ptint_drake.robot.plant import make_plant
+from ptint_drake.robot.reachability import check_reachable
+from ptint_drake.simulation.scenario import ScenarioError, load_scenario, parse_scenario
 from ptint_drake.worlds.registry import schedule_of, world_of
-from ptint_drake.reachability import check_reachable
-from ptint_drake.robot import make_plant
-from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario
 
 # x = 0.48 m at z = 0.15 m: within the reach of rvm1_5dof's tool (up to ~0.54 m there), but not
 # with the tool pointing down (the wrist would have to stand 0.12 m above it, out of reach)

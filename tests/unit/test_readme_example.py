@@ -40,7 +40,7 @@ def test_own_diagram_page_names_every_field_of_the_handles():
     """docs/own_diagram.md counts and names ``InterceptorHandles``' fields as the dataclass has them."""
     import dataclasses
 
-    from ptint_drake.systems.builder import InterceptorHandles
+    from ptint_drake.controllers.ptsmc.builder import InterceptorHandles
 
     page = (README.parent / "docs" / "own_diagram.md").read_text()
     paragraph = page.split("`handles` (an `InterceptorHandles`) has ", 1)[1].split("\n\n", 1)[0]

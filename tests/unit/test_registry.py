@@ -3,11 +3,10 @@ the schema, the validation and compare read; the plugin's params; the segment po
 
 import numpy as np
 import pytest
+from plugin_case import SCENARIO, TYPE
 
 from ptint_drake.controllers import REGISTRY, plugin
-from ptint_drake.scenario import ScenarioError, load_scenario, parse_scenario, scenario_text
-
-from plugin_case import SCENARIO, TYPE
+from ptint_drake.simulation.scenario import ScenarioError, load_scenario, parse_scenario, scenario_text
 
 
 def load_scenario_text() -> str:
@@ -26,7 +25,7 @@ def test_the_schema_validation_and_compare_read_the_one_registry():
     from dataclasses import fields  # noqa: PLC0415
 
     from ptint_drake.controllers import CONTROLLERS, REGISTRY  # noqa: PLC0415
-    from ptint_drake.scenario import ControllerConfig  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import ControllerConfig  # noqa: PLC0415
     from ptint_drake.studies.compare import DEFAULT_CONTROLLERS  # noqa: PLC0415
 
     assert CONTROLLERS == tuple(REGISTRY) == DEFAULT_CONTROLLERS
@@ -46,8 +45,8 @@ def test_the_schema_validation_and_compare_read_the_one_registry():
 def test_the_segment_port_carries_index_start_and_tf():
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
-    from ptint_drake.systems.active_segment import ActiveSegment  # noqa: PLC0415
-    from ptint_drake.systems.schedule import Schedule, Segment  # noqa: PLC0415
+    from ptint_drake.systems.task.active_segment import ActiveSegment  # noqa: PLC0415
+    from ptint_drake.systems.task.schedule import Schedule, Segment  # noqa: PLC0415
 
     builder = DiagramBuilder()
     clock = builder.AddSystem(ActiveSegment(Schedule([Segment(0.0, 0.5, 0.75), Segment(0.8, 1.4, 0.5)])))

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ptint_drake.replay import outline_segments
+from ptint_drake.views.replay import outline_segments
 
 
 def test_a_box_outline_is_its_twelve_edges():

@@ -1,5 +1,5 @@
 """Orientation from the camera (issue 21): the camera's orientation samples, the SO(3) filter of
-systems/rotation_estimator.py, its wiring to the interceptor's ``target_rotation`` and the
+systems/estimation/rotation_estimator.py, its wiring to the interceptor's ``target_rotation`` and the
 scenario field ``measurement.rot_noise_deg``."""
 
 import math
@@ -10,13 +10,13 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from ptint_drake.scenario import ScenarioError, load_scenario, parse_with_overrides, scenario_text
 from ptint_drake.simulation import build
-from ptint_drake.systems.camera import Camera, MeasurementConfig
-from ptint_drake.systems.orientation import (ObjectRotations, OrientedTarget, SpinningOrientation,
-                                             rotation_angle, rotation_log)
-from ptint_drake.systems.rotation_estimator import RotationEstimator
-from ptint_drake.systems.targets import LinearTarget
+from ptint_drake.simulation.scenario import ScenarioError, load_scenario, parse_with_overrides, scenario_text
+from ptint_drake.systems.estimation.rotation_estimator import RotationEstimator
+from ptint_drake.systems.perception.camera import Camera, MeasurementConfig
+from ptint_drake.systems.task.orientation import (ObjectRotations, OrientedTarget, SpinningOrientation,
+                                                  rotation_angle, rotation_log)
+from ptint_drake.systems.task.targets import LinearTarget
 
 LINE = LinearTarget([0.3, 0.0, 0.15], [0.0, 0.1, 0.0])
 
@@ -154,7 +154,7 @@ measurement: {rate_hz: 30.0, noise_std: 0.002, latency: 0.033}
 
 
 def test_a_plugin_declaring_target_rotation_gets_the_cameras_estimate(tmp_path, monkeypatch):
-    from ptint_drake.scenario import parse_scenario  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import parse_scenario  # noqa: PLC0415
 
     (tmp_path / "rotation_reader.py").write_text(ROTATION_PLUGIN)
     monkeypatch.syspath_prepend(str(tmp_path))

@@ -5,9 +5,9 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ptint_drake.run_warnings import Profile, feasibility_warning
-from ptint_drake.worlds.pick.runaway import SATURATED_FRACTION, SPEED_RUNAWAY_S, runaway_reasons
+from ptint_drake.verdict.run_warnings import Profile, feasibility_warning
 from ptint_drake.worlds.pick.collisions import touched_before_close
+from ptint_drake.worlds.pick.runaway import SATURATED_FRACTION, SPEED_RUNAWAY_S, runaway_reasons
 
 
 def test_the_thresholds_name_a_runaway_and_nothing_below_them():

@@ -5,9 +5,9 @@ import pytest
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from ptint_drake.systems.kinematics import TaskSpaceKinematics
-from ptint_drake.rvm1 import (START_Q_DEG, START_THETA_DEG, model_path, paper_fk, paper_jacobian,
-                              q_from_theta, theta_from_q)
+from ptint_drake.robot.rvm1 import (START_Q_DEG, START_THETA_DEG, model_path, paper_fk, paper_jacobian,
+                                    q_from_theta, theta_from_q)
+from ptint_drake.systems.task.kinematics import TaskSpaceKinematics
 
 
 @pytest.fixture(scope="module")

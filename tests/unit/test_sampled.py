@@ -11,10 +11,10 @@ from pydrake.systems.primitives import ZeroOrderHold
 
 from ptint_drake import cli
 from ptint_drake.controllers.hold import HOLD_NAME
-from ptint_drake.robot import make_plant
-from ptint_drake.run_warnings import sampled_control_warnings
-from ptint_drake.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
+from ptint_drake.robot.plant import make_plant
 from ptint_drake.simulation import build
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, dump_yaml, parse_scenario
+from ptint_drake.verdict.run_warnings import sampled_control_warnings
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 CURVE = "curve_b075_tf15"

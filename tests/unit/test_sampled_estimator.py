@@ -1,14 +1,14 @@
-"""systems/sampled_estimator.py: the camera-sample timing rule and the priming, written once and
+"""systems/estimation/sampled_estimator.py: the camera-sample timing rule and the priming, written once and
 used by the Kalman filter, the IMM and the rotation filter alike."""
 
 import numpy as np
 import pytest
 
-from ptint_drake.systems.camera import MeasurementConfig
-from ptint_drake.systems.imm import AdaptiveTargetEstimator
-from ptint_drake.systems.kalman import TargetKalmanFilter
-from ptint_drake.systems.rotation_estimator import RotationEstimator
-from ptint_drake.systems.sampled_estimator import SampledEstimator
+from ptint_drake.systems.estimation.imm import AdaptiveTargetEstimator
+from ptint_drake.systems.estimation.kalman import TargetKalmanFilter
+from ptint_drake.systems.estimation.rotation_estimator import RotationEstimator
+from ptint_drake.systems.estimation.sampled_estimator import SampledEstimator
+from ptint_drake.systems.perception.camera import MeasurementConfig
 
 CONFIG = MeasurementConfig(noise_std=0.002, rate_hz=30.0, latency=0.05, compensate_latency=True)
 MAKERS = {

@@ -7,8 +7,8 @@ import yaml
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.systems.analysis import SimulatorConfig
 
-from ptint_drake.scenario import (ScenarioError, bundled_scenarios, dump_dataclass, dump_yaml,
-                                  load_scenario, parse_scenario, scenario_text)
+from ptint_drake.simulation.scenario import (ScenarioError, bundled_scenarios, dump_dataclass, dump_yaml,
+                                             load_scenario, parse_scenario, scenario_text)
 
 DRAKE_FIELDS = set(yaml.safe_load(yaml_dump_typed(SimulatorConfig())))  # the installed Drake's
 

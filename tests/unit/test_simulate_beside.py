@@ -26,7 +26,7 @@ pytestmark = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_meth
 FORKED = r'''
 import json, os, sys, types
 from ptint_drake.report import run_outputs
-from ptint_drake.scenario import ScenarioError
+from ptint_drake.simulation.scenario import ScenarioError
 
 parent = os.getpid()
 

@@ -6,8 +6,8 @@ import signal
 
 import pytest
 
-from ptint_drake import outputs
-from ptint_drake.outputs import METRICS, staged_output
+from ptint_drake.outputs import folder as outputs
+from ptint_drake.outputs.folder import METRICS, staged_output
 
 
 class _Interrupted(Exception):

@@ -4,7 +4,7 @@ only where the bindings need it, and systems with continuous state left alone.""
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
-from ptint_drake.systems.stateless_derivatives import OVERRIDE_LOOKUP_THROWS, install_stateless_derivatives
+from ptint_drake.worlds.stateless_derivatives import OVERRIDE_LOOKUP_THROWS, install_stateless_derivatives
 
 
 class _Constant(LeafSystem):

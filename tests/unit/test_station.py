@@ -8,12 +8,12 @@ import pytest
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ptint_drake.worlds.interception.world import AddController
-from ptint_drake.robot import make_plant
-from ptint_drake.scenario import ScenarioError, load_scenario
+from ptint_drake.robot.plant import make_plant
 from ptint_drake.simulation import simulate
-from ptint_drake.worlds.registry import schedule_of
+from ptint_drake.simulation.scenario import ScenarioError, load_scenario
 from ptint_drake.worlds.interception.station import MakeStation
+from ptint_drake.worlds.interception.world import AddController
+from ptint_drake.worlds.registry import schedule_of
 
 
 def _scenario(mass_scale: float = 1.0, payload_kg: float = 0.0):

@@ -5,12 +5,9 @@ import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
 
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.target_prediction import (
-    POLYNOMIAL_SIZE,
-    ActiveTargetSelector,
-    PolynomialTargetSelector,
-)
+from ptint_drake.systems.estimation.target_prediction import (POLYNOMIAL_SIZE, ActiveTargetSelector,
+                                                              PolynomialTargetSelector)
+from ptint_drake.systems.task.schedule import Schedule, Segment
 
 
 def _value(c, t):

@@ -1,4 +1,4 @@
-"""The compiled task error (systems/task.py, orientation.py) against the equations written here
+"""The compiled task error (systems/task/error.py, orientation.py) against the equations written here
 with numpy and Drake's quaternion (the earlier Python implementation), to 1e-12; the fused
 pose kernel on the chain against the same law on the plant's kinematics."""
 
@@ -9,14 +9,14 @@ import pytest
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
 
-from ptint_drake import rvm1
-from ptint_drake.robot import parse_model
-from ptint_drake.systems.gains import ControllerGains
-from ptint_drake.systems.interceptor import InterceptorLaw
-from ptint_drake.systems.orientation import OrientedTarget, SpinningOrientation, rpy_matrix
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import SinusoidTarget
-from ptint_drake.systems.task import task_error
+from ptint_drake.controllers.ptsmc.gains import ControllerGains
+from ptint_drake.controllers.ptsmc.interceptor import InterceptorLaw
+from ptint_drake.robot import rvm1
+from ptint_drake.robot.plant import parse_model
+from ptint_drake.systems.task.error import task_error
+from ptint_drake.systems.task.orientation import OrientedTarget, SpinningOrientation, rpy_matrix
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import SinusoidTarget
 
 
 def _log(Re):

@@ -5,16 +5,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.special import betaincinv, gamma
 
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.tbg import (
-    TimeBaseGenerator,
-    alpha_gain,
-    alpha_peak,
-    gamma_gain,
-    tbg_derivatives,
-    tbg_profile,
-    tbg_state,
-)
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.tbg import (TimeBaseGenerator, alpha_gain, alpha_peak, gamma_gain,
+                                          tbg_derivatives, tbg_profile, tbg_state)
 
 
 @pytest.mark.parametrize("beta", [0.25, 0.5, 0.75, 0.9])

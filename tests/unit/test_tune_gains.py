@@ -4,7 +4,7 @@ run of the search and brackets the scenario's value; a position task has no rota
 import pytest
 
 from ptint_drake import cli
-from ptint_drake.scenario import LoadedScenario, ScenarioError, parse_scenario, scenario_text
+from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, parse_scenario, scenario_text
 from ptint_drake.studies import tune
 
 

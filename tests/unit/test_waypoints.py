@@ -1,11 +1,11 @@
-"""Waypoint targets: a smooth interpolation through recorded samples (systems/targets.py)."""
+"""Waypoint targets: a smooth interpolation through recorded samples (systems/task/targets.py)."""
 
 import timeit
 
 import numpy as np
 import pytest
 
-from ptint_drake.systems.targets import LinearTarget, WaypointTarget
+from ptint_drake.systems.task.targets import LinearTarget, WaypointTarget
 
 TIMES = [0.0, 0.4, 1.1, 1.5, 2.6]
 POSITIONS = [[0.3, -0.15, 0.15], [0.31, -0.1, 0.17], [0.28, -0.02, 0.2], [0.25, 0.03, 0.18],

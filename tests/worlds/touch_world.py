@@ -4,7 +4,7 @@ the gripper's tool point touches a fixed point at the prescribed time and stays 
 It uses only what a world's author reaches from outside the package's worlds: the protocol
 (``worlds.base``), the simulated arm (``robot.make_plant``), the controller slot
 (``controllers.AddControllerTo`` with a ``TargetView`` of analytic objects), the interceptor's
-segments (``systems.schedule``), a target law (``systems.targets.LinearTarget`` at rest) and the
+segments (``systems.task.schedule``), a target law (``systems.task.targets.LinearTarget`` at rest) and the
 segment verdict (``metrics.segments_reasons``).  Its station is the bare plant: no scene graph,
 no contact, continuous unless the scenario's ``multibody`` makes it discrete (as ``ptint
 hardware`` does).  ``params``: ``point`` (m, world frame), ``tf`` (s), ``beta``.
@@ -17,10 +17,10 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.controllers import AddControllerTo, TargetView
-from ptint_drake.metrics import segments_reasons
-from ptint_drake.robot import make_plant
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import LinearTarget
+from ptint_drake.robot.plant import make_plant
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import LinearTarget
+from ptint_drake.verdict.metrics import segments_reasons
 from ptint_drake.worlds.base import World, WorldRun
 
 

@@ -15,7 +15,7 @@ only up to the part's symmetry, and the sample reports the symmetric yaw nearest
 A frame where object i has no good fit (not in view, occluded, a poor fit) is a dropout for it:
 its output keeps the last sample (same stamp), as the pose camera's does.
 
-Timing (the pose camera's, ``systems.camera``): the sample taken at t_k becomes visible at
+Timing (the pose camera's, ``systems.perception.camera``): the sample taken at t_k becomes visible at
 t_k + latency (latency > 0: the frame is processed after it is taken).  The discrete state is a
 delay buffer of the last N frames, newest first, each [stamp, x, y, z, valid, R (9)] per object,
 and the association's memory; an abstract state holds the newest frame's fits (``fits``).
@@ -37,15 +37,15 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.perception import BaseField, DepthImageToPointCloud, PointCloud
 from pydrake.math import RigidTransform
+from pydrake.perception import BaseField, DepthImageToPointCloud, PointCloud
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, OutputPort
 from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
-from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
 from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, BeltRegion, belt_points, fit_parts,
                                                      part_height, reach)
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
 
 # m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
 # position error of a 30 mm cube's fit at 0.5 m is 0.2-0.7 mm (tests/unit/test_perception.py)

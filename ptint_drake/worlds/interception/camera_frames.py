@@ -18,8 +18,8 @@ import numpy as np
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder, System
 
 from ptint_drake.config.schema import Scenario
-from ptint_drake.systems.perception.part_pose_estimator import AddRgbdPerception
 from ptint_drake.systems.perception.frame_images import write_frame
+from ptint_drake.systems.perception.part_pose_estimator import AddRgbdPerception
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
 from ptint_drake.worlds.interception.station import MakeStation, Station
 

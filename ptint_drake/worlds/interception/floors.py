@@ -12,9 +12,9 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers.slot import TargetView, measures_orientation
-from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
+from ptint_drake.systems.task.schedule import Schedule
 from ptint_drake.worlds.interception.station import MakeStation, Station
+from ptint_drake.worlds.stateless_derivatives import install_stateless_derivatives
 
 
 @dataclass

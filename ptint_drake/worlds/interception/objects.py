@@ -4,9 +4,9 @@ and the schedule of the segments (SPEC 2.1) that intercept them."""
 from __future__ import annotations
 
 from ptint_drake.config.schema import Scenario, TargetConfig
-from ptint_drake.systems.orientation import OrientedTarget, SlerpOrientation, SpinningOrientation
-from ptint_drake.systems.schedule import Schedule, Segment
-from ptint_drake.systems.targets import BallisticTarget, LinearTarget, SinusoidTarget, WaypointTarget
+from ptint_drake.systems.task.orientation import OrientedTarget, SlerpOrientation, SpinningOrientation
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.systems.task.targets import BallisticTarget, LinearTarget, SinusoidTarget, WaypointTarget
 
 
 def interception_schedule(scenario: Scenario) -> Schedule:

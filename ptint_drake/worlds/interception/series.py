@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.orientation import rotation_error, target_rotation_values
-from ptint_drake.systems.targets import target_values
-from ptint_drake.systems.task import task_reference
+from ptint_drake.systems.task.error import task_reference
+from ptint_drake.systems.task.kinematics import FrameKinematics
+from ptint_drake.systems.task.orientation import rotation_error, target_rotation_values
+from ptint_drake.systems.task.targets import target_values
 
 
 def collect_series(built, context, kinematics: FrameKinematics) -> dict:

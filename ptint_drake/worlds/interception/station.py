@@ -42,21 +42,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import Saturation
 
-from pydrake.geometry import SceneGraph
-
-from ptint_drake.robot import actuator_effort_limits, effort_limits, make_plant, resolve_model
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
-from ptint_drake.systems.disturbance import JointDisturbance
-from ptint_drake.systems.orientation import ObjectRotations
+from ptint_drake.robot.plant import actuator_effort_limits, effort_limits, make_plant, resolve_model
 from ptint_drake.systems.perception.part_pose_estimator import perception_belts
 from ptint_drake.systems.perception.rgbd_camera import AddRgbdCamera
 from ptint_drake.systems.perception.scene_geometry import AddArmVisuals, AddPartGeometry
-from ptint_drake.systems.targets import TargetSource
+from ptint_drake.systems.task.orientation import ObjectRotations
+from ptint_drake.systems.task.targets import TargetSource
+from ptint_drake.worlds.interception.disturbance import JointDisturbance
 from ptint_drake.worlds.interception.objects import interception_schedule, interception_targets
 
 

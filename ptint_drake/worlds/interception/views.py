@@ -6,13 +6,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 from pydrake.common.yaml import yaml_load_typed
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.config.yaml_io import dump_yaml
-from ptint_drake.robot import resolve_model
-from ptint_drake.systems.orientation import target_rotation_values
+from ptint_drake.robot.plant import resolve_model
+from ptint_drake.systems.task.orientation import target_rotation_values
 
 
 def conveyor_belts(scenario: Scenario):
@@ -50,7 +49,7 @@ def view_tasks(scenario: Scenario, targets: list, series: dict, metrics: dict, s
                replay: bool, svg: bool) -> list[tuple]:
     """``draw_view`` arguments for a run's figures (PNG, and SVG when ``svg``) and its
     ``replay.html``, written in ``stage``."""
-    from ptint_drake.figures import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
+    from ptint_drake.views.plots import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
 
     formats = ("png", "svg") if svg else ("png",)
     replay_args = (str(resolve_model(scenario.robot.model)), conveyor_belts(scenario),
@@ -75,13 +74,13 @@ def draw_view(name: str, series: dict, metrics: dict, stage: Path, title: str, a
         write_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, stage)
         return name
     if name == "replay":
-        from ptint_drake.replay import write_replay  # noqa: PLC0415
+        from ptint_drake.views.replay import write_replay  # noqa: PLC0415
 
         model_file, belts, end_effector, orientation = args
         write_replay(series, metrics, model_file, stage / "replay.html", conveyors=belts,
                      end_effector=end_effector, orientation=orientation,
                      title=f"{title}: {metrics.get('status', '')}")
         return name
-    from ptint_drake.figures import run_figure  # noqa: PLC0415
+    from ptint_drake.views.plots import run_figure  # noqa: PLC0415
 
     return run_figure(name, series, metrics, stage, title, *args)

@@ -26,17 +26,16 @@ from pydrake.systems.primitives import LogVectorOutput
 from ptint_drake.config.measurement import MeasurementConfig
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
-from ptint_drake.derivatives import uniform_derivatives
-from ptint_drake.metrics import Reason, run_metrics, segments_reasons
-from ptint_drake.reachability import check_reachable
-from ptint_drake.run_warnings import (joint_limit_warnings, sampled_control_warnings, singularity_warnings,
-                                     torque_feasibility)
-from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.schedule import Schedule
-from ptint_drake.systems.signals import TARGET
-from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
-from ptint_drake.systems.targets import active_target_values
-from ptint_drake.watchdog import Watchdog
+from ptint_drake.robot.reachability import check_reachable
+from ptint_drake.systems.task.kinematics import FrameKinematics
+from ptint_drake.systems.task.schedule import Schedule
+from ptint_drake.systems.task.signals import TARGET
+from ptint_drake.systems.task.targets import active_target_values
+from ptint_drake.verdict.metrics import Reason, run_metrics, segments_reasons
+from ptint_drake.verdict.run_warnings import (joint_limit_warnings, sampled_control_warnings,
+                                              singularity_warnings, torque_feasibility)
+from ptint_drake.verdict.watchdog import Watchdog
+from ptint_drake.views.derivatives import uniform_derivatives
 from ptint_drake.worlds.base import World, WorldRun, arm_sample
 from ptint_drake.worlds.interception import views
 from ptint_drake.worlds.interception.checks import check_interceptions
@@ -44,6 +43,7 @@ from ptint_drake.worlds.interception.floors import floor_diagram
 from ptint_drake.worlds.interception.objects import interception_schedule, interception_targets
 from ptint_drake.worlds.interception.series import collect_series, orientation_series
 from ptint_drake.worlds.interception.station import MakeStation, Station
+from ptint_drake.worlds.stateless_derivatives import install_stateless_derivatives
 
 
 @dataclass
@@ -202,7 +202,7 @@ class InterceptionWorld(World):
         return segments_reasons(metrics, criteria)
 
     def figure_files(self, scenario: Scenario) -> list[str]:
-        from ptint_drake.figures import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
+        from ptint_drake.views.plots import run_figure_stems  # noqa: PLC0415  (no matplotlib import)
 
         return [f"{s}.png" for s in run_figure_stems(scenario.controller.task)]
 

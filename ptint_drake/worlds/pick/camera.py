@@ -44,15 +44,15 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.measurement import BeltRegionConfig, MeasurementConfig
 from ptint_drake.config.pick import PickConfig
-from ptint_drake.systems.imm import AdaptiveTargetEstimator
-from ptint_drake.systems.kalman import TargetKalmanFilter
+from ptint_drake.systems.estimation.imm import AdaptiveTargetEstimator
+from ptint_drake.systems.estimation.kalman import TargetKalmanFilter
+from ptint_drake.systems.estimation.rotation_estimator import RotationEstimator
 from ptint_drake.systems.perception.part_fit import BeltRegion, fold_yaw, yaw_symmetry
 from ptint_drake.systems.perception.part_pose_estimator import (FIT_NOISE_STD, MakeRgbdPerception,
-                                                                 PartPoseEstimator, PerceptionConfig,
-                                                                 belt_regions)
+                                                                PartPoseEstimator, PerceptionConfig,
+                                                                belt_regions)
 from ptint_drake.systems.perception.rgbd_camera import (AddRgbdCamera, RgbdCamera, camera_info, camera_pose,
-                                                         describe_pose, in_view)
-from ptint_drake.systems.rotation_estimator import RotationEstimator
+                                                        describe_pose, in_view)
 from ptint_drake.worlds.pick.placement import nominal_parts
 
 # a part is aimed at only after this many accepted fits (``world.PickRun``; fewer: ``pick k: part

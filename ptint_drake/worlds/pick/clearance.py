@@ -1,18 +1,18 @@
 """Before a pick run: do the fingers keep clear of the belts on the way to each part?
 
 The approach and the descend of a task are prescribed-time interceptions of a moving target: with
-the controller's design error dynamics e(t) = ξ(t) e(t0) (SPEC 2.1, ξ the time base generator
-ξ(τ) = I⁻¹(1−β, 1−β; 1 − τ/tf)), the fingertip centre follows x(t) = p(t) + ξ(t) (x(t0) − p(t0)),
-with p(t) the target riding its belt at the belt's nominal speed.  ``check_pick_clearance``
-samples that path (the approach from the start pose, or from the previous task's retreat, to
-``clearance`` above the part, by way of its via if it has one: ``route``; the descend onto the
-part's centre) and checks the fingers' vertical
-extent (from the pads' lower edge to the fingers' top, read from the gripper's collision geometry)
-against each belt's slab wherever the open fingers (a disc of half the opening plus the finger's
-thickness) are over it.  A pass into a belt, or less than ``MIN_CLEARANCE`` above it, is a
-one-line ScenarioError naming the field to change (exit 2), as is a part wider than the gripper's
-stroke less its task's margin (``check_pick_opening``).  The links above the hand are not
-checked here: their contacts are found during the run (``collisions``).
+the controller's design error dynamics e(t) = ξ(t) e(t0) (SPEC 2.1, ξ the time base generator ξ(τ)
+= I⁻¹(1−β, 1−β; 1 − τ/tf)), the fingertip centre follows x(t) = p(t) + ξ(t) (x(t0) − p(t0)), with
+p(t) the target riding its belt at the belt's nominal speed. ``check_pick_clearance`` samples that
+path — the planned way of ``route.segment_way``, the one tracer the vias and the feasibility check
+follow too: the approach from the start pose, or from the previous task's retreat, to ``clearance``
+above the part, by way of its via if it has one; the descend onto the part's centre — and checks
+the fingers' vertical extent (from the pads' lower edge to the fingers' top, read from the
+gripper's collision geometry) against each belt's slab wherever the open fingers (a disc of half
+the opening plus the finger's thickness) are over it. A pass into a belt, or less than
+``MIN_CLEARANCE`` above it, is a one-line ScenarioError naming the field to change (exit 2), as is
+a part wider than the gripper's stroke less its task's margin (``check_pick_opening``). The links
+above the hand are not checked here: their contacts are found during the run (``collisions``).
 """
 
 from __future__ import annotations
@@ -21,12 +21,12 @@ import numpy as np
 from pydrake.geometry import Box
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.systems.hand.datasheets import payload_warnings
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.feasibility import feasibility_warnings
-from ptint_drake.worlds.pick.grippers import payload_warnings
-from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
+from ptint_drake.worlds.pick.route import nominal, segment_way
 from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
-from ptint_drake.worlds.pick.route import xi
+from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.tasks import VIA_PART
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
@@ -59,47 +59,25 @@ def check_pick_clearance(scenario, built) -> None:
     docstring); ``built``: a ``run.PickBuilt``."""
     station, plan = built.station, built.plan
     config = station.config
-    belts = {b.name: b for b in config.belts}
-    context = station.plant.CreateDefaultContext()
-    arm_context = built.arm.CreateDefaultContext()
-    built.arm.SetPositions(arm_context, np.radians(scenario.robot.initial_q_deg))
-    x0 = built.arm.GetFrameByName(scenario.robot.end_effector).CalcPoseInWorld(arm_context).translation()
     reach, top, thickness = finger_extent(station)
     stroke = sum(station.plant.GetJointByName(n, station.gripper).position_upper_limits()[0]
                  for n in FINGER_JOINTS)
     check_pick_opening(scenario, stroke)
+    world = nominal(scenario, built.arm)
     for k, task in enumerate(scenario.pick.tasks):
         i_part = plan.segments[plan.segment_index(k, "approach")].index
-        part = config.parts[i_part]
-        belt = belts[part.belt]
-        start = station.parts[i_part].EvalPoseInWorld(context).translation()
-        ride = belt.speed * np.asarray(belt.direction, dtype=float)
-        radius = min(grasp_width(part) + task.margin, stroke) / 2 + thickness
+        radius = min(grasp_width(config.parts[i_part]) + task.margin, stroke) / 2 + thickness
+        approach_field = "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"
         via = [i for i, s in enumerate(plan.segments) if s.task == k and s.kind == VIA_PART]
-        if via:  # the way around the base (route): a fixed point first
-            seg = plan.schedule.segments[via[0]]
-            field = "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"
-            point = np.asarray(plan.segments[via[0]].offset)
+        checked = [(i, approach_field, "via") for i in via[:1]]  # the way around the base (route)
+        checked += [(plan.segment_index(k, "approach"), approach_field, "approach"),
+                    (plan.segment_index(k, "descend"), f"pick.parts[{i_part}].size", "descend")]
+        for i, field, phase in checked:
+            seg = plan.schedule.segments[i]
             tau = np.linspace(0.0, seg.tf, SAMPLES)
-            path = point + np.outer(xi(tau, seg.tf, seg.beta), x0 - point)
+            path = segment_way(world, plan, i, tau)
             for b in config.belts:
-                _check_belt(b, path, seg.start + tau, reach, top, radius, field, k, "via")
-            x0 = point
-        for phase, field in (("approach", "robot.initial_q_deg" if k == 0 else f"pick.tasks[{k}].clearance"),
-                             ("descend", f"pick.parts[{i_part}].size")):
-            seg = plan.schedule.segments[plan.segment_index(k, phase)]
-            lift = np.array([0.0, 0.0, task.clearance if phase == "approach" else 0.0])
-            tau = np.linspace(0.0, seg.tf, SAMPLES)
-            t = seg.start + tau
-            target = start + np.outer(t, ride) + lift
-            if phase == "descend":
-                x0 = start + seg.start * ride + [0.0, 0.0, task.clearance]
-            path = target + np.outer(xi(tau, seg.tf, seg.beta), x0 - target[0])
-            for b in config.belts:
-                _check_belt(b, path, t, reach, top, radius, field, k, phase)
-            x0 = path[-1]
-        place = built.targets.places[plan.segment_index(k, "place")]
-        x0 = place + [0.0, 0.0, task.clearance]
+                _check_belt(b, path, seg.start + tau, reach, top, radius, field, k, phase)
 
 
 def check_pick_opening(scenario, stroke: float) -> None:

@@ -13,10 +13,15 @@ the plant's settings (Drake's ``MultibodyPlantConfig`` fields that matter here).
 import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
-from ptint_drake.config.pick import (BeltConfig, GripperConfig, PartConfig, PickWorldConfig, SlotConfig,  # noqa: F401
-                                     TrayConfig)
-from ptint_drake.worlds.pick.grippers import check_gripper
-
+from ptint_drake.config.pick import (  # noqa: F401
+    BeltConfig,
+    GripperConfig,
+    PartConfig,
+    PickWorldConfig,
+    SlotConfig,
+    TrayConfig,
+)
+from ptint_drake.systems.hand.datasheets import check_gripper
 
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
 DEFAULT_APPROXIMATION = "sap"  # measured by scripts/contact_bench.py: the most accurate, and fast

@@ -4,7 +4,7 @@ commands and the grasp state, with no plant.
 
 ``AddPickControllerSide`` adds to a builder: ``PickTargets`` (what each segment aims at) fed from
 an input of the parts' motion as received, ``GripperSequence`` (the plan's gripper commands) and
-``GraspObserver`` (``systems.gripper``: the grasp state) fed from an input of the gripper's
+``GraspObserver`` (``systems.hand.gripper``: the grasp state) fed from an input of the gripper's
 reported fingers and drive forces.  The slots' places come from the scenario's tray (the station
 built once for its geometry: no state of it is read).
 
@@ -17,7 +17,7 @@ port (export)   size        meaning
                             the estimators and ``EstimatedParts`` run here (``camera``)
 ``gripper``     6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each finger
                             drive's force (N, − squeezes): ``GraspObserver``'s inputs
-``grasp_state`` 1           output: the observer's state (``systems.gripper.GRASP_STATES``)
+``grasp_state`` 1           output: the observer's state (``systems.hand.gripper.GRASP_STATES``)
 ==============  ==========  ================================================================
 
 ``grasp_reads`` gives when ``world.PickRun`` reads that state (its grasp checks and the reads
@@ -30,17 +30,16 @@ from dataclasses import dataclass
 
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.sensors import ImageDepth32F
 from pydrake.systems.primitives import Demultiplexer, PassThrough
+from pydrake.systems.sensors import ImageDepth32F
 
 from ptint_drake.config.schema import Scenario
+from ptint_drake.systems.hand.gripper import EMPTY, HOLDING, LOST, GraspObserver
 from ptint_drake.worlds.base import LinkPorts
-from ptint_drake.systems.gripper import EMPTY, HOLDING, LOST, GraspObserver
 from ptint_drake.worlds.pick.camera import AddPartEstimates
-from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
-from ptint_drake.worlds.pick.station import MakePickStation
-from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
 from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
+from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
 
 PART_MOTION = (9, 15)  # a part's [x, ẋ, ẍ] and [R, ω, ω̇]
 CAMERA_NAME = "camera"  # the station's rgbd camera over LCM: DRAKE_RGBD_CAMERA_IMAGES_camera
@@ -105,7 +104,7 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     ``period``: the control period, ``sense``: ``grasp_reads``'s."""
     pick = scenario.pick
     plan = routed_plan(scenario)
-    places = place_positions(MakePickStation(world_config(scenario)), plan)
+    places = place_positions(world_config(scenario), plan)
     count = len(pick.parts)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, count, places))
     m = scenario.measurement

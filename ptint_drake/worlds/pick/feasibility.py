@@ -26,11 +26,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ptint_drake.reachability import inverse_kinematics
-from ptint_drake.robot import effort_limits
-from ptint_drake.run_warnings import Profile, feasibility_warning, joint_demand, profile_times
-from ptint_drake.systems.tbg import tbg_profile
-from ptint_drake.worlds.pick.route import nominal, segment_target, tool_yaws
+from ptint_drake.robot.plant import effort_limits
+from ptint_drake.robot.reachability import inverse_kinematics
+from ptint_drake.systems.task.tbg import tbg_profile
+from ptint_drake.verdict.run_warnings import Profile, feasibility_warning, joint_demand, profile_times
+from ptint_drake.worlds.pick.route import nominal, segment_target, start_error, tool_yaws
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT
 
 HELD = ("lift", "carry", "place")  # phases that carry the part (a via before a carry too)
@@ -48,12 +48,11 @@ def _profiles(scenario, built) -> list:
     q, out = world.q0, []
     for i, (seg, s) in enumerate(zip(plan.segments, plan.schedule.segments)):
         tau = profile_times(s.tf)
-        x0 = world.start if i == 0 else segment_target(world, plan, i - 1, s.start)[0]
         target = segment_target(world, plan, i, s.start + tau)
         ride = world.parts[seg.index][1] if seg.kind in ("part",) else np.zeros(3)
         xi, xi_d = tbg_profile(tau, s.tf, s.beta)[0:2]
         xi_dd = tbg_profile(tau, s.tf, max(s.beta, 0.5))[2]
-        e0 = x0 - segment_target(world, plan, i, s.start)[0]
+        e0 = start_error(world, plan, i)
         yaw0, yaw1 = yaws[i]
         turn = yaw0 - yaw1
         postures = []

@@ -3,7 +3,7 @@
 ``pick_figure`` — ``picks.png``: the run's verdict on top; per pick a block of four panels under
 its outcome (grasp time against the prescribed, place error), over the task's time: the tool's distance to
 the part (mm, log scale) and its angle from the top-down grasp (deg), the finger opening (mm) with
-the grasp state the gripper reported (``systems.gripper.GraspObserver``: open … lost, a step line),
+the grasp state the gripper reported (``systems.hand.gripper.GraspObserver``: open … lost, a step line),
 the grip force (N): the measured contact force squeezing the part (the smaller of the two pads'
 normal forces, as ``peak_grip_force_N``) with the drives' force thin beside it, and the part's
 height (mm); each attempt's prescribed grasp time (dashed) and close command (dotted) marked.
@@ -28,7 +28,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 
 FONT_SIZE = 11  # pt, the pick figures' text (at 100 dpi: readable at the PNG's own size)
 
@@ -292,7 +291,7 @@ def _estimate_legend(axes) -> None:
 
 def _state_line(ax, t: np.ndarray, codes: np.ndarray) -> None:
     """The gripper's reported grasp state over time, a step line on its own axis (open … lost)."""
-    from ptint_drake.systems.gripper import GRASP_STATES  # noqa: PLC0415
+    from ptint_drake.systems.hand.gripper import GRASP_STATES  # noqa: PLC0415
 
     ax.step(t, codes, where="post", color="tab:green", lw=0.9, label="grasp state (right axis)")
     ax.set_yticks(range(len(GRASP_STATES)), GRASP_STATES, fontsize=FONT_SIZE - 2, color="tab:green")

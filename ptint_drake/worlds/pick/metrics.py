@@ -6,7 +6,7 @@ slot), and the tool's angle from the top-down grasp (deg).
 
 ``pick_metrics`` — metrics.json's ``"picks"``, one entry per task, from the probe's log
 (``pick.probe``, every 2 ms: the plant's truth, never the controller's view) and the grasp
-observer's log (``systems.gripper.GraspObserver``: what the gripper sensed):
+observer's log (``systems.hand.gripper.GraspObserver``: what the gripper sensed):
 
 - ``attempts``: approaches and descends made (1 + retries); ``attempt_details``: per attempt its
   close command, prescribed grasp time, when its grasp state was read (``t_check``) and what it
@@ -56,10 +56,10 @@ import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
 
+from ptint_drake.systems.task.orientation import rotation_angle, tool_yaw, top_down_reference
 from ptint_drake.worlds.pick.collisions import pick_collisions, touched_before_close
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.worlds.pick.runaway import runaway_reasons
-from ptint_drake.systems.orientation import rotation_angle, tool_yaw, top_down_reference
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time
 EARLY_GRASP = 0.05  # s before it
@@ -143,7 +143,7 @@ def _at(t: np.ndarray, when: float) -> int:
 
 
 def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
-    from ptint_drake.systems.gripper import GRASP_STATES, HOLDING  # noqa: PLC0415
+    from ptint_drake.systems.hand.gripper import GRASP_STATES, HOLDING  # noqa: PLC0415
 
     t, probe = logs["probe"]
     forces, states = logs["grip_forces"][1], logs["grasp_state"][1][:, 0]

@@ -52,7 +52,8 @@ from pydrake.multibody.plant import ContactResults
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
-from ptint_drake.worlds.pick.collisions import FINGER, OTHER as OBSTACLE_OTHER, CollisionProbe
+from ptint_drake.worlds.pick.collisions import FINGER, CollisionProbe
+from ptint_drake.worlds.pick.collisions import OTHER as OBSTACLE_OTHER
 from ptint_drake.worlds.pick.contact_pairs import contact_force
 
 PART_WIDTH = 10  # values per part in the probe's output

@@ -50,7 +50,7 @@ import numpy as np
 from pydrake.multibody.tree import JointIndex
 from scipy.special import betaincinv
 
-from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.worlds.pick.camera import nominal_paths as nominal_motions
 from ptint_drake.worlds.pick.placement import nominal_parts
 from ptint_drake.worlds.pick.scene import part_shape, tray_pose
@@ -132,18 +132,28 @@ def segment_target(world: Nominal, plan: PickPlan, i: int, t) -> np.ndarray:
     return p0 + np.outer(t, v) + offset
 
 
-def nominal_paths(world: Nominal, plan: PickPlan) -> list:
-    """Per segment of ``plan``: its way (``SAMPLES`` × 3, m) from where the previous segment's target
-    is at its start (the start posture's tool point for the first), under ideal tracking of the
-    error dynamics (module docstring)."""
-    out, x0 = [], world.start
-    for i, s in enumerate(plan.schedule.segments):
-        if i > 0:
-            x0 = segment_target(world, plan, i - 1, s.start)[0]
-        tau = np.linspace(0.0, s.tf, SAMPLES)
-        target = segment_target(world, plan, i, s.start + tau)
-        out.append(target + np.outer(xi(tau, s.tf, s.beta), x0 - target[0]))
-    return out
+def start_error(world: Nominal, plan: PickPlan, i: int) -> np.ndarray:
+    """e(t0) of segment i (m): where the way starts — the previous segment's target at this one's
+    start, the start posture's tool point for the first — less this segment's target then."""
+    s = plan.schedule.segments[i]
+    x0 = world.start if i == 0 else segment_target(world, plan, i - 1, s.start)[0]
+    return x0 - segment_target(world, plan, i, s.start)[0]
+
+
+def segment_way(world: Nominal, plan: PickPlan, i: int, tau: np.ndarray) -> np.ndarray:
+    """Segment i's way at the times ``tau`` after its start (rows × 3, m): its target plus
+    ξ(τ) e(t0), ideal tracking of the error dynamics (module docstring).  The one tracer of the
+    planned way: the vias here, the clearance and the feasibility checks all follow it."""
+    s = plan.schedule.segments[i]
+    tau = np.asarray(tau, float)
+    return (segment_target(world, plan, i, s.start + tau)
+            + np.outer(xi(tau, s.tf, s.beta), start_error(world, plan, i)))
+
+
+def nominal_paths(world: Nominal, plan: PickPlan, samples: int = SAMPLES) -> list:
+    """Per segment of ``plan``: its way (``samples`` × 3, m) over the whole segment (``segment_way``)."""
+    return [segment_way(world, plan, i, np.linspace(0.0, s.tf, samples))
+            for i, s in enumerate(plan.schedule.segments)]
 
 
 def _nearest(world: Nominal, path: np.ndarray) -> tuple:
@@ -310,7 +320,7 @@ def routed_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
     """The scenario's plan with the ``replans`` a run decided and its vias (``plan_vias``); ``arm``:
     the arm's model alone (default ``robot.nominal_plant``)."""
     if arm is None:
-        from ptint_drake.robot import nominal_plant  # noqa: PLC0415
+        from ptint_drake.robot.plant import nominal_plant  # noqa: PLC0415
 
         arm = nominal_plant(scenario)
     return pick_plan(scenario.pick, replans, plan_vias(scenario, nominal(scenario, arm), replans))

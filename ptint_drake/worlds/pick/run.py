@@ -6,7 +6,7 @@ through the drive's zero-order hold and the effort limits; the arm's kinematics 
 the arm's model file alone — the controller knows nothing of the gripper, the parts or the
 payload), ``PickTargets`` (what each segment aims at, from the parts' simulated poses),
 ``GripperSequence`` (open, close at the prescribed time, open), ``GraspObserver`` (the grasp
-state from the fingers' width, speed and drive force: ``systems.gripper``) and ``PickProbe``
+state from the fingers' width, speed and drive force: ``systems.hand.gripper``) and ``PickProbe``
 (poses, contacts and pad forces, recorded every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it
 through the one runner
 (``worlds.runner``), stopping at every segment's start and end; its metrics carry the segments and
@@ -25,19 +25,20 @@ from pydrake.systems.primitives import LogVectorOutput, Saturation
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario, default_simulator
 from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
-from ptint_drake.reachability import inverse_kinematics
-from ptint_drake.robot import actuator_effort_limits, nominal_plant
-from ptint_drake.systems.gripper import GraspObserver
-from ptint_drake.systems.kinematics import FrameKinematics
-from ptint_drake.systems.stateless_derivatives import install_stateless_derivatives
+from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
+from ptint_drake.robot.reachability import inverse_kinematics
+from ptint_drake.systems.hand.gripper import GraspObserver
+from ptint_drake.systems.task.kinematics import FrameKinematics
 from ptint_drake.worlds.pick.camera import AddPartEstimates, PartEstimates
 from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
 from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.worlds.pick.probe import PickProbe
+from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.scene import slot_pose
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
-from ptint_drake.worlds.pick.route import routed_plan
 from ptint_drake.worlds.pick.tasks import PickPlan, Replan
+from ptint_drake.worlds.stateless_derivatives import install_stateless_derivatives
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
@@ -78,7 +79,7 @@ class PickBuilt:
     loggers: dict
     arm: object  # the arm's model alone (continuous, nominal): the controller's kinematics
     limits: np.ndarray  # the arm's effort limits (N·m)
-    observer: GraspObserver = None  # the grasp state (systems.gripper)
+    observer: GraspObserver = None  # the grasp state (systems.hand.gripper)
     estimates: PartEstimates = None  # with an rgbd camera: what the pick aims at (pick.camera)
     # with an rgbd camera: the same plan's targets read off the simulated parts (the metrics' truth)
     true_targets: PickTargets = None
@@ -91,18 +92,19 @@ class PickBuilt:
         return self.diagram.GetSubsystemByName("pick_station")
 
 
-def place_positions(station: PickStation, plan: PickPlan) -> list:
+def place_positions(config: PickWorldConfig, plan: PickPlan) -> list:
     """Per segment: the world position of its slot's place pose (the part's centre resting on the
-    tray), None for the segments that aim at a part."""
-    context = station.plant.CreateDefaultContext()
+    tray), None for the segments that aim at a part — from the declared tray and slots alone
+    (``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at), so the controller
+    side needs no station to find them."""
     out = []
     for seg in plan.segments:
         if seg.kind != "slot":
             out.append(None)
             continue
-        part = station.config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
+        part = config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
         height = part.size[2] if part.shape == "box" else part.size[1]
-        out.append(station.slots[seg.index].CalcPoseInWorld(context).translation() + [0.0, 0.0, height / 2])
+        out.append(slot_pose(config.tray, seg.index).translation() + [0.0, 0.0, height / 2])
     return out
 
 
@@ -114,13 +116,14 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     arm = nominal_plant(scenario)
     plan = routed_plan(scenario, replans, arm)  # the way around the base where one is needed (route)
     n = len(station.parts)
-    targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, place_positions(station, plan)))
+    places = place_positions(station.config, plan)
+    targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, places))
     estimates, parts, true_targets = None, st, None
     if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
         estimates = AddPartEstimates(builder, st.GetOutputPort("depth_image"), scenario)
         parts = estimates.parts
         true_targets = builder.AddNamedSystem("pick_targets_true",
-                                              PickTargets(plan, n, place_positions(station, plan)))
+                                              PickTargets(plan, n, places))
         _connect_parts(builder, st, true_targets, n)
     _connect_parts(builder, parts, targets, n)
     limits = actuator_effort_limits(arm)

@@ -33,17 +33,16 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial,
-                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties,
-                              Sphere)
+                              AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties, Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelInstanceIndex,
                                     PdControllerGains, PrismaticJoint, SpatialInertia)
 
-from ptint_drake.worlds.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
-from ptint_drake.rvm1 import model_path
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.robot.rvm1 import model_path
+from ptint_drake.worlds.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
 
 BELT_KD = 1e5  # N·s/m: the belt's velocity servo (implicit, so any stiffness is stable)
 BELT_FORCE = 1e4  # N: the belt drive's force limit
@@ -213,6 +212,13 @@ def _part_nub_points(part: PartConfig) -> list:
 def tray_pose(tray: TrayConfig) -> RigidTransform:
     """The tray's top-surface centre, turned ``yaw_deg`` about the vertical."""
     return RigidTransform(RollPitchYaw(0.0, 0.0, np.radians(tray.yaw_deg)), tray.center)
+
+
+def slot_pose(tray: TrayConfig, k: int) -> RigidTransform:
+    """X_WS of slot k: the tray's pose times the slot's offset and yaw on its top surface."""
+    slot = tray.slots[k]
+    return tray_pose(tray).multiply(RigidTransform(RotationMatrix.MakeZRotation(np.radians(slot.yaw_deg)),
+                                                   [slot.offset[0], slot.offset[1], 0.0]))
 
 
 def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from ptint_drake.reachability import inverse_kinematics
+from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.worlds.pick.route import FULL_TOP_DOWN, INNER_MARGIN, nominal, nominal_paths, too_near
 from ptint_drake.worlds.pick.tasks import VIA_PART
 

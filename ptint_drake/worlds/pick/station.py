@@ -5,7 +5,7 @@ station (``station.MakeStation`` for the interception-only world): a discrete Mu
 (Drake's ``MultibodyPlantConfig`` + ``AddMultibodyPlant``: ``time_step`` 1 ms, the configured
 contact model and discrete contact approximation), the arm parsed from its model file into its own
 model instance (as ``robot.parse_model`` does), the gripper welded at the arm's end-effector frame
-with its driver (``systems.gripper.GripperDriver``), the belts running at their speeds, the parts
+with its driver (``systems.hand.gripper.GripperDriver``), the belts running at their speeds, the parts
 resting on them, the tray with its slots (``pick.scene``), and ``PartPoses`` reading every part's
 simulated motion.  The arm's controller sees only the arm: its state and actuation ports carry
 the arm's joints and nothing of the fingers, belts or parts.
@@ -54,16 +54,16 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.robot.plant import resolve_model
+from ptint_drake.systems.hand.datasheets import check_mount
+from ptint_drake.systems.hand.gripper import GripperDriver
 from ptint_drake.worlds.pick.camera import AddPickCamera
 from ptint_drake.worlds.pick.collisions import CollisionProbe
-from ptint_drake.worlds.pick.contact_pairs import ContactPairs
 from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
-from ptint_drake.worlds.pick.grippers import check_mount
+from ptint_drake.worlds.pick.contact_pairs import ContactPairs
 from ptint_drake.worlds.pick.part_pose import PartPoses
 from ptint_drake.worlds.pick.scene import AddBelt, AddFloor, AddGripper, AddPart, AddTray, gripper_stroke
-from ptint_drake.robot import resolve_model
-from ptint_drake.systems.gripper import GripperDriver
-from ptint_drake.config.errors import ScenarioError
 
 
 @dataclass

@@ -28,7 +28,7 @@ segment after it will be: as its part (``via_part``, before an approach), or to 
 ``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a
 function of time: the plan's commands, piecewise constant (output ``command``), and the width of
 the part the active task grasps (output ``part_width``, m: what a grasp command of a real gripper
-carries, for ``systems.gripper.GraspObserver``).
+carries, for ``systems.hand.gripper.GraspObserver``).
 """
 
 from __future__ import annotations
@@ -42,10 +42,9 @@ from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, Leaf
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from ptint_drake.systems.cache import DeclareVectorCache
-from ptint_drake.systems.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
+from ptint_drake.systems.task.cache import DeclareVectorCache
+from ptint_drake.systems.task.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan
-
 
 PART, LATCHED, SLOT, VIA = 0, 1, 2, 3  # a segment's kind ("part", "latched", "slot", "via_*") in ``_aims``
 

@@ -36,10 +36,11 @@ from typing import Optional
 
 import numpy as np
 
-from ptint_drake.worlds.pick.config import (grasp_width)
-from ptint_drake.systems.schedule import Schedule, Segment
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.pick import PHASES, MoveConfig, PickConfig, PickTaskConfig  # noqa: F401
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.worlds.pick.config import grasp_width
+
 
 @dataclass(frozen=True)
 class PlanSegment:

@@ -24,8 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ptint_drake.worlds.pick.figures import GRASP_TAIL
-from ptint_drake.worlds.pick.figures import estimate_figure, pick_figure  # noqa: F401 (re-exported)
+from ptint_drake.worlds.pick.figures import GRASP_TAIL, estimate_figure, pick_figure  # noqa: F401 (re-exported)
 
 
 def replay_world(scenario):
@@ -36,9 +35,9 @@ def replay_world(scenario):
     from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig  # noqa: PLC0415
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
+    from ptint_drake.views.replay import shared_meshcat  # noqa: PLC0415
     from ptint_drake.worlds.pick.run import world_config  # noqa: PLC0415
     from ptint_drake.worlds.pick.station import _add_world  # noqa: PLC0415
-    from ptint_drake.replay import shared_meshcat  # noqa: PLC0415
 
     config = world_config(scenario)
     builder = DiagramBuilder()
@@ -97,7 +96,7 @@ def cloud_intervals(clouds: list) -> list[tuple[str, float, float]]:
 
 def pick_legend(scenario, camera: bool) -> list:
     """The legend of a pick replay (``replay.finish_page``)."""
-    from ptint_drake.replay import FLOOR_COLOR, css_color  # noqa: PLC0415
+    from ptint_drake.views.replay import FLOOR_COLOR, css_color  # noqa: PLC0415
 
     legend = [("rgba(40, 90, 200, 1)", "the parts, on their belts (dark), to the tray"),
               ("rgba(150, 150, 150, 1)", "the arm and its two-finger gripper")]
@@ -118,7 +117,7 @@ def draw_pick_floor(meshcat, plant, context) -> None:
     body of the plant at its posed state, with a margin."""
     from pydrake.multibody.tree import BodyIndex  # noqa: PLC0415
 
-    from ptint_drake.replay import draw_floor, floor_extent  # noqa: PLC0415
+    from ptint_drake.views.replay import draw_floor, floor_extent  # noqa: PLC0415
 
     plant_context = plant.GetMyContextFromRoot(context)
     points = np.array([plant.EvalBodyPoseInWorld(plant_context, plant.get_body(BodyIndex(i))).translation()
@@ -131,7 +130,7 @@ def draw_estimates(meshcat, scenario) -> None:
     in blue and a frame triad, posed by ``estimate_poses``."""
     from pydrake.geometry import Rgba  # noqa: PLC0415
 
-    from ptint_drake.replay import draw_triad, outline_segments  # noqa: PLC0415
+    from ptint_drake.views.replay import draw_triad, outline_segments  # noqa: PLC0415
 
     for k, part in enumerate(scenario.pick.parts):
         starts, ends = outline_segments(part.shape, part.size)
@@ -161,7 +160,7 @@ def estimate_pose(series: dict, part: int, t: float):
 
 def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: str = "") -> int:
     """Write ``replay.html`` (module docstring); returns its size in bytes."""
-    from ptint_drake.replay import finish_page  # noqa: PLC0415
+    from ptint_drake.views.replay import finish_page  # noqa: PLC0415
     plant, viz, meshcat, context = replay_world(scenario)
     plant_context = plant.GetMyMutableContextFromRoot(context)
     times, states = series["replay_t"], series["plant_state"]

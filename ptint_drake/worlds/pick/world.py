@@ -28,30 +28,29 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
-from pydrake.common.yaml import yaml_load_typed
-
 import numpy as np
+from pydrake.common.yaml import yaml_load_typed
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.config.yaml_io import dump_yaml
-from ptint_drake.mass_scaling import scale_in_context
-from ptint_drake.metrics import Reason, drive_metrics
-from ptint_drake.run_warnings import joint_limit_warnings, sampled_control_warnings
+from ptint_drake.robot.mass_scaling import scale_in_context
+from ptint_drake.robot.reachability import inverse_kinematics
+from ptint_drake.systems.hand.gripper import CLOSING, GRASP_STATES, HOLDING
+from ptint_drake.verdict.metrics import Reason, drive_metrics
+from ptint_drake.verdict.run_warnings import joint_limit_warnings, sampled_control_warnings
 from ptint_drake.worlds.base import LinkPorts, World, WorldRun
 from ptint_drake.worlds.pick import studies
 from ptint_drake.worlds.pick.camera import MIN_FITS, check_pick_camera, estimate_metrics
 from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
+from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
-from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_series,
-                                         pick_logs, pick_simulator, segment_aims, world_config)
-from ptint_drake.reachability import inverse_kinematics
-from ptint_drake.systems.gripper import CLOSING, GRASP_STATES, HOLDING
-from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_logs,
+                                         pick_series, pick_simulator, segment_aims, world_config)
 from ptint_drake.worlds.pick.runaway import runaway_metrics
 from ptint_drake.worlds.pick.tasks import Replan, check_tasks, pick_plan
 

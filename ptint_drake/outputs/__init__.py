@@ -1,0 +1,1 @@
+"""A run's files on disk: written into its output folder, never left half-written (``folder``)."""
