@@ -29,6 +29,7 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.hardware.camera_link import image_channel, pack_depth_image
+from ptint_drake.hardware.driver_modes import position_refusal
 from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
@@ -40,7 +41,7 @@ from ptint_drake.hardware.link import (
     pack_parts,
     pack_status,
     pack_wsg_status,
-    unpack_command,
+    unpack_command_positions,
     unpack_wsg_command,
     utime_of,
 )
@@ -67,6 +68,7 @@ class HardwareSession:
         self._answered: Optional[int] = None  # utime of the last status answered
         self._answered_tau: Optional[np.ndarray] = None
         self._pending: Optional[int] = None
+        self._pending_q: Optional[np.ndarray] = None  # the measured positions of the pending status
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
         self._after_handshake = False
@@ -112,9 +114,12 @@ class HardwareSession:
     def _check(self, t: float, data: bytes, t_recv: float) -> None:
         """One received command against the checks (module docstring); a fault or its use."""
         try:
-            utime, tau = unpack_command(data, self.n)
+            utime, tau, positions = unpack_command_positions(data, self.n)
         except ValueError as exc:
             return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {exc}")
+        refusal = position_refusal(positions, self._pending_q) if utime == self._pending else None
+        if refusal:  # a torque-only driver: positions that mean something are refused, not ignored
+            return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {refusal}")
         if not np.all(np.isfinite(tau)):
             return self._fail(
                 t,
@@ -279,7 +284,7 @@ class HardwareSession:
         start = time.perf_counter()
         data = pack_status(0.0, q, v, tau)
         self._set_companions(0.0, extras)
-        self._pending = 0
+        self._pending, self._pending_q = 0, np.array(q, dtype=float)
         self._sent[0] = self._publish(data)
         wsg = 0 if self.ports is not None else None  # the gripper command the driver takes at t = 0
         if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True, wsg=wsg):
@@ -333,7 +338,7 @@ class HardwareSession:
             self.record.duplicates += len(self.endpoint.poll(0.0))
         data = pack_status(t, q, v, tau)
         self._set_companions(t, extras)
-        self._pending = utime
+        self._pending, self._pending_q = utime, np.array(q, dtype=float)
         self._sent[utime] = self._publish(data)
         if len(self._sent) > 4096:
             for key in sorted(self._sent)[:2048]:
