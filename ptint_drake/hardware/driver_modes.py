@@ -46,6 +46,7 @@ class DriverTerms:
         if mode not in DRIVER_MODES:
             raise ValueError(f"--driver-mode: {mode!r} is not one of {', '.join(DRIVER_MODES)}")
         self.mode, self.n = mode, plant.num_velocities()
+        self._plant = plant  # (pydrake's InverseDynamics keeps no reference to it)
         self._system = None
         if mode != "torque":
             kind = (InverseDynamics.InverseDynamicsMode.kGravityCompensation if mode == "torque-gravity"
