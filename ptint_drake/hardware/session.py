@@ -117,6 +117,8 @@ class HardwareSession:
             utime, tau, positions = unpack_command_positions(data, self.n)
         except ValueError as exc:
             return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {exc}")
+        if utime + 1 in (self._pending, self._answered):  # Drake's IiwaCommandSender truncates t·10⁶:
+            utime += 1  # 1 µs short for 1.6 % of 1 ms stamps (measured); that status's answer
         refusal = position_refusal(positions, self._pending_q) if utime == self._pending else None
         if refusal:  # a torque-only driver: positions that mean something are refused, not ignored
             return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {refusal}")
