@@ -97,7 +97,8 @@ class Lockstep:
         self.lcm = DrakeLcm(url) if url else DrakeLcm()
         self.inbox: list[bytes] = []
         self.lcm.Subscribe(COMMAND, lambda data: self.inbox.append(bytes(data)))
-        self.status_ser, self.command_ser = _Serializer_[lcmt_iiwa_status](), _Serializer_[lcmt_iiwa_command]()
+        self.status_ser = _Serializer_[lcmt_iiwa_status]()
+        self.command_ser = _Serializer_[lcmt_iiwa_command]()
         self.command = self.command_ser.CreateDefaultValue()
         self.diagram, self.simulator = diagram, Simulator(diagram)
         self.context = self.simulator.get_mutable_context()
@@ -140,7 +141,8 @@ def tool_motion(plant, frame_name: str, q: np.ndarray, v: np.ndarray) -> tuple[n
     plant.SetPositions(context, q)
     frame, world = plant.GetFrameByName(frame_name), plant.world_frame()
     x = plant.CalcPointsPositions(context, frame, np.zeros(3), world).ravel()
-    J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3), world, world)
+    J = plant.CalcJacobianTranslationalVelocity(
+        context, JacobianWrtVariable.kV, frame, np.zeros(3), world, world)
     return x, J @ v
 
 

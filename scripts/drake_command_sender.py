@@ -51,7 +51,8 @@ def build_controller(model_file: str, q0: np.ndarray, mode: str):
     builder = DiagramBuilder()
     receiver = builder.AddSystem(IiwaStatusReceiver(n))
     state = builder.AddSystem(Multiplexer([n, n]))
-    hold = builder.AddSystem(InverseDynamicsController(plant, np.full(n, KP), np.zeros(n), np.full(n, KD), False))
+    hold = builder.AddSystem(
+        InverseDynamicsController(plant, np.full(n, KP), np.zeros(n), np.full(n, KD), False))
     desired = builder.AddSystem(ConstantVectorSource(np.concatenate([q0, np.zeros(n)])))
     sender = builder.AddSystem(IiwaCommandSender(n, ParseIiwaControlMode(mode)))
     builder.Connect(receiver.GetOutputPort("position_measured"), state.get_input_port(0))

@@ -175,8 +175,10 @@ class _DriveLoop:
         """The next statuses received (polling until some arrive); ``DriveFault`` after the
         start-up or status timeout without one."""
         while True:
-            # until the first tick after the hand-shake, the hardware may still be building its diagram
-            timeout = self.settings.startup_timeout if not self.answered else self.settings.status_timeout
+            # until the first tick after the hand-shake (two commands: the hand-shake's and that
+            # tick's; a drive started mid-run: its first two), the hardware may still be building
+            s = self.settings
+            timeout = s.startup_timeout if self.record.commands < 2 else s.status_timeout
             messages = self.endpoint.poll(0.05)
             now = time.perf_counter()
             if messages:

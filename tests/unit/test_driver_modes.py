@@ -76,3 +76,14 @@ def test_ptint_hardware_takes_echoed_positions_and_refuses_commanded_ones():
     assert "a position + torque command (joint 1 commanded 0.25 rad, measured 0 rad)" in session.record.fault
     assert "\n" not in session.record.fault
     assert position_refusal(None, np.zeros(3)) is None
+
+
+def test_a_stamp_truncated_by_drakes_command_sender_is_the_answer():
+    """Drake's ``IiwaCommandSender`` truncates t·10⁶ (1.001 s → 1000999 µs): that command answers
+    the status of 1.001 s; a stamp 2 µs short is still no status's."""
+    session, _ = pair()
+    tau = np.ones(N)
+    assert np.array_equal(tick(session, 1.001, [pack_command(1_000_999, tau)]), tau)
+    assert session.record.fault is None
+    tick(session, 1.002, [pack_command(1_001_998, tau)])
+    assert session.record.fault_kind == "second sender"
