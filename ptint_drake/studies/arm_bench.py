@@ -63,8 +63,9 @@ ARM_CURVES = {
 }
 # The package's realtime factor is at least this fraction of the plain loop's on every arm (CPU
 # time, median of the pairs).  Measured (`ptint bench --arms`, 5 pairs, Drake 1.58, Python 3.13,
-# 2-core machine at load ~6; docs/speed.md): 0.855-0.935 on the 5- to 7-joint arms, 2.57 on the
-# 3-joint rvm1 (its closed-form kinematics); the bound leaves room for a busier machine.
+# 2-core machine at load ~6, two runs; docs/speed.md): 0.86-0.98 on the 5- to 7-joint arms,
+# 2.46-2.57 on the 3-joint rvm1 (its closed-form kinematics); single pairs down to 0.64, so the
+# bound is on the median and leaves room for a busier machine.
 BOUND = 0.7
 # the plain loop's gains: task-space stiffness (N/m), damping (N·s/m), joint damping (N·m·s/rad)
 PLAIN_KP, PLAIN_KD, PLAIN_JOINT_DAMPING = 2000.0, 150.0, 1.0
