@@ -7,7 +7,7 @@ import numpy as np
 
 from ptint_drake.robot.plant import nominal_plant
 from ptint_drake.simulation.scenario import load_scenario
-from ptint_drake.worlds.pick import route
+from ptint_drake.worlds.pick import route, ways
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, pick_plan
 
 MIRRORED = str(Path(__file__).resolve().parents[1] / "two_belt_pick_mirrored.yaml")
@@ -22,10 +22,10 @@ def test_a_way_past_the_waist_axis_gets_a_via_on_the_far_side_and_keeps_every_pr
     block (+y) passes 113 mm from the axis, within 40 mm of the inner edge (≈ 85 mm)."""
     scenario = load_scenario(MIRRORED)
     arm = nominal_plant(scenario)
-    world = route.nominal(scenario, arm)
+    world = ways.nominal(scenario, arm)
     straight, routed = pick_plan(scenario.pick), route.routed_plan(scenario, arm=arm)
     i = next(n for n, s in enumerate(straight.segments) if s.task == 1 and s.phase == "approach")
-    assert route.too_near(world, route.nominal_paths(world, straight)[i]) is not None
+    assert route.too_near(world, ways.nominal_paths(world, straight)[i]) is not None
     via = [n for n, s in enumerate(routed.segments) if s.kind == VIA_PART]
     assert len(via) == 1
     j = via[0]
@@ -40,7 +40,7 @@ def test_a_way_past_the_waist_axis_gets_a_via_on_the_far_side_and_keeps_every_pr
     assert routed.grasp_times == straight.grasp_times and routed.close_times == straight.close_times
     assert routed.commands == straight.commands and np.isclose(routed.end, straight.end)
     # no way of the routed plan passes too near the edge any more
-    for seg, path in zip(routed.segments, route.nominal_paths(world, routed)):
+    for seg, path in zip(routed.segments, ways.nominal_paths(world, routed)):
         assert route.too_near(world, path) is None, seg
 
 

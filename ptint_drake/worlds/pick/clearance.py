@@ -4,7 +4,7 @@ The approach and the descend of a task are prescribed-time interceptions of a mo
 the controller's design error dynamics e(t) = ξ(t) e(t0) (SPEC 2.1, ξ the time base generator ξ(τ)
 = I⁻¹(1−β, 1−β; 1 − τ/tf)), the fingertip centre follows x(t) = p(t) + ξ(t) (x(t0) − p(t0)), with
 p(t) the target riding its belt at the belt's nominal speed. ``check_pick_clearance`` samples that
-path — the planned way of ``route.segment_way``, the one tracer the vias and the feasibility check
+path — the planned way of ``ways.segment_way``, the one tracer the vias and the feasibility check
 follow too: the approach from the start pose, or from the previous task's retreat, to ``clearance``
 above the part, by way of its via if it has one; the descend onto the part's centre — and checks
 the fingers' vertical extent (from the pads' lower edge to the fingers' top, read from the
@@ -18,40 +18,19 @@ above the hand are not checked here: their contacts are found during the run (``
 from __future__ import annotations
 
 import numpy as np
-from pydrake.geometry import Box
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.systems.hand.datasheets import payload_warnings
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.feasibility import feasibility_warnings
-from ptint_drake.worlds.pick.route import nominal, segment_way
-from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame
+from ptint_drake.worlds.pick.obstacles import obstacle_warnings
+from ptint_drake.worlds.pick.scene import FINGER_JOINTS, belt_frame, finger_extent
 from ptint_drake.worlds.pick.singularity import inner_reach_warnings, singularity_warnings
 from ptint_drake.worlds.pick.tasks import VIA_PART
+from ptint_drake.worlds.pick.ways import nominal, segment_way
 
 MIN_CLEARANCE = 0.001  # m: the least gap wanted between the fingers and a belt's top surface
 SAMPLES = 60  # points along each checked segment
-
-
-def finger_extent(station) -> tuple:
-    """(reach, top, thickness) of the fingers in the fingertip-centre frame, from their collision
-    boxes: how far they reach past the fingertip centre along the approach, how far their top is
-    before it (both m, positive), and the finger's thickness outward of the pad's face."""
-    plant, inspector = station.plant, station.scene_graph.model_inspector()
-    reach, top, thickness = 0.0, 0.0, 0.0
-    for name in ("left_finger", "right_finger"):
-        body = plant.GetBodyByName(name, station.gripper)
-        for g in plant.GetCollisionGeometriesForBody(body):
-            shape = inspector.GetShape(g)
-            if not isinstance(shape, Box):
-                continue
-            X = inspector.GetPoseInFrame(g)
-            half = np.array([shape.width(), shape.depth(), shape.height()]) / 2
-            corners = np.array([X.multiply(half * np.array([sx, sy, sz]))
-                                for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-            reach, top = max(reach, corners[:, 2].max()), max(top, -corners[:, 2].min())
-            thickness = max(thickness, np.abs(corners[:, 0]).max())
-    return reach, top, thickness
 
 
 def check_pick_clearance(scenario, built) -> None:
@@ -59,7 +38,7 @@ def check_pick_clearance(scenario, built) -> None:
     docstring); ``built``: a ``run.PickBuilt``."""
     station, plan = built.station, built.plan
     config = station.config
-    reach, top, thickness = finger_extent(station)
+    reach, top, thickness = finger_extent(station.plant, station.scene_graph, station.gripper)
     stroke = sum(station.plant.GetJointByName(n, station.gripper).position_upper_limits()[0]
                  for n in FINGER_JOINTS)
     check_pick_opening(scenario, stroke)
@@ -118,10 +97,12 @@ def arm_warnings(scenario, built) -> list[str]:
     """Warnings before a pick run about the arm: the gripper plus a part beyond the arm's rated
     payload (``grippers.payload_warnings``), a path past a singularity or near the inner edge of a
     5-joint arm's top-down workspace (``singularity``), a segment too short for a joint's speed or
-    effort limit along its planned profile (``feasibility``)."""
+    effort limit along its planned profile (``feasibility``), a way the hand still sweeps through an
+    obstacle after the vias (``obstacles``)."""
     station = built.station
     plant = station.plant
     gripper_kg = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(station.gripper))
     return (payload_warnings(scenario.robot.model, station.config.gripper.model, gripper_kg,
                              station.config.parts) + singularity_warnings(scenario, built)
-            + inner_reach_warnings(scenario, built) + feasibility_warnings(scenario, built))
+            + inner_reach_warnings(scenario, built) + feasibility_warnings(scenario, built)
+            + obstacle_warnings(scenario, nominal(scenario, built.arm), built.plan))

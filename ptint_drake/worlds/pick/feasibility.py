@@ -3,7 +3,7 @@
 The feasibility model of ``run_warnings`` (``joint_demand``: the joint speeds |J⁺ẋ| against the
 model's velocity limits and the torques of the inverse dynamics against its effort limits) is
 evaluated along the whole planned profile of every segment of the run's plan, vias included: the
-way ``route.nominal_paths`` follows (each segment's target — the part riding its belt at its
+way ``ways.nominal_paths`` follows (each segment's target — the part riding its belt at its
 nominal speed, the latched lift point, a slot, a via — and the error dynamics e(t) = ξ(t) e(t0)
 from where the previous segment's target was), sampled ``run_warnings.SPEED_SAMPLES`` times, so
 the time base generator's peak speed (ξ̇, at mid-segment) and acceleration (ξ̈; β < 1/2 is taken
@@ -30,7 +30,8 @@ from ptint_drake.robot.plant import effort_limits
 from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.systems.task.tbg import tbg_profile
 from ptint_drake.verdict.run_warnings import Profile, feasibility_warning, joint_demand, profile_times
-from ptint_drake.worlds.pick.route import nominal, segment_target, start_error, tool_yaws
+from ptint_drake.worlds.pick.route import tool_yaws
+from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT
 
 HELD = ("lift", "carry", "place")  # phases that carry the part (a via before a carry too)

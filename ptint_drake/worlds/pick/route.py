@@ -44,116 +44,20 @@ isolated), and without them it places every part of both (docs/pick_place.md).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-from pydrake.multibody.tree import JointIndex
-from scipy.special import betaincinv
 
+from ptint_drake.worlds.pick.obstacles import obstacle_vias
 from ptint_drake.robot.reachability import inverse_kinematics
-from ptint_drake.worlds.pick.camera import nominal_paths as nominal_motions
-from ptint_drake.worlds.pick.placement import nominal_parts
-from ptint_drake.worlds.pick.scene import part_shape, tray_pose
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
+from ptint_drake.worlds.pick.ways import Nominal, down_posture, nominal, nominal_paths
 
 INNER_MARGIN = 0.04  # m: a way closer than this to the inner edge of the top-down workspace is too near
-SAMPLES = 41  # samples of each segment's way
 VIA_STEP = 0.005  # m: the via's radius is searched in these steps
 EDGE_TOLERANCE = 0.002  # m: the inner edge's bisection stops at this width
 ROUTED = ("approach", "carry")  # the phases a via may split (the first attempt's approach)
 TURN_SAMPLES = 9  # samples of a carry's joint-space continuation
 FULL_TOP_DOWN = 6  # joints: an arm with as many has no via (module docstring)
 JUMP = np.radians(60.0)  # rad: a joint moving more than this between two samples breaks a continuation
-
-
-def xi(tau: np.ndarray, tf: float, beta: float) -> np.ndarray:
-    """ξ(τ) = I⁻¹(1−β, 1−β; 1 − τ/tf): the share of a segment's initial error left at τ."""
-    return betaincinv(1.0 - beta, 1.0 - beta, np.clip(1.0 - tau / tf, 0.0, 1.0))
-
-
-@dataclass
-class Nominal:
-    """What the plan is made against: per part its nominal centre at t = 0 and its belt's velocity,
-    per segment of ``plan`` the place pose of a "slot" segment (None otherwise), the start
-    posture's tool point, the waist axis (x, y) and the arm's kinematics."""
-
-    parts: list
-    part_yaws: list
-    places: list
-    start: np.ndarray
-    axis: np.ndarray
-    arm: object
-    frame: object
-    q0: np.ndarray
-
-
-def waist_axis(arm) -> np.ndarray:
-    """(x, y) of the arm's first revolute joint axis (its waist), in the world."""
-    context = arm.CreateDefaultContext()
-    for i in range(arm.num_joints()):
-        joint = arm.get_joint(JointIndex(i))
-        if joint.num_velocities() == 1 and "revolute" in joint.type_name():
-            return joint.frame_on_child().CalcPoseInWorld(context).translation()[:2]
-    return np.zeros(2)
-
-
-def nominal(scenario, arm) -> Nominal:
-    """The ``Nominal`` of a pick scenario (configuration and the arm's model only)."""
-    pick = scenario.pick
-    parts = nominal_motions(pick)
-    yaws = [float(np.radians(part.yaw_deg)) for part in nominal_parts(pick.parts)]
-    X_WT = tray_pose(pick.tray)
-    names = [p.name for p in pick.parts]
-    places = []
-    for task in pick.tasks:
-        slot = pick.tray.slots[task.slot]
-        _, height = part_shape(pick.parts[names.index(task.part)])
-        places.append(X_WT.multiply(np.array([slot.offset[0], slot.offset[1], 0.0])) + [0.0, 0.0, height / 2])
-    frame = arm.GetFrameByName(scenario.robot.end_effector)
-    context = arm.CreateDefaultContext()
-    q0 = np.radians(scenario.robot.initial_q_deg)
-    arm.SetPositions(context, q0)
-    start = frame.CalcPoseInWorld(context).translation()
-    return Nominal(parts, yaws, places, start, waist_axis(arm), arm, frame, q0)
-
-
-def segment_target(world: Nominal, plan: PickPlan, i: int, t) -> np.ndarray:
-    """Where segment i aims at time(s) t (rows), nominally."""
-    seg, s = plan.segments[i], plan.schedule.segments[i]
-    t = np.atleast_1d(np.asarray(t, float))
-    offset = np.asarray(seg.offset, float)
-    if seg.kind in (VIA_PART, VIA_SLOT):
-        return np.tile(offset, (len(t), 1))
-    if seg.kind == "slot":
-        return np.tile(world.places[seg.task] + offset, (len(t), 1))
-    p0, v = world.parts[seg.index]
-    if seg.kind == "latched":
-        return np.tile(p0 + v * s.start + offset, (len(t), 1))
-    return p0 + np.outer(t, v) + offset
-
-
-def start_error(world: Nominal, plan: PickPlan, i: int) -> np.ndarray:
-    """e(t0) of segment i (m): where the way starts — the previous segment's target at this one's
-    start, the start posture's tool point for the first — less this segment's target then."""
-    s = plan.schedule.segments[i]
-    x0 = world.start if i == 0 else segment_target(world, plan, i - 1, s.start)[0]
-    return x0 - segment_target(world, plan, i, s.start)[0]
-
-
-def segment_way(world: Nominal, plan: PickPlan, i: int, tau: np.ndarray) -> np.ndarray:
-    """Segment i's way at the times ``tau`` after its start (rows × 3, m): its target plus
-    ξ(τ) e(t0), ideal tracking of the error dynamics (module docstring).  The one tracer of the
-    planned way: the vias here, the clearance and the feasibility checks all follow it."""
-    s = plan.schedule.segments[i]
-    tau = np.asarray(tau, float)
-    return (segment_target(world, plan, i, s.start + tau)
-            + np.outer(xi(tau, s.tf, s.beta), start_error(world, plan, i)))
-
-
-def nominal_paths(world: Nominal, plan: PickPlan, samples: int = SAMPLES) -> list:
-    """Per segment of ``plan``: its way (``samples`` × 3, m) over the whole segment (``segment_way``)."""
-    return [segment_way(world, plan, i, np.linspace(0.0, s.tf, samples))
-            for i, s in enumerate(plan.schedule.segments)]
 
 
 def _nearest(world: Nominal, path: np.ndarray) -> tuple:
@@ -171,10 +75,6 @@ def _at(world: Nominal, point: np.ndarray, radius: float) -> np.ndarray:
     return np.array([*(world.axis + radius * u), point[2]])
 
 
-def _down(world: Nominal, x: np.ndarray, guess=None):
-    return inverse_kinematics(world.arm, world.frame, x, world.q0 if guess is None else guess, down=True)
-
-
 def too_near(world: Nominal, path: np.ndarray) -> tuple:
     """(radius, nearest point) of a way that passes within ``INNER_MARGIN`` of the inner edge (no
     top-down posture ``INNER_MARGIN`` nearer the axis than its nearest point, solved from the start
@@ -185,10 +85,10 @@ def too_near(world: Nominal, path: np.ndarray) -> tuple:
     if radius <= INNER_MARGIN:
         return radius, point
     inner = _at(world, point, radius - INNER_MARGIN)
-    if _down(world, inner) is not None:
+    if down_posture(world, inner) is not None:
         return None
-    own = _down(world, point)
-    if own is not None and _down(world, inner, own) is not None:
+    own = down_posture(world, point)
+    if own is not None and down_posture(world, inner, own) is not None:
         return None
     return radius, point
 
@@ -198,18 +98,18 @@ def inner_edge(world: Nominal, point: np.ndarray, far: float = 0.6) -> float:
     bisection to ``EDGE_TOLERANCE`` between the axis and the first radius (from the point's own,
     outwards in ``VIA_STEP`` steps, up to ``far``) that has one; ``far`` if none has."""
     hi = max(_nearest(world, point[None])[0], VIA_STEP)
-    q = _down(world, _at(world, point, hi))
+    q = down_posture(world, _at(world, point, hi))
     while q is None and hi < far:
         hi += VIA_STEP
-        q = _down(world, _at(world, point, hi))
+        q = down_posture(world, _at(world, point, hi))
     if q is None:
         return far
     lo = 0.0
-    if _down(world, _at(world, point, lo), q) is not None:
+    if down_posture(world, _at(world, point, lo), q) is not None:
         return 0.0
     while hi - lo > EDGE_TOLERANCE:
         mid = 0.5 * (lo + hi)
-        solution = _down(world, _at(world, point, mid), q)
+        solution = down_posture(world, _at(world, point, mid), q)
         if solution is None:
             lo = mid
         else:
@@ -225,7 +125,7 @@ def _via_for(world: Nominal, pick, replans: tuple, vias: tuple, k: int, phase: s
     start, end = path[0], path[-1]
     for radius in np.arange(safe, safe + 0.5, VIA_STEP):
         via = _at(world, point, radius)
-        if _down(world, via) is None:
+        if down_posture(world, via) is None:
             continue
         first, second = np.linalg.norm(via - start), np.linalg.norm(end - via)
         candidate = Via(k, phase, tuple(float(c) for c in via), float(first / (first + second)))
@@ -278,7 +178,7 @@ def _carry_turn(world: Nominal, plan: PickPlan, pick, replans: tuple, vias: tupl
         return None
     yaws, path = tool_yaws(world, plan)[i], nominal_paths(world, plan)[i]
     start, end = path[0], path[-1]
-    q = _down(world, start)
+    q = down_posture(world, start)
     if q is None:
         return None
     s = np.linspace(0.0, 1.0, TURN_SAMPLES)[:, None]
@@ -316,6 +216,12 @@ def plan_vias(scenario, world: Nominal, replans: tuple = ()) -> tuple:
     return vias
 
 
+def routed_vias(scenario, world: Nominal, replans: tuple = ()) -> tuple:
+    """The plan's vias: around the base (``plan_vias``), then above what is in the way
+    (``obstacles.obstacle_vias``)."""
+    return obstacle_vias(scenario, world, replans, plan_vias(scenario, world, replans))
+
+
 def routed_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
     """The scenario's plan with the ``replans`` a run decided and its vias (``plan_vias``); ``arm``:
     the arm's model alone (default ``robot.nominal_plant``)."""
@@ -323,4 +229,4 @@ def routed_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
         from ptint_drake.robot.plant import nominal_plant  # noqa: PLC0415
 
         arm = nominal_plant(scenario)
-    return pick_plan(scenario.pick, replans, plan_vias(scenario, nominal(scenario, arm), replans))
+    return pick_plan(scenario.pick, replans, routed_vias(scenario, nominal(scenario, arm), replans))

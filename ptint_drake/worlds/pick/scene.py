@@ -143,6 +143,27 @@ def gripper_stroke(plant: MultibodyPlant, gripper: ModelInstanceIndex) -> float:
     return float(sum(plant.GetJointByName(n, gripper).position_upper_limits()[0] for n in FINGER_JOINTS))
 
 
+def finger_extent(plant: MultibodyPlant, scene_graph, gripper: ModelInstanceIndex) -> tuple:
+    """(reach, top, thickness) of the fingers in the fingertip-centre frame, from their collision
+    boxes: how far they reach past the fingertip centre along the approach, how far their top is
+    before it (both m, positive), and the finger's thickness outward of the pad's face."""
+    inspector = scene_graph.model_inspector()
+    reach, top, thickness = 0.0, 0.0, 0.0
+    for name in ("left_finger", "right_finger"):
+        body = plant.GetBodyByName(name, gripper)
+        for g in plant.GetCollisionGeometriesForBody(body):
+            shape = inspector.GetShape(g)
+            if not isinstance(shape, Box):
+                continue
+            X = inspector.GetPoseInFrame(g)
+            half = np.array([shape.width(), shape.depth(), shape.height()]) / 2
+            corners = np.array([X.multiply(half * np.array([sx, sy, sz]))
+                                for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+            reach, top = max(reach, corners[:, 2].max()), max(top, -corners[:, 2].min())
+            thickness = max(thickness, np.abs(corners[:, 0]).max())
+    return reach, top, thickness
+
+
 def belt_frame(belt: BeltConfig) -> RigidTransform:
     """Pose of the belt's top-surface centre at t = 0; its x axis = the direction of travel."""
     d = np.asarray(belt.direction, dtype=float)

@@ -16,7 +16,7 @@ A 5-joint arm on ``top_down`` has another edge: near its own waist axis it canno
 down at all (``rvm1_5dof`` at z = 0.15-0.19 m: no top-down posture within its joint limits closer
 than about 85 mm, where the wrist pitch reaches its −90° limit), and its Jacobian loses rank on
 the way there.  The plan goes around it (``route``: a via on the far side of the axis); where no
-way around was found, ``inner_reach_warnings`` follows the plan's ways (``route.nominal_paths``)
+way around was found, ``inner_reach_warnings`` follows the plan's ways (``ways.nominal_paths``)
 and warns, one line per task, where one passes within ``route.INNER_MARGIN`` of that inner edge.
 Measured (issue 33), before the route: tests/two_belt_pick.yaml and its mirror image in y both
 swung past the base 106-108 mm from the axis; on the mirror image the arm slid into the inner edge
@@ -30,7 +30,8 @@ import numpy as np
 from pydrake.multibody.tree import JacobianWrtVariable
 
 from ptint_drake.robot.reachability import inverse_kinematics
-from ptint_drake.worlds.pick.route import FULL_TOP_DOWN, INNER_MARGIN, nominal, nominal_paths, too_near
+from ptint_drake.worlds.pick.route import FULL_TOP_DOWN, INNER_MARGIN, too_near
+from ptint_drake.worlds.pick.ways import nominal, nominal_paths
 from ptint_drake.worlds.pick.tasks import VIA_PART
 
 MIN_SIGMA = 0.01  # m: on rvm1_6dof (rot_scale 0.1 m/rad) about a wrist pitch of 10°
@@ -113,7 +114,7 @@ def _warning(scenario, k: int, phase: str, sigma: float, q: np.ndarray) -> str:
 
 
 def inner_reach_warnings(scenario, built) -> list[str]:
-    """One warning per task whose way (``route.nominal_paths`` of the run's plan, its vias
+    """One warning per task whose way (``ways.nominal_paths`` of the run's plan, its vias
     included) passes within ``route.INNER_MARGIN`` of the inner edge of the arm's top-down
     workspace: where ``route.plan_vias`` found no way around the base (module docstring); [] for
     other tasks and for arms of ``route.FULL_TOP_DOWN`` joints or more (no vias there)."""
