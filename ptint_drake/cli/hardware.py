@@ -128,6 +128,16 @@ def _add_drive_parser(sub) -> None:
         "SimIiwaDriver torque-only), position-torque (Drake's IiwaDriver default: inverse dynamics "
         "around the positions sent, the measured ones) (default torque; docs/hardware.md)",
     )
+    dr.add_argument(
+        "--messages",
+        choices=("iiwa", "panda"),
+        default="iiwa",
+        help="the arm driver's messages: iiwa (lcmt_iiwa_status / lcmt_iiwa_command on IIWA_STATUS / "
+        "IIWA_COMMAND: ptint hardware, Drake's iiwa blocks) or panda (lcmt_panda_status / "
+        "lcmt_panda_command on PANDA_STATUS / PANDA_COMMAND: Drake's PandaCommandReceiver, the franka "
+        "driver, whose torque mode adds gravity compensation: --driver-mode torque-gravity) "
+        "(default iiwa)",
+    )
     dr.add_argument("--out", help="output folder (default out/drive_NAME)")
     dr.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     dr.add_argument("--quiet", action="store_true", help="accepted like the other commands")
@@ -278,6 +288,7 @@ def cmd_drive(args: argparse.Namespace) -> int:
         status_timeout=args.status_timeout,
         priority=args.priority,
         driver_mode=args.driver_mode,
+        messages=args.messages,
     )
     record = DriveRecord()
     fault, url = None, args.url
