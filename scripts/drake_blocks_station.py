@@ -215,7 +215,8 @@ def run(args: argparse.Namespace) -> dict:
         loop.simulator.AdvanceTo((k + 1) * args.status_period)
     segments = measure(scenario, plant, np.array(t), np.array(q), np.array(v)) if t else []
     ok = fault is None and all(not s["reasons"] for s in segments)
-    return {"scenario": scenario.name, "messages": args.messages, "mode": args.mode, "status_period": args.status_period,
+    return {"scenario": scenario.name, "messages": args.messages, "mode": args.mode,
+            "status_period": args.status_period,
             "plant_step": args.plant_step, "ticks": len(t), "status_resends": loop.resends,
             "other_commands": loop.others, "wall_s": time.monotonic() - wall, "fault": fault,
             "segments": segments, "status": "ok" if ok else "missed" if fault is None else "failed"}
@@ -255,7 +256,8 @@ def main(argv=None) -> int:
         print(f"segment {i}: e(tf) = {e * 1e3:.4f} mm" if e is not None else f"segment {i}: not reached",
               f"hold max = {seg['e_hold_max_norm'] * 1e3:.4f} mm" if seg["e_hold_max_norm"] else "",
               ", ".join(seg["reasons"]) or "ok")
-    print(f"station {result['messages']} {result['mode']}, status {result['status_period'] * 1e3:g} ms: {result['status']}"
+    print(f"station {result['messages']} {result['mode']}, status {result['status_period'] * 1e3:g} ms: "
+          f"{result['status']}"
           + (f" ({result['fault']})" if result["fault"] else "") + f"; wrote {out}/station.json")
     return 0 if result["status"] == "ok" else 1
 

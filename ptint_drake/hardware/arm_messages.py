@@ -47,7 +47,8 @@ class ArmMessages:
     unpack_command_positions: Callable[[bytes, int], tuple]  # (data, n) -> (utime, tau, positions)
 
 
-def _iiwa_command(utime: int, tau: np.ndarray, positions: Optional[np.ndarray], with_positions: bool) -> bytes:
+def _iiwa_command(utime: int, tau: np.ndarray, positions: Optional[np.ndarray],
+                  with_positions: bool) -> bytes:
     """``link.pack_command``: the iiwa's command always carries the positions given."""
     return link.pack_command(utime, tau, positions=positions)
 
@@ -81,7 +82,8 @@ def panda_unpack_status(data: bytes, n: int) -> tuple[int, np.ndarray, np.ndarra
     return m.utime, np.array(m.joint_position), np.array(m.joint_velocity)
 
 
-def panda_command(utime: int, tau: np.ndarray, positions: Optional[np.ndarray], with_positions: bool) -> bytes:
+def panda_command(utime: int, tau: np.ndarray, positions: Optional[np.ndarray],
+                  with_positions: bool) -> bytes:
     """An ``lcmt_panda_command`` answering the status of ``utime``: τ (N·m), and with
     ``with_positions`` the ``positions`` (rad) in position + torque mode (module docstring)."""
     m = lcmt_panda_command()

@@ -21,8 +21,9 @@ of its own before the motors see it, so the drive takes them off (``DriverTerms.
 Every iiwa command carries ``num_joints`` = n and positions (the measured ones in the torque
 modes, where a torque-only driver ignores them; Drake's ``IiwaCommandReceiver`` rejects 0 in any
 position mode); a Panda command (``arm_messages``) carries them in ``position-torque`` alone.  The
-Panda's torque mode adds gravity compensation (Franka's FCI: ``torque-gravity``).  ``ptint hardware`` is a torque-only driver: it refuses a command whose positions
-are not the status's measured ones (``position_refusal``) rather than ignore them.
+Panda's torque mode adds gravity compensation (Franka's FCI: ``torque-gravity``).  ``ptint
+hardware`` is a torque-only driver: it refuses a command whose positions are not the status's
+measured ones (``position_refusal``) rather than ignore them.
 """
 
 from __future__ import annotations

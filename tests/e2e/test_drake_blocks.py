@@ -1,11 +1,13 @@
-"""Drake's own iiwa blocks and ptint's LCM path (issue 45), as real processes in a private
-network namespace (``tests/lcm_link/netns.py``):
+"""Drake's own iiwa and Panda blocks and ptint's LCM path (issue 45), as real processes in a
+private network namespace (``tests/lcm_link/netns.py``):
 
 - ``ptint drive curve_iiwa14`` against a station of Drake's blocks (``scripts/drake_blocks_station.py``:
   ``IiwaCommandReceiver`` → ``SimIiwaDriver`` → plant, ``IiwaStatusSender``) in lockstep, in
   torque-only mode (the driver's gravity compensation taken off: ``--driver-mode torque-gravity``)
   and in position + torque mode, at a 1 ms status: the criteria met; at Drake's 5 ms status the
-  run reaches its end;
+  run reaches its end; the same for ``ptint drive curve_panda --messages panda`` against
+  ``PandaCommandReceiver`` → ``SimIiwaDriver`` → plant, ``PandaStatusSender`` over
+  ``lcmt_panda_*``;
 - Drake's ``IiwaCommandSender`` (``scripts/drake_command_sender.py``) → ``ptint hardware``:
   torque-only commands applied for 2 s (stamps truncated by the sender included), position +
   torque refused in one line;
@@ -33,16 +35,23 @@ def script(name: str, *args: str) -> list[str]:
     return [sys.executable, str(ROOT / "scripts" / name), *args]
 
 
-@pytest.mark.parametrize("mode, driver_mode, period", [
-    ("torque_only", "torque-gravity", "0.001"),
-    ("position_and_torque", "position-torque", "0.001"),
-    ("torque_only", "torque-gravity", "0.005"),
+CURVES = {"iiwa": ARM, "panda": "curve_panda"}  # the message set -> its arm's curve
+
+
+@pytest.mark.parametrize("messages, mode, driver_mode, period", [
+    ("iiwa", "torque_only", "torque-gravity", "0.001"),
+    ("iiwa", "position_and_torque", "position-torque", "0.001"),
+    ("iiwa", "torque_only", "torque-gravity", "0.005"),
+    ("panda", "torque_only", "torque-gravity", "0.001"),
+    ("panda", "position_and_torque", "position-torque", "0.001"),
+    ("panda", "torque_only", "torque-gravity", "0.005"),
 ])
-def test_drive_against_drakes_blocks(tmp_path, mode, driver_mode, period):
+def test_drive_against_drakes_blocks(tmp_path, messages, mode, driver_mode, period):
+    curve, over = CURVES[messages], ("--messages", messages)
     out = run_plan([
-        {"name": "station", "argv": script("drake_blocks_station.py", ARM, "--mode", mode, "--status-period",
-                                           period, *SHORT, "--out", str(tmp_path / "st"))},
-        {"name": "drive", "argv": ptint("drive", ARM, *PATIENT, "--driver-mode", driver_mode, *SHORT,
+        {"name": "station", "argv": script("drake_blocks_station.py", curve, *over, "--mode", mode,
+                                           "--status-period", period, *SHORT, "--out", str(tmp_path / "st"))},
+        {"name": "drive", "argv": ptint("drive", curve, *over, *PATIENT, "--driver-mode", driver_mode, *SHORT,
                                         "--out", str(tmp_path / "dr"))},
     ], tmp_path, timeout=240.0)
     assert out["drive"]["rc"] == 0, out["drive"]["stderr"]
@@ -50,6 +59,8 @@ def test_drive_against_drakes_blocks(tmp_path, mode, driver_mode, period):
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert station["fault"] is None and station["ticks"] == round(2.0 / float(period))
     assert drive["driver_mode"] == driver_mode and drive["statuses_stale"] == 0
+    assert station["messages"] == drive["messages"] == messages
+    assert drive["command_channel"] == {"iiwa": "IIWA_COMMAND", "panda": "PANDA_COMMAND"}[messages]
     seg = station["segments"][0]
     if period == "0.001":  # the accuracy runs: the scenario's criteria (e(tf) <= 1 mm, ...)
         assert out["station"]["rc"] == 0 and seg["reasons"] == [] and seg["e_tf_norm"] < 1e-3, seg
