@@ -85,6 +85,7 @@ def _add_hardware_link_options(hw: argparse.ArgumentParser) -> None:
         "(default 5; a loaded virtual machine may stall a process longer: see docs/hardware.md)",
     )
     _add_priority_option(hw, "without --lockstep: ")
+    _add_messages_option(hw, "commands in torque mode, or position + torque with the measured positions")
     hw.add_argument(
         "--hold-time",
         type=seconds("--hold-time"),
@@ -128,20 +129,24 @@ def _add_drive_parser(sub) -> None:
         "SimIiwaDriver torque-only), position-torque (Drake's IiwaDriver default: inverse dynamics "
         "around the positions sent, the measured ones) (default torque; docs/hardware.md)",
     )
-    dr.add_argument(
-        "--messages",
-        choices=("iiwa", "panda"),
-        default="iiwa",
-        help="the arm driver's messages: iiwa (lcmt_iiwa_status / lcmt_iiwa_command on IIWA_STATUS / "
-        "IIWA_COMMAND: ptint hardware, Drake's iiwa blocks) or panda (lcmt_panda_status / "
-        "lcmt_panda_command on PANDA_STATUS / PANDA_COMMAND: Drake's PandaCommandReceiver, the franka "
-        "driver, whose torque mode adds gravity compensation: --driver-mode torque-gravity) "
-        "(default iiwa)",
-    )
+    _add_messages_option(dr, "Drake's PandaCommandReceiver, the franka driver, whose torque mode adds "
+                         "gravity compensation: --driver-mode torque-gravity")
     dr.add_argument("--out", help="output folder (default out/drive_NAME)")
     dr.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     dr.add_argument("--quiet", action="store_true", help="accepted like the other commands")
     dr.set_defaults(func=cmd_drive)
+
+
+def _add_messages_option(parser: argparse.ArgumentParser, panda: str) -> None:
+    """``--messages``: the arm driver's message types and channels (``hardware.arm_messages``)."""
+    parser.add_argument(
+        "--messages",
+        choices=("iiwa", "panda"),
+        default="iiwa",
+        help="the arm's messages: iiwa (lcmt_iiwa_status / lcmt_iiwa_command on IIWA_STATUS / "
+        "IIWA_COMMAND) or panda (lcmt_panda_status / lcmt_panda_command on PANDA_STATUS / "
+        f"PANDA_COMMAND: {panda}) (default iiwa; docs/hardware.md)",
+    )
 
 
 def _add_priority_option(parser: argparse.ArgumentParser, when: str) -> None:
@@ -178,6 +183,7 @@ def _link_settings(args: argparse.Namespace, scenario):
         seed=args.seed,
         priority=args.priority,
         silent_periods=args.silent_periods,
+        messages=args.messages,
     )
 
 

@@ -83,4 +83,4 @@ def position_refusal(positions: Optional[np.ndarray], measured: Optional[np.ndar
     j = int(np.argmax(off))
     return (f"a position + torque command (joint {j} commanded {positions[j]:.6g} rad, measured "
             f"{measured[j]:.6g} rad): ptint hardware is a torque-only driver, it applies the torques "
-            f"alone; send torque-only commands (num_joints 0, or the status's measured positions)")
+            f"alone; send torque-only commands (no positions, or the status's measured ones)")

@@ -8,9 +8,9 @@ private network namespace (``tests/lcm_link/netns.py``):
   run reaches its end; the same for ``ptint drive curve_panda --messages panda`` against
   ``PandaCommandReceiver`` → ``SimIiwaDriver`` → plant, ``PandaStatusSender`` over
   ``lcmt_panda_*``;
-- Drake's ``IiwaCommandSender`` (``scripts/drake_command_sender.py``) → ``ptint hardware``:
-  torque-only commands applied for 2 s (stamps truncated by the sender included), position +
-  torque refused in one line;
+- Drake's ``IiwaCommandSender`` or ``PandaCommandSender`` (``scripts/drake_command_sender.py``)
+  → ``ptint hardware`` (``--messages panda``: ``lcmt_panda_*``): torque-only commands applied for
+  2 s (stamps truncated by the sender included), position + torque refused in one line;
 - a second ``ptint drive`` started mid-run is named by its source address."""
 
 from __future__ import annotations
@@ -68,14 +68,17 @@ def test_drive_against_drakes_blocks(tmp_path, messages, mode, driver_mode, peri
         assert seg["e_tf_norm"] is not None and drive["ticks_missing"] >= 4 * 399
 
 
+@pytest.mark.parametrize("messages", ["iiwa", "panda"])
 @pytest.mark.parametrize("mode", ["torque_only", "position_and_torque"])
-def test_drakes_command_sender_to_ptint_hardware(tmp_path, mode):
+def test_drakes_command_sender_to_ptint_hardware(tmp_path, mode, messages):
+    curve, over = CURVES[messages], ("--messages", messages)
     out = run_plan([
-        {"name": "hw", "argv": ptint("hardware", ARM, *PATIENT, "--lockstep", "--quiet", *SHORT,
+        {"name": "hw", "argv": ptint("hardware", curve, *over, *PATIENT, "--lockstep", "--quiet", *SHORT,
                                      "--out", str(tmp_path / "hw"))},
-        {"name": "sender", "argv": script("drake_command_sender.py", ARM, "--mode", mode, *SHORT)},
+        {"name": "sender", "argv": script("drake_command_sender.py", curve, *over, "--mode", mode, *SHORT)},
     ], tmp_path, timeout=240.0)
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
+    assert link["messages"] == messages
     if mode == "torque_only":  # applied to the end (a hold, not an interception: the verdict is missed)
         assert link["fault"] is None and link["ticks"] == 2000 and link["commands_accepted"] >= 1999, link
     else:

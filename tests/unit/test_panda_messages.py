@@ -123,3 +123,27 @@ def test_the_sets_by_name():
     assert arm_messages("iiwa") is IIWA and arm_messages("panda").status_channel == "PANDA_STATUS"
     with pytest.raises(ValueError, match="--messages: 'ur' is not one of iiwa, panda"):
         arm_messages("ur")
+
+
+def test_ptint_hardware_and_drive_over_panda_messages_as_over_the_iiwas(tmp_path):
+    """``ptint hardware --messages panda`` and ``ptint drive --messages panda`` (two threads over
+    one ``memq://`` LCM, lockstep): the arm moves bit for bit as over the iiwa's messages, on the
+    Panda's channels."""
+    from ptint_drake.hardware.in_memory import run_pair  # noqa: PLC0415
+    from ptint_drake.hardware.session import LinkSettings  # noqa: PLC0415
+    from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
+
+    short = ["duration=0.3", "interceptions[0].tf=0.25", "controller.control_period=0.001",
+             "multibody.time_step=0.001"]
+    scenario = parse_with_overrides(scenario_text("curve_panda")[1], short, "curve_panda")
+    finals = {}
+    for messages in ("iiwa", "panda"):
+        settings = LinkSettings(period=0.001, duration=0.3, messages=messages)
+        metrics, drive = run_pair(scenario, settings, tmp_path / messages)
+        link = metrics["hardware"]
+        assert link["fault"] is None and link["ticks"] == 300 and drive["commands_sent"] >= 300
+        assert link["command_channel"] == drive["command_channel"] == arm_messages(messages).command_channel
+        series = np.load(tmp_path / messages / "series.npz")
+        finals[messages] = series["x"][-1]
+    assert np.array_equal(finals["iiwa"], finals["panda"])
+    assert np.linalg.norm(finals["panda"] - series["x"][0]) > 1e-3  # (the arm moved: the check can fail)
