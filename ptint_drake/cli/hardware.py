@@ -28,7 +28,8 @@ def _add_hardware_parser(sub) -> None:
         help="the simulated world as hardware over LCM (with `ptint drive`; docs/hardware.md)",
         description="Run the scenario's world alone as the hardware: a discrete plant at the control period "
         "publishing the arm's status (lcmt_iiwa_status on IIWA_STATUS) and applying the torque "
-        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive` (a station "
+        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND; --messages panda: lcmt_panda_*) from "
+        "`ptint drive` (a station "
         "with a gripper adds the gripper's lcmt_schunk_wsg_status/command and its objects' motion); a "
         "fault (no command, a bad command, a second sender) holds the arm and ends the run with its "
         "reason, and so do SIGINT and SIGTERM (exit 130, 143). Writes metrics.json (the verdict, and "
@@ -100,7 +101,8 @@ def _add_drive_parser(sub) -> None:
         "drive",
         help="the controller alone over LCM, driving `ptint hardware` or a robot (docs/hardware.md)",
         description="Run the scenario's targets and controller alone: answer each lcmt_iiwa_status on "
-        "IIWA_STATUS with an lcmt_iiwa_command on IIWA_COMMAND (the torques, less what the driver "
+        "IIWA_STATUS with an lcmt_iiwa_command on IIWA_COMMAND (--messages panda: lcmt_panda_*; the "
+        "torques, less what the driver "
         "adds: --driver-mode; the measured positions). Writes drive.json "
         "(what was received and sent) and drive_series.npz. Exit 0 when the scenario's end was "
         "reached, 1 when the status stopped (one line), 2 bad input.",
