@@ -1,21 +1,30 @@
-"""A station built of Drake's own iiwa blocks on LCM, for ``ptint drive`` (issue 45: Drake's
+"""A station built of Drake's own arm blocks on LCM, for ``ptint drive`` (issue 45: Drake's
 drivers, both directions): a discrete ``MultibodyPlant`` of the scenario's arm (its model file,
-parsed by Drake), ``IiwaCommandReceiver`` → ``SimIiwaDriver`` (``IiwaDriver`` config: its
-``control_mode``; ``desired_kp_gains`` for an arm of other than 7 joints) → the plant, and
-``IiwaStatusSender``; no ptint code in the loop.
+parsed by Drake), the command receiver → ``SimIiwaDriver`` (``IiwaDriver`` config: its
+``control_mode``; ``desired_kp_gains`` for an arm of other than 7 joints) → the plant, and the
+status sender; no ptint code in the loop.  ``--messages`` picks the receiver and the sender:
 
-The harness runs it in lockstep: at each status period it publishes the sender's
-``lcmt_iiwa_status`` on IIWA_STATUS (re-sent every 5 ms until answered), waits for the
-``lcmt_iiwa_command`` on IIWA_COMMAND that carries that status's stamp (others are counted and
-dropped), hands it to the receiver, and advances the diagram one status period.  It then measures
-the scenario's segments from the statuses it sent (the tool point from the plant's kinematics
-against the scenario's true target) and writes station.json::
+- ``iiwa``: ``IiwaCommandReceiver`` / ``IiwaStatusSender``, ``lcmt_iiwa_*`` on IIWA_STATUS /
+  IIWA_COMMAND;
+- ``panda``: ``PandaCommandReceiver`` (control mode: the torque bit, with the position bit in
+  ``position_and_torque``) / ``PandaStatusSender``, ``lcmt_panda_*`` on PANDA_STATUS /
+  PANDA_COMMAND (the franka driver's channels).  Drake has no Panda driver block:
+  ``SimIiwaDriver`` stands in; in ``torque_only`` it adds gravity compensation from the arm's
+  model, as Franka's FCI torque mode does.
+
+The harness runs it in lockstep: at each status period it publishes the sender's status
+(re-sent every 5 ms until answered), waits for the command that carries that status's stamp
+(others are counted and dropped), hands it to the receiver, and advances the diagram one status
+period.  It then measures the scenario's segments from the statuses it sent (the tool point from
+the plant's kinematics against the scenario's true target) and writes station.json::
 
     python scripts/drake_blocks_station.py curve_iiwa14 --mode torque_only --out /tmp/st
     ptint drive curve_iiwa14 --driver-mode torque-gravity          # in another shell
+    python scripts/drake_blocks_station.py curve_panda --messages panda --out /tmp/sp
+    ptint drive curve_panda --messages panda --driver-mode torque-gravity
 
-``--mode``: ``torque_only`` (``SimIiwaDriver`` adds gravity compensation: drive with
-``--driver-mode torque-gravity``) or ``position_and_torque`` (Drake's default: ``--driver-mode
+``--mode``: ``torque_only`` (the driver adds gravity compensation: drive with ``--driver-mode
+torque-gravity``) or ``position_and_torque`` (Drake's iiwa default: ``--driver-mode
 position-torque``).  ``--status-period`` (s, 0.001; Drake's iiwa: 0.005) and ``--plant-step``
 (s, 0.001).  Exit 0 when every segment meets the scenario's criteria, 1 otherwise or when no
 command came in time, 2 on bad input (one line).
@@ -30,10 +39,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from drake import lcmt_iiwa_command, lcmt_iiwa_status
+from drake import lcmt_iiwa_command, lcmt_iiwa_status, lcmt_panda_command, lcmt_panda_status
 from pydrake.lcm import DrakeLcm
 from pydrake.manipulation import IiwaCommandReceiver, IiwaDriver, IiwaStatusSender, ParseIiwaControlMode
-from pydrake.manipulation import SimIiwaDriver
+from pydrake.manipulation import PandaCommandReceiver, PandaControlMode, PandaStatusSender, SimIiwaDriver
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import JacobianWrtVariable
@@ -47,7 +56,10 @@ from ptint_drake.robot.plant import resolve_model
 from ptint_drake.simulation.scenario import LoadedScenario
 from ptint_drake.worlds.registry import objects_of, schedule_of
 
-STATUS, COMMAND = "IIWA_STATUS", "IIWA_COMMAND"
+# the arm's messages (``--messages``): status type, command type, their channels (Drake's iiwa
+# driver's; the franka driver's defaults)
+PROTOCOLS = {"iiwa": (lcmt_iiwa_status, lcmt_iiwa_command, "IIWA_STATUS", "IIWA_COMMAND"),
+             "panda": (lcmt_panda_status, lcmt_panda_command, "PANDA_STATUS", "PANDA_COMMAND")}
 IIWA_KP = (2000.0, 1500.0, 1500.0, 1500.0, 1500.0, 500.0, 500.0)  # SimIiwaDriver's default gains
 RESEND = 0.005  # s wall between re-sends of an unanswered status
 MODES = ("torque_only", "position_and_torque")
@@ -64,7 +76,17 @@ def arm_plant(model_file: str, time_step: float, builder=None):
     return plant
 
 
-def build_station(model_file: str, mode: str, plant_step: float):
+def arm_blocks(messages: str, n: int, mode: str):
+    """(receiver, sender, the sender's port fed by the driver's ``velocity_estimated``) of the
+    ``messages`` set for ``n`` joints in ``mode``: Drake's iiwa blocks, or its Panda blocks (the
+    receiver's control mode the torque bit, with the position bit in ``position_and_torque``)."""
+    if messages == "panda":
+        bits = int(PandaControlMode.kTorque) | (int(PandaControlMode.kPosition) if mode == MODES[1] else 0)
+        return PandaCommandReceiver(n, bits), PandaStatusSender(n), "velocity_measured"
+    return IiwaCommandReceiver(n, ParseIiwaControlMode(mode)), IiwaStatusSender(n), "velocity_estimated"
+
+
+def build_station(model_file: str, mode: str, plant_step: float, messages: str = "iiwa"):
     """(diagram, plant, the controller plant, receiver, sender) of the station (module docstring)."""
     builder = DiagramBuilder()
     plant = arm_plant(model_file, plant_step, builder)
@@ -76,15 +98,17 @@ def build_station(model_file: str, mode: str, plant_step: float):
         config.desired_kp_gains = np.resize(np.array(IIWA_KP), n)
     instance = plant.get_joint_actuator(plant.GetJointActuatorIndices()[0]).joint().model_instance()
     driver = SimIiwaDriver.AddToBuilder(builder, plant, instance, config, controller_plant)
-    receiver = builder.AddSystem(IiwaCommandReceiver(n, ParseIiwaControlMode(mode)))
-    sender = builder.AddSystem(IiwaStatusSender(n))
+    receiver, sender, velocity = arm_blocks(messages, n, mode)
+    builder.AddSystem(receiver)
+    builder.AddSystem(sender)
     builder.Connect(driver.GetOutputPort("position_measured"), receiver.get_position_measured_input_port())
     builder.Connect(receiver.get_commanded_torque_output_port(), driver.GetInputPort("torque"))
     if mode == "position_and_torque":
         builder.Connect(receiver.get_commanded_position_output_port(), driver.GetInputPort("position"))
-    for port in ("position_commanded", "position_measured", "velocity_estimated", "torque_commanded",
-                 "torque_measured", "torque_external"):
+    for port in ("position_commanded", "position_measured", "torque_commanded", "torque_measured",
+                 "torque_external"):
         builder.Connect(driver.GetOutputPort(port), sender.GetInputPort(port))
+    builder.Connect(driver.GetOutputPort("velocity_estimated"), sender.GetInputPort(velocity))
     builder.ExportInput(receiver.get_message_input_port(), "command")
     builder.ExportOutput(sender.get_output_port(), "status")
     return builder.Build(), plant, controller_plant, receiver, sender
@@ -93,12 +117,13 @@ def build_station(model_file: str, mode: str, plant_step: float):
 class Lockstep:
     """The harness: one status period at a time, each waiting for the command with its stamp."""
 
-    def __init__(self, diagram, url, command_timeout: float, startup_timeout: float):
+    def __init__(self, diagram, url, command_timeout: float, startup_timeout: float, messages: str = "iiwa"):
         self.lcm = DrakeLcm(url) if url else DrakeLcm()
         self.inbox: list[bytes] = []
-        self.lcm.Subscribe(COMMAND, lambda data: self.inbox.append(bytes(data)))
-        self.status_ser = _Serializer_[lcmt_iiwa_status]()
-        self.command_ser = _Serializer_[lcmt_iiwa_command]()
+        self.status_type, self.command_type, self.status_channel, command = PROTOCOLS[messages]
+        self.lcm.Subscribe(command, lambda data: self.inbox.append(bytes(data)))
+        self.status_ser = _Serializer_[self.status_type]()
+        self.command_ser = _Serializer_[self.command_type]()
         self.command = self.command_ser.CreateDefaultValue()
         self.diagram, self.simulator = diagram, Simulator(diagram)
         self.context = self.simulator.get_mutable_context()
@@ -111,15 +136,15 @@ class Lockstep:
         """Publish the status of the current time, take the command with its stamp (returns the
         stamp); TimeoutError when none came in time."""
         data = self.status_ser.Serialize(self.diagram.GetOutputPort("status").EvalAbstract(self.context))
-        stamp = lcmt_iiwa_status.decode(data).utime
+        stamp = self.status_type.decode(data).utime
         wait = self.timeouts[0 if first else 1]
         deadline = time.monotonic() + wait
         sent = time.monotonic()
-        self.lcm.Publish(STATUS, data)
+        self.lcm.Publish(self.status_channel, data)
         while True:
             self.lcm.HandleSubscriptions(1)
             for message in self.inbox:
-                if lcmt_iiwa_command.decode(message).utime == stamp:
+                if self.command_type.decode(message).utime == stamp:
                     self.inbox.clear()
                     self.command_ser.Deserialize(message, self.command)
                     self.command_in.FixValue(self.context, self.command)
@@ -132,7 +157,7 @@ class Lockstep:
             if now - sent >= RESEND:
                 self.resends += 1
                 sent = now
-                self.lcm.Publish(STATUS, data)
+                self.lcm.Publish(self.status_channel, data)
 
 
 def tool_motion(plant, frame_name: str, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -169,8 +194,8 @@ def run(args: argparse.Namespace) -> dict:
     """Build, run in lockstep and measure (module docstring); station.json's content."""
     scenario = LoadedScenario.load(args.scenario, args.set or ()).scenario
     model_file = str(resolve_model(scenario.robot.model))
-    diagram, plant, _, _, _ = build_station(model_file, args.mode, args.plant_step)
-    loop = Lockstep(diagram, args.url, args.command_timeout, args.startup_timeout)
+    diagram, plant, _, _, _ = build_station(model_file, args.mode, args.plant_step, args.messages)
+    loop = Lockstep(diagram, args.url, args.command_timeout, args.startup_timeout, args.messages)
     plant_context = plant.GetMyMutableContextFromRoot(loop.context)
     plant.SetPositions(plant_context, np.radians(scenario.robot.initial_q_deg))
     loop.simulator.Initialize()  # (after the start pose: the receiver and the driver latch it)
@@ -190,7 +215,8 @@ def run(args: argparse.Namespace) -> dict:
         loop.simulator.AdvanceTo((k + 1) * args.status_period)
     segments = measure(scenario, plant, np.array(t), np.array(q), np.array(v)) if t else []
     ok = fault is None and all(not s["reasons"] for s in segments)
-    return {"scenario": scenario.name, "mode": args.mode, "status_period": args.status_period,
+    return {"scenario": scenario.name, "messages": args.messages, "mode": args.mode,
+            "status_period": args.status_period,
             "plant_step": args.plant_step, "ticks": len(t), "status_resends": loop.resends,
             "other_commands": loop.others, "wall_s": time.monotonic() - wall, "fault": fault,
             "segments": segments, "status": "ok" if ok else "missed" if fault is None else "failed"}
@@ -200,6 +226,7 @@ def parse(argv) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("scenario")
     p.add_argument("--mode", choices=MODES, default="torque_only")
+    p.add_argument("--messages", choices=tuple(PROTOCOLS), default="iiwa")
     p.add_argument("--status-period", type=float, default=0.001)
     p.add_argument("--plant-step", type=float, default=0.001)
     p.add_argument("--command-timeout", type=float, default=5.0)
@@ -229,7 +256,8 @@ def main(argv=None) -> int:
         print(f"segment {i}: e(tf) = {e * 1e3:.4f} mm" if e is not None else f"segment {i}: not reached",
               f"hold max = {seg['e_hold_max_norm'] * 1e3:.4f} mm" if seg["e_hold_max_norm"] else "",
               ", ".join(seg["reasons"]) or "ok")
-    print(f"station {result['mode']}, status {result['status_period'] * 1e3:g} ms: {result['status']}"
+    print(f"station {result['messages']} {result['mode']}, status {result['status_period'] * 1e3:g} ms: "
+          f"{result['status']}"
           + (f" ({result['fault']})" if result["fault"] else "") + f"; wrote {out}/station.json")
     return 0 if result["status"] == "ok" else 1
 

@@ -1,9 +1,13 @@
-"""Drake's ``IiwaCommandSender`` driving ``ptint hardware`` (issue 45: Drake's drivers, the other
-direction): a controller built of Drake's blocks alone — ``IiwaStatusReceiver`` → an
-``InverseDynamicsController`` holding the start pose (kp 100/s², kd 20/s, the arm's model file
-parsed by Drake) → ``IiwaCommandSender`` — answering each ``lcmt_iiwa_status`` on IIWA_STATUS
-with its ``lcmt_iiwa_command`` on IIWA_COMMAND, the sender's time input fed from the receiver's
-``time_measured``, as a Drake diagram wires them.
+"""Drake's ``IiwaCommandSender`` or ``PandaCommandSender`` driving ``ptint hardware`` (issue 45:
+Drake's drivers, the other direction): a controller built of Drake's blocks alone — the status
+receiver → an ``InverseDynamicsController`` holding the start pose (kp 100/s², kd 20/s, the arm's
+model file parsed by Drake) → the command sender — answering each status with its command.
+``--messages iiwa`` (default): ``IiwaStatusReceiver`` / ``IiwaCommandSender``, ``lcmt_iiwa_*`` on
+IIWA_STATUS / IIWA_COMMAND, the sender's time input fed from the receiver's ``time_measured``, as
+a Drake diagram wires them.  ``--messages panda``: ``PandaStatusReceiver`` /
+``PandaCommandSender`` (control mode: torque, or position | torque), ``lcmt_panda_*`` on
+PANDA_STATUS / PANDA_COMMAND; the Panda sender has no time input and stamps its context's time,
+set to the status's (``ptint hardware --messages panda`` beside).
 
 ``--mode torque_only``: torques alone (num_joints 0): ``ptint hardware`` applies them.
 ``--mode position_and_torque``: the start pose as positions beside the torques: ``ptint
@@ -24,9 +28,10 @@ import sys
 import time
 
 import numpy as np
-from drake import lcmt_iiwa_command, lcmt_iiwa_status
+from drake import lcmt_iiwa_command, lcmt_iiwa_status, lcmt_panda_command, lcmt_panda_status
 from pydrake.lcm import DrakeLcm
 from pydrake.manipulation import IiwaCommandSender, IiwaStatusReceiver, ParseIiwaControlMode
+from pydrake.manipulation import PandaCommandSender, PandaControlMode, PandaStatusReceiver
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.controllers import InverseDynamicsController
@@ -40,27 +45,39 @@ from ptint_drake.simulation.scenario import LoadedScenario
 
 MODES = ("torque_only", "position_and_torque")
 KP, KD = 100.0, 20.0  # 1/s², 1/s: the hold's gains (inverse dynamics: accelerations)
+PROTOCOLS = {"iiwa": (lcmt_iiwa_status, lcmt_iiwa_command, "IIWA_STATUS", "IIWA_COMMAND"),
+             "panda": (lcmt_panda_status, lcmt_panda_command, "PANDA_STATUS", "PANDA_COMMAND")}
 
 
-def build_controller(model_file: str, q0: np.ndarray, mode: str):
+def arm_blocks(messages: str, n: int, mode: str):
+    """(status receiver, command sender, the receiver's velocity port) of the ``messages`` set."""
+    if messages == "panda":
+        bits = int(PandaControlMode.kTorque) | (int(PandaControlMode.kPosition) if mode == MODES[1] else 0)
+        return PandaStatusReceiver(n), PandaCommandSender(n, bits), "velocity_measured"
+    return IiwaStatusReceiver(n), IiwaCommandSender(n, ParseIiwaControlMode(mode)), "velocity_estimated"
+
+
+def build_controller(model_file: str, q0: np.ndarray, mode: str, messages: str = "iiwa"):
     """(diagram, its plant) of receiver → inverse-dynamics hold of ``q0`` → sender."""
     plant = MultibodyPlant(0.0)
     Parser(plant).AddModels(model_file)
     plant.Finalize()
     n = plant.num_positions()
     builder = DiagramBuilder()
-    receiver = builder.AddSystem(IiwaStatusReceiver(n))
+    receiver, sender, velocity = arm_blocks(messages, n, mode)
+    builder.AddSystem(receiver)
+    builder.AddSystem(sender)
     state = builder.AddSystem(Multiplexer([n, n]))
     hold = builder.AddSystem(
         InverseDynamicsController(plant, np.full(n, KP), np.zeros(n), np.full(n, KD), False))
     desired = builder.AddSystem(ConstantVectorSource(np.concatenate([q0, np.zeros(n)])))
-    sender = builder.AddSystem(IiwaCommandSender(n, ParseIiwaControlMode(mode)))
     builder.Connect(receiver.GetOutputPort("position_measured"), state.get_input_port(0))
-    builder.Connect(receiver.GetOutputPort("velocity_estimated"), state.get_input_port(1))
+    builder.Connect(receiver.GetOutputPort(velocity), state.get_input_port(1))
     builder.Connect(state.get_output_port(), hold.get_input_port_estimated_state())
     builder.Connect(desired.get_output_port(), hold.get_input_port_desired_state())
     builder.Connect(hold.get_output_port_control(), sender.get_torque_input_port())
-    builder.Connect(receiver.GetOutputPort("time_measured"), sender.get_time_input_port())
+    if messages == "iiwa":
+        builder.Connect(receiver.GetOutputPort("time_measured"), sender.get_time_input_port())
     if mode == "position_and_torque":
         start = builder.AddSystem(ConstantVectorSource(q0))
         builder.Connect(start.get_output_port(), sender.get_position_input_port())
@@ -69,13 +86,14 @@ def build_controller(model_file: str, q0: np.ndarray, mode: str):
     return builder.Build(), plant
 
 
-def answer(diagram, url, idle: float, startup: float) -> int:
+def answer(diagram, url, idle: float, startup: float, messages: str = "iiwa") -> int:
     """Answer each status until ``idle`` s without one (``startup`` s before the first); the
     number of commands sent."""
     lcm = DrakeLcm(url) if url else DrakeLcm()
     inbox: list[bytes] = []
-    lcm.Subscribe("IIWA_STATUS", lambda data: inbox.append(bytes(data)))
-    status_ser, command_ser = _Serializer_[lcmt_iiwa_status](), _Serializer_[lcmt_iiwa_command]()
+    status_type, command_type, status_channel, command_channel = PROTOCOLS[messages]
+    lcm.Subscribe(status_channel, lambda data: inbox.append(bytes(data)))
+    status_ser, command_ser = _Serializer_[status_type](), _Serializer_[command_type]()
     status = status_ser.CreateDefaultValue()
     context = diagram.CreateDefaultContext()
     port_in, port_out = diagram.GetInputPort("status"), diagram.GetOutputPort("command")
@@ -85,7 +103,8 @@ def answer(diagram, url, idle: float, startup: float) -> int:
         for data in inbox:
             status_ser.Deserialize(data, status)
             port_in.FixValue(context, status)
-            lcm.Publish("IIWA_COMMAND", command_ser.Serialize(port_out.EvalAbstract(context)))
+            context.SetTime(max(0.0, status_type.decode(data).utime * 1e-6))  # (the Panda sender's stamp)
+            lcm.Publish(command_channel, command_ser.Serialize(port_out.EvalAbstract(context)))
             sent, last = sent + 1, time.monotonic()
         inbox.clear()
     return sent
@@ -95,6 +114,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("scenario")
     p.add_argument("--mode", choices=MODES, default="torque_only")
+    p.add_argument("--messages", choices=tuple(PROTOCOLS), default="iiwa")
     p.add_argument("--url")
     p.add_argument("--idle", type=float, default=1.0)
     p.add_argument("--startup-timeout", type=float, default=60.0)
@@ -106,9 +126,10 @@ def main(argv=None) -> int:
     except ScenarioError as exc:
         print(f"drake_command_sender: error: {exc}", file=sys.stderr)
         return 2
-    diagram, _ = build_controller(model_file, np.radians(scenario.robot.initial_q_deg), args.mode)
-    sent = answer(diagram, args.url, args.idle, args.startup_timeout)
-    print(f"drake_command_sender {args.mode}: sent {sent} commands")
+    q0 = np.radians(scenario.robot.initial_q_deg)
+    diagram, _ = build_controller(model_file, q0, args.mode, args.messages)
+    sent = answer(diagram, args.url, args.idle, args.startup_timeout, args.messages)
+    print(f"drake_command_sender {args.messages} {args.mode}: sent {sent} commands")
     return 0
 
 

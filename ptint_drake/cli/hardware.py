@@ -28,7 +28,8 @@ def _add_hardware_parser(sub) -> None:
         help="the simulated world as hardware over LCM (with `ptint drive`; docs/hardware.md)",
         description="Run the scenario's world alone as the hardware: a discrete plant at the control period "
         "publishing the arm's status (lcmt_iiwa_status on IIWA_STATUS) and applying the torque "
-        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND) from `ptint drive` (a station "
+        "commands it receives (lcmt_iiwa_command on IIWA_COMMAND; --messages panda: lcmt_panda_*) from "
+        "`ptint drive` (a station "
         "with a gripper adds the gripper's lcmt_schunk_wsg_status/command and its objects' motion); a "
         "fault (no command, a bad command, a second sender) holds the arm and ends the run with its "
         "reason, and so do SIGINT and SIGTERM (exit 130, 143). Writes metrics.json (the verdict, and "
@@ -85,6 +86,7 @@ def _add_hardware_link_options(hw: argparse.ArgumentParser) -> None:
         "(default 5; a loaded virtual machine may stall a process longer: see docs/hardware.md)",
     )
     _add_priority_option(hw, "without --lockstep: ")
+    _add_messages_option(hw, "commands in torque mode, or position + torque with the measured positions")
     hw.add_argument(
         "--hold-time",
         type=seconds("--hold-time"),
@@ -99,7 +101,8 @@ def _add_drive_parser(sub) -> None:
         "drive",
         help="the controller alone over LCM, driving `ptint hardware` or a robot (docs/hardware.md)",
         description="Run the scenario's targets and controller alone: answer each lcmt_iiwa_status on "
-        "IIWA_STATUS with an lcmt_iiwa_command on IIWA_COMMAND (the torques, less what the driver "
+        "IIWA_STATUS with an lcmt_iiwa_command on IIWA_COMMAND (--messages panda: lcmt_panda_*; the "
+        "torques, less what the driver "
         "adds: --driver-mode; the measured positions). Writes drive.json "
         "(what was received and sent) and drive_series.npz. Exit 0 when the scenario's end was "
         "reached, 1 when the status stopped (one line), 2 bad input.",
@@ -128,10 +131,24 @@ def _add_drive_parser(sub) -> None:
         "SimIiwaDriver torque-only), position-torque (Drake's IiwaDriver default: inverse dynamics "
         "around the positions sent, the measured ones) (default torque; docs/hardware.md)",
     )
+    _add_messages_option(dr, "Drake's PandaCommandReceiver, the franka driver, whose torque mode adds "
+                         "gravity compensation: --driver-mode torque-gravity")
     dr.add_argument("--out", help="output folder (default out/drive_NAME)")
     dr.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     dr.add_argument("--quiet", action="store_true", help="accepted like the other commands")
     dr.set_defaults(func=cmd_drive)
+
+
+def _add_messages_option(parser: argparse.ArgumentParser, panda: str) -> None:
+    """``--messages``: the arm driver's message types and channels (``hardware.arm_messages``)."""
+    parser.add_argument(
+        "--messages",
+        choices=("iiwa", "panda"),
+        default="iiwa",
+        help="the arm's messages: iiwa (lcmt_iiwa_status / lcmt_iiwa_command on IIWA_STATUS / "
+        "IIWA_COMMAND) or panda (lcmt_panda_status / lcmt_panda_command on PANDA_STATUS / "
+        f"PANDA_COMMAND: {panda}) (default iiwa; docs/hardware.md)",
+    )
 
 
 def _add_priority_option(parser: argparse.ArgumentParser, when: str) -> None:
@@ -168,6 +185,7 @@ def _link_settings(args: argparse.Namespace, scenario):
         seed=args.seed,
         priority=args.priority,
         silent_periods=args.silent_periods,
+        messages=args.messages,
     )
 
 
@@ -278,6 +296,7 @@ def cmd_drive(args: argparse.Namespace) -> int:
         status_timeout=args.status_timeout,
         priority=args.priority,
         driver_mode=args.driver_mode,
+        messages=args.messages,
     )
     record = DriveRecord()
     fault, url = None, args.url

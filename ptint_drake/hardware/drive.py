@@ -41,8 +41,8 @@ from pydrake.systems.primitives import PassThrough
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, TargetView
-from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL, Endpoint,
-                                       pack_wsg_command, unpack_status, url_warning)
+from ptint_drake.hardware.arm_messages import arm_messages
+from ptint_drake.hardware.link import WSG_COMMAND_CHANNEL, Endpoint, pack_wsg_command, url_warning
 from ptint_drake.hardware.camera_link import with_receive_buffer
 from ptint_drake.hardware.companions import CompanionFault, CompanionInbox, companion_channels
 from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
@@ -124,7 +124,8 @@ class _DriveLoop:
         self.period_us = int(round(settings.period * 1e6))
         # the driver's stamps to scenario time, and what the driver adds to a command
         self.clock = record.clock = StatusClock(settings.period)
-        self.terms = DriverTerms(settings.driver_mode, nominal_plant(scenario))
+        self.messages = arm_messages(settings.messages)  # the arm's status and command types
+        self.terms = DriverTerms(settings.driver_mode, nominal_plant(scenario), self.messages)
         # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
         # the hardware side rejects a torque beyond an effort limit as a fault
         self.limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
@@ -142,8 +143,9 @@ class _DriveLoop:
         also = companion_channels(ports)
         if ports is not None and ports.camera and lcm is None:  # a depth frame is hundreds of kB
             url = with_receive_buffer(url)
-        self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also, lcm=lcm)
-        record.channels = [STATUS_CHANNEL, *also]
+        status, command = self.messages.status_channel, self.messages.command_channel
+        self.endpoint = Endpoint(url, listen=status, publish=command, also=also, lcm=lcm)
+        record.channels = [status, *also]
         if side is not None:
             self.gripper_in = diagram.GetInputPort("gripper")
             self.parts_in = diagram.GetInputPort("parts") if ports.objects else None
@@ -180,7 +182,8 @@ class _DriveLoop:
                 if self.answered is None:
                     raise DriveFault(
                         f"no status from the hardware within the start-up timeout of {timeout:g} s on "
-                        f"{self.endpoint.url} (channel {STATUS_CHANNEL}): is `ptint hardware` running?"
+                        f"{self.endpoint.url} (channel {self.messages.status_channel}): is `ptint hardware` "
+                        f"running?"
                     )
                 last = self.answered * 1e-6
                 if last >= self.end - END_SLACK * self.settings.period:
@@ -198,7 +201,7 @@ class _DriveLoop:
         """One status received at wall time ``t_recv``: re-send the answer to a repeat, skip a stale
         one, otherwise check it and answer it."""
         try:
-            stamp, q, v = unpack_status(data, self.n)
+            stamp, q, v = self.messages.unpack_status(data, self.n)
         except ValueError as exc:
             raise DriveFault(f"status rejected: {exc}; stopped commanding") from None
         self.record.statuses += 1

@@ -8,7 +8,8 @@ from typing import Optional
 
 import numpy as np
 
-from ptint_drake.hardware.link import COMMAND_CHANNEL, STATUS_CHANNEL, spread
+from ptint_drake.hardware.arm_messages import arm_messages
+from ptint_drake.hardware.link import spread
 from ptint_drake.hardware.process import DEFAULT_PRIORITY, scheduler_name
 
 
@@ -22,6 +23,7 @@ class DriveSettings:
     status_timeout: float = 0.5  # s wall without a status once running
     priority: int = DEFAULT_PRIORITY  # SCHED_FIFO priority of the loop (0: none; ``hardware.priority``)
     driver_mode: str = "torque"  # what the driver adds to a command (``driver_modes.DRIVER_MODES``)
+    messages: str = "iiwa"  # the arm's message set and channels (``arm_messages.MESSAGES``)
 
 
 @dataclass
@@ -48,11 +50,13 @@ class DriveRecord:
 
 def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dict:
     """drive.json: what the drive received and sent."""
+    messages = arm_messages(settings.messages)
     return {
         "url": url,
-        "status_channel": STATUS_CHANNEL,
+        "messages": messages.name,
+        "status_channel": messages.status_channel,
         "subscribed_channels": list(record.channels),
-        "command_channel": COMMAND_CHANNEL,
+        "command_channel": messages.command_channel,
         "period": settings.period,
         "statuses_received": record.statuses,
         "statuses_repeated": record.repeats,

@@ -18,10 +18,12 @@ of its own before the motors see it, so the drive takes them off (``DriverTerms.
   finite difference of the commanded positions) and the arm's: measured on e(tf) in
   docs/hardware.md.
 
-Every command carries ``num_joints`` = n and positions (the measured ones in the torque modes,
-where a torque-only driver ignores them; Drake's ``IiwaCommandReceiver`` rejects 0 in any
-position mode).  ``ptint hardware`` is a torque-only driver: it refuses a command whose positions
-are not the status's measured ones (``position_refusal``) rather than ignore them.
+Every iiwa command carries ``num_joints`` = n and positions (the measured ones in the torque
+modes, where a torque-only driver ignores them; Drake's ``IiwaCommandReceiver`` rejects 0 in any
+position mode); a Panda command (``arm_messages``) carries them in ``position-torque`` alone.  The
+Panda's torque mode adds gravity compensation (Franka's FCI: ``torque-gravity``).  ``ptint
+hardware`` is a torque-only driver: it refuses a command whose positions are not the status's
+measured ones (``position_refusal``) rather than ignore them.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.controllers import InverseDynamics
 
-from ptint_drake.hardware.link import pack_command
+from ptint_drake.hardware.arm_messages import IIWA, ArmMessages
 
 DRIVER_MODES = ("torque", "torque-gravity", "position-torque")
 POSITION_TOLERANCE = 1e-9  # rad: positions within this of the measured ones are an echo, not a command
@@ -42,10 +44,10 @@ class DriverTerms:
     """The command for a driver of ``mode`` (module docstring), with the arm's model ``plant``
     (continuous, finalized: what the driver's own model is assumed to be)."""
 
-    def __init__(self, mode: str, plant: MultibodyPlant):
+    def __init__(self, mode: str, plant: MultibodyPlant, messages: ArmMessages = IIWA):
         if mode not in DRIVER_MODES:
             raise ValueError(f"--driver-mode: {mode!r} is not one of {', '.join(DRIVER_MODES)}")
-        self.mode, self.n = mode, plant.num_velocities()
+        self.mode, self.n, self.messages = mode, plant.num_velocities(), messages
         self._plant = plant  # (pydrake's InverseDynamics keeps no reference to it)
         self._system = None
         if mode != "torque":
@@ -64,9 +66,10 @@ class DriverTerms:
         return np.array(self._system.get_output_port_generalized_force().Eval(self._context), dtype=float)
 
     def command(self, stamp: int, tau: np.ndarray, q: np.ndarray, v: np.ndarray) -> bytes:
-        """The ``lcmt_iiwa_command`` stamped ``stamp`` that makes the arm get ``tau``: the torque
-        less what the driver adds, and the measured positions ``q``."""
-        return pack_command(stamp, tau - self.added(q, v), positions=q)
+        """The command (of the ``messages`` set) stamped ``stamp`` that makes the arm get ``tau``:
+        the torque less what the driver adds, and the measured positions ``q`` (the Panda's
+        command carries them in ``position-torque`` alone: ``arm_messages``)."""
+        return self.messages.pack_command(stamp, tau - self.added(q, v), q, self.mode == "position-torque")
 
 
 def position_refusal(positions: Optional[np.ndarray], measured: Optional[np.ndarray]) -> Optional[str]:
@@ -80,4 +83,4 @@ def position_refusal(positions: Optional[np.ndarray], measured: Optional[np.ndar
     j = int(np.argmax(off))
     return (f"a position + torque command (joint {j} commanded {positions[j]:.6g} rad, measured "
             f"{measured[j]:.6g} rad): ptint hardware is a torque-only driver, it applies the torques "
-            f"alone; send torque-only commands (num_joints 0, or the status's measured positions)")
+            f"alone; send torque-only commands (no positions, or the status's measured ones)")

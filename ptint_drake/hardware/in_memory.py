@@ -37,7 +37,8 @@ def run_pair(scenario: Scenario, settings: LinkSettings, out: Path) -> tuple[dic
             result["error"] = exc
 
     drive = DriveSettings(
-        period=settings.period, duration=settings.duration, startup_timeout=settings.startup_timeout
+        period=settings.period, duration=settings.duration, startup_timeout=settings.startup_timeout,
+        messages=settings.messages,
     )
     record = DriveRecord()
     interval = sys.getswitchinterval()

@@ -27,6 +27,7 @@ class LinkSettings:
     drop_status: float = 0.0  # a test option: the fraction of status messages not sent
     seed: int = 0
     priority: int = DEFAULT_PRIORITY  # real time: SCHED_FIFO priority of the loop (0: none; ``priority``)
+    messages: str = "iiwa"  # the arm's message set and channels (``arm_messages.MESSAGES``)
 
 
 @dataclass

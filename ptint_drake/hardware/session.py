@@ -34,9 +34,9 @@ from ptint_drake.hardware.driver_modes import position_refusal
 from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
+from ptint_drake.hardware.arm_messages import arm_messages
 from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
-                                       pack_parts, pack_status, pack_wsg_status, unpack_command_positions,
-                                       unpack_wsg_command, utime_of)
+                                       pack_parts, pack_wsg_status, unpack_wsg_command, utime_of)
 
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
@@ -55,6 +55,7 @@ class HardwareSession:
 
     def __init__(self, endpoint: Endpoint, n: int, limits: np.ndarray, settings: LinkSettings):
         self.endpoint, self.n, self.limits, self.s = endpoint, n, np.asarray(limits, float), settings
+        self.messages = arm_messages(settings.messages)  # the arm's status and command types
         self.record = LinkRecord()
         self._rng = np.random.default_rng(settings.seed)
         self._answered: Optional[int] = None  # utime of the last status answered
@@ -114,7 +115,7 @@ class HardwareSession:
     def _check(self, t: float, data: bytes, t_recv: float) -> None:
         """One received command against the checks (module docstring); a fault or its use."""
         try:
-            utime, tau, positions = unpack_command_positions(data, self.n)
+            utime, tau, positions = self.messages.unpack_command_positions(data, self.n)
         except ValueError as exc:
             return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {exc}")
         utime, refusal = self._matched(utime, positions)
@@ -283,7 +284,7 @@ class HardwareSession:
             if refused and self.warn is not None:
                 self.warn(refused)
         start = time.perf_counter()
-        data = pack_status(0.0, q, v, tau)
+        data = self.messages.pack_status(0.0, q, v, tau)
         self._set_companions(0.0, extras)
         self._pending, self._pending_q = 0, np.array(q, dtype=float)
         self._sent[0] = self._publish(data)
@@ -337,7 +338,7 @@ class HardwareSession:
         if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
             self._after_handshake = False
             self.record.duplicates += len(self.endpoint.poll(0.0))
-        data = pack_status(t, q, v, tau)
+        data = self.messages.pack_status(t, q, v, tau)
         self._set_companions(t, extras)
         self._pending, self._pending_q = utime, np.array(q, dtype=float)
         self._sent[utime] = self._publish(data)

@@ -24,8 +24,9 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.hardware.camera_link import image_channel, with_receive_buffer
-from ptint_drake.hardware.link import (COMMAND_CHANNEL, PARTS_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL,
-                                       WSG_STATUS_CHANNEL, Endpoint, SenderWatch, spread, url_warning)
+from ptint_drake.hardware.arm_messages import arm_messages
+from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
+                                       SenderWatch, spread, url_warning)
 from ptint_drake.hardware.process import scheduler_name, stop_on_signals
 from ptint_drake.hardware.session import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
 from ptint_drake.outputs.folder import METRICS, SERIES, save_series, staged_output, write_json_atomic
@@ -116,8 +117,9 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
     periods = np.diff(r.tick_wall) if len(r.tick_wall) > 1 else []
     block = {
         "url": session.endpoint.url,
-        "status_channel": STATUS_CHANNEL,
-        "command_channel": COMMAND_CHANNEL,
+        "messages": session.messages.name,
+        "status_channel": session.messages.status_channel,
+        "command_channel": session.messages.command_channel,
         "mode": "lockstep" if settings.lockstep else "realtime",
         "period": settings.period,
         "realtime_rate": None if settings.lockstep else settings.realtime_rate,
@@ -206,15 +208,15 @@ def run_hardware(
     endpoint = Endpoint(
         url,
         lcm=lcm,
-        listen=COMMAND_CHANNEL,
-        publish=STATUS_CHANNEL,
+        listen=arm_messages(settings.messages).command_channel,
+        publish=arm_messages(settings.messages).status_channel,
         also=(WSG_COMMAND_CHANNEL,) if ports is not None else (),
     )
     risk = url_warning(endpoint.url)
     if risk:
         warn(risk)
     session = HardwareSession(endpoint, n, actuator_effort_limits(plant), settings)
-    session.watch = SenderWatch.for_url(endpoint.url, (COMMAND_CHANNEL, WSG_COMMAND_CHANNEL))
+    session.watch = SenderWatch.for_url(endpoint.url, (session.messages.command_channel, WSG_COMMAND_CHANNEL))
     session.warn = warn
     session.ports = ports
     token = ACTIVE.set(session)

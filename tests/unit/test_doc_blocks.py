@@ -15,7 +15,8 @@ sys.path.insert(0, str(ROOT / "scripts"))
 import doc_blocks  # noqa: E402
 
 OTHER_TESTS = {"layers (scripts/layers_doc.py)": "tests/unit/test_layers.py",
-               "arms": "tests/unit/test_arm_table.py"}  # scripts/arm_table.py --check: its gains exactly
+               "arms": "tests/unit/test_arm_table.py",  # scripts/arm_table.py --check: its gains exactly
+               "interop": "tests/unit/test_interop_matrix.py"}  # scripts/interop_matrix.py --check
 
 
 def _markers() -> set:
