@@ -1,6 +1,6 @@
 """The companions of a status as ``ptint drive`` receives them: what a station with a gripper
-sends before each status of the arm (``World.link_ports``) — the gripper's status, the parts'
-motion where the station sends it (a pose tracker's report), a depth frame where one falls in the
+sends before each status of the arm (``World.link_ports``) — the gripper's status, the pose
+tracker's report where the station has one, a depth frame where one falls in the
 tick's period (``camera_link.frame_due``) — filed by their time stamp until the status of that
 time takes them."""
 
@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 from ptint_drake.hardware.camera_link import frame_due, image_channel, unpack_depth_image
-from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_STATUS_CHANNEL, Endpoint, unpack_parts,
+from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_STATUS_CHANNEL, Endpoint, unpack_tracked,
                                        unpack_wsg_status)
 
 
@@ -21,10 +21,10 @@ class CompanionFault(Exception):
 
 def companion_channels(ports) -> tuple:
     """The channels a station's companions of a status arrive on (``World.link_ports``): the
-    gripper's status, the parts' motion where the station sends it, the camera's frames."""
+    gripper's status, the tracker's reports where the station has one, the camera's frames."""
     if ports is None:
         return ()
-    return ((WSG_STATUS_CHANNEL,) + ((PARTS_CHANNEL,) if ports.objects else ())
+    return ((WSG_STATUS_CHANNEL,) + ((TRACKER_CHANNEL,) if ports.objects else ())
             + ((image_channel(ports.camera),) if ports.camera else ()))
 
 
@@ -34,11 +34,11 @@ class CompanionInbox:
 
     def __init__(self, endpoint: Endpoint, ports, period: float, timeout: float):
         self.endpoint, self.ports, self.period, self.timeout = endpoint, ports, period, timeout
-        # utime → {"gripper": [fingers; forces], "parts": motion, "image": a depth frame}
+        # utime → {"gripper": [fingers; forces], "tracked": a tracker's report, "image": a depth frame}
         self.companions: dict[int, dict] = {}
 
     def collect(self) -> None:
-        """File the gripper statuses, parts messages and depth frames received by their ``utime``."""
+        """File the gripper statuses, tracker reports and depth frames received by their ``utime``."""
         for data in self.endpoint.take_side(WSG_STATUS_CHANNEL):
             try:
                 utime, fingers, force = unpack_wsg_status(data)
@@ -46,12 +46,12 @@ class CompanionInbox:
                 raise CompanionFault(f"gripper status rejected: {exc}; stopped commanding") from None
             self.companions.setdefault(utime, {})["gripper"] = np.concatenate([fingers, force])
         if self.ports.objects:
-            for data in self.endpoint.take_side(PARTS_CHANNEL):
+            for data in self.endpoint.take_side(TRACKER_CHANNEL):
                 try:
-                    utime, motion = unpack_parts(data, self.ports.objects)
+                    utime, report = unpack_tracked(data, self.ports.objects)
                 except ValueError as exc:
-                    raise CompanionFault(f"parts message rejected: {exc}; stopped commanding") from None
-                self.companions.setdefault(utime, {})["parts"] = motion
+                    raise CompanionFault(f"tracker message rejected: {exc}; stopped commanding") from None
+                self.companions.setdefault(utime, {})["tracked"] = report
         if self.ports.camera:
             for data in self.endpoint.take_side(image_channel(self.ports.camera)):
                 try:
@@ -61,11 +61,11 @@ class CompanionInbox:
                 self.companions.setdefault(utime, {})["image"] = image
 
     def expected(self, utime: int, handshake: bool = False) -> tuple:
-        """The companions a status of ``utime`` brings: the gripper's, the parts' motion where the
-        station sends it, and a depth frame where one falls in the tick's period (``frame_due``)."""
+        """The companions a status of ``utime`` brings: the gripper's, the tracker's report where the
+        station has one, and a depth frame where one falls in the tick's period (``frame_due``)."""
         ports = self.ports
         frame = bool(ports.camera) and frame_due(utime * 1e-6, self.period, ports.camera_rate_hz, handshake)
-        return ("gripper",) + (("parts",) if ports.objects else ()) + (("image",) if frame else ())
+        return ("gripper",) + (("tracked",) if ports.objects else ()) + (("image",) if frame else ())
 
     def take(self, utime: int, handshake: bool = False) -> dict:
         """The companions of the tick ``utime`` (``_expected``; the hardware sends them before the

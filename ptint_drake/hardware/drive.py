@@ -58,7 +58,7 @@ from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot import actuator_effort_limits, nominal_plant
 from ptint_drake.systems.gripper import GRASP_STATES
-from ptint_drake.worlds.base import new_simulator
+from ptint_drake.worlds.base import TRACKER_PORT, new_simulator
 from ptint_drake.worlds.registry import objects_of, schedule_of, world_of
 
 
@@ -78,10 +78,10 @@ def DriveDiagram(scenario: Scenario):
     """(diagram, controller handles, joint count, the world's controller side or None:
     ``World.controller_side``, e.g. a world's targets, gripper sequence and grasp observer) of the
     scenario's controller alone (module docstring).  Inputs: ``state`` (the arm's [q; v]); with a
-    controller side
-    also ``parts`` (``link.PART_SIZE`` a part) and ``gripper`` ([fingers (4), drive forces (2)], as
-    ``link.unpack_wsg_status`` gives them).  Outputs: ``actuation``; with a controller side also
-    ``grasp_state``."""
+    controller side also ``tracked_poses`` (a pose tracker's report, ``worlds.base.TRACKED_SIZE``
+    a body; a station that has one) or ``depth_image``, and ``gripper`` ([fingers (4), drive
+    forces (2)], as ``link.unpack_wsg_status`` gives them).  Outputs: ``actuation``; with a
+    controller side also ``grasp_state``."""
     plant = nominal_plant(scenario)
     builder = DiagramBuilder()
     n = plant.num_positions() + plant.num_velocities()
@@ -150,7 +150,7 @@ class _DriveLoop:
         record.channels = [STATUS_CHANNEL, *also]
         if side is not None:
             self.gripper_in = diagram.GetInputPort("gripper")
-            self.parts_in = diagram.GetInputPort("parts") if ports.objects else None
+            self.tracked_in = diagram.GetInputPort(TRACKER_PORT) if ports.objects else None
             self.depth_in = diagram.GetInputPort("depth_image") if ports.camera else None
             self.grasp_out = diagram.GetOutputPort("grasp_state")
             self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout)
@@ -246,7 +246,7 @@ class _DriveLoop:
     def torque(self, t: float, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None) -> np.ndarray:
         """The controller's torque at the status's time ``t`` for its [q; v] (module docstring),
         clipped to the effort limits when saturating.  With a controller side ``companion`` holds the
-        tick's gripper status and parts' motion: the parts are read like the arm's state; the
+        tick's gripper status and tracker report: the report is read like the arm's state; the
         gripper status is the grasp observer's at its update at ``t`` (a periodic update like
         the one-process run's hold, which samples the arm after the plant's step)."""
         if self.answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
@@ -284,8 +284,8 @@ class _DriveLoop:
         """The diagram's inputs: a status's [q; v] and, with a controller side, its companions."""
         self.state_in.FixValue(self.context, np.concatenate([q, v]))
         if companion is not None:
-            if "parts" in companion:
-                self.parts_in.FixValue(self.context, companion["parts"])
+            if "tracked" in companion:
+                self.tracked_in.FixValue(self.context, companion["tracked"])
             if "image" in companion:
                 self.depth_in.FixValue(self.context, companion["image"])
             self.gripper_in.FixValue(self.context, companion["gripper"])

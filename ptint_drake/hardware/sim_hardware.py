@@ -34,8 +34,8 @@ from ptint_drake.hardware.session import (
 )
 from ptint_drake.hardware.link import (
     COMMAND_CHANNEL,
-    PARTS_CHANNEL,
     STATUS_CHANNEL,
+    TRACKER_CHANNEL,
     WSG_COMMAND_CHANNEL,
     WSG_STATUS_CHANNEL,
     Endpoint,
@@ -164,7 +164,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         block |= {
             "gripper_status_channel": WSG_STATUS_CHANNEL,
             "gripper_command_channel": WSG_COMMAND_CHANNEL,
-            "parts_channel": PARTS_CHANNEL if ports.objects else None,
+            "tracker_channel": TRACKER_CHANNEL if ports.objects else None,
             "gripper_commands_taken": r.gripper_commands,
         }
         if ports.camera:

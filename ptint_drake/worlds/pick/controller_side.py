@@ -3,22 +3,23 @@ in messages (``ptint drive``, ``hardware.drive``): what the controller aims at, 
 commands and the grasp state, with no plant.
 
 ``AddPickControllerSide`` adds to a builder: ``PickTargets`` (what each segment aims at) fed from
-an input of the parts' motion as received, ``GripperSequence`` (the plan's gripper commands) and
-``GraspObserver`` (``systems.gripper``: the grasp state) fed from an input of the gripper's
-reported fingers and drive forces.  The slots' places come from the scenario's tray (the station
-built once for its geometry: no state of it is read).
+the part tracker's reports or the camera's frames as received, ``GripperSequence`` (the plan's
+gripper commands) and ``GraspObserver`` (``systems.gripper``: the grasp state) fed from an input
+of the gripper's reported fingers and drive forces.  The slots' places come from the scenario's
+tray (the station built once for its geometry: no state of it is read).
 
-==============  ==========  ================================================================
-port (export)   size        meaning
-==============  ==========  ================================================================
-``parts``       24 a part   input: per part (scenario order) [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15),
-                            ``pick.part_pose``'s ports (without an rgbd camera)
-``depth_image`` image       input (an rgbd camera): the station's depth frame; the perception,
-                            the estimators and ``EstimatedParts`` run here (``camera``)
-``gripper``     6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each finger
-                            drive's force (N, − squeezes): ``GraspObserver``'s inputs
-``grasp_state`` 1           output: the observer's state (``systems.gripper.GRASP_STATES``)
-==============  ==========  ================================================================
+=================  ==========  =============================================================
+port (export)      size        meaning
+=================  ==========  =============================================================
+``tracked_poses``  18 a part   input (without an rgbd camera): the part tracker's report, per
+                               part (scenario order) [p, v, R, ω] (``tracker``), read by
+                               ``TrackedParts`` as ``ptint run`` reads the station's port
+``depth_image``    image       input (an rgbd camera): the station's depth frame; the
+                               perception, the estimators and ``EstimatedParts`` run here
+``gripper``        6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each
+                               finger drive's force (N, − squeezes): ``GraspObserver``'s inputs
+``grasp_state``    1           output: the observer's state (``systems.gripper.GRASP_STATES``)
+=================  ==========  =============================================================
 
 ``grasp_reads`` gives when ``world.PickRun`` reads that state (its grasp checks and the reads
 every ``world.SENSE_PERIOD`` from a close command), on the control period's grid.
@@ -41,15 +42,15 @@ from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_conf
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
 from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.tracker import TRACKER_PORT, TrackedParts
 
-PART_MOTION = (9, 15)  # a part's [x, ẋ, ẍ] and [R, ω, ω̇]
 CAMERA_NAME = "camera"  # the station's rgbd camera over LCM: DRAKE_RGBD_CAMERA_IMAGES_camera
 
 
 def pick_link_ports(scenario: Scenario) -> LinkPorts:
     """What crosses ``ptint hardware``'s link beside the arm (``World.link_ports``): the gripper
-    (its force limit) and every part's motion, or with an rgbd camera its depth frames instead
-    (the drive runs the perception: no part's motion crosses the link)."""
+    (its force limit) and the part tracker's reports of every part, or with an rgbd camera its
+    depth frames instead (the drive runs the perception).  No truth port crosses it."""
     force, m = scenario.pick.gripper.max_force, scenario.measurement
     if m is not None and m.sensor == "rgbd":
         return LinkPorts(gripper_max_force=force, objects=0, camera=CAMERA_NAME,
@@ -117,14 +118,12 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
             for what in (f"part_{k}_pose", f"part_{k}_rotation"):
                 builder.Connect(seen.GetOutputPort(what), targets.GetInputPort(what))
         builder.ExportInput(depth.get_input_port(), "depth_image")
-    else:  # the parts' motion in, as a pose tracker reports it
-        parts = builder.AddNamedSystem("status_parts", PassThrough(sum(PART_MOTION) * count))
-        split = builder.AddNamedSystem("parts_split", Demultiplexer(list(PART_MOTION) * count))
-        builder.Connect(parts.get_output_port(), split.get_input_port(0))
+    else:  # the part tracker's reports in, read as ``ptint run`` reads them (``tracker``)
+        tracked = builder.AddNamedSystem("tracked_parts", TrackedParts(count))
         for k in range(count):
-            builder.Connect(split.get_output_port(2 * k), targets.GetInputPort(f"part_{k}_pose"))
-            builder.Connect(split.get_output_port(2 * k + 1), targets.GetInputPort(f"part_{k}_rotation"))
-        builder.ExportInput(parts.get_input_port(), "parts")
+            for what in (f"part_{k}_pose", f"part_{k}_rotation"):
+                builder.Connect(tracked.GetOutputPort(what), targets.GetInputPort(what))
+        builder.ExportInput(tracked.get_input_port(), TRACKER_PORT)
     sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
     gripper = builder.AddNamedSystem("status_gripper", PassThrough(6))
     fingers = builder.AddNamedSystem("gripper_split", Demultiplexer([4, 2]))
