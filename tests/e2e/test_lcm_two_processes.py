@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -81,20 +82,32 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     assert drive["commands_sent"] >= 3000 and drive["fault"] is None
 
 
+# what a cell's devices send and take: the arm's and the gripper's drivers, the part tracker
+PICK_WIRE = {"IIWA_STATUS", "IIWA_COMMAND", "SCHUNK_WSG_STATUS", "SCHUNK_WSG_COMMAND", "TRACKED_POSES"}
+TRUTH_WORDS = r"PART|MOTION|TRUTH|TRUE|GROUND"  # a channel named for part motion or truth
+
+
 def test_pick_lockstep_places_like_one_process(tmp_path, run):
-    """Acceptance, the pick world: lockstep across two processes (arm, gripper and parts over
-    LCM; the targets, gripper sequence and grasp observer in the drive) = ptint run of
-    conveyor_pick_place (its control period and plant step are 1 ms already): every part placed,
-    the same verdict, the place error within 1e-6 m (measured: 0.155655 against 0.155582 mm, the
-    first 10 ms bit-identical, then round-off amplified by the contacts)."""
+    """Acceptance, the pick world: lockstep across two processes (arm, gripper and the part
+    tracker's reports over LCM; the targets, gripper sequence and grasp observer in the drive) =
+    ptint run of conveyor_pick_place (its control period and plant step are 1 ms already): every
+    part placed, the same verdict, the place error within 1e-6 m (measured: 0.155655 against
+    0.155582 mm, the first 10 ms bit-identical, then round-off amplified by the contacts).  A
+    bystander on the group sees every channel on the wire: the devices' own, none named for
+    part motion or truth; the drive subscribes to the three its controller side reads."""
     out = run_plan(
         [
-            {"name": "hw", "argv": ptint("hardware", PICK, *PATIENT, "--lockstep", "--quiet",
-                                         "--out", str(tmp_path / "hw"))},
-            {"name": "drive", "argv": ptint("drive", PICK, *PATIENT, "--out", str(tmp_path / "dr"))},
+            {"name": "wire", "argv": [sys.executable, str(HERE / "listen.py"), "110"], "timeout": 115.0},
+            {"name": "hw", "delay": 0.5, "argv": ptint("hardware", PICK, *PATIENT, "--lockstep", "--quiet",
+                                                       "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "delay": 0.5,
+             "argv": ptint("drive", PICK, *PATIENT, "--out", str(tmp_path / "dr"))},
         ],
         tmp_path,
     )
+    wire = json.loads(out["wire"]["stdout"])
+    wire.pop("LCM_SELF_TEST", None)  # LCM's own, each process's start-up check of the group
+    assert set(wire) == PICK_WIRE and not any(re.search(TRUTH_WORDS, c) for c in wire), wire
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
     reference = run(PICK).metrics
@@ -107,8 +120,10 @@ def test_pick_lockstep_places_like_one_process(tmp_path, run):
     link = metrics["hardware"]
     assert link["ticks"] == 5000 and link["fault"] is None
     assert link["gripper_commands_taken"] == link["ticks"]  # one gripper command a tick
+    assert link["tracker_channel"] == "TRACKED_POSES"
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert drive["fault"] is None and drive["commands_sent"] >= 5000
+    assert drive["subscribed_channels"] == ["IIWA_STATUS", "SCHUNK_WSG_STATUS", "TRACKED_POSES"]
 
 
 def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
@@ -135,7 +150,7 @@ def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
         assert pick["placed"] and abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 1e-3, (pick, ref)
         assert pick["t_grasp"] == ref["t_grasp"]
     link = metrics["hardware"]
-    assert link["parts_channel"] is None and link["image_channel"] == "DRAKE_RGBD_CAMERA_IMAGES_camera"
+    assert link["tracker_channel"] is None and link["image_channel"] == "DRAKE_RGBD_CAMERA_IMAGES_camera"
     assert link["frames_sent"] >= 150 and link["fault"] is None  # 30 Hz over 5 s
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert drive["subscribed_channels"] == ["IIWA_STATUS", "SCHUNK_WSG_STATUS",
