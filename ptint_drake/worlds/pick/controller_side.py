@@ -30,7 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.sensors import ImageDepth32F
 from pydrake.systems.primitives import Demultiplexer, PassThrough
 
@@ -38,7 +38,8 @@ from ptint_drake.config.schema import Scenario
 from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.systems.gripper import EMPTY, HOLDING, LOST, GraspObserver
 from ptint_drake.worlds.pick.camera import AddPartEstimates
-from ptint_drake.worlds.pick.run import PortTargets, place_positions, world_config
+from ptint_drake.worlds.pick.run import (PROBE_PERIOD, REPLAY_PERIOD, PortTargets, place_positions,
+                                         world_config)
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
 from ptint_drake.worlds.pick.route import routed_plan
@@ -65,6 +66,21 @@ def plan_stands(state: int, read: str) -> bool:
     nothing (``empty``) or lost the part (``lost``).  Otherwise the world plans anew (a retry, an
     abort, or at a check still ``closing``, a longer wait)."""
     return state == HOLDING if read == "check" else state not in (EMPTY, LOST)
+
+
+class RunSampleTimes(LeafSystem):
+    """No output, no state: publish events (that do nothing) every one of ``periods`` s from 0 —
+    the sample times of ``ptint run``'s loggers (``run.PROBE_PERIOD``, ``run.REPLAY_PERIOD``), at
+    which its simulator ends a step.  In the drive's diagram they end its steps at the same
+    times, so that the controller's own state (σ, one explicit Euler step per interval) is
+    integrated over the same sub-steps as in the one-process run, to the last bit (without them,
+    the steps split at 1/30 s differ by round-off, which the contacts amplify: 2.2 µm at
+    assembly_pick_place's last place)."""
+
+    def __init__(self, periods: tuple):
+        super().__init__()
+        for period in periods:
+            self.DeclarePeriodicPublishEvent(period, 0.0, lambda context: None)
 
 
 @dataclass
@@ -124,6 +140,7 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
             for what in (f"part_{k}_pose", f"part_{k}_rotation"):
                 builder.Connect(tracked.GetOutputPort(what), targets.GetInputPort(what))
         builder.ExportInput(tracked.get_input_port(), TRACKER_PORT)
+    builder.AddNamedSystem("run_sample_times", RunSampleTimes((PROBE_PERIOD, REPLAY_PERIOD)))
     sequence = builder.AddNamedSystem("gripper_sequence", GripperSequence(plan.commands, plan.widths))
     gripper = builder.AddNamedSystem("status_gripper", PassThrough(6))
     fingers = builder.AddNamedSystem("gripper_split", Demultiplexer([4, 2]))
