@@ -91,8 +91,8 @@ def test_pick_lockstep_places_like_one_process(tmp_path, run):
     """Acceptance, the pick world: lockstep across two processes (arm, gripper and the part
     tracker's reports over LCM; the targets, gripper sequence and grasp observer in the drive) =
     ptint run of conveyor_pick_place (its control period and plant step are 1 ms already): every
-    part placed, the same verdict, the place error within 1e-6 m (measured: 0.155655 against
-    0.155582 mm, the first 10 ms bit-identical, then round-off amplified by the contacts).  A
+    part placed, the same verdict, the place error within 1e-12 m (measured: bit-identical, as is
+    every arm and part sample of the run; assembly_pick_place's last place 1.3e-15 m apart).  A
     bystander on the group sees every channel on the wire: the devices' own, none named for
     part motion or truth; the drive subscribes to the three its controller side reads."""
     out = run_plan(
@@ -115,7 +115,7 @@ def test_pick_lockstep_places_like_one_process(tmp_path, run):
     assert len(metrics["picks"]) == len(reference["picks"])
     for pick, ref in zip(metrics["picks"], reference["picks"]):
         assert pick["placed"] and ref["placed"]
-        assert abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 1e-3  # 1e-6 m (measured 7e-8 m)
+        assert abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 1e-9  # 1e-12 m (measured 0)
         assert [a["state"] for a in pick["attempt_details"]] == [a["state"] for a in ref["attempt_details"]]
     link = metrics["hardware"]
     assert link["ticks"] == 5000 and link["fault"] is None
