@@ -7,6 +7,7 @@ time takes them."""
 from __future__ import annotations
 
 import time
+from typing import Optional
 
 import numpy as np
 
@@ -36,6 +37,7 @@ class CompanionInbox:
         self.endpoint, self.ports, self.period, self.timeout = endpoint, ports, period, timeout
         # utime → {"gripper": [fingers; forces], "tracked": a tracker's report, "image": a depth frame}
         self.companions: dict[int, dict] = {}
+        self.lost = 0  # ticks skipped for a lost companion (``take``)
 
     def collect(self) -> None:
         """File the gripper statuses, tracker reports and depth frames received by their ``utime``."""
@@ -67,10 +69,13 @@ class CompanionInbox:
         frame = bool(ports.camera) and frame_due(utime * 1e-6, self.period, ports.camera_rate_hz, handshake)
         return ("gripper",) + (("tracked",) if ports.objects else ()) + (("image",) if frame else ())
 
-    def take(self, utime: int, handshake: bool = False) -> dict:
+    def take(self, utime: int, handshake: bool = False) -> Optional[dict]:
         """The companions of the tick ``utime`` (``_expected``; the hardware sends them before the
-        arm's status; a lost one comes again with the status's re-send); ``DriveFault`` after the
-        status timeout without them."""
+        arm's status; in lockstep a lost one comes again with the status's re-send).  None when
+        one of them is lost: a later tick's companions came while this tick's set is incomplete
+        (one publishing socket on the hardware side: its packets arrive in order, so the missing
+        one will not come; in real time nothing re-sends it) — the tick is skipped, as a lost
+        status is.  ``CompanionFault`` after the status timeout without them."""
         deadline = time.perf_counter() + self.timeout
         expected = self.expected(utime, handshake)
         while True:
@@ -82,6 +87,11 @@ class CompanionInbox:
                 for old in [u for u in self.companions if u <= utime]:
                     del self.companions[old]
                 return got
+            if not handshake and any(u > utime for u in self.companions):
+                self.lost += 1
+                for old in [u for u in self.companions if u <= utime]:
+                    del self.companions[old]
+                return None
             if time.perf_counter() >= deadline:
                 missing = " and ".join(k for k in expected if k not in got)
                 raise CompanionFault(

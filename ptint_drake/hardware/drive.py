@@ -220,10 +220,15 @@ class _DriveLoop:
             return
         if answered is not None:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
-        self.respond(t_recv, utime, q, v, self.companion(utime) if self.side is not None else None)
+        companion = self.companion(utime) if self.side is not None else None
+        if self.side is not None and companion is None:  # one of its companions lost: skipped
+            self.record.companions_lost = self.inbox.lost
+            return
+        self.respond(t_recv, utime, q, v, companion)
 
-    def companion(self, utime: int) -> dict:
-        """The station's companions of the status of ``utime`` (``companions.CompanionInbox``)."""
+    def companion(self, utime: int) -> Optional[dict]:
+        """The station's companions of the status of ``utime`` (``companions.CompanionInbox``;
+        None: one was lost, the tick is skipped)."""
         try:
             return self.inbox.take(utime, handshake=self.answered is None)
         except CompanionFault as exc:

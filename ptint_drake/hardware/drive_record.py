@@ -31,6 +31,7 @@ class DriveRecord:
     repeats: int = 0  # statuses received again (re-sent by the hardware)
     stale: int = 0  # statuses older than one already answered
     gaps: int = 0  # ticks skipped between two statuses (lost or not sent)
+    companions_lost: int = 0  # statuses not answered: a companion of theirs lost (``companions``)
     commands: int = 0
     compute: list = field(default_factory=list)  # s wall: status received → command sent
     clipped: int = 0  # commands clipped to the actuators' effort limits
@@ -56,6 +57,7 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "statuses_repeated": record.repeats,
         "statuses_stale": record.stale,
         "ticks_missing": record.gaps,
+        "companions_lost": record.companions_lost,
         "commands_sent": record.commands,
         "first_t": record.first_t,
         "last_t": record.last_t,

@@ -75,6 +75,7 @@ class HardwareSession:
             int, tuple[float, float]
         ] = {}  # gripper commands: driver's tick utime → (opening, force)
         self._companions: list = []  # this tick's gripper status, tracker report, frame (``ports``)
+        self._drop_gripper = False  # ``drop_companion``: this tick's gripper status not sent once
         self.handshake_s: Optional[float] = None  # wall s the hand-shake took
         self.builds = 0  # CommandLinks built in this session (more than one: a world planned anew)
         self.watch = (
@@ -98,6 +99,9 @@ class HardwareSession:
     # -- the protocol -------------------------------------------------------------------------
     def _publish(self, data: bytes) -> float:
         for channel, message in self._companions:  # before the arm's status: it completes a tick
+            if self._drop_gripper and channel == WSG_STATUS_CHANNEL:
+                self._drop_gripper, self.record.companions_dropped = False, self.record.companions_dropped + 1
+                continue
             self.endpoint.publish_on(channel, message)
         if self.s.drop_status > 0 and self._rng.random() < self.s.drop_status:
             self.record.dropped += 1
@@ -259,6 +263,9 @@ class HardwareSession:
             return
         fingers, force, tracked, image = extras
         self._companions = [(WSG_STATUS_CHANNEL, pack_wsg_status(t, fingers, force))]
+        drop = self.s.drop_companion  # (a test: the gripper status's first publish is lost)
+        self._drop_gripper = (drop is not None and utime_of(t) == utime_of(drop)
+                              and not self.record.companions_dropped)
         if tracked is not None:
             self._companions.append((TRACKER_CHANNEL, pack_tracked(t, tracked)))
         if image is not None:  # the camera's frame of this tick's period: before the status too

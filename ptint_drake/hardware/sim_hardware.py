@@ -166,6 +166,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
             "gripper_command_channel": WSG_COMMAND_CHANNEL,
             "tracker_channel": TRACKER_CHANNEL if ports.objects else None,
             "gripper_commands_taken": r.gripper_commands,
+            "companions_dropped": r.companions_dropped,
         }
         if ports.camera:
             block |= {"image_channel": image_channel(ports.camera), "frames_sent": r.frames_sent}

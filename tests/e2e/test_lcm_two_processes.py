@@ -337,6 +337,35 @@ def test_dropped_status_completes(tmp_path):
     )
 
 
+def test_realtime_lost_gripper_status_does_not_end_the_run(tmp_path):
+    """Issue 43: in real time nothing re-sends a companion; one lost gripper status (the hardware's
+    test option --drop-companion: the tick at 1 s) costs that tick, not the run — the drive sees
+    the next tick's companions first, skips the tick (a late tick for the hardware, which keeps
+    the previous torque) and answers the next; the run goes on to its end.  (The silent-peer
+    timeouts are set out of the way, 5 s on both sides, and the pace at a quarter of real time: at
+    load 7 on this 2-core machine a process stalled for 0.9 s, the arm drifted on the old torque
+    and missed its grasp; the hold is not what this test checks.)"""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", PICK, *PATIENT, "--silent-periods", "5000", "--quiet",
+                                         "--realtime-rate", "0.25", "--drop-companion", "1.0",
+                                         "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", PICK, *PATIENT, "--status-timeout", "5",
+                                            "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["drive"]["rc"] == 0, out
+    metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
+    link = metrics["hardware"]
+    assert link["companions_dropped"] == 1 and link["fault"] is None and link["ticks"] == 5000, link
+    assert link["ticks_late"] >= 1  # the tick whose gripper status was lost went unanswered
+    drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
+    assert drive["fault"] is None and drive["companions_lost"] == 1 and drive["last_t"] >= 4.998, drive
+    # placed, unless the machine's load made enough late ticks to cost the accuracy (then exit 1)
+    assert out["hw"]["rc"] == 0 or (out["hw"]["rc"] == 1 and link["ticks_late"] > 1), out
+
+
 def test_in_memory_pair_matches_two_processes(tmp_path):
     """The fallback where no private namespace can be made: hardware and drive as two threads
     over one ``memq://`` LCM (``hardware.in_memory``), the same messages and checks; lockstep

@@ -58,9 +58,11 @@ def test_the_wire_carries_the_devices_channels_only(tmp_path):
     lcm = DrakeLcm("memq://")
     seen: dict[str, list] = {}
     lcm.SubscribeAllChannels(lambda channel, data: seen.setdefault(channel, []).append(bytes(data)))
-    settings = LinkSettings(period=1e-3, duration=scenario.duration)
+    # (and in lockstep a lost gripper status is re-sent with its status: no tick lost)
+    settings = LinkSettings(period=1e-3, duration=scenario.duration, drop_companion=1.0)
     metrics, drive = run_pair(scenario, settings, tmp_path, lcm=lcm)
     assert metrics["hardware"]["fault"] is None and metrics["status"] == "ok"
+    assert metrics["hardware"]["companions_dropped"] == 1 and drive["companions_lost"] == 0
     assert set(seen) == DEVICES and not any(re.search(TRUTH_WORDS, c) for c in seen), sorted(seen)
     assert drive["subscribed_channels"] == ["IIWA_STATUS", "SCHUNK_WSG_STATUS", "TRACKED_POSES"]
     utime, report = unpack_tracked(seen["TRACKED_POSES"][-1], 1)  # [p, v, R, ω]: no acceleration
