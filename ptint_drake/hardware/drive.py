@@ -154,6 +154,9 @@ class _DriveLoop:
             self.depth_in = diagram.GetInputPort("depth_image") if ports.camera else None
             self.grasp_out = diagram.GetOutputPort("grasp_state")
             self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout)
+        self.frames = getattr(side, "frames", None)  # a perception in a process of its own
+        if self.frames is not None:
+            self.frames.start()
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
         if risk:
@@ -256,6 +259,7 @@ class _DriveLoop:
         the one-process run's hold, which samples the arm after the plant's step)."""
         if self.answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
             self._fix(q, v, companion)
+            self._frame(t, companion, handshake=True)
             self.context.SetTime(t)
             self.simulator.Initialize()
         elif companion is not None and (t > self.context.get_time() or not self.started):
@@ -266,11 +270,12 @@ class _DriveLoop:
             # runner does at its stops: ``WorldRun.advance_at_reached_stops``; the first tick, at
             # t = 0 as the hand-shake, takes the events at t = 0 so); only then the new sample
             self.started = True
+            if self.frames is not None:  # the frames whose samples are visible by t, written
+                self.frames.take_due(self.context, t)
             self.simulator.AdvanceTo(t)
             self.check_grasp(int(round(t * 1e6)))
             self.gripper_in.FixValue(self.context, companion["gripper"])
-            if "image" in companion:  # this period's frame, before the perception's event in it
-                self.depth_in.FixValue(self.context, companion["image"])
+            self._frame(t, companion)  # this period's frame, before the perception's event in it
             self.simulator.AdvanceTo(t)
         elif t > self.context.get_time():
             # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
@@ -291,17 +296,23 @@ class _DriveLoop:
         if companion is not None:
             if "tracked" in companion:
                 self.tracked_in.FixValue(self.context, companion["tracked"])
-            if "image" in companion:
-                self.depth_in.FixValue(self.context, companion["image"])
             self.gripper_in.FixValue(self.context, companion["gripper"])
+
+    def _frame(self, t: float, companion: Optional[dict], handshake: bool = False) -> None:
+        """A depth frame that came with the status of ``t``: to the perception's process, or input."""
+        if companion is None or "image" not in companion:
+            return
+        if self.frames is not None:
+            self.frames.submit(t, companion["image"], handshake)
+        else:
+            self.depth_in.FixValue(self.context, companion["image"])
 
     def respond(
         self, t_recv: float, utime: int, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None
     ) -> None:
         """Send the command stamped ``utime`` answering a status checked (with a gripper, first,
         the gripper command for the driver's next tick), and record it."""
-        # the hardware's time as its simulator has it: Drake puts the k-th periodic tick at
-        # k · T (a product), which for 13 % of the ticks at T = 1 ms is 1 ulp from utime / 10⁶
+        # the hardware simulator's time: Drake's k-th tick is k · T, 1 ulp from utime / 10⁶ at 13 %
         t = round(utime / self.period_us) * self.settings.period if self.period_us else utime / 1e6
         first = self.answered is None
         tau = self.torque(t, q, v, companion)
@@ -342,6 +353,8 @@ class _DriveLoop:
         scratch.Initialize()
         scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
         self.out.Eval(scratch.get_context())
+        if self.frames is not None:  # the hand-shake's frame fitted before the first tick
+            self.frames.prefetch()
 
     def go_realtime(self) -> None:
         """After the hand-shake's command and the warm-up, before the answer goes out: the
@@ -372,11 +385,14 @@ def run_drive(
     into ``record``; returns the URL used.  ``lcm``: a ``DrakeLcm`` to use instead of one of
     ``url`` (``in_memory``)."""
     loop = _DriveLoop(scenario, settings, record, url, warn, lcm)
-    while True:
-        for t_recv, data in loop.wait():
-            loop.take(t_recv, data)
-        if loop.finished():
-            return loop.endpoint.url
+    try:
+        while True:
+            for t_recv, data in loop.wait():
+                loop.take(t_recv, data)
+            if loop.finished():
+                return loop.endpoint.url
+    finally:
+        record.perception = loop.frames.close() if loop.frames is not None else None
 
 
 __all__ = ["DriveDiagram", "DriveFault", "DriveRecord", "DriveSettings", "drive_series", "drive_summary",

@@ -34,6 +34,7 @@ class DriveRecord:
     companions_lost: int = 0  # statuses not answered: a companion of theirs lost (``companions``)
     commands: int = 0
     compute: list = field(default_factory=list)  # s wall: status received → command sent
+    perception: Optional[dict] = None  # a perception in its own process: its fits' and waits' times
     clipped: int = 0  # commands clipped to the actuators' effort limits
     url: Optional[str] = None  # the LCM URL in use
     channels: list = field(default_factory=list)  # the channels subscribed to
@@ -62,6 +63,8 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "first_t": record.first_t,
         "last_t": record.last_t,
         "compute_ms": spread(record.compute, 1e3),
+        "ticks_over_period": int(np.count_nonzero(np.asarray(record.compute) > settings.period)),
+        "perception": record.perception,
         "commands_clipped": record.clipped,
         "scheduler": scheduler_name(),
     }

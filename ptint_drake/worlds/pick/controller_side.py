@@ -15,7 +15,8 @@ port (export)      size        meaning
                                part (scenario order) [p, v, R, ω] (``tracker``), read by
                                ``TrackedParts`` as ``ptint run`` reads the station's port
 ``depth_image``    image       input (an rgbd camera): the station's depth frame; the
-                               perception, the estimators and ``EstimatedParts`` run here
+                               estimators and ``EstimatedParts`` run here, the perception's
+                               fits in a process of their own (``side.frames``: ``FrameProcess``)
 ``gripper``        6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each
                                finger drive's force (N, − squeezes): ``GraspObserver``'s inputs
 ``grasp_state``    1           output: the observer's state (``systems.gripper.GRASP_STATES``)
@@ -37,6 +38,7 @@ from pydrake.systems.primitives import Demultiplexer, PassThrough
 from ptint_drake.config.schema import Scenario
 from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.systems.gripper import EMPTY, HOLDING, LOST, GraspObserver
+from ptint_drake.systems.perception.frame_process import FrameProcess
 from ptint_drake.worlds.pick.camera import AddPartEstimates
 from ptint_drake.worlds.pick.run import (PROBE_PERIOD, REPLAY_PERIOD, PortTargets, place_positions,
                                          world_config)
@@ -95,6 +97,8 @@ class PickControllerSide:
     max_force: float
     reads: dict
     target: PortTargets
+    # with an rgbd camera: the perception's fits in a process of their own (``FrameProcess``)
+    frames: object = None
 
     def stands(self, utime: int, state: int) -> bool:
         """Whether the plan stands at the status of ``utime`` with the observer's ``state``
@@ -121,6 +125,7 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     """The pick world's controller side in ``builder`` (module docstring), its ports exported;
     ``period``: the control period, ``sense``: ``grasp_reads``'s."""
     pick = scenario.pick
+    frames = None
     plan = routed_plan(scenario)
     places = place_positions(MakePickStation(world_config(scenario)), plan)
     count = len(pick.parts)
@@ -129,7 +134,9 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     if m is not None and m.sensor == "rgbd":  # the camera's frames in, the perception here
         depth = builder.AddNamedSystem("status_depth_image",
                                        PassThrough(AbstractValue.Make(ImageDepth32F())))
-        seen = AddPartEstimates(builder, depth.get_output_port(), scenario).parts
+        estimates = AddPartEstimates(builder, depth.get_output_port(), scenario, fits_elsewhere=True)
+        frames = FrameProcess(estimates.estimator, estimates.config, period)
+        seen = estimates.parts
         for k in range(count):
             for what in (f"part_{k}_pose", f"part_{k}_rotation"):
                 builder.Connect(seen.GetOutputPort(what), targets.GetInputPort(what))
@@ -155,4 +162,4 @@ def AddPickControllerSide(builder: DiagramBuilder, scenario: Scenario, period: f
     builder.ExportOutput(observer.GetOutputPort("grasp_state"), "grasp_state")
     target = PortTargets(targets.GetOutputPort("target"), targets.GetOutputPort("target_rotation"))
     return PickControllerSide(plan, sequence, observer, count, pick.gripper.max_force,
-                              grasp_reads(plan, period, sense), target)
+                              grasp_reads(plan, period, sense), target, frames)
