@@ -11,7 +11,7 @@ from typing import Optional
 
 import numpy as np
 
-from ptint_drake.hardware.camera_link import frame_due, image_channel, unpack_depth_image
+from ptint_drake.hardware.camera_link import frame_due, frame_utime, image_channel, unpack_depth_image
 from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_STATUS_CHANNEL, Endpoint, unpack_tracked,
                                        unpack_wsg_status)
 
@@ -33,8 +33,11 @@ class CompanionInbox:
     """The companions received, by ``utime`` (module docstring); ``ports``: the station's
     ``LinkPorts``, ``period``: T (s), ``timeout``: s to wait for a status's companions."""
 
-    def __init__(self, endpoint: Endpoint, ports, period: float, timeout: float):
+    def __init__(self, endpoint: Endpoint, ports, period: float, timeout: float, raw_frames: bool = False):
         self.endpoint, self.ports, self.period, self.timeout = endpoint, ports, period, timeout
+        # a depth frame kept as received (its bytes; only its time stamp read here): a process of
+        # its own decodes it (``FrameProcess``), not the control loop
+        self.raw_frames = raw_frames
         # utime → {"gripper": [fingers; forces], "tracked": a tracker's report, "image": a depth frame}
         self.companions: dict[int, dict] = {}
         self.lost = 0  # ticks skipped for a lost companion (``take``)
@@ -57,7 +60,7 @@ class CompanionInbox:
         if self.ports.camera:
             for data in self.endpoint.take_side(image_channel(self.ports.camera)):
                 try:
-                    utime, image = unpack_depth_image(data)
+                    utime, image = (frame_utime(data), data) if self.raw_frames else unpack_depth_image(data)
                 except ValueError as exc:
                     raise CompanionFault(f"camera frame rejected: {exc}; stopped commanding") from None
                 self.companions.setdefault(utime, {})["image"] = image

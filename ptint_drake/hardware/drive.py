@@ -24,7 +24,9 @@ by a message (no NaN, nothing the hardware must reject): it stops commanding, an
 holds the arm after ``LinkSettings.silent_periods`` periods without a command.  A second sender
 is the hardware's to find, by the packets' source addresses (``link.SenderWatch``); the drive
 does not compare the status's torque echo with its own commands (a driver may add its own
-terms, e.g. gravity compensation, to what it reports).
+terms, e.g. gravity compensation, to what it reports).  A controller side with a camera fits its
+frames in a process of its own (``side.frames``: ``systems.perception.frame_process``): the loop
+hands each frame's message over as received and writes the fits in when their samples are due.
 """
 
 from __future__ import annotations
@@ -41,17 +43,10 @@ from pydrake.systems.primitives import PassThrough
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, TargetView
-from ptint_drake.hardware.link import (
-    COMMAND_CHANNEL,
-    STATUS_CHANNEL,
-    WSG_COMMAND_CHANNEL,
-    Endpoint,
-    pack_command,
-    pack_wsg_command,
-    unpack_status,
-    url_warning,
-)
+from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL, Endpoint,
+                                       pack_command, pack_wsg_command, unpack_status, url_warning)
 from ptint_drake.hardware.camera_link import with_receive_buffer
+from ptint_drake.systems.perception.frame_process import FrameError
 from ptint_drake.hardware.companions import CompanionFault, CompanionInbox, companion_channels
 from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
 from ptint_drake.hardware.process import quiet_collector, request_realtime
@@ -68,6 +63,7 @@ EVENT_STEP = 1e-9
 # statuses lost within this many periods of the run's end: the run ended (a timeout then is not a fault)
 END_SLACK = 20
 WARM_UP_PERIODS = 3  # control periods of the throwaway run after the hand-shake (``warm_up``)
+FRAME_DECODER = "ptint_drake.hardware.camera_link:unpack_depth_image"  # a frame's, in its process
 
 
 class DriveFault(Exception):
@@ -148,15 +144,16 @@ class _DriveLoop:
             url = with_receive_buffer(url)
         self.endpoint = Endpoint(url, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, also=also, lcm=lcm)
         record.channels = [STATUS_CHANNEL, *also]
+        self.frames = getattr(side, "frames", None)  # a perception in a process of its own
         if side is not None:
             self.gripper_in = diagram.GetInputPort("gripper")
             self.tracked_in = diagram.GetInputPort(TRACKER_PORT) if ports.objects else None
             self.depth_in = diagram.GetInputPort("depth_image") if ports.camera else None
             self.grasp_out = diagram.GetOutputPort("grasp_state")
-            self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout)
-        self.frames = getattr(side, "frames", None)  # a perception in a process of its own
+            self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout,
+                                        raw_frames=self.frames is not None)
         if self.frames is not None:
-            self.frames.start()
+            self.frames.start(decoder=FRAME_DECODER)
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
         if risk:
@@ -230,8 +227,7 @@ class _DriveLoop:
         self.respond(t_recv, utime, q, v, companion)
 
     def companion(self, utime: int) -> Optional[dict]:
-        """The station's companions of the status of ``utime`` (``companions.CompanionInbox``;
-        None: one was lost, the tick is skipped)."""
+        """The companions of the status of ``utime`` (``CompanionInbox``; None: one was lost)."""
         try:
             return self.inbox.take(utime, handshake=self.answered is None)
         except CompanionFault as exc:
@@ -300,11 +296,9 @@ class _DriveLoop:
 
     def _frame(self, t: float, companion: Optional[dict], handshake: bool = False) -> None:
         """A depth frame that came with the status of ``t``: to the perception's process, or input."""
-        if companion is None or "image" not in companion:
-            return
-        if self.frames is not None:
-            self.frames.submit(t, companion["image"], handshake)
-        else:
+        if companion is not None and "image" in companion and self.frames is not None:
+            self.frames.submit(t, companion["image"], handshake)  # (as received: its bytes)
+        elif companion is not None and "image" in companion:
             self.depth_in.FixValue(self.context, companion["image"])
 
     def respond(
@@ -391,6 +385,8 @@ def run_drive(
                 loop.take(t_recv, data)
             if loop.finished():
                 return loop.endpoint.url
+    except FrameError as exc:  # a frame the perception's process could not read
+        raise DriveFault(f"{exc}; stopped commanding") from None
     finally:
         record.perception = loop.frames.close() if loop.frames is not None else None
 

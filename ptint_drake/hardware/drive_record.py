@@ -77,4 +77,5 @@ def drive_series(record: DriveRecord) -> dict:
         "q": np.asarray(record.q),
         "v": np.asarray(record.v),
         "tau": np.asarray(record.tau),
+        "compute": np.asarray(record.compute),  # s wall: status received → command sent
     }

@@ -1,21 +1,25 @@
 """Issue 43, the perception in a process of its own on the drive side
 (``systems.perception.frame_process``): a frame fitted in the worker process and written into
 the estimator when its sample is due leaves the estimator exactly as its own update at the
-frame's time does (the bundled camera pick's station, its first frame); a frame fitted ahead is
-written without a wait; and submitting a frame does not wait for its fit."""
+frame's time does (the bundled camera pick's station, its first frame, handed over as its LCM
+message); a frame fitted ahead is written without a wait; submitting a frame does not wait for
+its fit; and a frame the worker cannot read is one line (``FrameError``)."""
 
 from __future__ import annotations
 
 import time
 
 import numpy as np
+import pytest
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import PassThrough
 from pydrake.systems.sensors import ImageDepth32F
 
+from ptint_drake.hardware.camera_link import pack_depth_image
+from ptint_drake.hardware.drive import FRAME_DECODER
 from ptint_drake.scenario import load_scenario
-from ptint_drake.systems.perception.frame_process import FrameProcess
+from ptint_drake.systems.perception.frame_process import FrameError, FrameProcess
 from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.pick.camera import AddPartEstimates
 from ptint_drake.worlds.pick.run import world_config
@@ -63,14 +67,15 @@ def test_a_frame_fitted_in_the_worker_leaves_the_estimator_as_its_own_update():
     simulator.AdvanceTo(latency)
     expected = _state(estimates, simulator.get_context())
     assert expected[0].any()  # the frame's sample is in the buffer (the part was fitted)
-    # the drive's way: the frame to the worker, written when due
+    # the drive's way: the frame's message as received to the worker, written when due
     diagram, estimates = _estimator(scenario, elsewhere=True)
     frames = FrameProcess(estimates.estimator, estimates.config, 1e-3)
+    message = pack_depth_image(0.0, image, "camera")
     try:
-        frames.start()
+        frames.start(decoder=FRAME_DECODER)
         simulator = new_simulator(diagram)
         start = time.perf_counter()
-        frames.submit(0.0, image, handshake=True)
+        frames.submit(0.0, message, handshake=True)
         handed = time.perf_counter() - start
         frames.prefetch()
         frames.take_due(simulator.get_mutable_context(), latency - 1e-3)  # not due yet: not written
@@ -78,6 +83,9 @@ def test_a_frame_fitted_in_the_worker_leaves_the_estimator_as_its_own_update():
         frames.take_due(simulator.get_mutable_context(), latency)
         simulator.AdvanceTo(latency)
         got = _state(estimates, simulator.get_context())
+        frames.submit(0.033, b"not an image message")  # frame 1 (1/30 s, in the tick after 33 ms)
+        with pytest.raises(FrameError, match="camera frame rejected"):
+            frames.take_due(simulator.get_mutable_context(), 1.0 / 30.0 + latency)
     finally:
         summary = frames.close()
     for a, b in zip(expected, got, strict=True):

@@ -3,32 +3,35 @@ parts' fit, ``PartPoseEstimator.fit_frame``: 3–10 ms a frame) in a process of 
 control loop that must answer every 1 ms tick (``ptint drive``).
 
 In the one-process run the estimator fits frame k in its update at t_k = k · (1 / rate) and its
-sample becomes visible at t_k + latency: nothing reads it before then.  With
+sample becomes visible at t_k + latency: nothing reads it before then. With
 ``PerceptionConfig.fits_elsewhere`` the estimator's event at t_k only marks the time (the
-simulator ends a step there, as before), and this object does the rest: ``submit`` hands a
-frame's image to the worker process as soon as it arrives (with the status of the tick whose
-period holds t_k); ``take_due(context, t)``, called before the loop advances its diagram to a
-tick t, writes every frame whose sample is visible by t (t_k + latency ≤ t) into the
-estimator's state (``PartPoseEstimator.write_frame``: the same association, buffer and memory
-as its own update), oldest first — waiting for a fit that is not back yet.  A sample written
-before t_k + latency is not visible before then, so every output of the estimator, at every
-time, is what the one-process run's is: the loop's result does not depend on when a fit comes
-back (lockstep: bit-identical), only its timing does.  In real time the fit has the latency to
-come back (33 ms in the bundled camera picks); the loop waits only for one that has not.
+simulator ends a step there, as before), and this object does the rest: ``submit`` hands a frame
+to the worker process as soon as it arrives (with the status of the tick whose period holds t_k) —
+its LCM message's bytes as received, decoded in the worker by the function ``start`` names (the
+loop reads only its time stamp), or an image's pixels; ``take_due(context, t)``, called before the
+loop advances its diagram to a tick t, writes every frame whose sample is visible by t (t_k +
+latency ≤ t) into the estimator's state (``PartPoseEstimator.write_frame``: the same association,
+buffer and memory as its own update), oldest first — waiting for a fit that is not back yet. A
+sample written before t_k + latency is not visible before then, so every output of the estimator,
+at every time, is what the one-process run's is: the loop's result does not depend on when a fit
+comes back (lockstep: the same as with the fit in the loop, to the last bit), only its timing
+does. In real time the fit has the latency to come back (33 ms in the bundled camera picks); the
+loop waits only for one that has not.
 
 A process, not a thread: a fit is Python (numpy, scipy) and would hold Python's interpreter lock
-for most of its milliseconds, and pydrake's ``DrakeLcm.HandleSubscriptions`` keeps that lock
-while it waits for a message (measured: a spinning thread ran 3 % as fast during the wait as
-during a sleep), so a thread would both starve and delay the loop.  The worker is a fresh
-interpreter (``python -m`` this module, one end of a socket pair: no copy of the parent's LCM
-sockets, threads or real-time priority), builds the perception (``MakeRgbdPerception``) from
-the pickled ``PerceptionConfig`` and answers each image with its fits (``multiprocessing``'s
-``Connection`` framing); ``start`` returns once it is ready, ``close`` ends it.
+for most of its milliseconds, and pydrake's ``DrakeLcm.HandleSubscriptions`` keeps that lock while
+it waits for a message (measured: a spinning thread ran 3 % as fast during the wait as during a
+sleep), so a thread would both starve and delay the loop. The worker is a fresh interpreter
+(``python -m`` this module, one end of a socket pair: no copy of the parent's LCM sockets, threads
+or real-time priority), builds the perception (``MakeRgbdPerception``) from the pickled
+``PerceptionConfig`` and answers each image with its fits (``multiprocessing``'s ``Connection``
+framing); ``start`` returns once it is ready, ``close`` ends it.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import math
 import os
 import socket
@@ -46,16 +49,31 @@ from ptint_drake.systems.perception.part_pose_estimator import (TIME_TOL, PartPo
                                                                  PerceptionConfig)
 
 READY_TIMEOUT = 120.0  # s: the worker's start (a fresh interpreter imports pydrake)
+SEND_BUFFER = 4 << 20  # bytes: the socket's send buffer (a frame of 424 × 240 floats is 407 kB)
+
+
+class FrameError(Exception):
+    """A frame the worker could not read (the message is the one-line reason)."""
+
+
+def _decoder(name: Optional[str]):
+    """The function ``module:function`` that reads a frame's message bytes into (utime, image)."""
+    if name is None:
+        return None
+    module, function = name.split(":")
+    return getattr(importlib.import_module(module), function)
 
 
 def _serve(conn) -> None:
-    """The worker process: build the perception from the first message (a ``PerceptionConfig``),
-    then fit every image received until None."""
+    """The worker process: build the perception from the first message (a ``PerceptionConfig``
+    and the name of a message decoder, or None), then fit every image received until None: an
+    image's pixels, or a frame's message bytes (decoded here)."""
     from pydrake.systems.sensors import ImageDepth32F  # noqa: PLC0415
 
     from ptint_drake.systems.perception.part_pose_estimator import MakeRgbdPerception  # noqa: PLC0415
 
-    config = conn.recv()
+    config, decoder = conn.recv()
+    decode = _decoder(decoder)
     perception, estimator = MakeRgbdPerception(dataclasses.replace(config, fits_elsewhere=False))
     context = perception.CreateDefaultContext()
     cloud_system = perception.GetSubsystemByName("depth_to_cloud")
@@ -66,10 +84,18 @@ def _serve(conn) -> None:
         job = conn.recv()
         if job is None:
             return
-        k, width, height, data = job
+        k, width, height = job
+        data = conn.recv_bytes()
         start = time.perf_counter()
-        image = ImageDepth32F(width, height)
-        image.mutable_data[:, :, 0] = np.frombuffer(data, dtype=np.float32).reshape(height, width)
+        if width is None:  # a frame's message as received
+            try:
+                _, image = decode(data)
+            except ValueError as exc:
+                conn.send((k, f"camera frame rejected: {exc}", None))
+                continue
+        else:
+            image = ImageDepth32F(width, height)
+            image.mutable_data[:, :, 0] = np.frombuffer(data, dtype=np.float32).reshape(height, width)
         perception.get_input_port().FixValue(context, image)
         cloud = cloud_port.Eval(cloud_context)
         rendered = time.perf_counter()
@@ -90,11 +116,13 @@ class FrameProcess:
         self.waits: list = []  # s the loop waited for each frame written
         self.fit_s: list = []  # s of each fit in the worker (cloud and fit)
 
-    def start(self) -> None:
-        """Start the worker and wait until it is ready (``READY_TIMEOUT``)."""
+    def start(self, decoder: Optional[str] = None) -> None:
+        """Start the worker and wait until it is ready (``READY_TIMEOUT``); ``decoder``:
+        ``module:function`` reading a frame's message bytes into (utime, ImageDepth32F)."""
         if self._process is not None:
             return
         ours, theirs = socket.socketpair()
+        ours.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)  # a frame never blocks
         env = dict(os.environ)  # this package's tree first, whatever the caller's sys.path
         env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[3]),
                                              env.get("PYTHONPATH", "")])
@@ -102,7 +130,7 @@ class FrameProcess:
                                          pass_fds=(theirs.fileno(),), env=env)
         theirs.close()
         self._conn = Connection(ours.detach())
-        self._conn.send(self._config)
+        self._conn.send((self._config, decoder))
         if not self._conn.poll(READY_TIMEOUT) or self._conn.recv() != "ready":
             raise RuntimeError(f"the perception's worker process did not start within {READY_TIMEOUT:g} s")
 
@@ -114,12 +142,17 @@ class FrameProcess:
         return math.floor((t + self._tick) / self._period + TIME_TOL)
 
     def submit(self, t: float, image, handshake: bool = False) -> None:
-        """Hand the frame that came with the status of ``t`` (an ``ImageDepth32F``) to the worker."""
+        """Hand the frame that came with the status of ``t`` to the worker: an ``ImageDepth32F``,
+        or its message's bytes as received (read there by ``start``'s decoder)."""
         k = self.frame_index(t, handshake)
         if any(j == k for j, _ in self._jobs):
             return  # (a status's re-send brings its frame again)
-        data = np.ascontiguousarray(np.asarray(image.data, dtype=np.float32)[:, :, 0]).tobytes()
-        self._conn.send((k, image.width(), image.height(), data))
+        if isinstance(image, (bytes, bytearray)):
+            self._conn.send((k, None, None))
+            self._conn.send_bytes(image)
+        else:
+            self._conn.send((k, image.width(), image.height()))
+            self._conn.send_bytes(np.ascontiguousarray(np.asarray(image.data, dtype=np.float32)[:, :, 0]))
         self._jobs.append((k, k * self._period))
 
     def _collect(self, wait: Optional[float]) -> None:
@@ -127,7 +160,8 @@ class FrameProcess:
         while self._conn.poll(wait if wait is not None else 0):
             k, fits, timing = self._conn.recv()
             self._results[k] = (fits, timing)
-            self.fit_s.append(timing["cloud_s"] + timing["fit_s"])
+            if timing is not None:
+                self.fit_s.append(timing["cloud_s"] + timing["fit_s"])
             wait = None
 
     def take_due(self, root_context, t: float) -> None:
@@ -143,6 +177,8 @@ class FrameProcess:
                 self._collect(0.5)
             self.waits.append(time.perf_counter() - start)
             fits, timing = self._results.pop(k)
+            if timing is None:  # the worker could not read the frame
+                raise FrameError(fits)
             context = self._estimator.GetMyMutableContextFromRoot(root_context)
             self._estimator.write_frame(context, t_k, fits, timing)
         self._collect(None)
