@@ -158,7 +158,10 @@ class FrameProcess:
     def _collect(self, wait: Optional[float]) -> None:
         """Results back from the worker (``wait``: s to block for one; None: none)."""
         while self._conn.poll(wait if wait is not None else 0):
-            k, fits, timing = self._conn.recv()
+            try:
+                k, fits, timing = self._conn.recv()
+            except EOFError:  # the worker is gone (``take_due`` says so)
+                return
             self._results[k] = (fits, timing)
             if timing is not None:
                 self.fit_s.append(timing["cloud_s"] + timing["fit_s"])
@@ -173,7 +176,8 @@ class FrameProcess:
             start = time.perf_counter()
             while k not in self._results:
                 if self._process.poll() is not None:
-                    raise RuntimeError("the perception's worker process ended")
+                    code = self._process.returncode
+                    raise FrameError(f"the perception's process ended (exit code {code})")
                 self._collect(0.5)
             self.waits.append(time.perf_counter() - start)
             fits, timing = self._results.pop(k)
