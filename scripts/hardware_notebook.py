@@ -109,8 +109,8 @@ print(f"statuses sent {link['statuses_sent']}, re-sent {link['status_resends']},
       f"{link['statuses_dropped']}; commands accepted {link['commands_accepted']}; ticks missing at "
       f"the drive {drive['ticks_missing']}; second-sender check: {link['sender_check']}")""",
         "md:The pick world (`conveyor_pick_place`) runs the same way, with the gripper's status and "
-        "command (`lcmt_schunk_wsg_status` / `lcmt_schunk_wsg_command`) and the parts' motion "
-        "(`lcmt_scope` on `PART_MOTION`) beside the arm's messages; the targets, the gripper's "
+        "command (`lcmt_schunk_wsg_status` / `lcmt_schunk_wsg_command`) and the part tracker's "
+        "reports (`lcmt_scope` on `TRACKED_POSES`) beside the arm's messages; the targets, the gripper's "
         "sequence and the grasp observer run in the drive. Faults (a dead drive, a NaN command, a "
         "second sender) hold the arm: docs/hardware.md has each one's measured reaction.",
     ]

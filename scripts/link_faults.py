@@ -6,9 +6,12 @@ processes in a private network namespace (``tests/lcm_link``), one row per fault
 Rows: ``realtime`` N clean real-time runs (a hold there is spurious); ``drive SIGKILL`` (the
 drive killed at 30 % of the run: periods from its last command to the hold); ``hardware SIGTERM``
 and ``hardware SIGINT`` (held, metrics.json written, the exit code); ``second drive`` (a second
-``ptint drive`` started mid-run: named as the second sender).  Each row gives the reaction in
-control periods, whether the arm was held (joint speeds below 0.05 rad/s at the end) and the
-files written.
+``ptint drive`` started mid-run: named as the second sender); ``lost gripper status`` (the pick
+scenario, ``--pick-scenario``, with the gripper status of the tick at 1 s not sent, once: in real
+time at a quarter of real time — the camera-free pick's station keeps that pace on a loaded
+2-core machine — and in lockstep: the drive skips the tick, or the status's re-send brings it).
+Each row gives the reaction in control periods, whether the arm was held (joint speeds below
+0.05 rad/s at the end), the files written, and the drive's exit code, fault and lost companions.
 """
 
 from __future__ import annotations
@@ -59,20 +62,35 @@ def row(name: str, out: dict, folder: Path, proc: str = "hw") -> dict:
         "ticks_late": link.get("ticks_late"),
         "late_run_max": link.get("late_run_max"),
         "files": sorted(p.name for p in (folder / "hw").glob("*")) if (folder / "hw").is_dir() else [],
+        "ticks": link.get("ticks"),
+        "drive": _drive(folder),
     }
+
+
+def _drive(folder: Path) -> dict:
+    """The drive's own account (drive.json): its fault and the ticks it skipped for a lost companion."""
+    path = folder / "dr" / "drive.json"
+    if not path.is_file():
+        return {}
+    drive = json.loads(path.read_text())
+    return {"fault": drive.get("fault"), "companions_lost": drive.get("companions_lost"),
+            "last_t": drive.get("last_t")}
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=10, help="clean real-time runs (default 10)")
     parser.add_argument("--scenario", default="curve_b075_tf15")
-    parser.add_argument("--only", help="comma-separated rows: realtime,kill,sigterm,sigint,second")
+    parser.add_argument("--pick-scenario", default="conveyor_pick_place",
+                        help="the lost-companion rows' scenario")
+    parser.add_argument("--only", help="comma-separated rows: realtime,kill,sigterm,sigint,second,companion")
     args = parser.parse_args()
     problem = namespace_problem()
     if problem:
         raise SystemExit(f"link_faults: no private network namespace: {problem}")
     name = args.scenario
-    only = set(args.only.split(",")) if args.only else {"realtime", "kill", "sigterm", "sigint", "second"}
+    only = (set(args.only.split(",")) if args.only
+            else {"realtime", "kill", "sigterm", "sigint", "second", "companion"})
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(tmp)
@@ -84,12 +102,13 @@ def main() -> None:
             rows.append(row(label, out, folder))
             print(json.dumps(rows[-1]), file=sys.stderr)
 
-        def hw(folder, *extra):
-            argv = ptint("hardware", name, *PATIENT, *extra, "--out", str(folder / "hw"))
+        def hw(folder, *extra, scenario=name):
+            argv = ptint("hardware", scenario, *PATIENT, *extra, "--out", str(folder / "hw"))
             return {"name": "hw", "argv": argv}
 
-        def drive(label="drive", **more):
-            return {"name": label, "argv": ptint("drive", name, *PATIENT), **more}
+        def drive(label="drive", folder=None, scenario=name, extra=(), **more):
+            out = ("--out", str(folder / "dr")) if folder is not None else ()
+            return {"name": label, "argv": ptint("drive", scenario, *PATIENT, *extra, *out), **more}
 
         if "realtime" in only:
             for _ in range(args.runs):
@@ -102,6 +121,14 @@ def main() -> None:
                      lambda f, sig=sig: [{**hw(f), "kill_when": ["hw", " 30 %"], "signal": sig}, drive()])
         if "second" in only:
             case("second drive", lambda f: [hw(f), drive(), drive("drive2", delay=1.0)])
+        if "companion" in only:
+            pick, lost = args.pick_scenario, ("--drop-companion", "1.0", "--quiet")
+            slow = ("--realtime-rate", "0.25", "--silent-periods", "5000")  # (the pace: docstring)
+            case("lost gripper status (real time)", lambda f: [
+                hw(f, *lost, *slow, scenario=pick),
+                drive(folder=f, scenario=pick, extra=("--status-timeout", "5"))])
+            case("lost gripper status (lockstep)", lambda f: [
+                hw(f, *lost, "--lockstep", scenario=pick), drive(folder=f, scenario=pick)])
     clean = [r for r in rows if r["fault"] == "realtime (no fault)"]
     summary = {"rows": rows, "realtime_runs": len(clean),
                "spurious_holds": sum(1 for r in clean if r["fault_kind"] is not None)}

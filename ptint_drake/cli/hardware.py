@@ -44,6 +44,13 @@ def _add_hardware_parser(sub) -> None:
         default=0.0,
         help="a test option: the fraction of status messages not sent (default 0)",
     )
+    hw.add_argument(
+        "--drop-companion",
+        type=seconds("--drop-companion", allow_zero=True),
+        default=None,
+        metavar="T",
+        help="a test option: the gripper status of the tick at T s not sent (once; a lost packet)",
+    )
     hw.add_argument("--seed", type=int, default=0, help="seed of --drop-status")
     hw.add_argument("--out", help="output folder (default out/hardware_NAME)")
     hw.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
@@ -182,6 +189,7 @@ def _link_settings(args: argparse.Namespace, scenario):
         hold_time=args.hold_time,
         realtime_rate=args.realtime_rate,
         drop_status=args.drop_status,
+        drop_companion=args.drop_companion,
         seed=args.seed,
         priority=args.priority,
         silent_periods=args.silent_periods,

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import struct
 import urllib.parse
 import zlib
 from typing import Optional
@@ -87,6 +88,15 @@ def pack_depth_image(t: float, image: ImageDepth32F, camera: str) -> bytes:
     array.header.utime, array.header.frame_name = utime_of(t), camera
     array.num_images, array.images = 1, [one]
     return array.encode()
+
+
+def frame_utime(data: bytes) -> int:
+    """The ``header.utime`` of an ``lcmt_image_array`` message, read without decoding the rest
+    (LCM's encoding: an 8-byte fingerprint, then the header's int32 ``seq`` and int64 ``utime``,
+    big-endian); ValueError when the message is too short to hold one."""
+    if len(data) < 20:
+        raise ValueError(f"an image message of {len(data)} bytes")
+    return struct.unpack(">q", data[12:20])[0]
 
 
 def unpack_depth_image(data: bytes) -> tuple[int, ImageDepth32F]:

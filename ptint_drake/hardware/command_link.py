@@ -28,11 +28,11 @@ from __future__ import annotations
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
-from pydrake.systems.primitives import Multiplexer
 from pydrake.systems.sensors import ImageDepth32F
 
 from ptint_drake.hardware.camera_link import frame_due
-from ptint_drake.hardware.link import PART_SIZE, utime_of
+from ptint_drake.hardware.link import utime_of
+from ptint_drake.worlds.base import TRACKED_SIZE, TRACKER_PORT
 from ptint_drake.hardware.session import ACTIVE, LinkFault
 from ptint_drake.robot.plant import actuator_effort_limits
 
@@ -67,8 +67,8 @@ class CommandLink(LeafSystem):
         if self._ports is not None:
             self._fingers = self.DeclareVectorInputPort("gripper_state", 4)
             self._drive = self.DeclareVectorInputPort("grip_force", 2)
-            self._parts = (self.DeclareVectorInputPort("parts", PART_SIZE * self._ports.objects)
-                           if self._ports.objects else None)
+            self._tracked = (self.DeclareVectorInputPort(TRACKER_PORT, TRACKED_SIZE * self._ports.objects)
+                             if self._ports.objects else None)
             self._depth = (self.DeclareAbstractInputPort("depth_image", AbstractValue.Make(ImageDepth32F()))
                            if self._ports.camera else None)
             self.DeclareVectorOutputPort(
@@ -88,17 +88,13 @@ class CommandLink(LeafSystem):
 
     def wire_station(self, builder, station, sequence):
         """In a world's diagram with a gripper (``World.link_ports``): the station's gripper, its
-        objects (``part_k_pose`` / ``part_k_rotation``) or its camera (``depth_image``) into the
-        link, and the gripper command the link took (in place of the world's ``sequence``: the
-        drive side runs it) out; returns that output port."""
+        pose tracker (``tracked_poses``: a sensor's reports, never a truth port) or its camera
+        (``depth_image``) into the link, and the gripper command the link took (in place of the
+        world's ``sequence``: the drive side runs it) out; returns that output port."""
         builder.Connect(station.GetOutputPort("gripper_state"), self._fingers)
         builder.Connect(station.GetOutputPort("grip_force"), self._drive)
-        if self._parts is not None:
-            mux = builder.AddNamedSystem("link_parts", Multiplexer([9, 15] * self._ports.objects))
-            for k in range(self._ports.objects):
-                builder.Connect(station.GetOutputPort(f"part_{k}_pose"), mux.get_input_port(2 * k))
-                builder.Connect(station.GetOutputPort(f"part_{k}_rotation"), mux.get_input_port(2 * k + 1))
-            builder.Connect(mux.get_output_port(), self._parts)
+        if self._tracked is not None:
+            builder.Connect(station.GetOutputPort(TRACKER_PORT), self._tracked)
         if self._depth is not None:
             builder.Connect(station.GetOutputPort("depth_image"), self._depth)
         return self.GetOutputPort("gripper_command")
@@ -107,17 +103,17 @@ class CommandLink(LeafSystem):
         output.SetAtIndex(0, context.get_discrete_state(self._xd).value()[-1])
 
     def _extras(self, context, handshake: bool = False):
-        """The station's companions of a status: fingers, drive forces, the objects' motion (or
+        """The station's companions of a status: fingers, drive forces, the tracker's report (or
         None), the depth image when a camera frame falls in this tick's period (or None:
         ``camera_link.frame_due``)."""
         if self._ports is None:
             return None
-        parts = self._parts.Eval(context) if self._parts is not None else None
+        tracked = self._tracked.Eval(context) if self._tracked is not None else None
         image = None
         if self._depth is not None and frame_due(context.get_time(), self._session.s.period,
                                                  self._ports.camera_rate_hz, handshake):
             image = self._depth.Eval(context)
-        return self._fingers.Eval(context), self._drive.Eval(context), parts, image
+        return self._fingers.Eval(context), self._drive.Eval(context), tracked, image
 
     def _initialize(self, context, discrete_state) -> None:
         """The hand-shake (``HardwareSession.handshake``) with the arm's start, once per session;

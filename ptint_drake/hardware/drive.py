@@ -1,5 +1,5 @@
-"""``ptint drive``: the controller side alone — the scenario's targets and controller, answering
-each status of the arm with a torque command over LCM.
+"""``ptint drive``: the controller side alone — the scenario's targets and controller, answering each
+status of the arm with a torque command over LCM.
 
 ``DriveDiagram`` is the scenario's controller in its slot (``controllers.AddControllerTo``, the
 same code path as ``ptint run``) between an exported input ``state`` (the arm's [q; v] from the
@@ -10,50 +10,48 @@ The drive adds no hold: the hardware side samples and holds (``command_link``).
 ``run_drive`` answers each status stamped t_k: the controller's own state (σ) is advanced to t_k
 with the previous status's [q; v] (``Simulator.AdvanceTo``, then ``EVENT_STEP`` further for the
 controller's events at t_k), as the one-process run's controller sees a discrete plant's state
-between two steps; then the state input is set to this status's [q; v] (initialized at the
-first status, so that the controller's start is the arm's), and the command
-stamped with the status's ``utime`` carries its output.  A status repeated (the hardware re-sends
-an unanswered one) gets the same command again; a second status of the same time with another
-state (the first tick after the hand-shake: the arm after the plant's first step) a new one.
-Torques beyond the actuators' effort limits are clipped to them (``limits.saturate``, the
-default: where ``ptint run``'s station saturates; the hardware side rejects them as a fault).
-It ends when it has answered the last tick
+between two steps; then the state input is set to this status's [q; v] (initialized at the first
+status, so that the controller's start is the arm's), and the command stamped with the status's
+``utime`` carries its output. A status repeated (the hardware re-sends an unanswered one) gets the
+same command again; a second status of the same time with another state (the first tick after the
+hand-shake: the arm after the plant's first step) a new one. Torques beyond the actuators' effort
+limits are clipped to them (``limits.saturate``, the default: where ``ptint run``'s station
+saturates; the hardware side rejects them as a fault). It ends when it has answered the last tick
 (t ≥ duration − 1.5 T), or with ``DriveFault`` (one line): no status within the start-up timeout,
-no status for ``status_timeout`` s, or a status of the wrong size.  The drive never stops the arm
-by a message (no NaN, nothing the hardware must reject): it stops commanding, and the hardware
-holds the arm after ``LinkSettings.silent_periods`` periods without a command.  A second sender
-is the hardware's to find, by the packets' source addresses (``link.SenderWatch``); the drive
-does not compare the status's torque echo with its own commands (a driver may add its own
-terms, e.g. gravity compensation, to what it reports).
+no status for ``status_timeout`` s, or a status of the wrong size. The drive never stops the arm by
+a message (no NaN, nothing the hardware must reject): it stops commanding, and the hardware holds
+the arm after ``LinkSettings.silent_periods`` periods without a command. A second sender is the
+hardware's to find, by the packets' source addresses (``link.SenderWatch``); the drive does not
+compare the status's torque echo with its own commands (a driver may add its own terms, e.g.
+gravity compensation, to what it reports). A controller side with a camera fits its frames in a
+process of its own (``side.frames``: ``systems.perception.frame_process``): the loop hands each
+frame's message over as received and writes the fits in when their samples are due.
 """
 
 from __future__ import annotations
 
 import copy
-import dataclasses
 import time
 from typing import Callable, Optional
 
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import PassThrough
 
 from ptint_drake.config.schema import Scenario
-from ptint_drake.controllers import AddControllerTo, TargetView
 from ptint_drake.hardware.arm_messages import arm_messages
 from ptint_drake.hardware.link import WSG_COMMAND_CHANNEL, Endpoint, pack_wsg_command, url_warning
+from ptint_drake.systems.perception.frame_process import FrameError
 from ptint_drake.hardware.camera_link import with_receive_buffer
 from ptint_drake.hardware.companions import CompanionFault, CompanionInbox, companion_channels
+from ptint_drake.hardware.drive_diagram import DriveDiagram
 from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
 from ptint_drake.hardware.driver_modes import DriverTerms
 from ptint_drake.hardware.status_clock import StatusClock
 from ptint_drake.hardware.process import quiet_collector, request_realtime
-from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
 from ptint_drake.systems.hand.gripper import GRASP_STATES
-from ptint_drake.worlds.base import new_simulator
-from ptint_drake.worlds.registry import objects_of, schedule_of, world_of
+from ptint_drake.worlds.base import TRACKER_PORT, new_simulator
+from ptint_drake.worlds.registry import world_of
 
 # s: after integrating σ to a status's time t, a step this short takes the controller's events at t
 # (a segment's start stores s(t0)) with that status's state, as the one-process run's do
@@ -61,47 +59,11 @@ EVENT_STEP = 1e-9
 # statuses lost within this many periods of the run's end: the run ended (a timeout then is not a fault)
 END_SLACK = 20
 WARM_UP_PERIODS = 3  # control periods of the throwaway run after the hand-shake (``warm_up``)
+FRAME_DECODER = "ptint_drake.hardware.camera_link:unpack_depth_image"  # a frame's, in its process
 
 
 class DriveFault(Exception):
     """The drive stopped commanding (the message is the one-line reason)."""
-
-
-def DriveDiagram(scenario: Scenario):
-    """(diagram, controller handles, joint count, the world's controller side or None:
-    ``World.controller_side``, e.g. a world's targets, gripper sequence and grasp observer) of the
-    scenario's controller alone (module docstring).  Inputs: ``state`` (the arm's [q; v]); with a
-    controller side
-    also ``parts`` (``link.PART_SIZE`` a part) and ``gripper`` ([fingers (4), drive forces (2)], as
-    ``link.unpack_wsg_status`` gives them).  Outputs: ``actuation``; with a controller side also
-    ``grasp_state``."""
-    plant = nominal_plant(scenario)
-    builder = DiagramBuilder()
-    n = plant.num_positions() + plant.num_velocities()
-    state = builder.AddNamedSystem("status_state", PassThrough(n))
-    actuation = builder.AddNamedSystem("command_torque", PassThrough(plant.num_actuators()))
-    unsampled = copy.copy(scenario)  # the hardware samples and holds: no hold of its own here
-    unsampled.controller = dataclasses.replace(scenario.controller, control_period=0.0)
-    schedule, targets = schedule_of(scenario), objects_of(scenario)
-    # the world's own controller side (its targets, gripper sequence and grasp observer), if any
-    side = world_of(scenario).controller_side(builder, scenario, link_period(scenario))
-    target = side.target if side is not None else TargetView(builder, None, unsampled, schedule, targets)
-    handles = AddControllerTo(
-        builder,
-        plant=plant,
-        frame=plant.GetFrameByName(scenario.robot.end_effector),
-        schedule=schedule,
-        state=state.get_output_port(),
-        actuation=actuation.get_input_port(),
-        scenario=unsampled,
-        target=target,
-        targets=targets,
-    )
-    builder.ExportInput(state.get_input_port(), "state")
-    builder.ExportOutput(actuation.get_output_port(), "actuation")
-    diagram = builder.Build()
-    diagram.set_name("drive")
-    return diagram, handles, plant.num_actuators(), side
 
 
 class _DriveLoop:
@@ -146,12 +108,16 @@ class _DriveLoop:
         status, command = self.messages.status_channel, self.messages.command_channel
         self.endpoint = Endpoint(url, listen=status, publish=command, also=also, lcm=lcm)
         record.channels = [status, *also]
+        self.frames = getattr(side, "frames", None)  # a perception in a process of its own
         if side is not None:
             self.gripper_in = diagram.GetInputPort("gripper")
-            self.parts_in = diagram.GetInputPort("parts") if ports.objects else None
+            self.tracked_in = diagram.GetInputPort(TRACKER_PORT) if ports.objects else None
             self.depth_in = diagram.GetInputPort("depth_image") if ports.camera else None
             self.grasp_out = diagram.GetOutputPort("grasp_state")
-            self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout)
+            self.inbox = CompanionInbox(self.endpoint, ports, settings.period, settings.status_timeout,
+                                        raw_frames=self.frames is not None)
+        if self.frames is not None:
+            self.frames.start(decoder=FRAME_DECODER)
         record.url = self.endpoint.url
         risk = url_warning(self.endpoint.url)
         if risk:
@@ -224,11 +190,15 @@ class _DriveLoop:
             return
         if answered is not None:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
+        companion = self.companion(stamp) if self.side is not None else None
+        if self.side is not None and companion is None:  # one of its companions lost: skipped
+            self.record.companions_lost = self.inbox.lost
+            return
         self.stamp = stamp
-        self.respond(t_recv, utime, q, v, self.companion(stamp) if self.side is not None else None)
+        self.respond(t_recv, utime, q, v, companion)
 
-    def companion(self, utime: int) -> dict:
-        """The station's companions of the status of ``utime`` (``companions.CompanionInbox``)."""
+    def companion(self, utime: int) -> Optional[dict]:
+        """The companions of the status of ``utime`` (``CompanionInbox``; None: one was lost)."""
         try:
             return self.inbox.take(utime, handshake=self.answered is None)
         except CompanionFault as exc:
@@ -251,11 +221,12 @@ class _DriveLoop:
     def torque(self, t: float, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None) -> np.ndarray:
         """The controller's torque at the status's time ``t`` for its [q; v] (module docstring),
         clipped to the effort limits when saturating.  With a controller side ``companion`` holds the
-        tick's gripper status and parts' motion: the parts are read like the arm's state; the
+        tick's gripper status and tracker report: the report is read like the arm's state; the
         gripper status is the grasp observer's at its update at ``t`` (a periodic update like
         the one-process run's hold, which samples the arm after the plant's step)."""
         if self.answered is None:  # the controller's start (s(t0) of the first segment) is the arm's
             self._fix(q, v, companion)
+            self._frame(t, companion, handshake=True)
             self.context.SetTime(t)
             self.simulator.Initialize()
         elif companion is not None and (t > self.context.get_time() or not self.started):
@@ -266,11 +237,12 @@ class _DriveLoop:
             # runner does at its stops: ``WorldRun.advance_at_reached_stops``; the first tick, at
             # t = 0 as the hand-shake, takes the events at t = 0 so); only then the new sample
             self.started = True
+            if self.frames is not None:  # the frames whose samples are visible by t, written
+                self.frames.take_due(self.context, t)
             self.simulator.AdvanceTo(t)
             self.check_grasp(int(round(t * 1e6)))
             self.gripper_in.FixValue(self.context, companion["gripper"])
-            if "image" in companion:  # this period's frame, before the perception's event in it
-                self.depth_in.FixValue(self.context, companion["image"])
+            self._frame(t, companion)  # this period's frame, before the perception's event in it
             self.simulator.AdvanceTo(t)
         elif t > self.context.get_time():
             # σ over (t_prev, t] sees the previous sample, as the one-process run's controller
@@ -289,18 +261,24 @@ class _DriveLoop:
         """The diagram's inputs: a status's [q; v] and, with a controller side, its companions."""
         self.state_in.FixValue(self.context, np.concatenate([q, v]))
         if companion is not None:
-            if "parts" in companion:
-                self.parts_in.FixValue(self.context, companion["parts"])
-            if "image" in companion:
-                self.depth_in.FixValue(self.context, companion["image"])
+            if "tracked" in companion:
+                self.tracked_in.FixValue(self.context, companion["tracked"])
             self.gripper_in.FixValue(self.context, companion["gripper"])
+
+    def _frame(self, t: float, companion: Optional[dict], handshake: bool = False) -> None:
+        """A depth frame that came with the status of ``t``: to the perception's process, or input."""
+        if companion is not None and "image" in companion and self.frames is not None:
+            self.frames.submit(t, companion["image"], handshake)  # (as received: its bytes)
+        elif companion is not None and "image" in companion:
+            self.depth_in.FixValue(self.context, companion["image"])
 
     def respond(
         self, t_recv: float, utime: int, q: np.ndarray, v: np.ndarray, companion: Optional[dict] = None
     ) -> None:
         """Send the command stamped ``utime`` answering a status checked (with a gripper, first,
         the gripper command for the driver's next tick), and record it."""
-        t = utime / 1e6
+        # the hardware simulator's time: Drake's k-th tick is k · T, 1 ulp from utime / 10⁶ at 13 %
+        t = round(utime / self.period_us) * self.settings.period if self.period_us else utime / 1e6
         first = self.answered is None
         tau = self.torque(t, q, v, companion)
         if first:  # before the hand-shake's answer: the hardware waits for it up to its start-up
@@ -340,6 +318,8 @@ class _DriveLoop:
         scratch.Initialize()
         scratch.AdvanceTo(t + WARM_UP_PERIODS * self.settings.period)
         self.out.Eval(scratch.get_context())
+        if self.frames is not None:  # the hand-shake's frame fitted before the first tick
+            self.frames.prefetch()
 
     def go_realtime(self) -> None:
         """After the hand-shake's command and the warm-up, before the answer goes out: the
@@ -370,11 +350,16 @@ def run_drive(
     into ``record``; returns the URL used.  ``lcm``: a ``DrakeLcm`` to use instead of one of
     ``url`` (``in_memory``)."""
     loop = _DriveLoop(scenario, settings, record, url, warn, lcm)
-    while True:
-        for t_recv, data in loop.wait():
-            loop.take(t_recv, data)
-        if loop.finished():
-            return loop.endpoint.url
+    try:
+        while True:
+            for t_recv, data in loop.wait():
+                loop.take(t_recv, data)
+            if loop.finished():
+                return loop.endpoint.url
+    except FrameError as exc:  # a frame the perception's process could not read
+        raise DriveFault(f"{exc}; stopped commanding") from None
+    finally:
+        record.perception = loop.frames.close() if loop.frames is not None else None
 
 
 __all__ = ["DriveDiagram", "DriveFault", "DriveRecord", "DriveSettings", "drive_series", "drive_summary",

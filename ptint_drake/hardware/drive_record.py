@@ -34,8 +34,10 @@ class DriveRecord:
     repeats: int = 0  # statuses received again (re-sent by the hardware)
     stale: int = 0  # statuses older than one already answered
     gaps: int = 0  # ticks skipped between two statuses (lost or not sent)
+    companions_lost: int = 0  # statuses not answered: a companion of theirs lost (``companions``)
     commands: int = 0
     compute: list = field(default_factory=list)  # s wall: status received → command sent
+    perception: Optional[dict] = None  # a perception in its own process: its fits' and waits' times
     clipped: int = 0  # commands clipped to the actuators' effort limits
     url: Optional[str] = None  # the LCM URL in use
     channels: list = field(default_factory=list)  # the channels subscribed to
@@ -62,10 +64,13 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "statuses_repeated": record.repeats,
         "statuses_stale": record.stale,
         "ticks_missing": record.gaps,
+        "companions_lost": record.companions_lost,
         "commands_sent": record.commands,
         "first_t": record.first_t,
         "last_t": record.last_t,
         "compute_ms": spread(record.compute, 1e3),
+        "ticks_over_period": int(np.count_nonzero(np.asarray(record.compute) > settings.period)),
+        "perception": record.perception,
         "commands_clipped": record.clipped,
         "scheduler": scheduler_name(),
         "driver_mode": settings.driver_mode,
@@ -80,4 +85,5 @@ def drive_series(record: DriveRecord) -> dict:
         "q": np.asarray(record.q),
         "v": np.asarray(record.v),
         "tau": np.asarray(record.tau),
+        "compute": np.asarray(record.compute),  # s wall: status received → command sent
     }

@@ -13,6 +13,7 @@ from __future__ import annotations
 import sys
 import threading
 from pathlib import Path
+from typing import Optional
 
 from pydrake.lcm import DrakeLcm
 
@@ -24,10 +25,12 @@ from ptint_drake.hardware.sim_hardware import run_hardware
 SWITCH_INTERVAL = 1e-4  # s: the interpreter's thread switch interval while both sides run
 
 
-def run_pair(scenario: Scenario, settings: LinkSettings, out: Path) -> tuple[dict, dict]:
+def run_pair(scenario: Scenario, settings: LinkSettings, out: Path, lcm: Optional[DrakeLcm] = None
+             ) -> tuple[dict, dict]:
     """(metrics.json of the hardware, drive.json's summary) of ``scenario`` run as hardware (a
-    thread) and drive (this thread) over one in-memory LCM; the hardware's outputs in ``out``."""
-    lcm = DrakeLcm("memq://")
+    thread) and drive (this thread) over one in-memory LCM (``lcm``, a ``memq://`` one, e.g. with
+    a listener of its own; default a new one); the hardware's outputs in ``out``."""
+    lcm = lcm if lcm is not None else DrakeLcm("memq://")
     result: dict = {}
 
     def hardware() -> None:

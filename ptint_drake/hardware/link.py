@@ -14,8 +14,8 @@ The messages are Drake's own (the ``drake`` Python package that ships with pydra
   position + torque driver gets: ``driver_modes``), ``num_torques`` = n, ``joint_torque`` (N·m, in
   the plant's actuator order).
 
-A station with a gripper (``worlds.base.LinkPorts``) adds Drake's gripper messages and one vector
-of its objects' motion:
+A station with a gripper (``worlds.base.LinkPorts``) adds Drake's gripper messages and, where the
+station tracks its objects with a pose tracker, the tracker's reports:
 
 - ``lcmt_schunk_wsg_status`` (hardware → drive, channel ``SCHUNK_WSG_STATUS``, Drake's
   ``hardware_sim`` name), one per tick, before the arm's status: ``utime`` as the arm's,
@@ -26,11 +26,13 @@ of its objects' motion:
   arm's command: ``utime`` = the tick at which the gripper's driver takes it (the answered status's
   ``utime`` + T; the hand-shake's: 0), ``target_position_mm`` = the wanted opening (mm; 0 = close),
   ``force`` = the grip force limit (N).
-- ``lcmt_scope`` (hardware → drive, ``PART_MOTION``), one per tick, before the arm's status:
-  ``utime`` as the arm's; ``value`` = per part (scenario order) its [x, ẋ, ẍ] (m, m/s, m/s²; the
-  centre, world frame) and [R row-major, ω, ω̇] (rad/s, rad/s²): the station's object ports, 24
-  doubles a part.  Drake has no message of a body's full motion (``lcmt_viewer_draw`` carries float
-  poses without velocities); ``lcmt_scope`` is its plain vector of doubles.
+- ``lcmt_scope`` (hardware → drive, ``TRACKED_POSES``), one per tick, before the arm's status:
+  ``utime`` as the arm's; ``value`` = the station's ``tracked_poses`` port, the pose tracker's
+  report: per tracked body (the station's order) [p, v, R row-major, ω] (m, m/s, rad/s; world
+  frame), ``TRACKED_SIZE`` doubles a body.  A sensor's output, as a cell's tracker sends it: no
+  station's truth port (a body's simulated motion, its accelerations) is on the wire.  Drake has
+  no message of a tracked body's pose and twist (``lcmt_viewer_draw`` carries float poses
+  without velocities); ``lcmt_scope`` is its plain vector of doubles.
 
 LCM carries no sender identity and no authentication: the default URL stays on this machine
 (``ttl=0``) and ``url_warning`` names the risk of any other; the hardware side's checks
@@ -52,16 +54,17 @@ from drake import (lcmt_iiwa_command, lcmt_iiwa_status, lcmt_schunk_wsg_command,
                    lcmt_scope)
 from pydrake.lcm import DrakeLcm
 
+from ptint_drake.worlds.base import TRACKED_SIZE
+
 STATUS_CHANNEL = "IIWA_STATUS"  # Drake's iiwa driver's channel names
 COMMAND_CHANNEL = "IIWA_COMMAND"
 WSG_STATUS_CHANNEL = "SCHUNK_WSG_STATUS"  # Drake's hardware_sim names
 WSG_COMMAND_CHANNEL = "SCHUNK_WSG_COMMAND"
-PARTS_CHANNEL = "PART_MOTION"
+TRACKER_CHANNEL = "TRACKED_POSES"  # a pose tracker's reports (``worlds.base.LinkPorts``)
 MEMQ_NAP = 5e-5  # s: a memq:// wait's sleep between two non-blocking handles
 # one thread at a time in a memq:// LCM shared by two threads (``in_memory``): pydrake's calls keep
 # Python's interpreter lock while LCM takes its own, and LCM calls back into Python
 MEMQ_LOCK = threading.Lock()
-PART_SIZE = 24  # doubles a part: [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15)
 
 
 def url_warning(url: str) -> Optional[str]:
@@ -323,22 +326,23 @@ def unpack_wsg_command(data: bytes) -> tuple[int, float, float]:
     return m.utime, m.target_position_mm / 1e3, m.force
 
 
-def pack_parts(t: float, motion: np.ndarray) -> bytes:
-    """An ``lcmt_scope`` of the parts' motion at ``t`` (``PART_SIZE`` doubles a part)."""
+def pack_tracked(t: float, report: np.ndarray) -> bytes:
+    """An ``lcmt_scope`` of a pose tracker's report at ``t`` (``TRACKED_SIZE`` doubles a body)."""
     m = lcmt_scope()
-    m.utime, m.size, m.value = utime_of(t), len(motion), [float(x) for x in motion]
+    m.utime, m.size, m.value = utime_of(t), len(report), [float(x) for x in report]
     return m.encode()
 
 
-def unpack_parts(data: bytes, parts: int) -> tuple[int, np.ndarray]:
-    """(utime, motion) of a parts message for ``parts`` parts; ValueError naming what is wrong."""
+def unpack_tracked(data: bytes, bodies: int) -> tuple[int, np.ndarray]:
+    """(utime, report) of a tracker's message for ``bodies`` bodies; ValueError naming what is wrong."""
     try:
         m = lcmt_scope.decode(data)
     except Exception as exc:  # noqa: BLE001
-        raise ValueError(f"an undecodable parts message ({type(exc).__name__})") from None
-    if m.size != PART_SIZE * parts:
+        raise ValueError(f"an undecodable tracker message ({type(exc).__name__})") from None
+    if m.size != TRACKED_SIZE * bodies:
         raise ValueError(
-            f"a parts message of {m.size} values, the scenario's {parts} parts need {PART_SIZE * parts}"
+            f"a tracker message of {m.size} values, the scenario's {bodies} tracked bodies need "
+            f"{TRACKED_SIZE * bodies}"
         )
     return m.utime, np.array(m.value, dtype=float)
 

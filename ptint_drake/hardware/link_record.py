@@ -25,6 +25,7 @@ class LinkSettings:
     budget: float = 0.8  # real time: the part of T a tick waits for its command
     realtime_rate: float = 1.0
     drop_status: float = 0.0  # a test option: the fraction of status messages not sent
+    drop_companion: Optional[float] = None  # a test option: the tick (s) whose gripper status is not sent
     seed: int = 0
     priority: int = DEFAULT_PRIORITY  # real time: SCHED_FIFO priority of the loop (0: none; ``priority``)
     messages: str = "iiwa"  # the arm's message set and channels (``arm_messages.MESSAGES``)
@@ -39,6 +40,7 @@ class LinkRecord:
     tick_time: list = field(default_factory=list)  # simulated t of each tick
     statuses: int = 0  # status messages published (re-sends included)
     dropped: int = 0  # status messages not sent (``drop_status``)
+    companions_dropped: int = 0  # gripper statuses not sent (``drop_companion``)
     resends: int = 0
     accepted: int = 0
     duplicates: int = 0  # a command repeated for its status (an answer to a re-sent status)

@@ -35,8 +35,8 @@ from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.hardware.arm_messages import arm_messages
-from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
-                                       pack_parts, pack_wsg_status, unpack_wsg_command, utime_of)
+from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
+                                       pack_tracked, pack_wsg_status, unpack_wsg_command, utime_of)
 
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
@@ -69,7 +69,8 @@ class HardwareSession:
         self._wsg: dict[
             int, tuple[float, float]
         ] = {}  # gripper commands: driver's tick utime → (opening, force)
-        self._companions: list = []  # this tick's gripper status and objects' motion (``ports``)
+        self._companions: list = []  # this tick's gripper status, tracker report, frame (``ports``)
+        self._drop_gripper = False  # ``drop_companion``: this tick's gripper status not sent once
         self.handshake_s: Optional[float] = None  # wall s the hand-shake took
         self.builds = 0  # CommandLinks built in this session (more than one: a world planned anew)
         self.watch = (
@@ -93,6 +94,9 @@ class HardwareSession:
     # -- the protocol -------------------------------------------------------------------------
     def _publish(self, data: bytes) -> float:
         for channel, message in self._companions:  # before the arm's status: it completes a tick
+            if self._drop_gripper and channel == WSG_STATUS_CHANNEL:
+                self._drop_gripper, self.record.companions_dropped = False, self.record.companions_dropped + 1
+                continue
             self.endpoint.publish_on(channel, message)
         if self.s.drop_status > 0 and self._rng.random() < self.s.drop_status:
             self.record.dropped += 1
@@ -260,14 +264,17 @@ class HardwareSession:
 
     def _set_companions(self, t: float, extras) -> None:
         """The station's messages of the tick at ``t`` beside the arm's (``extras`` = fingers,
-        drive forces, the objects' motion; None: the arm alone)."""
+        drive forces, the tracker's report, the depth frame; None: the arm alone)."""
         if extras is None or self.ports is None:
             self._companions = []
             return
-        fingers, force, parts, image = extras
+        fingers, force, tracked, image = extras
         self._companions = [(WSG_STATUS_CHANNEL, pack_wsg_status(t, fingers, force))]
-        if parts is not None:
-            self._companions.append((PARTS_CHANNEL, pack_parts(t, parts)))
+        drop = self.s.drop_companion  # (a test: the gripper status's first publish is lost)
+        self._drop_gripper = (drop is not None and utime_of(t) == utime_of(drop)
+                              and not self.record.companions_dropped)
+        if tracked is not None:
+            self._companions.append((TRACKER_CHANNEL, pack_tracked(t, tracked)))
         if image is not None:  # the camera's frame of this tick's period: before the status too
             camera = self.ports.camera
             self._companions.append((image_channel(camera), pack_depth_image(t, image, camera)))
@@ -325,7 +332,7 @@ class HardwareSession:
         self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
     ) -> Optional[np.ndarray]:
         """The tick at ``t``: publish the status (and with a gripper, first, the gripper's status
-        and the objects' motion: ``extras``), take its command (None: none, keep the last torque;
+        and the tracker's report: ``extras``), take its command (None: none, keep the last torque;
         ``record.fault`` says when that is a fault); the gripper command for the driver's next
         tick is then ``gripper_opening(utime_of(t) + utime_of(T))`` when it came."""
         utime = utime_of(t)

@@ -25,7 +25,7 @@ from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.hardware.camera_link import image_channel, with_receive_buffer
 from ptint_drake.hardware.arm_messages import arm_messages
-from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
+from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
                                        SenderWatch, spread, url_warning)
 from ptint_drake.hardware.process import scheduler_name, stop_on_signals
 from ptint_drake.hardware.session import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
@@ -151,8 +151,9 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         block |= {
             "gripper_status_channel": WSG_STATUS_CHANNEL,
             "gripper_command_channel": WSG_COMMAND_CHANNEL,
-            "parts_channel": PARTS_CHANNEL if ports.objects else None,
+            "tracker_channel": TRACKER_CHANNEL if ports.objects else None,
             "gripper_commands_taken": r.gripper_commands,
+            "companions_dropped": r.companions_dropped,
         }
         if ports.camera:
             block |= {"image_channel": image_channel(ports.camera), "frames_sent": r.frames_sent}

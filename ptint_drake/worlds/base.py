@@ -36,6 +36,10 @@ from ptint_drake.systems.task.schedule import Schedule
 from ptint_drake.verdict.metrics import Reason
 
 Progress = Optional[Callable[[float, float, int], None]]
+# doubles of a pose tracker's report of one body: [p (3), v (3), R row-major (9), ω (3)] (m, m/s,
+# rad/s; world frame), a station's ``tracked_poses`` port and the link's ``TRACKED_POSES`` channel
+TRACKED_SIZE = 18
+TRACKER_PORT = "tracked_poses"  # a station's port of its pose tracker's reports (``LinkPorts``)
 
 
 def new_simulator(diagram, context=None, config=None) -> Simulator:
@@ -70,10 +74,11 @@ class RunResult:
 @dataclass(frozen=True)
 class LinkPorts:
     """A station's ports that cross ``ptint hardware``'s link beside the arm's (``World.link_ports``):
-    a gripper (status out, command in; ``gripper_max_force`` N, the commands' limit); the motion
-    of ``objects`` bodies, in the station's order (``link.PART_SIZE`` doubles each: what a pose
-    tracker would report; 0 where a camera sees them); and a depth camera (``camera``: its name,
-    the station's ``depth_image`` port, one frame every 1 / ``camera_rate_hz`` s)."""
+    a gripper (status out, command in; ``gripper_max_force`` N, the commands' limit); a pose
+    tracker's reports of ``objects`` bodies, in the station's order (its ``tracked_poses`` port,
+    ``TRACKED_SIZE`` doubles a body: [p, v, R row-major, ω]; 0 where a camera sees them: no
+    tracker); and a depth camera (``camera``: its name, the station's ``depth_image`` port, one
+    frame every 1 / ``camera_rate_hz`` s).  No truth port of a station crosses the link."""
 
     gripper_max_force: float
     objects: int

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -80,20 +81,32 @@ def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     assert drive["commands_sent"] >= 3000 and drive["fault"] is None
 
 
+# what a cell's devices send and take: the arm's and the gripper's drivers, the part tracker
+PICK_WIRE = {"IIWA_STATUS", "IIWA_COMMAND", "SCHUNK_WSG_STATUS", "SCHUNK_WSG_COMMAND", "TRACKED_POSES"}
+TRUTH_WORDS = r"PART|MOTION|TRUTH|TRUE|GROUND"  # a channel named for part motion or truth
+
+
 def test_pick_lockstep_places_like_one_process(tmp_path, run):
-    """Acceptance, the pick world: lockstep across two processes (arm, gripper and parts over
-    LCM; the targets, gripper sequence and grasp observer in the drive) = ptint run of
-    conveyor_pick_place (its control period and plant step are 1 ms already): every part placed,
-    the same verdict, the place error within 1e-6 m (measured: 0.155655 against 0.155582 mm, the
-    first 10 ms bit-identical, then round-off amplified by the contacts)."""
+    """Acceptance, the pick world: lockstep across two processes (arm, gripper and the part
+    tracker's reports over LCM; the targets, gripper sequence and grasp observer in the drive) =
+    ptint run of conveyor_pick_place (its control period and plant step are 1 ms already): every
+    part placed, the same verdict, the place error within 1e-12 m (measured: bit-identical, as is
+    every arm and part sample of the run; assembly_pick_place's last place 1.3e-15 m apart).  A
+    bystander on the group sees every channel on the wire: the devices' own, none named for
+    part motion or truth; the drive subscribes to the three its controller side reads."""
     out = run_plan(
         [
-            {"name": "hw", "argv": ptint("hardware", PICK, *PATIENT, "--lockstep", "--quiet",
-                                         "--out", str(tmp_path / "hw"))},
-            {"name": "drive", "argv": ptint("drive", PICK, *PATIENT, "--out", str(tmp_path / "dr"))},
+            {"name": "wire", "argv": [sys.executable, str(HERE / "listen.py"), "110"], "timeout": 115.0},
+            {"name": "hw", "delay": 0.5, "argv": ptint("hardware", PICK, *PATIENT, "--lockstep", "--quiet",
+                                                       "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "delay": 0.5,
+             "argv": ptint("drive", PICK, *PATIENT, "--out", str(tmp_path / "dr"))},
         ],
         tmp_path,
     )
+    wire = json.loads(out["wire"]["stdout"])
+    wire.pop("LCM_SELF_TEST", None)  # LCM's own, each process's start-up check of the group
+    assert set(wire) == PICK_WIRE and not any(re.search(TRUTH_WORDS, c) for c in wire), wire
     assert out["hw"]["rc"] == 0 and out["drive"]["rc"] == 0, out
     metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
     reference = run(PICK).metrics
@@ -101,21 +114,25 @@ def test_pick_lockstep_places_like_one_process(tmp_path, run):
     assert len(metrics["picks"]) == len(reference["picks"])
     for pick, ref in zip(metrics["picks"], reference["picks"]):
         assert pick["placed"] and ref["placed"]
-        assert abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 1e-3  # 1e-6 m (measured 7e-8 m)
+        assert abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 1e-9  # 1e-12 m (measured 0)
         assert [a["state"] for a in pick["attempt_details"]] == [a["state"] for a in ref["attempt_details"]]
     link = metrics["hardware"]
     assert link["ticks"] == 5000 and link["fault"] is None
     assert link["gripper_commands_taken"] == link["ticks"]  # one gripper command a tick
+    assert link["tracker_channel"] == "TRACKED_POSES"
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert drive["fault"] is None and drive["commands_sent"] >= 5000
+    assert drive["subscribed_channels"] == ["IIWA_STATUS", "SCHUNK_WSG_STATUS", "TRACKED_POSES"]
 
 
 def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
     """Issue 43, the camera over LCM: conveyor_pick_place_rgbd across two processes in lockstep.
     The hardware sends the station's depth frames (Drake's ``lcmt_image_array``, lossless 32F, on
-    ``DRAKE_RGBD_CAMERA_IMAGES_camera``) and no part's motion; the drive runs the perception, the
-    estimators and the plan: the part placed as ``ptint run`` places it, within 1e-6 m (measured:
-    1.269128 against 1.269194 mm, 6.5e-8 m), and no channel of truth on the wire."""
+    ``DRAKE_RGBD_CAMERA_IMAGES_camera``) and no part's motion; the drive runs the perception (its
+    fits in a process of its own), the estimators and the plan: the part placed as ``ptint run``
+    places it, within 1e-6 m (measured: 1.189753 against 1.189694 mm, 6.1e-8 m: the first
+    estimate reaches the drive's command one tick before ``ptint run``'s hold, whose sample at
+    0.033 s is simultaneous with the filters' update), and no channel of truth on the wire."""
     out = run_plan(
         [
             {"name": "hw", "argv": ptint("hardware", RGBD_PICK, *PATIENT, "--lockstep", "--quiet",
@@ -134,11 +151,13 @@ def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
         assert pick["placed"] and abs(pick["place_error_mm"] - ref["place_error_mm"]) <= 1e-3, (pick, ref)
         assert pick["t_grasp"] == ref["t_grasp"]
     link = metrics["hardware"]
-    assert link["parts_channel"] is None and link["image_channel"] == "DRAKE_RGBD_CAMERA_IMAGES_camera"
+    assert link["tracker_channel"] is None and link["image_channel"] == "DRAKE_RGBD_CAMERA_IMAGES_camera"
     assert link["frames_sent"] >= 150 and link["fault"] is None  # 30 Hz over 5 s
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert drive["subscribed_channels"] == ["IIWA_STATUS", "SCHUNK_WSG_STATUS",
                                             "DRAKE_RGBD_CAMERA_IMAGES_camera"]
+    # the fits made in the drive's perception process, one a frame (frame_process)
+    assert drive["perception"]["process"] == "own" and drive["perception"]["fit_ms"]["count"] >= 150
 
 
 def test_pick_replan_is_refused_in_one_line(tmp_path):
@@ -319,6 +338,35 @@ def test_dropped_status_completes(tmp_path):
         0.15 < link["statuses_dropped"] / total < 0.25
         and link["status_resends"] >= link["statuses_dropped"] - 1
     )
+
+
+def test_realtime_lost_gripper_status_does_not_end_the_run(tmp_path):
+    """Issue 43: in real time nothing re-sends a companion; one lost gripper status (the hardware's
+    test option --drop-companion: the tick at 1 s) costs that tick, not the run — the drive sees
+    the next tick's companions first, skips the tick (a late tick for the hardware, which keeps
+    the previous torque) and answers the next; the run goes on to its end.  (The silent-peer
+    timeouts are set out of the way, 5 s on both sides, and the pace at a quarter of real time: at
+    load 7 on this 2-core machine a process stalled for 0.9 s, the arm drifted on the old torque
+    and missed its grasp; the hold is not what this test checks.)"""
+    out = run_plan(
+        [
+            {"name": "hw", "argv": ptint("hardware", PICK, *PATIENT, "--silent-periods", "5000", "--quiet",
+                                         "--realtime-rate", "0.25", "--drop-companion", "1.0",
+                                         "--out", str(tmp_path / "hw"))},
+            {"name": "drive", "argv": ptint("drive", PICK, *PATIENT, "--status-timeout", "5",
+                                            "--out", str(tmp_path / "dr"))},
+        ],
+        tmp_path,
+    )
+    assert out["drive"]["rc"] == 0, out
+    metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
+    link = metrics["hardware"]
+    assert link["companions_dropped"] == 1 and link["fault"] is None and link["ticks"] == 5000, link
+    assert link["ticks_late"] >= 1  # the tick whose gripper status was lost went unanswered
+    drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
+    assert drive["fault"] is None and drive["companions_lost"] == 1 and drive["last_t"] >= 4.998, drive
+    # placed, unless the machine's load made enough late ticks to cost the accuracy (then exit 1)
+    assert out["hw"]["rc"] == 0 or (out["hw"]["rc"] == 1 and link["ticks_late"] > 1), out
 
 
 def test_in_memory_pair_matches_two_processes(tmp_path):

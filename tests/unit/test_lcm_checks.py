@@ -194,7 +194,7 @@ def pick_tick(session, lcm, t, gripper=()):
     for data in gripper:
         lcm.Publish(WSG_COMMAND_CHANNEL, data)
     lcm.Publish(COMMAND_CHANNEL, pack_command(utime_of(t), np.zeros(N)))
-    extras = (np.zeros(4), np.zeros(2), np.zeros(24), None)  # fingers, drive forces, parts, no frame
+    extras = (np.zeros(4), np.zeros(2), np.zeros(18), None)  # fingers, drive forces, tracker, no frame
     return session.exchange(t, np.zeros(N), np.zeros(N), np.zeros(N), extras)
 
 

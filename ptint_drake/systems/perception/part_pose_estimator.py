@@ -79,6 +79,9 @@ class PerceptionConfig:
     # OCCLUDER_GAP above its top to OCCLUDER_HEIGHT): a dropout (e.g. the gripper coming down over
     # it hides part of its top face before the fit fails the completeness check)
     check_above: bool = False
+    # the fits are made outside the diagram (``frame_process.FrameProcess``: a control loop that
+    # must not wait for them) and written by ``write_frame``; the frame's event only marks its time
+    fits_elsewhere: bool = False
 
 
 class PartPoseEstimator(LeafSystem):
@@ -103,7 +106,10 @@ class PartPoseEstimator(LeafSystem):
         self._memory = self.DeclareDiscreteState(np.zeros(self._n * 5))
         self._fits = self.DeclareAbstractState(AbstractValue.Make([]))
         self._timing = self.DeclareAbstractState(AbstractValue.Make({}))
-        self.DeclarePeriodicUnrestrictedUpdateEvent(self._period, 0.0, self._update)
+        if config.fits_elsewhere:
+            self.DeclarePeriodicPublishEvent(self._period, 0.0, lambda context: None)
+        else:
+            self.DeclarePeriodicUnrestrictedUpdateEvent(self._period, 0.0, self._update)
         self.DeclarePeriodicPublishEvent(self._period, config.latency, lambda context: None)
         prerequisites = {self.time_ticket(), self.xd_ticket()}
         self.measurement_ports, self.rotation_ports = [], []
@@ -204,7 +210,17 @@ class PartPoseEstimator(LeafSystem):
         cloud = self._cloud_in.Eval(context)
         rendered = time.perf_counter()
         fits = self.fit_frame(cloud)
-        done = time.perf_counter()
+        timing = {"cloud_s": rendered - start, "fit_s": time.perf_counter() - rendered}
+        self._write(context, state, t, fits, timing)
+
+    def write_frame(self, context, t: float, fits: list, timing: dict) -> None:
+        """With ``fits_elsewhere``: the fits of the frame taken at ``t`` into ``context`` (this
+        system's), as this system's own update at ``t`` writes them."""
+        self._write(context, context, t, fits, timing)
+
+    def _write(self, context, state, t: float, fits: list, timing: dict) -> None:
+        """The frame at ``t``'s samples from ``fits`` into ``state`` (a State, or the context
+        itself), associated with the memory in ``context``."""
         memory = context.get_discrete_state(self._memory).value().reshape(self._n, 5).copy()
         chosen = self._associate(fits, memory)
         old = context.get_discrete_state(self._buffer).value()
@@ -225,8 +241,7 @@ class PartPoseEstimator(LeafSystem):
         state.get_mutable_discrete_state(self._buffer).SetFromVector(new)
         state.get_mutable_discrete_state(self._memory).SetFromVector(memory.ravel())
         state.get_mutable_abstract_state(self._fits).set_value(fits)
-        state.get_mutable_abstract_state(self._timing).set_value(
-            {"t": t, "cloud_s": rendered - start, "fit_s": done - rendered})
+        state.get_mutable_abstract_state(self._timing).set_value({"t": t} | timing)
 
     def _visible(self, context, i: int) -> np.ndarray:
         t = context.get_time()

@@ -204,6 +204,7 @@ class PartEstimates:
     perception: object  # the perception diagram (input ``depth_image``)
     position_filters: list
     rotation_filters: list
+    config: PerceptionConfig = None  # what the perception was built from
 
 
 def _position_filter(config: MeasurementConfig) -> LeafSystem:
@@ -213,16 +214,18 @@ def _position_filter(config: MeasurementConfig) -> LeafSystem:
     return TargetKalmanFilter(config=config, model=config.estimator.split("_", 1)[1], prior=[])
 
 
-def AddPartEstimates(builder: DiagramBuilder, depth_image, scenario) -> PartEstimates:
+def AddPartEstimates(builder: DiagramBuilder, depth_image, scenario, fits_elsewhere: bool = False
+                     ) -> PartEstimates:
     """The perception, the estimators and ``EstimatedParts`` reading ``depth_image`` (module
-    docstring)."""
+    docstring); ``fits_elsewhere``: the fits are made outside the diagram
+    (``PerceptionConfig.fits_elsewhere``, ``systems.perception.frame_process``)."""
     m, pick = scenario.measurement, scenario.pick
     camera = camera_of(m, pick)
     belts = belt_regions(camera.belts)
     of = part_belts(pick) if not m.camera.belts else _nearest_belts(belts, pick)
     config = PerceptionConfig(camera_info(camera), camera_pose(camera), belts, camera.part_shape,
                               list(camera.part_size), of, float(m.rate_hz), float(m.latency),
-                              check_above=True)
+                              check_above=True, fits_elsewhere=fits_elsewhere)
     perception, estimator = MakeRgbdPerception(config)
     builder.AddNamedSystem("rgbd_perception", perception)
     builder.Connect(depth_image, perception.get_input_port())
@@ -242,7 +245,7 @@ def AddPartEstimates(builder: DiagramBuilder, depth_image, scenario) -> PartEsti
         builder.Connect(rf.get_target_rotation_output_port(), parts.GetInputPort(f"rotation_{k}"))
         positions.append(kf)
         rotations.append(rf)
-    return PartEstimates(parts, estimator, perception, positions, rotations)
+    return PartEstimates(parts, estimator, perception, positions, rotations, config)
 
 
 def estimate_metrics(scenario, picks: list, estimates: dict) -> None:

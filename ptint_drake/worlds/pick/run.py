@@ -4,7 +4,8 @@
 controller in its slot (``controllers.AddControllerTo``: the arm's [q; v] in, its torques out
 through the drive's zero-order hold and the effort limits; the arm's kinematics from a plant of
 the arm's model file alone — the controller knows nothing of the gripper, the parts or the
-payload), ``PickTargets`` (what each segment aims at, from the parts' simulated poses),
+payload), ``PickTargets`` (what each segment aims at, from the part tracker's reports,
+``tracker``, or the camera's estimates),
 ``GripperSequence`` (open, close at the prescribed time, open), ``GraspObserver`` (the grasp
 state from the fingers' width, speed and drive force: ``systems.hand.gripper``) and ``PickProbe``
 (poses, contacts and pad forces, recorded every ``PROBE_PERIOD``).  ``world.PickWorld`` runs it
@@ -37,6 +38,7 @@ from ptint_drake.worlds.pick.route import routed_plan
 from ptint_drake.worlds.pick.scene import slot_pose
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
 from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
+from ptint_drake.worlds.pick.tracker import TRACKER_PORT, TrackedParts
 from ptint_drake.worlds.pick.tasks import PickPlan, Replan
 from ptint_drake.worlds.stateless_derivatives import install_stateless_derivatives
 
@@ -86,10 +88,10 @@ class PickBuilt:
 
     def part_system(self):
         """The system whose ``part_k_pose`` / ``part_k_rotation`` the targets read: the camera's
-        estimates, or the station's simulated poses."""
+        estimates, or the part tracker's reports (``tracker.TrackedParts``)."""
         if self.estimates is not None:
             return self.estimates.parts
-        return self.diagram.GetSubsystemByName("pick_station")
+        return self.diagram.GetSubsystemByName("tracked_parts")
 
 
 def place_positions(config: PickWorldConfig, plan: PickPlan) -> list:
@@ -118,13 +120,16 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuil
     n = len(station.parts)
     places = place_positions(station.config, plan)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, places))
-    estimates, parts, true_targets = None, st, None
+    estimates, true_targets = None, None
     if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
         estimates = AddPartEstimates(builder, st.GetOutputPort("depth_image"), scenario)
         parts = estimates.parts
         true_targets = builder.AddNamedSystem("pick_targets_true",
                                               PickTargets(plan, n, places))
         _connect_parts(builder, st, true_targets, n)
+    else:  # the part tracker's reports (a sensor: the station's truth ports are the metrics')
+        parts = builder.AddNamedSystem("tracked_parts", TrackedParts(n))
+        builder.Connect(st.GetOutputPort(TRACKER_PORT), parts.get_input_port())
     _connect_parts(builder, parts, targets, n)
     limits = actuator_effort_limits(arm)
     saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))

@@ -6,9 +6,10 @@ station (``station.MakeStation`` for the interception-only world): a discrete Mu
 contact model and discrete contact approximation), the arm parsed from its model file into its own
 model instance (as ``robot.parse_model`` does), the gripper welded at the arm's end-effector frame
 with its driver (``systems.hand.gripper.GripperDriver``), the belts running at their speeds, the parts
-resting on them, the tray with its slots (``pick.scene``), and ``PartPoses`` reading every part's
-simulated motion.  The arm's controller sees only the arm: its state and actuation ports carry
-the arm's joints and nothing of the fingers, belts or parts.
+resting on them, the tray with its slots (``pick.scene``), ``PartPoses`` reading every part's
+simulated motion (truth: the metrics') and ``PartTracker``, the part tracker (a sensor: what the
+controller side reads).  The arm's controller sees only the arm: its state and actuation ports
+carry the arm's joints and nothing of the fingers, belts or parts.
 
 ==================  =======  ================================================================
 port                size     meaning
@@ -20,6 +21,9 @@ port                size     meaning
 ``part_k_pose``     9        output: part k's simulated [x, ẋ, ẍ] (its centre, world; a
                              ``target`` port's layout), k = index in ``config.parts``
 ``part_k_rotation`` 15       output: part k's [R row-major, ω, ω̇] (a ``target_rotation`` layout)
+``tracked_poses``   18·n     output: the part tracker's report, per part [p, v, R, ω]
+                             (``tracker.PartTracker``: the sensor the controller side reads;
+                             the ``part_k_*`` ports are truth, the metrics')
 ``gripper_state``   4        output: fingers [q_left, q_right, v_left, v_right] (m, m/s; q = the
                              pad's distance from the centre plane, opening = q_left + q_right)
 ``grip_force``      2        output: force of each finger's drive (N, + opens, − squeezes), the
@@ -63,6 +67,7 @@ from ptint_drake.worlds.pick.collisions import CollisionProbe
 from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, grasp_width
 from ptint_drake.worlds.pick.contact_pairs import ContactPairs
 from ptint_drake.worlds.pick.part_pose import PartPoses
+from ptint_drake.worlds.pick.tracker import TRACKER_PORT, PartTracker
 from ptint_drake.worlds.pick.scene import AddBelt, AddFloor, AddGripper, AddPart, AddTray, gripper_stroke
 
 
@@ -171,6 +176,10 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
     builder.Connect(plant.get_body_poses_output_port(), poses.get_input_port(0))
     builder.Connect(plant.get_state_output_port(), poses.get_input_port(1))
     builder.Connect(plant.get_generalized_acceleration_output_port(), poses.get_input_port(2))
+    tracker = builder.AddNamedSystem("part_tracker", PartTracker(plant, parts))
+    builder.Connect(plant.get_body_poses_output_port(), tracker.GetInputPort("body_poses"))
+    builder.Connect(plant.get_state_output_port(), tracker.GetInputPort("state"))
+    builder.ExportOutput(tracker.get_output_port(), TRACKER_PORT)
     builder.ExportInput(plant.get_actuation_input_port(arm), "actuation")
     builder.ExportInput(driver.GetInputPort("command"), "gripper_command")
     builder.ExportOutput(plant.get_state_output_port(arm), "state")

@@ -350,7 +350,7 @@ class PickWorld(World):
         return world_config(scenario).time_step if scenario.multibody is None else None
 
     def link_ports(self, scenario: Scenario) -> LinkPorts:
-        """The gripper, and the parts' motion or the camera's frames (``controller_side``)."""
+        """The gripper, and the part tracker's reports or the camera's frames (``controller_side``)."""
         return pick_link_ports(scenario)
 
     def controller_side(self, builder, scenario: Scenario, period: float):
