@@ -251,8 +251,8 @@ def _add_bench_parser(sub) -> None:
         description="Speed and accuracy of the bundled scenarios (or the SCENARIOs) as JSON on stdout: per "
                     "scenario and configuration the realtime factor, integrator steps, derivative "
                     "evaluations, µs per evaluation and e(tf) next to a tight-tolerance reference run "
-                    "(runge_kutta5, accuracy 1e-10). --schemes, --pair and --floors print their studies "
-                    "instead. Progress on stderr; exit 0, 2 on bad input (docs/speed.md).")
+                    "(runge_kutta5, accuracy 1e-10). --schemes, --pair, --floors and --arms print their "
+                    "studies instead. Progress on stderr; exit 0, 2 on bad input (docs/speed.md).")
     bench.add_argument("scenarios", nargs="*", type=opt.scenario_source, metavar="SCENARIO",
                        help="bundled scenario names or YAML files (default: every bundled scenario)")
     bench.add_argument("--configs", type=opt.bench_configs, action=opt.Items, default=",".join(CONFIGS),
@@ -274,7 +274,13 @@ def _add_bench_parser(sub) -> None:
                        help=f"time two override mappings side by side (interleaved), e.g. '{{}}' '{BEFORE}'")
     bench.add_argument("--repeats", type=opt.count("--repeats"), default=5,
                        help="with --pair: pairs per scenario; with --floors: runs per diagram, at most 3 "
-                            "(a pick scenario: alternated pairs, at least 5) (default 5)")
+                            "(a pick scenario: alternated pairs, at least 5); with --arms: alternated "
+                            "pairs per arm (default 5)")
+    bench.add_argument("--arms", nargs="?", const="all", type=opt.bench_arms, metavar="LIST",
+                       help="instead: each arm's curve realtime factor against a plain pydrake loop on the "
+                            "same arm and integrator (a MultibodyPlant and a Python LeafSystem), and the "
+                            "bound the package holds to; every bundled arm, or a comma-separated LIST "
+                            "(rvm1, rvm1_5dof, rvm1_6dof, iiwa14, panda, ur5e)")
     bench.add_argument("--floors", action="store_true",
                        help="instead: µs per derivative evaluation of the plant with a C++ constant "
                             "actuation, with a do-nothing Python controller, and with the scenario's "

@@ -99,7 +99,8 @@ def _add_drive_parser(sub) -> None:
         "drive",
         help="the controller alone over LCM, driving `ptint hardware` or a robot (docs/hardware.md)",
         description="Run the scenario's targets and controller alone: answer each lcmt_iiwa_status on "
-        "IIWA_STATUS with a torque-only lcmt_iiwa_command on IIWA_COMMAND. Writes drive.json "
+        "IIWA_STATUS with an lcmt_iiwa_command on IIWA_COMMAND (the torques, less what the driver "
+        "adds: --driver-mode; the measured positions). Writes drive.json "
         "(what was received and sent) and drive_series.npz. Exit 0 when the scenario's end was "
         "reached, 1 when the status stopped (one line), 2 bad input.",
     )
@@ -118,6 +119,15 @@ def _add_drive_parser(sub) -> None:
         help="s to wait for the first status (default 10)",
     )
     _add_priority_option(dr, "")
+    dr.add_argument(
+        "--driver-mode",
+        choices=("torque", "torque-gravity", "position-torque"),
+        default="torque",
+        help="what the robot's driver adds to a command, which the drive takes off: torque (nothing: "
+        "ptint hardware), torque-gravity (gravity compensation: KUKA FRI torque mode, Drake's "
+        "SimIiwaDriver torque-only), position-torque (Drake's IiwaDriver default: inverse dynamics "
+        "around the positions sent, the measured ones) (default torque; docs/hardware.md)",
+    )
     dr.add_argument("--out", help="output folder (default out/drive_NAME)")
     dr.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     dr.add_argument("--quiet", action="store_true", help="accepted like the other commands")
@@ -267,6 +277,7 @@ def cmd_drive(args: argparse.Namespace) -> int:
         startup_timeout=args.startup_timeout,
         status_timeout=args.status_timeout,
         priority=args.priority,
+        driver_mode=args.driver_mode,
     )
     record = DriveRecord()
     fault, url = None, args.url

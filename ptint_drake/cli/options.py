@@ -264,6 +264,14 @@ def bench_configs(text: str) -> list[str]:
 
 
 @_option
+def bench_arms(text: str) -> list[str]:
+    """``--arms`` of ``bench``: names of ``arm_bench.ARM_CURVES`` (the bundled arms), or ``all``."""
+    from ptint_drake.studies.arm_bench import ARM_CURVES  # noqa: PLC0415
+
+    return list(ARM_CURVES) if text.strip() == "all" else names(text, "--arms", list(ARM_CURVES))
+
+
+@_option
 def integration_schemes(text: str) -> list[str]:
     """``--schemes`` of ``bench``: Drake's integration schemes (``GetIntegrationSchemes``)."""
     from pydrake.systems.analysis import GetIntegrationSchemes  # noqa: PLC0415

@@ -41,11 +41,13 @@ from pydrake.systems.primitives import PassThrough
 
 from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers import AddControllerTo, TargetView
+from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL, Endpoint,
+                                       pack_wsg_command, unpack_status, url_warning)
 from ptint_drake.hardware.camera_link import with_receive_buffer
 from ptint_drake.hardware.companions import CompanionFault, CompanionInbox, companion_channels
 from ptint_drake.hardware.drive_record import DriveRecord, DriveSettings, drive_series, drive_summary
-from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, WSG_COMMAND_CHANNEL, Endpoint,
-                                       pack_command, pack_wsg_command, unpack_status, url_warning)
+from ptint_drake.hardware.driver_modes import DriverTerms
+from ptint_drake.hardware.status_clock import StatusClock
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.hardware.sim_hardware import link_period
 from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
@@ -120,6 +122,9 @@ class _DriveLoop:
         self.warn, self.in_memory = warn, lcm is not None  # (memq: both sides in one process)
         self.n, self.settings, self.record, self.side = n, settings, record, side
         self.period_us = int(round(settings.period * 1e6))
+        # the driver's stamps to scenario time, and what the driver adds to a command
+        self.clock = record.clock = StatusClock(settings.period)
+        self.terms = DriverTerms(settings.driver_mode, nominal_plant(scenario))
         # the drive's own saturation, where ``ptint run``'s station saturates (``limits.saturate``):
         # the hardware side rejects a torque beyond an effort limit as a fault
         self.limits = actuator_effort_limits(nominal_plant(scenario)) if scenario.limits.saturate else None
@@ -149,7 +154,8 @@ class _DriveLoop:
         risk = url_warning(self.endpoint.url)
         if risk:
             warn(risk)
-        self.answered: Optional[int] = None
+        self.answered: Optional[int] = None  # scenario µs of the last status answered
+        self.stamp: Optional[int] = None  # the driver's stamp of the status answered last
         self.answer = b""
         self.last_q = self.last_v = None
         self.started = False  # with a controller side: the events at the first tick's time taken
@@ -161,8 +167,10 @@ class _DriveLoop:
         """The next statuses received (polling until some arrive); ``DriveFault`` after the
         start-up or status timeout without one."""
         while True:
-            # until the first tick after the hand-shake, the hardware may still be building its diagram
-            timeout = self.settings.startup_timeout if not self.answered else self.settings.status_timeout
+            # until the first tick after the hand-shake (two commands: the hand-shake's and that
+            # tick's; a drive started mid-run: its first two), the hardware may still be building
+            s = self.settings
+            timeout = s.startup_timeout if self.record.commands < 2 else s.status_timeout
             messages = self.endpoint.poll(0.05)
             now = time.perf_counter()
             if messages:
@@ -190,14 +198,19 @@ class _DriveLoop:
         """One status received at wall time ``t_recv``: re-send the answer to a repeat, skip a stale
         one, otherwise check it and answer it."""
         try:
-            utime, q, v = unpack_status(data, self.n)
+            stamp, q, v = unpack_status(data, self.n)
         except ValueError as exc:
             raise DriveFault(f"status rejected: {exc}; stopped commanding") from None
         self.record.statuses += 1
         answered = self.answered
+        utime = self.clock.place(stamp)  # scenario µs (``status_clock``); the command keeps the stamp
+        if utime is None:
+            self.record.stale += 1
+            return
         if (
             answered is not None
             and utime == answered
+            and stamp == self.stamp
             and np.array_equal(q, self.last_q)
             and np.array_equal(v, self.last_v)
         ):
@@ -206,12 +219,10 @@ class _DriveLoop:
                 self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
             self.endpoint.publish(self.answer)
             return
-        if answered is not None and utime < answered:
-            self.record.stale += 1
-            return
         if answered is not None:
             self.record.gaps += max(0, int(round((utime - answered) * 1e-6 / self.settings.period)) - 1)
-        self.respond(t_recv, utime, q, v, self.companion(utime) if self.side is not None else None)
+        self.stamp = stamp
+        self.respond(t_recv, utime, q, v, self.companion(stamp) if self.side is not None else None)
 
     def companion(self, utime: int) -> dict:
         """The station's companions of the status of ``utime`` (``companions.CompanionInbox``)."""
@@ -293,13 +304,13 @@ class _DriveLoop:
             self.warm_up(t)  # timeout, while a tick waits only its command timeout (0.25 s)
             self.go_realtime()
         self.last_q, self.last_v = q, v
-        self.answer = pack_command(utime, tau)
+        self.answer = self.terms.command(self.stamp, tau, q, v)
         if self.side is not None:
             # the gripper's driver takes it at its next tick (the hand-shake's: at t = 0), as the
             # one-process run's driver reads the plan's command at each of its ticks
-            at = utime if first else utime + self.period_us
+            ahead = 0 if first else self.period_us  # (stamped in the driver's clock)
             self.gripper_answer = pack_wsg_command(
-                at, self.side.sequence.opening(at / 1e6), self.side.max_force
+                self.stamp + ahead, self.side.sequence.opening((utime + ahead) / 1e6), self.side.max_force
             )
             self.endpoint.publish_on(WSG_COMMAND_CHANNEL, self.gripper_answer)
         sent = self.endpoint.publish(self.answer)

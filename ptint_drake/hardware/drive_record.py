@@ -21,6 +21,7 @@ class DriveSettings:
     startup_timeout: float = 10.0  # s wall for the first status
     status_timeout: float = 0.5  # s wall without a status once running
     priority: int = DEFAULT_PRIORITY  # SCHED_FIFO priority of the loop (0: none; ``hardware.priority``)
+    driver_mode: str = "torque"  # what the driver adds to a command (``driver_modes.DRIVER_MODES``)
 
 
 @dataclass
@@ -42,6 +43,7 @@ class DriveRecord:
     q: list = field(default_factory=list)
     v: list = field(default_factory=list)
     tau: list = field(default_factory=list)
+    clock: Optional[object] = None  # the ``status_clock.StatusClock`` of the driver's stamps
 
 
 def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dict:
@@ -62,6 +64,8 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "compute_ms": spread(record.compute, 1e3),
         "commands_clipped": record.clipped,
         "scheduler": scheduler_name(),
+        "driver_mode": settings.driver_mode,
+        "clock": record.clock.summary() if record.clock is not None else None,
     }
 
 

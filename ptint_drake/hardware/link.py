@@ -9,9 +9,10 @@ The messages are Drake's own (the ``drake`` Python package that ships with pydra
   (N·m: the torque the drive applies over this period), ``joint_position_commanded`` /
   ``joint_position_ipo`` = the measured position (torque-only: nothing else is commanded),
   ``joint_torque_external`` = 0 (not estimated).
-- ``lcmt_iiwa_command`` (drive → hardware, channel ``IIWA_COMMAND``), torque-only: ``utime`` = the
-  ``utime`` of the status it answers, ``num_joints`` = 0 (no position), ``num_torques`` = n,
-  ``joint_torque`` (N·m, in the plant's actuator order).
+- ``lcmt_iiwa_command`` (drive → hardware, channel ``IIWA_COMMAND``): ``utime`` = the ``utime`` of
+  the status it answers, ``num_joints`` = n with the status's measured positions (rad; what a
+  position + torque driver gets: ``driver_modes``), ``num_torques`` = n, ``joint_torque`` (N·m, in
+  the plant's actuator order).
 
 A station with a gripper (``worlds.base.LinkPorts``) adds Drake's gripper messages and one vector
 of its objects' motion:
@@ -248,17 +249,27 @@ def status_torque(data: bytes) -> np.ndarray:
     return np.array(lcmt_iiwa_status.decode(data).joint_torque_commanded, dtype=float)
 
 
-def pack_command(utime: int, tau: np.ndarray) -> bytes:
-    """A torque-only ``lcmt_iiwa_command`` answering the status of ``utime``: τ (N·m)."""
+def pack_command(utime: int, tau: np.ndarray, positions: Optional[np.ndarray] = None) -> bytes:
+    """An ``lcmt_iiwa_command`` answering the status of ``utime``: τ (N·m), and ``positions``
+    (rad; ``num_joints`` = their count, 0 without: ``driver_modes`` says which positions)."""
     m = lcmt_iiwa_command()
-    m.utime, m.num_joints, m.joint_position = int(utime), 0, []
+    m.utime = int(utime)
+    m.joint_position = [] if positions is None else [float(x) for x in positions]
+    m.num_joints = len(m.joint_position)
     m.num_torques, m.joint_torque = len(tau), [float(x) for x in tau]
     return m.encode()
 
 
 def unpack_command(data: bytes, n: int) -> tuple[int, np.ndarray]:
-    """(utime, τ) of a torque-only command for ``n`` joints; ValueError naming what is wrong
-    (undecodable, a position command, a wrong number of torques)."""
+    """(utime, τ) of a command for ``n`` joints; ValueError naming what is wrong
+    (``unpack_command_positions``)."""
+    utime, tau, _ = unpack_command_positions(data, n)
+    return utime, tau
+
+
+def unpack_command_positions(data: bytes, n: int) -> tuple[int, np.ndarray, Optional[np.ndarray]]:
+    """(utime, τ, positions or None) of a command for ``n`` joints; ValueError naming what is
+    wrong (undecodable, a wrong number of torques or positions)."""
     try:
         m = lcmt_iiwa_command.decode(data)
     except Exception as exc:  # noqa: BLE001
@@ -266,8 +277,9 @@ def unpack_command(data: bytes, n: int) -> tuple[int, np.ndarray]:
     if m.num_torques != n or len(m.joint_torque) != n:
         raise ValueError(f"a command of {m.num_torques} torques, the arm has {n} joints")
     if m.num_joints not in (0, n):
-        raise ValueError(f"a command of {m.num_joints} positions (torque-only: 0 or {n})")
-    return m.utime, np.array(m.joint_torque, dtype=float)
+        raise ValueError(f"a command of {m.num_joints} positions (0 or {n})")
+    positions = np.array(m.joint_position, dtype=float) if m.num_joints else None
+    return m.utime, np.array(m.joint_torque, dtype=float), positions
 
 
 def pack_wsg_status(t: float, fingers: np.ndarray, drive_force: np.ndarray) -> bytes:

@@ -10,7 +10,8 @@ and checks, the timing it records; ``command_link.CommandLink`` calls it at each
   that many control periods of the last command.
 
 Every command passes the checks before it reaches the plant (``HardwareSession._check``): its
-size, finite torques within the actuators' effort limits, and one command per status — LCM
+size, finite torques within the actuators' effort limits, positions (if any) equal to the status's
+measured ones (a torque-only driver: ``driver_modes.position_refusal``), and one command per status — LCM
 carries no sender identity, so a second sender shows up as a command for a status nobody asked
 about, two different commands for one status, or a time stamp that goes backwards.  A failed
 check or a timeout is a *fault*: the link stops publishing status, and the arm is held for
@@ -29,12 +30,13 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.hardware.camera_link import image_channel, pack_depth_image
-from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
-                                       pack_parts, pack_status, pack_wsg_status, unpack_command,
-                                       unpack_wsg_command, utime_of)
+from ptint_drake.hardware.driver_modes import position_refusal
 from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
 from ptint_drake.worlds.base import LinkPorts
+from ptint_drake.hardware.link import (PARTS_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
+                                       pack_parts, pack_status, pack_wsg_status, unpack_command_positions,
+                                       unpack_wsg_command, utime_of)
 
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
@@ -58,6 +60,7 @@ class HardwareSession:
         self._answered: Optional[int] = None  # utime of the last status answered
         self._answered_tau: Optional[np.ndarray] = None
         self._pending: Optional[int] = None
+        self._pending_q: Optional[np.ndarray] = None  # the measured positions of the pending status
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
         self._after_handshake = False
@@ -100,12 +103,23 @@ class HardwareSession:
         if self.record.fault is None:
             self.record.fault, self.record.fault_time, self.record.fault_kind = message, t, kind
 
+    def _matched(self, utime: int, positions: Optional[np.ndarray]) -> tuple[int, Optional[str]]:
+        """(the stamp of the status a command answers, why its positions are refused or None).
+        Drake's ``IiwaCommandSender`` truncates t·10⁶: a stamp 1 µs short of the pending or
+        answered status's is that status's answer (48 of 3001 stamps at 1 ms, measured)."""
+        if utime + 1 in (self._pending, self._answered):
+            utime += 1
+        return utime, position_refusal(positions, self._pending_q) if utime == self._pending else None
+
     def _check(self, t: float, data: bytes, t_recv: float) -> None:
         """One received command against the checks (module docstring); a fault or its use."""
         try:
-            utime, tau = unpack_command(data, self.n)
+            utime, tau, positions = unpack_command_positions(data, self.n)
         except ValueError as exc:
             return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {exc}")
+        utime, refusal = self._matched(utime, positions)
+        if refusal:  # a torque-only driver: positions that mean something are refused, not ignored
+            return self._fail(t, "bad command", f"command rejected at t = {t:.3f} s: {refusal}")
         if not np.all(np.isfinite(tau)):
             return self._fail(
                 t,
@@ -224,9 +238,10 @@ class HardwareSession:
         while True:
             now = time.perf_counter()
             step = min(deadline - now, self.s.resend) if resend else deadline - now
-            for t_recv, message in self.endpoint.poll(max(step, 0.0)):
+            messages = self.endpoint.poll(max(step, 0.0))
+            self._check_senders(t)  # first: a second sender is named by its address, not its stamps
+            for t_recv, message in messages:
                 self._check(t, message, t_recv)
-            self._check_senders(t)
             self._check_stop(t)
             if self.ports is not None:
                 for message in self.endpoint.take_side(WSG_COMMAND_CHANNEL):
@@ -270,7 +285,7 @@ class HardwareSession:
         start = time.perf_counter()
         data = pack_status(0.0, q, v, tau)
         self._set_companions(0.0, extras)
-        self._pending = 0
+        self._pending, self._pending_q = 0, np.array(q, dtype=float)
         self._sent[0] = self._publish(data)
         wsg = 0 if self.ports is not None else None  # the gripper command the driver takes at t = 0
         if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True, wsg=wsg):
@@ -324,7 +339,7 @@ class HardwareSession:
             self.record.duplicates += len(self.endpoint.poll(0.0))
         data = pack_status(t, q, v, tau)
         self._set_companions(t, extras)
-        self._pending = utime
+        self._pending, self._pending_q = utime, np.array(q, dtype=float)
         self._sent[utime] = self._publish(data)
         if len(self._sent) > 4096:
             for key in sorted(self._sent)[:2048]:

@@ -11,10 +11,11 @@ from ptint_drake.config.controller import default_pinv_damping
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.fields import nonnegative, positive
 from ptint_drake.controllers import CONTROLLERS, REGISTRY, known_type, plugin
-from ptint_drake.controllers.ptsmc.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
-from ptint_drake.systems.perception.camera import validate_measurement
-from ptint_drake.systems.task.error import TASKS
 from ptint_drake.verdict.metrics import validate_criteria
+from ptint_drake.robot.plant import resolve_model
+from ptint_drake.systems.perception.camera import validate_measurement
+from ptint_drake.controllers.ptsmc.sliding_surface import SIGMA_POLICIES, SWITCHING_LAWS
+from ptint_drake.systems.task.error import TASKS
 from ptint_drake.worlds.registry import TARGET_KINDS, world_of
 
 __all__ = ["IMPLEMENTATIONS", "TARGET_KINDS", "ScenarioError", "validate"]
@@ -23,8 +24,10 @@ IMPLEMENTATIONS = ("fused", "blocks")
 
 
 def validate(s) -> None:
-    """Checks that need no robot model (the model-dependent ones live in ``robot``)."""
+    """Checks that need no robot model (the model-dependent ones live in ``robot``); ``robot.model``
+    must name a bundled model or an existing file (not parsed here)."""
     positive(s.duration, "duration")
+    resolve_model(s.robot.model)  # a bundled name or a file: named before any study fans out
     if s.controller.pinv_damping is None:  # left out: one start angle per joint (checked on the model)
         s.controller.pinv_damping = default_pinv_damping(s.controller.task, len(s.robot.initial_q_deg))
     _validate_controller(s.controller)

@@ -325,10 +325,10 @@ def sweep_benchmark(name: str = "curve_b075_tf15", betas=(0.25, 0.5, 0.75),
 
 def from_options(args: Namespace, say: "Callable[[str], None] | None" = None) -> dict:
     """The JSON ``ptint bench`` prints for its parsed options (``args``: lists already split and
-    checked): ``--floors``, ``--schemes`` and ``--pair`` (any of them) with the machine's
+    checked): ``--floors``, ``--schemes``, ``--pair`` and ``--arms`` (any of them) with the machine's
     description, else every configuration against the reference run (and ``--sweep``)."""
     names = args.scenarios or None
-    if not (args.floors or args.schemes or args.pair):
+    if not (args.floors or args.schemes or args.pair or args.arms):
         result = benchmark(names, args.configs, not args.no_reference, progress=say)
         if args.sweep:
             result["sweep"] = sweep_benchmark()
@@ -341,4 +341,8 @@ def from_options(args: Namespace, say: "Callable[[str], None] | None" = None) ->
         result["schemes"] = scheme_table(names, args.schemes, args.accuracies, args.simulator_extra, say)
     if args.pair:
         result["paired"] = paired(names, args.pair[0], args.pair[1], args.repeats, say)
+    if args.arms:
+        from ptint_drake.studies.arm_bench import arms  # noqa: PLC0415
+
+        result["arms"] = arms(args.arms, args.repeats, say)
     return result

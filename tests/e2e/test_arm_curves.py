@@ -42,7 +42,7 @@ def test_unknown_model_is_one_line(tmp_path, ptint_here):
     assert out.returncode == 2
     lines = [line for line in out.stderr.splitlines() if line.strip()]
     assert len(lines) == 1, out.stderr
-    assert lines[0].startswith("ptint: error: robot.model: 'iiwa15'") and "iiwa14" in lines[0]
+    assert lines[0].startswith("ptint: error: --set: robot.model: 'iiwa15'") and "iiwa14" in lines[0]
     assert not (tmp_path / "out" / "metrics.json").exists()
 
 

@@ -1,7 +1,9 @@
 """Run a plan of processes (inside the private namespace, ``netns.run_in_netns``) and print
 what became of each as JSON: ``python pair.py PLAN_JSON``.
 
-PLAN: a list of {"name", "argv", "delay" (s before starting), "kill_when" ([other name, text]:
+PLAN: a list of {"name", "argv", "delay" (s before starting), "start_when" ([other name, text]:
+started once that process's stderr shows the text, after the steps without one), "kill_when"
+([other name, text]:
 a signal once that process's stderr shows the text, e.g. a progress line), "signal" (its name,
 default "SIGKILL"), "timeout" (s)}.
 Result: {name: {"rc", "stdout", "stderr", "started", "ended", "killed"}}, wall times in s from
@@ -24,8 +26,13 @@ def main() -> None:
     folder = Path(tempfile.mkdtemp(prefix="ptint_pair_"))
     t0 = time.monotonic()
     procs = {}
-    for step in sorted(plan, key=lambda s: s.get("delay", 0.0)):
+    for step in sorted(plan, key=lambda s: (s.get("start_when") is not None, s.get("delay", 0.0))):
         while time.monotonic() - t0 < step.get("delay", 0.0):
+            time.sleep(0.01)
+        when = step.get("start_when")
+        while when and when[1] not in (folder / f"{when[0]}.err").read_text():
+            if procs[when[0]]["proc"].poll() is not None:
+                break  # (it ended without the text: started anyway, the test sees it)
             time.sleep(0.01)
         name = step["name"]
         out, err = open(folder / f"{name}.out", "w"), open(folder / f"{name}.err", "w")

@@ -6,7 +6,6 @@ plain DH implementation, limits, masses, inertias and collision geometry.
 """
 
 import math
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -19,7 +18,6 @@ from pydrake.multibody.tree import RevoluteJoint
 from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.robot.rvm1 import bundled_models, model_path
-from ptint_drake.simulation.scenario import bundled_scenarios
 
 ROOT = Path(__file__).resolve().parents[2]
 D = math.pi / 180.0
@@ -183,42 +181,6 @@ def test_generated_files_are_current():
     result = subprocess.run([sys.executable, str(ROOT / "scripts" / "arm_models.py"), "--check"],
                             capture_output=True, text=True, check=False)
     assert result.returncode == 0, result.stdout + result.stderr
-
-
-def test_no_remote_drake_models():
-    """No bundled model or package file refers to the remote drake_models package."""
-    needle = "package://" + "drake_models"
-    hits = [str(path) for folder in (ROOT / "models", ROOT / "ptint_drake") for path in folder.rglob("*")
-            if path.is_file() and path.suffix in (".urdf", ".sdf", ".xml", ".py", ".yaml", ".md")
-            and needle in path.read_text(errors="ignore")]
-    assert hits == []
-
-
-def test_every_bundled_model_parses_with_an_empty_cache(tmp_path):
-    """Every bundled arm and gripper, and every bundled scenario's plant, parses with HOME and
-    XDG_CACHE_HOME in a fresh folder (nothing downloaded earlier can help), in a subprocess."""
-    files = sorted(str(p) for p in (ROOT / "models").iterdir() if p.suffix in (".urdf", ".sdf"))
-    assert len(files) >= 8
-    code = ("import sys\nfrom pydrake.multibody.parsing import Parser\n"
-            "from pydrake.multibody.plant import MultibodyPlant\n"
-            "for path in sys.argv[1:]:\n"
-            "    plant = MultibodyPlant(0.0)\n"
-            "    Parser(plant).AddModels(path)\n"
-            "    plant.Finalize()\n"
-            "    print('ok', path)\n"
-            "from ptint_drake.robot.plant import make_plant\n"
-            "from ptint_drake.simulation.scenario import bundled_scenarios, load_scenario\n"
-            "for name in bundled_scenarios():\n"
-            "    make_plant(load_scenario(name))\n"
-            "    print('scenario', name)\n")
-    env = dict(os.environ, HOME=str(tmp_path), XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
-    result = subprocess.run([sys.executable, "-c", code, *files], capture_output=True, text=True,
-                            env=env, check=False, timeout=300)
-    assert result.returncode == 0, result.stderr[-2000:]
-    assert result.stdout.count("ok ") == len(files)
-    assert result.stdout.count("scenario ") == len(bundled_scenarios())
-    assert not (tmp_path / "cache" / "drake").exists() or not any((tmp_path / "cache" / "drake").rglob("*"))
 
 
 def test_null_space_term_at_a_singular_jacobian():
