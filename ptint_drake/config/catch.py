@@ -19,7 +19,11 @@ class CatchConfig:
     """A catch: ``throw`` (the thrower's seed), the ``gripper``, ``sensing`` (s of flight seen
     before the plan), ``replan_every`` (s between the revisions of the catch time),
     ``commit`` (s before the catch time after which the plan stays), ``beta`` (the TBG's β),
-    ``held_for`` (s after the catch at which the ball must still be held)."""
+    ``held_for`` (s after the catch at which the ball must still be held); the moving target
+    (``worlds.catch.target``): ``match`` (the fraction of the ball's velocity the hand has at the
+    catch), ``match_time`` (s, how long before the catch the matching sets in), ``freeze`` (s
+    before the catch from which the estimate is held); ``final`` (s: the catch segment split in two,
+    the second this long, so that a new segment starts from the state near the catch; 0: one)."""
 
     throw: int = 0
     gripper: GripperConfig = field(default_factory=_wsg)
@@ -28,3 +32,7 @@ class CatchConfig:
     commit: float = 0.15
     beta: float = 0.75
     held_for: float = 0.5
+    match: float = 0.5
+    match_time: float = 0.05
+    freeze: float = 0.02
+    final: float = 0.0

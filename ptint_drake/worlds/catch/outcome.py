@@ -40,7 +40,10 @@ LATE_RADIUS = 0.025  # m
 
 
 def _held(d: float, opening: float) -> bool:
-    return d <= HELD_RADIUS and abs(opening - BALL_DIAMETER) <= GRIP_TOLERANCE
+    """The ball's centre near the fingertip centre and the jaws stopped on it: above half its
+    diameter (the foam ball squeezed by the jaws' force: measured 55 mm on 65 at 40 N) and not
+    open beyond it."""
+    return d <= HELD_RADIUS and 0.5 * BALL_DIAMETER <= opening <= BALL_DIAMETER + GRIP_TOLERANCE
 
 
 def outcome(plan, touched: dict, at: dict) -> str:

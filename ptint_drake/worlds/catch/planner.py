@@ -10,12 +10,7 @@ direction (Drake's ``InverseKinematics`` with the joint limits, nearest the pres
 feasibility model, which is not binding on the arm's tf at these speeds, as a margin).  Of those, the
 one nearest the hand's present tip (least motion) is chosen; none: ``not reachable``.
 
-``CatchTarget`` gives the controller the catch point (``target``: [x, 0, 0]) and the hand's
-orientation (``target_rotation``: [R, 0, 0]): the start pose until t_plan, then the ball's
-predicted centre at t_catch, revised from the estimate every millisecond until ``REVISE_UNTIL`` s
-before t_catch (the hand then occludes the ball), then held.  ``CloseCommand`` opens the hand to
-its pre-shape and closes it at t_close = t_catch − (pre-shape − ball) / 2 / jaw speed: the jaws
-meet the ball when it reaches the fingertip centre.
+What the controller and the hand are then given is ``target``'s.
 """
 
 from __future__ import annotations
@@ -26,9 +21,7 @@ from typing import Optional
 import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
-from pydrake.systems.framework import BasicVector, LeafSystem
 
-from ptint_drake.controllers.slot import TargetView
 from ptint_drake.systems.task.tbg import tbg_profile
 
 APPROACH_CONE_DEG = 25.0
@@ -36,7 +29,6 @@ FLOOR_Z = 0.2
 TORQUE_MARGIN = 1.25
 GRID = 0.01
 HORIZON = 1.0
-REVISE_UNTIL = 0.03
 
 
 @dataclass(frozen=True)
@@ -100,64 +92,3 @@ class Planner:
                 best = Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf)
                 break
         return best
-
-
-class CatchTarget(LeafSystem):
-    """The controller's target and orientation (module docstring).  Input ``estimate`` (9)."""
-
-    def __init__(self, start: np.ndarray, R_start: np.ndarray, plan: Optional[Plan]):
-        super().__init__()
-        self._plan, self._start, self._R0 = plan, np.asarray(start, float), np.asarray(R_start, float)
-        self._in = self.DeclareVectorInputPort("estimate", 9)
-        self._point = self.DeclareDiscreteState(BasicVector(self._start))
-        self.DeclarePeriodicDiscreteUpdateEvent(0.001, 0.0, self._update)
-        self.DeclareVectorOutputPort("target", 9, self._target, {self.xd_ticket()})
-        self.DeclareVectorOutputPort("target_rotation", 15, self._rotation, {self.time_ticket()})
-
-    def _update(self, context, state) -> None:
-        plan, t = self._plan, context.get_time()
-        if plan is None or t < plan.t_plan or t > plan.t_catch - REVISE_UNTIL:
-            return
-        estimate = self._in.Eval(context)
-        if np.any(estimate[3:6]):
-            state.get_mutable_vector().SetFromVector(predict(estimate, [plan.t_catch - t])[0])
-
-    def _target(self, context, output) -> None:
-        output.SetFromVector(np.concatenate([context.get_discrete_state_vector().value(), np.zeros(6)]))
-
-    def _rotation(self, context, output) -> None:
-        plan = self._plan
-        R = plan.R if plan is not None and context.get_time() >= plan.t_plan else self._R0
-        output.SetFromVector(np.concatenate([R.reshape(-1), np.zeros(6)]))
-
-
-class CloseCommand(LeafSystem):
-    """The gripper's opening command: the pre-shape, 0 (close) from ``t_close`` on."""
-
-    def __init__(self, preshape: float, t_close: float):
-        super().__init__()
-        self.DeclareVectorOutputPort(
-            "command", 1, lambda c, o: o.SetAtIndex(0, preshape if c.get_time() < t_close else 0.0),
-            {self.time_ticket()})
-
-
-class CatchTargetView(TargetView):
-    """The controller's view of the target: the planner's ports (the ball's estimate through the
-    plan), never the station's truth."""
-
-    def __init__(self, target_port, rotation_port):
-        self.analytic = None
-        self._port, self._rotation_port = target_port, rotation_port
-
-    def port(self):
-        return self._port
-
-    def rotation_port(self):
-        return self._rotation_port
-
-
-def close_time(plan: Optional[Plan], preshape: float, diameter: float, speed: float) -> float:
-    """When the jaws start closing (module docstring); never without a plan."""
-    if plan is None:
-        return float("inf")
-    return plan.t_catch - 0.5 * (preshape - diameter) / speed
