@@ -1,10 +1,18 @@
-"""The catch world (issue 46) on the world seam: a scenario with a ``catch`` block."""
+"""The catch world (issue 46) on the world seam: a scenario with a ``catch`` block.
+
+``ptint robust <catch scenario> --samples N``: sample i is throw ``seed + i`` of the frozen thrower,
+seen by the camera with noise seed ``seed + i`` (the arm's own deviations are not drawn: the
+catch station takes none); each row keeps the named outcome, the hand's error against the true
+ball at t_catch, the peak contact force on the ball and the oracle's verdict on that throw
+(``oracle``); robust.json's summary adds the catch rate, the oracle's reachable rate, the catch
+rate over the reachable throws and the failures by reason (``oracle.summary``)."""
 
 from __future__ import annotations
 
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.verdict.metrics import Reason
 from ptint_drake.worlds.base import World
+from ptint_drake.worlds.catch import oracle
 from ptint_drake.worlds.catch.run import CatchRun
 
 
@@ -28,3 +36,14 @@ class CatchWorld(World):
 
     def own_plant_step(self, scenario) -> float:
         return 0.001
+
+    def robust_sample(self, scenario, name: str, seed: int, u) -> tuple:
+        scenario.catch.throw = int(seed)
+        scenario.measurement.seed = int(seed)
+        return scenario, {"throw": int(seed)}
+
+    def robust_row(self, seed: int, params: dict, metrics: dict) -> dict:
+        return oracle.row(seed, params, metrics)
+
+    def robust_summary(self, rows: list) -> dict:
+        return oracle.summary(rows)
