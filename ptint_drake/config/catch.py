@@ -32,7 +32,7 @@ class CatchConfig:
     commit: float = 0.15
     beta: float = 0.75
     held_for: float = 0.5
-    match: float = 0.5
+    match: float = 0.3
     match_time: float = 0.05
     freeze: float = 0.02
     final: float = 0.0

@@ -52,8 +52,9 @@ def summary(rows: list) -> dict:
     return {"catch": {
         "throws": n, "caught": len(caught), "catch_rate": len(caught) / n if n else None,
         "reachable_rate": len(reach) / len(known) if known else None,
-        "caught_of_reachable": (sum(r.get("outcome") == "caught" for r in reach) / len(reach)) if reach else None,
-        "failures_by_reason": dict(Counter(r.get("outcome", "error") for r in rows
-                                           if r.get("outcome") != "caught").most_common()),
+        "caught_of_reachable": (sum(r.get("outcome") == "caught" for r in reach) / len(reach)
+                                if reach else None),
+        "failures_by_reason": dict(Counter(
+            r.get("outcome", "error") for r in rows if r.get("outcome") != "caught").most_common()),
         "error_at_catch_mm_median": errors[len(errors) // 2] if errors else None,
         "peak_force_caught_n_median": forces[len(forces) // 2] if forces else None}}

@@ -8,9 +8,10 @@ Outcomes, each a truth test of the finished run (``outcome``), in this order:
 ``not reachable`` (no plan: the arm never moved); ``collision with <body>`` (the ball touched a
 body of the arm); ``caught`` (at t_catch + ``held_for`` the ball's centre within ``outcome.HELD_RADIUS``
 of the fingertip centre and the jaws stopped on it: the sensed opening between half the ball's
-diameter and the diameter + ``GRIP_TOLERANCE``); ``slipped out`` (so held at t_catch + 0.1 s, not at the end); ``late`` (the
-hand's tip more than ``LATE_RADIUS`` from the ball's centre at t_catch); ``closed on nothing``
-(the jaws closed below half the ball's diameter); else ``bounced off``.
+diameter and the diameter + ``GRIP_TOLERANCE``); ``slipped out`` (so held at t_catch + 0.1 s,
+not at the end); ``late`` (the hand's tip more than ``LATE_RADIUS`` from the ball's centre at
+t_catch); ``closed on nothing`` (the jaws closed below half the ball's diameter); else
+``bounced off``.
 """
 
 from __future__ import annotations
