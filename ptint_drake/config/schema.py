@@ -20,6 +20,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from ptint_drake.config.controller import ControllerConfig, ParamValue
 from ptint_drake.config.criteria import Criteria
 from ptint_drake.config.measurement import MeasurementConfig
+from ptint_drake.config.catch import CatchConfig
 from ptint_drake.config.pick import PickConfig
 
 
@@ -156,6 +157,8 @@ class Scenario:
     # a pick and place (``worlds.pick``): the world and the tasks, whose segments replace
     # ``interceptions`` (None: an interception scenario)
     pick: Optional[PickConfig] = None
+    # a thrown ball caught in the hand (``worlds.catch``, issue 46)
+    catch: Optional[CatchConfig] = None
     # a world of the user's own (``WorldConfig``; None: the world of the blocks above)
     world: Optional[WorldConfig] = None
     name: str = ""

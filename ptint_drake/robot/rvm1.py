@@ -28,7 +28,7 @@ FINGERTIP_OFFSET = 0.12  # m
 def _models_dir() -> Path:
     """The bundled models: the source tree's models/ beside this package when there is one (a
     checkout, whatever else is installed), else ``ptint_drake.models`` (an installed package)."""
-    source = Path(__file__).resolve().parents[2] / "models"
+    source = Path(__file__).resolve().parents[2] / "models"  # (robot/ is one folder down)
     if (source / "rvm1.urdf").is_file():
         return source
     try:

@@ -15,6 +15,7 @@ from ptint_drake.config.schema import Scenario
 from ptint_drake.controllers.plugin import is_plugin, load_class, search_folders
 from ptint_drake.systems.task.schedule import Schedule
 from ptint_drake.worlds.base import RunResult, World
+from ptint_drake.worlds.catch.world import CatchWorld
 from ptint_drake.worlds.interception.checks import TARGET_KINDS
 from ptint_drake.worlds.interception.world import InterceptionWorld
 from ptint_drake.worlds.pick.world import PickWorld
@@ -22,6 +23,7 @@ from ptint_drake.worlds.pick.world import PickWorld
 WORLDS: dict[str, World] = {w.name: w for w in (
     InterceptionWorld(),  # the default: scenarios without another world's block
     PickWorld(),
+    CatchWorld(),
 )}
 
 __all__ = ["TARGET_KINDS", "WORLDS", "RunResult", "World", "objects_of", "plugin_world", "schedule_of",

@@ -1,0 +1,167 @@
+"""One catch run (issue 46): the station, the planner's target and close command, the controller
+in its slot; started from the arm settled at its start pose (``settle``); planned once at the
+end of the sensing (a new diagram resumed from the old state), the catch segment's null-space
+posture the planned catch posture (the redundant arm's self-motion led to where the planner's IK
+found the catch within the joint limits).
+
+Outcomes, each a truth test of the finished run (``outcome``), in this order:
+``not reachable`` (no plan: the arm never moved); ``collision with <body>`` (the ball touched a
+body of the arm); ``caught`` (at t_catch + ``held_for`` the ball's centre within ``outcome.HELD_RADIUS``
+of the fingertip centre and the jaws stopped on it: the sensed opening between half the ball's
+diameter and the diameter + ``GRIP_TOLERANCE``); ``slipped out`` (so held at t_catch + 0.1 s,
+not at the end); ``late`` (the hand's tip more than ``LATE_RADIUS`` from the ball's centre at
+t_catch); ``closed on nothing`` (the jaws closed below half the ball's diameter); else
+``bounced off``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from pydrake.math import RigidTransform
+from pydrake.multibody.math import SpatialVelocity
+from pydrake.systems.analysis import SimulatorConfig
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
+
+from ptint_drake.controllers import AddControllerTo
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.worlds.base import WorldRun
+from ptint_drake.worlds.catch.ball import BALL_DIAMETER
+from ptint_drake.worlds.catch.planner import Planner
+from ptint_drake.worlds.catch.settle import SETTLE_STARTS, SETTLE_TF, snapshot, start_from
+from ptint_drake.worlds.catch.station import TIP, AddCatchStation, arm_plant
+from ptint_drake.worlds.catch.outcome import BallContacts, outcome
+from ptint_drake.worlds.catch.target import CatchTarget, CatchTargetView, CloseCommand, close_time
+from ptint_drake.worlds.catch.thrower import throw
+
+_SETTLED: dict = {}
+
+
+def settled(scenario):
+    """The settled start of ``scenario``'s arm, controller and hand (``settle``), cached."""
+    key = (tuple(scenario.robot.initial_q_deg), repr(scenario.controller), repr(scenario.catch.gripper))
+    if key not in _SETTLED:
+        _SETTLED[key] = snapshot(CatchRun(scenario, settling=True))
+    return _SETTLED[key]
+
+
+class CatchRun(WorldRun):
+    """The catch of ``scenario.catch.throw`` (module docstring)."""
+
+    def __init__(self, scenario, log: bool = True, settling: bool = False):
+        self.scenario, c, self.settling = scenario, scenario.catch, settling
+        self.arm = arm_plant()
+        self.planner = Planner(self.arm, TIP, c.beta)
+        self.q0 = np.radians(scenario.robot.initial_q_deg)
+        self.x0, self.R0 = self.planner.tip(self.q0)
+        self.throw = throw(c.throw, self.x0)
+        self.parked = RigidTransform([self.throw.launch[0], self.throw.launch[1], -10.0])
+        self.plan, self.planned, self._pieces, self.touched, self._at = None, False, [], {}, {}
+        self.simulator_config = SimulatorConfig(integration_scheme="explicit_euler", use_error_control=False,
+                                                max_step_size=0.001)
+        self.plant_time_step = 0.001
+        self._build()
+
+    def schedule(self) -> Schedule:
+        c = self.scenario.catch
+        if self.settling:
+            return Schedule([Segment(start, SETTLE_TF, c.beta) for start in SETTLE_STARTS])
+        if self.plan is None:
+            return Schedule([Segment(0.0, c.sensing, c.beta), Segment(c.sensing, 0.6, c.beta)])
+        t_plan, t_c = self.plan.t_plan, self.plan.t_catch
+        t_mid = t_c - c.final
+        if c.final <= 0.0 or t_mid - t_plan < c.final:
+            return Schedule([Segment(0.0, t_plan, c.beta), Segment(t_plan, t_c - t_plan, c.beta)])
+        return Schedule([Segment(0.0, t_plan, c.beta), Segment(t_plan, t_mid - t_plan, c.beta),
+                         Segment(t_mid, c.final, c.beta)])
+
+    def _build(self) -> None:
+        c, builder = self.scenario.catch, DiagramBuilder()
+        self.station = st = AddCatchStation(builder, self.scenario)
+        target = builder.AddNamedSystem("catch_target", CatchTarget(self.x0, self.R0, self.plan, c))
+        builder.Connect(st.estimate, target.get_input_port())
+        close = builder.AddNamedSystem("close_command", CloseCommand(
+            c.gripper.initial_opening, close_time(self.plan, c.gripper.initial_opening, BALL_DIAMETER,
+                                                  c.gripper.speed)))
+        builder.Connect(close.get_output_port(), st.command)
+        view = CatchTargetView(target.GetOutputPort("target"), target.GetOutputPort("target_rotation"))
+        self.controller = AddControllerTo(builder, plant=self.arm, frame=self.arm.GetFrameByName(TIP),
+                                          schedule=self.schedule(), state=st.state, actuation=st.actuation,
+                                          scenario=self._posture_scenario(), target=view, targets=[])
+        self.logger = LogVectorOutput(st.plant.get_state_output_port(), builder, publish_period=0.001)
+        self.estimate_log = LogVectorOutput(st.estimate, builder, publish_period=0.001)
+        self.target_log = LogVectorOutput(target.GetOutputPort("target"), builder, publish_period=0.001)
+        probe = builder.AddNamedSystem("ball_contacts", BallContacts(st.plant, st.ball, self.touched))
+        builder.Connect(st.plant.get_contact_results_output_port(), probe.get_input_port())
+        self.diagram = builder.Build()
+
+    def _posture_scenario(self):
+        """The scenario whose controller's null-space posture is the plan's catch posture."""
+        if self.plan is None:
+            return self.scenario
+        posture = np.degrees(self.plan.q[:7]).tolist()
+        return dataclasses.replace(self.scenario, controller=dataclasses.replace(
+            self.scenario.controller, null_space_posture_deg=posture))
+
+    def initialize(self, context) -> None:
+        start_from(settled(self.scenario), self, context)
+        st = self.station
+        pc = st.plant.GetMyMutableContextFromRoot(context)
+        st.plant.SetFreeBodyPose(pc, st.ball, RigidTransform(np.array(self.throw.launch)))
+        v0 = SpatialVelocity(np.zeros(3), np.array(self.throw.velocity))
+        st.plant.SetFreeBodySpatialVelocity(pc, st.ball, v0)
+
+    def stops(self) -> list[float]:
+        c = self.scenario.catch
+        ends = [self.scenario.duration, c.sensing]
+        if self.plan is not None:
+            ends += [self.plan.t_catch, self.plan.t_catch + 0.1, self.plan.t_catch + c.held_for]
+        return sorted(set(t for t in ends if t <= self.scenario.duration))
+
+    def at_stop(self, context, t: float) -> None:
+        st = self.station
+        pc = st.plant.GetMyContextFromRoot(context)
+        tip = self.planner.tip(st.plant.GetPositions(pc, st.arm))[0]
+        ball = st.plant.EvalBodyPoseInWorld(pc, st.ball).translation()
+        self._at[t] = (float(np.linalg.norm(tip - ball)), float(np.sum(st.plant.GetPositions(pc, st.hand))))
+        if t == self.scenario.catch.sensing and not self.planned:
+            estimate = st.estimate.Eval(st.estimator.GetMyContextFromRoot(context))
+            q = st.plant.GetPositions(st.plant.GetMyContextFromRoot(context), st.arm)
+            self.plan = self.planner.plan(np.asarray(estimate), t, q) if np.any(estimate[3:6]) else None
+            self._replan = True
+
+    def replan(self, context, t: float) -> bool:
+        if not getattr(self, "_replan", False):
+            return False
+        self._replan, self.planned = False, True
+        self._pieces.append(tuple(log.FindLog(context) for log in self._logs()))
+        self._build()
+        return True
+
+    def resume(self, new_context, old_context) -> None:
+        new_context.SetTime(old_context.get_time())
+        new_context.SetContinuousState(old_context.get_continuous_state_vector().CopyToVector())
+        for i in range(old_context.num_discrete_state_groups()):
+            new_context.SetDiscreteState(i, old_context.get_discrete_state(i).value())
+
+    def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
+        pieces = self._pieces + [tuple(log.FindLog(context) for log in self._logs())]
+        t = np.concatenate([logs[0].sample_times() for logs in pieces])
+        x, estimate, target = (np.hstack([logs[i].data() for logs in pieces]).T for i in range(3))
+        plan, name = self.plan, outcome(self.plan, self.touched, self._at)
+        at_catch = self._at.get(plan.t_catch) if plan is not None else None
+        metrics = {"scenario": self.scenario.name, "duration": self.scenario.duration, "segments": [],
+                   "catch": {"throw": self.throw.seed, "outcome": name, "caught": name == "caught",
+                             "t_catch": plan.t_catch if plan else None,
+                             "tf_min": plan.tf_min if plan else None,
+                             "catch_point": plan.point.tolist() if plan else None,
+                             "catch_posture_deg": np.degrees(plan.q[:7]).tolist() if plan else None,
+                             "error_at_catch_m": at_catch[0] if at_catch else None,
+                             "peak_contact_force_n": max(self.touched.values(), default=0.0),
+                             "touched": dict(sorted(self.touched.items()))}}
+        return metrics, {"t": t, "plant_state": x, "estimate": estimate, "target": target}, []
+
+    def _logs(self) -> tuple:
+        return self.logger, self.estimate_log, self.target_log

@@ -1,0 +1,139 @@
+"""What the catch planner gives the controller and the hand (issue 46): the moving catch target,
+the hand's orientation, and the close command.
+
+``CatchTarget`` (input ``estimate``, the ball's [p̂, v̂, â] at t): before t_plan the hand's
+start pose.  From t_plan on, the prescribed-time law aims at a *moving* target that reaches the
+ball's predicted centre at exactly t_catch:
+
+    p_c(t)  = p̂ + v̂ T + ½ â T²,  T = t_catch − t    (the estimate's catch point; with a
+                                                       ballistic estimate d/dt p_c = 0)
+    x_r(t)  = p_c + m w(t) (p̂ − p_c),  w = exp(−T / τ_m)
+    ẋ_r     = m (w v̂ + (w / τ_m)(p̂ − p_c)),   ẍ_r = m (w â + 2 (w / τ_m) v̂ + (w / τ_m²)(p̂ − p_c))
+
+so that x_r(t_catch) = p̂(t_catch), the ball's estimated centre, and ẋ_r(t_catch) = m v̂: the
+hand arrives moving with the ball at the fraction m (``catch.match``; 0: it waits at the
+point) and the ball enters between the jaws at (1 − m) of its speed.  w switches the matching on
+only in the last few τ_m (``catch.match_time``): earlier, x_r is the catch point itself (the
+largest offset, m |v| τ_m / e, at T = τ_m).  Every term is recomputed from the estimate each
+time the controller reads it, so the law tracks the catch point as the estimate converges (the
+paper's interception of a known moving target, the knowledge improving as frames come in);
+from ``freeze`` s before t_catch (``catch.freeze``) the estimate is held: the hand then
+occludes the ball and the ball, once held, moves with the hand.
+
+After t_catch the target brakes: x_r = x_c + u τ_b (1 − e^(−τ/τ_b)), ẋ_r = u e^(−τ/τ_b),
+u = ẋ_r(t_catch), τ = t − t_catch, τ_b = ``BRAKE_TIME`` (the hand and the ball come to rest
+within ~4 τ_b, m |v| τ_b further on).
+
+``CloseCommand`` opens the hand to its pre-shape and closes it at ``close_time``: t_catch −
+(pre-shape − ball) / 2 / jaw speed (each jaw moves at the driver's speed), so the jaws reach the
+ball when its centre reaches the fingertip centre.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from ptint_drake.controllers.slot import TargetView
+
+BRAKE_TIME = 0.04  # s
+
+
+def catch_reference(estimate: np.ndarray, T: float, m: float, tau_m: float) -> np.ndarray:
+    """[x_r, ẋ_r, ẍ_r] (9) of the module docstring from an estimate [p̂, v̂, â], T = t_catch − t."""
+    p, v, a = estimate[0:3], estimate[3:6], estimate[6:9]
+    T = max(T, 0.0)
+    p_c = p + v * T + 0.5 * a * T * T
+    w, d = np.exp(-T / tau_m), p - p_c
+    x = p_c + m * w * d
+    xd = m * (w * v + (w / tau_m) * d)
+    xdd = m * (w * a + 2.0 * (w / tau_m) * v + (w / tau_m ** 2) * d)
+    return np.concatenate([x, xd, xdd])
+
+
+def braking(at_catch: np.ndarray, tau: float) -> np.ndarray:
+    """[x_r, ẋ_r, ẍ_r] ``tau`` s after the catch from the reference there (module docstring)."""
+    x, u = at_catch[0:3], at_catch[3:6]
+    f = np.exp(-tau / BRAKE_TIME)
+    return np.concatenate([x + u * BRAKE_TIME * (1.0 - f), u * f, -u * f / BRAKE_TIME])
+
+
+class CatchTarget(LeafSystem):
+    """The controller's target and orientation (module docstring).  Input ``estimate`` (9);
+    ``plan``: a ``planner.Plan`` or None (the start pose throughout)."""
+
+    def __init__(self, start: np.ndarray, R_start: np.ndarray, plan, catch):
+        super().__init__()
+        self._plan, self._start, self._R0 = plan, np.asarray(start, float), np.asarray(R_start, float)
+        self._m, self._tau_m, self._freeze = float(catch.match), float(catch.match_time), float(catch.freeze)
+        self._in = self.DeclareVectorInputPort("estimate", 9)
+        self._held = self.DeclareDiscreteState(BasicVector(np.zeros(10)))  # [held?, estimate]
+        if plan is not None:
+            self.DeclarePeriodicDiscreteUpdateEvent(0.001, 0.0, self._hold)
+        self.DeclareVectorOutputPort("target", 9, self._target, {self.all_sources_ticket()})
+        self.DeclareVectorOutputPort("target_rotation", 15, self._rotation, {self.time_ticket()})
+
+    def _hold(self, context, state) -> None:
+        if context.get_time() < self._plan.t_catch - self._freeze:
+            state.get_mutable_vector().SetFromVector(np.r_[1.0, self._in.Eval(context)])
+
+    def reference(self, context) -> np.ndarray:
+        """[x_r, ẋ_r, ẍ_r] at the context's time."""
+        plan, t = self._plan, context.get_time()
+        if plan is None or t < plan.t_plan:
+            return np.concatenate([self._start, np.zeros(6)])
+        held = context.get_discrete_state(self._held).get_value()
+        live = t < plan.t_catch - self._freeze or held[0] == 0.0
+        estimate = self._in.Eval(context) if live else self._extrapolated(held[1:], t)
+        if t <= plan.t_catch:
+            return catch_reference(estimate, plan.t_catch - t, self._m, self._tau_m)
+        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, self._m, self._tau_m)
+        return braking(at_catch, t - plan.t_catch)
+
+    def _extrapolated(self, held: np.ndarray, t: float) -> np.ndarray:
+        """The held estimate (taken at the last update before the freeze) moved on to ``t``."""
+        dt = t - (self._plan.t_catch - self._freeze)
+        dt = max(dt, 0.0)
+        p, v, a = held[0:3], held[3:6], held[6:9]
+        return np.concatenate([p + v * dt + 0.5 * a * dt * dt, v + a * dt, a])
+
+    def _target(self, context, output) -> None:
+        output.SetFromVector(self.reference(context))
+
+    def _rotation(self, context, output) -> None:
+        plan = self._plan
+        R = plan.R if plan is not None and context.get_time() >= plan.t_plan else self._R0
+        output.SetFromVector(np.concatenate([R.reshape(-1), np.zeros(6)]))
+
+
+class CloseCommand(LeafSystem):
+    """The gripper's opening command: the pre-shape, 0 (close) from ``t_close`` on."""
+
+    def __init__(self, preshape: float, t_close: float):
+        super().__init__()
+        self.DeclareVectorOutputPort(
+            "command", 1, lambda c, o: o.SetAtIndex(0, preshape if c.get_time() < t_close else 0.0),
+            {self.time_ticket()})
+
+
+class CatchTargetView(TargetView):
+    """The controller's view of the target: the planner's ports (the ball's estimate through the
+    plan), never the station's truth."""
+
+    def __init__(self, target_port, rotation_port):
+        self.analytic = None
+        self._port, self._rotation_port = target_port, rotation_port
+
+    def port(self):
+        return self._port
+
+    def rotation_port(self):
+        return self._rotation_port
+
+
+def close_time(plan, preshape: float, diameter: float, speed: float) -> float:
+    """When the jaws start closing (module docstring); never without a plan."""
+    if plan is None:
+        return float("inf")
+    return plan.t_catch - 0.5 * (preshape - diameter) / speed
+

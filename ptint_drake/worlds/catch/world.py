@@ -1,0 +1,49 @@
+"""The catch world (issue 46) on the world seam: a scenario with a ``catch`` block.
+
+``ptint robust <catch scenario> --samples N``: sample i is throw ``seed + i`` of the frozen thrower,
+seen by the camera with noise seed ``seed + i`` (the arm's own deviations are not drawn: the
+catch station takes none); each row keeps the named outcome, the hand's error against the true
+ball at t_catch, the peak contact force on the ball and the oracle's verdict on that throw
+(``oracle``); robust.json's summary adds the catch rate, the oracle's reachable rate, the catch
+rate over the reachable throws and the failures by reason (``oracle.summary``)."""
+
+from __future__ import annotations
+
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.verdict.metrics import Reason
+from ptint_drake.worlds.base import World
+from ptint_drake.worlds.catch import oracle
+from ptint_drake.worlds.catch.run import CatchRun
+
+
+class CatchWorld(World):
+    """A thrown ball caught in the hand at a time the planner chooses (``worlds.catch``)."""
+
+    name = "catch"
+    block = "catch"
+    summary = "a thrown foam ball caught in the hand of the iiwa 14 with a WSG 50-110"
+
+    def schedule(self, scenario) -> Schedule:
+        c = scenario.catch
+        return Schedule([Segment(0.0, c.sensing, c.beta), Segment(c.sensing, 0.6, c.beta)])
+
+    def prepare(self, scenario, log: bool = True) -> CatchRun:
+        return CatchRun(scenario, log)
+
+    def reasons(self, metrics: dict, criteria) -> list:
+        name = metrics.get("catch", {}).get("outcome")
+        return [] if name == "caught" else [Reason(None, "catch", f"not caught: {name}")]
+
+    def own_plant_step(self, scenario) -> float:
+        return 0.001
+
+    def robust_sample(self, scenario, name: str, seed: int, u) -> tuple:
+        scenario.catch.throw = int(seed)
+        scenario.measurement.seed = int(seed)
+        return scenario, {"throw": int(seed)}
+
+    def robust_row(self, seed: int, params: dict, metrics: dict) -> dict:
+        return oracle.row(seed, params, metrics)
+
+    def robust_summary(self, rows: list) -> dict:
+        return oracle.summary(rows)

@@ -1,0 +1,53 @@
+"""The catch world end to end (issue 46), on the real station (iiwa 14, WSG 50-110, the foam
+ball with drag, SAP contact, the formula camera and the ``auto`` estimator): the arm waits at
+rest, a real throw is caught and still held 0.5 s later, and a throw the frozen oracle calls
+too fast is refused before the arm moves (``not reachable``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ptint_drake.simulation.scenario import LoadedScenario
+from ptint_drake.worlds.catch import oracle
+from ptint_drake.worlds.catch.outcome import HAND_BODIES
+from ptint_drake.worlds.catch.run import CatchRun, settled
+from ptint_drake.worlds.runner import simulate
+
+
+def _run(*overrides):
+    return simulate(LoadedScenario.load("catch_toss_iiwa14", list(overrides)).scenario)
+
+
+def test_the_arm_waits_for_the_throw_at_rest_at_its_start_pose():
+    scenario = LoadedScenario.load("catch_toss_iiwa14").scenario
+    snap, run = settled(scenario), CatchRun(scenario)
+    tip = run.planner.tip(snap.arm[:7])[0]
+    assert np.linalg.norm(tip - run.x0) < 1e-3
+    assert np.max(np.abs(snap.arm[7:])) < 0.01  # rad/s
+
+
+@pytest.fixture(scope="module")
+def caught():
+    return _run("catch.throw=1", "measurement.seed=1")
+
+
+def test_a_real_throw_is_caught_and_still_held_half_a_second_later(caught):
+    c = caught.metrics["catch"]
+    assert c["outcome"] == "caught" and caught.metrics["status"] == "ok"
+    assert c["error_at_catch_m"] < 0.01  # the hand's tip against the true ball centre at t_catch
+    assert set(c["touched"]) <= set(HAND_BODIES)
+    t, x = caught.series["t"], caught.series["plant_state"]
+    later = np.searchsorted(t, c["t_catch"] + 0.5)
+    ball, opening = x[later:, 13:16], x[later:, 7] + x[later:, 8]
+    assert np.ptp(ball, axis=0).max() < 0.01  # at rest in the hand
+    assert np.all(opening > 0.03) and np.all(opening < 0.075)  # the jaws on the ball
+
+
+def test_a_throw_the_oracle_calls_too_fast_is_named_not_reachable_before_moving():
+    run = _run("catch.throw=96", "measurement.seed=96")  # the frozen oracle: "too fast for the arm"
+    c = run.metrics["catch"]
+    assert c["outcome"] == "not reachable" and run.metrics["status"] == "missed"
+    assert oracle.reachable(96) is False
+    q = run.series["plant_state"][:, :7]
+    assert np.abs(q - q[0]).max() < np.radians(0.5)  # the arm held its pose throughout
