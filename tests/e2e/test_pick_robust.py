@@ -10,7 +10,7 @@ from ptint_drake.config.errors import ScenarioError
 from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
 from ptint_drake.studies import robust
 from ptint_drake.worlds.pick.config import check_pick_parts
-from ptint_drake.worlds.pick.run import world_config
+from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.scene import gripper_path
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.studies import failure_reason, picks_ok, robust_summary

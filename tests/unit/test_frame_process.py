@@ -22,7 +22,7 @@ from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.systems.perception.frame_process import FrameError, FrameProcess
 from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.pick.camera import AddPartEstimates
-from ptint_drake.worlds.pick.run import world_config
+from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 
 RGBD_PICK = "conveyor_pick_place_rgbd"

@@ -8,7 +8,7 @@ from ptint_drake.cli import main
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.collisions import collision_bodies
 from ptint_drake.worlds.pick.metrics import pick_reasons
-from ptint_drake.worlds.pick.run import world_config
+from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 
 # rvm1_5dof with the fingertip centre at (0.30, 0, 0.09), pointing down: the fingers inside the belt

@@ -8,7 +8,8 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.probe import PART_WIDTH
-from ptint_drake.worlds.pick.run import PROBE_PERIOD, AddPickProbe, world_config
+from ptint_drake.worlds.pick.cell import PROBE_PERIOD, world_config
+from ptint_drake.worlds.pick.run import AddPickProbe
 from ptint_drake.worlds.pick.station import MakePickStation
 
 INTO_BELT_DEG = [0.0, 76.2, -5.9, 17.7, 0.0]  # the fingers inside the belt (test_pick_collisions)

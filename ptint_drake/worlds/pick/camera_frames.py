@@ -26,7 +26,7 @@ from ptint_drake.config.schema import Scenario
 from ptint_drake.systems.perception.frame_images import write_frame
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
 from ptint_drake.worlds.pick.camera import AddPartEstimates
-from ptint_drake.worlds.pick.run import world_config
+from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 
 ESTIMATE = (40, 120, 255)  # the estimate's colour in the frames (RGB)

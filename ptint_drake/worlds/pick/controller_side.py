@@ -52,9 +52,8 @@ from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.systems.perception.frame_process import FrameProcess
 from ptint_drake.worlds.pick.camera import AddPartEstimates
 from ptint_drake.worlds.pick.route import routed_plan
-from ptint_drake.worlds.pick.run import (PROBE_PERIOD, REPLAY_PERIOD, PortTargets, place_positions,
-                                         world_config)
-from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
+from ptint_drake.worlds.pick.cell import PROBE_PERIOD, REPLAY_PERIOD, place_positions, world_config
+from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets, PortTargets
 from ptint_drake.worlds.pick.tracker import TRACKER_PORT, TrackedParts
 
 CAMERA_NAME = "camera"  # the station's rgbd camera over LCM: DRAKE_RGBD_CAMERA_IMAGES_camera

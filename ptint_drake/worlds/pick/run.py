@@ -25,49 +25,20 @@ from pydrake.systems.primitives import LogVectorOutput, Saturation
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario, default_simulator
-from ptint_drake.controllers import AddControllerTo, ControllerHandles, TargetView
+from ptint_drake.controllers import AddControllerTo, ControllerHandles
 from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
 from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.systems.hand.gripper import GraspObserver
 from ptint_drake.systems.task.kinematics import FrameKinematics
 from ptint_drake.worlds.pick.camera import AddPartEstimates, PartEstimates
-from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
-from ptint_drake.worlds.pick.placement import placed_parts
+from ptint_drake.worlds.pick.cell import PROBE_PERIOD, REPLAY_PERIOD, place_positions, world_config
 from ptint_drake.worlds.pick.probe import PickProbe
 from ptint_drake.worlds.pick.route import routed_plan
-from ptint_drake.worlds.pick.scene import slot_pose
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
-from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets
+from ptint_drake.worlds.pick.targets import GripperSequence, PickTargets, PortTargets
 from ptint_drake.worlds.pick.tracker import TRACKER_PORT, TrackedParts
 from ptint_drake.worlds.pick.tasks import PickPlan, Replan
 from ptint_drake.worlds.stateless_derivatives import install_stateless_derivatives
-
-PROBE_PERIOD = 0.002  # s, between logged probe samples
-REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
-
-
-def world_config(scenario: Scenario) -> PickWorldConfig:
-    """The pick world of a scenario: its robot, its ``multibody`` plant settings (default: 1 ms,
-    point contact, SAP) and its ``pick`` block."""
-    mb, p = scenario.multibody, scenario.pick
-    seed = scenario.measurement.seed if scenario.measurement is not None else 0
-    config = PickWorldConfig(model=scenario.robot.model, end_effector=scenario.robot.end_effector,
-                             initial_q_deg=list(scenario.robot.initial_q_deg), gripper=p.gripper,
-                             belts=p.belts, parts=placed_parts(p.parts, seed), tray=p.tray)
-    if mb is not None:
-        config.time_step = mb.time_step
-        config.contact_approximation = mb.discrete_contact_approximation or DEFAULT_APPROXIMATION
-        config.contact_model = mb.contact_model
-    return config
-
-
-class PortTargets(TargetView):
-    """The target as ports already in the diagram (``PickTargets``'s outputs)."""
-
-    def __init__(self, target, rotation):  # noqa: D107  (no call of TargetView.__init__: no analytic view)
-        self.analytic = None
-        self._port, self._rotation_port = target, rotation
-
 
 @dataclass
 class PickBuilt:
@@ -92,22 +63,6 @@ class PickBuilt:
         if self.estimates is not None:
             return self.estimates.parts
         return self.diagram.GetSubsystemByName("tracked_parts")
-
-
-def place_positions(config: PickWorldConfig, plan: PickPlan) -> list:
-    """Per segment: the world position of its slot's place pose (the part's centre resting on the
-    tray), None for the segments that aim at a part — from the declared tray and slots alone
-    (``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at), so the controller
-    side needs no station to find them."""
-    out = []
-    for seg in plan.segments:
-        if seg.kind != "slot":
-            out.append(None)
-            continue
-        part = config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
-        height = part.size[2] if part.shape == "box" else part.size[1]
-        out.append(slot_pose(config.tray, seg.index).translation() + [0.0, 0.0, height / 2])
-    return out
 
 
 def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuilt:

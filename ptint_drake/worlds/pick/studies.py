@@ -20,7 +20,8 @@ from ptint_drake.config.pick import PHASES
 from ptint_drake.robot.mass_scaling import scale_in_context
 from ptint_drake.worlds.base import advance_over_stops, new_simulator
 from ptint_drake.worlds.pick.placement import placed_parts
-from ptint_drake.worlds.pick.run import pick_simulator, world_config
+from ptint_drake.worlds.pick.cell import world_config
+from ptint_drake.worlds.pick.run import pick_simulator
 from ptint_drake.worlds.pick.station import MakePickStation
 
 

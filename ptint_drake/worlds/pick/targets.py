@@ -42,6 +42,7 @@ from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, Leaf
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
+from ptint_drake.controllers import TargetView
 from ptint_drake.systems.task.cache import DeclareVectorCache
 from ptint_drake.systems.task.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan
@@ -181,3 +182,11 @@ class GripperSequence(Diagram):
     def part_width(self, t: float) -> float:
         """The width of the part the active task grasps at time t (m)."""
         return float(self._width.value(t)[0, 0])
+
+
+class PortTargets(TargetView):
+    """The target as ports already in the diagram (``PickTargets``'s outputs)."""
+
+    def __init__(self, target, rotation):  # noqa: D107  (no call of TargetView.__init__: no analytic view)
+        self.analytic = None
+        self._port, self._rotation_port = target, rotation

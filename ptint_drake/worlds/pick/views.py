@@ -36,7 +36,7 @@ def replay_world(scenario):
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
     from ptint_drake.views.replay import shared_meshcat  # noqa: PLC0415
-    from ptint_drake.worlds.pick.run import world_config  # noqa: PLC0415
+    from ptint_drake.worlds.pick.cell import world_config  # noqa: PLC0415
     from ptint_drake.worlds.pick.station import _add_world  # noqa: PLC0415
 
     config = world_config(scenario)

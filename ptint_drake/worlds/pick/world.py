@@ -49,8 +49,9 @@ from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.run import (build_pick, check_pick_plant, check_pick_reachable, pick_logs,
-                                         pick_series, pick_simulator, segment_aims, world_config)
+                                         pick_series, pick_simulator, segment_aims)
 from ptint_drake.worlds.pick.runaway import runaway_metrics
 from ptint_drake.worlds.pick.tasks import Replan, check_tasks, pick_plan
 

@@ -1,0 +1,49 @@
+"""The pick cell as its scenario declares it: what the simulated station and the controller side
+both build from, so that the controller side needs no station — the world's configuration
+(``world_config``: the robot, the plant settings, the belts, the parts as placed, the tray), the
+slots' place positions from the declared tray (``place_positions``) and a run's logging periods
+(``PROBE_PERIOD``, ``REPLAY_PERIOD``: ``ptint run`` logs at them, and the drive's controller side
+takes its sample times there too, so that its integration splits where the run's does).
+"""
+
+from __future__ import annotations
+
+from ptint_drake.config.schema import Scenario
+from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
+from ptint_drake.worlds.pick.placement import placed_parts
+from ptint_drake.worlds.pick.scene import slot_pose
+from ptint_drake.worlds.pick.tasks import PickPlan
+
+PROBE_PERIOD = 0.002  # s, between logged probe samples
+REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
+
+
+def world_config(scenario: Scenario) -> PickWorldConfig:
+    """The pick world of a scenario: its robot, its ``multibody`` plant settings (default: 1 ms,
+    point contact, SAP) and its ``pick`` block."""
+    mb, p = scenario.multibody, scenario.pick
+    seed = scenario.measurement.seed if scenario.measurement is not None else 0
+    config = PickWorldConfig(model=scenario.robot.model, end_effector=scenario.robot.end_effector,
+                             initial_q_deg=list(scenario.robot.initial_q_deg), gripper=p.gripper,
+                             belts=p.belts, parts=placed_parts(p.parts, seed), tray=p.tray)
+    if mb is not None:
+        config.time_step = mb.time_step
+        config.contact_approximation = mb.discrete_contact_approximation or DEFAULT_APPROXIMATION
+        config.contact_model = mb.contact_model
+    return config
+
+
+def place_positions(config: PickWorldConfig, plan: PickPlan) -> list:
+    """Per segment: the world position of its slot's place pose (the part's centre resting on the
+    tray), None for the segments that aim at a part — from the declared tray and slots alone
+    (``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at), so the controller
+    side needs no station to find them."""
+    out = []
+    for seg in plan.segments:
+        if seg.kind != "slot":
+            out.append(None)
+            continue
+        part = config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
+        height = part.size[2] if part.shape == "box" else part.size[1]
+        out.append(slot_pose(config.tray, seg.index).translation() + [0.0, 0.0, height / 2])
+    return out
