@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -43,8 +43,9 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Outpu
 from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
-from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, BeltRegion, belt_points, fit_parts,
-                                                     part_height, reach)
+from ptint_drake.systems.perception.catalog_fit import catalog_points, fit_catalog
+from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, BeltRegion, fit_parts, part_height,
+                                                     reach)
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
 
 # m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
@@ -79,6 +80,13 @@ class PerceptionConfig:
     # OCCLUDER_GAP above its top to OCCLUDER_HEIGHT): a dropout (e.g. the gripper coming down over
     # it hides part of its top face before the fit fails the completeness check)
     check_above: bool = False
+    # the kinds of part, (shape, size) each (issue 44: ``catalog_fit``); empty: (shape, size) alone
+    catalog: list = field(default_factory=list)
+    tracking: object = None  # ``tracks.TrackerSettings`` of ``track_system.TrackingPartPoseEstimator``
+
+    def kinds(self) -> list:
+        """The catalog, or the one known shape."""
+        return list(self.catalog) or [(self.shape, list(self.size))]
 
 
 class PartPoseEstimator(LeafSystem):
@@ -132,8 +140,8 @@ class PartPoseEstimator(LeafSystem):
         if not self._c.belts:
             return np.zeros(3), np.zeros(3)
         corners = []
-        r = reach(self._c.shape, self._c.size)
-        top = part_height(self._c.shape, self._c.size) + TOP_BAND
+        r = max(reach(shape, size) for shape, size in self._c.kinds())
+        top = max(part_height(shape, size) for shape, size in self._c.kinds()) + TOP_BAND
         for b in self._c.belts:
             u, v = b.frame()
             for su in (-1, 1):
@@ -152,7 +160,7 @@ class PartPoseEstimator(LeafSystem):
             z = xyz[2]
             boxed = xyz[:, np.flatnonzero((z >= self._lo[2]) & (z <= self._hi[2]))].T
             boxed = boxed[np.all((boxed >= self._lo) & (boxed <= self._hi), axis=1)]
-        points = belt_points(boxed, self._c.belts, self._c.shape, self._c.size)
+        points = catalog_points(boxed, self._c.belts, self._c.kinds())
         if len(points) == 0:
             return points
         kept = PointCloud(len(points))
@@ -160,8 +168,11 @@ class PartPoseEstimator(LeafSystem):
         return kept.VoxelizedDownSample(VOXEL).xyzs().T
 
     def fit_frame(self, cloud: PointCloud) -> list:
-        fits = fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size,
-                         footprint=self._footprint, spacing=max(VOXEL, 1.2 * self._footprint))
+        options = {"footprint": self._footprint, "spacing": max(VOXEL, 1.2 * self._footprint)}
+        if len(self._c.kinds()) > 1:
+            fits = fit_catalog(self.frame_points(cloud), self._c.belts, self._c.kinds(), **options)
+        else:
+            fits = fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size, **options)
         if self._c.check_above and any(f.ok for f in fits):
             self._mark_covered(cloud, fits)
         return fits
@@ -169,11 +180,11 @@ class PartPoseEstimator(LeafSystem):
     def _mark_covered(self, cloud: PointCloud, fits: list) -> None:
         """``check_above``: a good fit with cloud points above it is a dropout."""
         xyz = cloud.xyzs()
-        top = 0.5 * part_height(self._c.shape, self._c.size)
-        lo = min(f.position[2] for f in fits if f.ok) + top + OCCLUDER_GAP
+        tops = [0.5 * part_height(*self._c.kinds()[f.kind]) for f in fits]
+        lo = min(f.position[2] + top for f, top in zip(fits, tops) if f.ok) + OCCLUDER_GAP
         with np.errstate(invalid="ignore"):
             high = xyz[:, np.flatnonzero((xyz[2] > lo) & (xyz[2] < lo + OCCLUDER_HEIGHT))].T
-        for f in fits:
+        for f, top in zip(fits, tops):
             if not f.ok or len(high) == 0:
                 continue
             above = high[high[:, 2] > f.position[2] + top + OCCLUDER_GAP]
@@ -198,6 +209,10 @@ class PartPoseEstimator(LeafSystem):
             chosen.append(fit)
         return chosen
 
+    def _choose(self, context, state, fits: list, memory: np.ndarray) -> list:
+        """Per object: its fit of this frame, or None (``track_system`` chooses by tracks)."""
+        return self._associate(fits, memory)
+
     def _update(self, context, state) -> None:
         t = context.get_time()
         start = time.perf_counter()
@@ -206,7 +221,7 @@ class PartPoseEstimator(LeafSystem):
         fits = self.fit_frame(cloud)
         done = time.perf_counter()
         memory = context.get_discrete_state(self._memory).value().reshape(self._n, 5).copy()
-        chosen = self._associate(fits, memory)
+        chosen = self._choose(context, state, fits, memory)
         old = context.get_discrete_state(self._buffer).value()
         slot = old[:self._n * _WIDTH].reshape(self._n, _WIDTH).copy()  # a dropout holds the last sample
         for i, fit in enumerate(chosen):
@@ -258,15 +273,16 @@ class PartPoseEstimator(LeafSystem):
         return dict(context.get_abstract_state(self._timing).get_value())
 
 
-def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstimator]:
+def MakeRgbdPerception(config: PerceptionConfig, estimator_type=None) -> tuple[Diagram, PartPoseEstimator]:
     """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of
-    ``PartPoseEstimator`` (``measurement_i``, ``measured_rotation_i``, ``fits``)."""
+    ``PartPoseEstimator`` (``measurement_i``, ``measured_rotation_i``, ``fits``) or of
+    ``estimator_type`` (a subclass: ``track_system.TrackingPartPoseEstimator``; its ``tracks``)."""
     builder = DiagramBuilder()
     cloud = builder.AddNamedSystem("depth_to_cloud", DepthImageToPointCloud(  # (RENDER_PIXEL_SHIFT)
         cloud_camera_info(config.info), PixelType.kDepth32F, 1.0, BaseField.kXYZs))
     pose = builder.AddNamedSystem("camera_pose", ConstantValueSource(AbstractValue.Make(config.X_WC)))
     builder.Connect(pose.get_output_port(), cloud.camera_pose_input_port())
-    estimator = builder.AddNamedSystem("part_poses", PartPoseEstimator(config))
+    estimator = builder.AddNamedSystem("part_poses", (estimator_type or PartPoseEstimator)(config))
     builder.Connect(cloud.point_cloud_output_port(), estimator.GetInputPort("point_cloud"))
     builder.ExportInput(cloud.depth_image_input_port(), "depth_image")
     for i in range(len(config.object_belts)):
@@ -274,6 +290,8 @@ def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstim
         builder.ExportOutput(estimator.GetOutputPort(f"measured_rotation_{i}"), f"measured_rotation_{i}")
         builder.ExportOutput(estimator.GetOutputPort(f"quality_{i}"), f"quality_{i}")
     builder.ExportOutput(estimator.GetOutputPort("fits"), "fits")
+    if estimator.HasOutputPort("tracks"):
+        builder.ExportOutput(estimator.GetOutputPort("tracks"), "tracks")
     diagram = builder.Build()
     diagram.set_name("rgbd_perception")
     return diagram, estimator
