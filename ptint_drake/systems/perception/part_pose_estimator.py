@@ -178,12 +178,17 @@ class PartPoseEstimator(LeafSystem):
         return fits
 
     def _mark_covered(self, cloud: PointCloud, fits: list) -> None:
-        """``check_above``: a good fit with cloud points above it is a dropout."""
-        xyz = cloud.xyzs()
-        tops = [0.5 * part_height(*self._c.kinds()[f.kind]) for f in fits]
+        """``check_above``: a good fit with cloud points above it is a dropout (not the points of
+        another good fit's part: a taller neighbour of another kind is not an occluder)."""
+        xyz, kinds = cloud.xyzs(), self._c.kinds()
+        tops = [0.5 * part_height(*kinds[f.kind]) for f in fits]
         lo = min(f.position[2] + top for f, top in zip(fits, tops) if f.ok) + OCCLUDER_GAP
         with np.errstate(invalid="ignore"):
             high = xyz[:, np.flatnonzero((xyz[2] > lo) & (xyz[2] < lo + OCCLUDER_HEIGHT))].T
+        for g, top in zip(fits, tops):
+            if g.ok and len(high) and len(kinds) > 1:
+                high = high[(np.hypot(*(high[:, 0:2] - g.position[0:2]).T) > reach(*kinds[g.kind]) + 0.003)
+                            | (high[:, 2] > g.position[2] + top + TOP_BAND)]
         for f, top in zip(fits, tops):
             if not f.ok or len(high) == 0:
                 continue
@@ -324,7 +329,6 @@ def belt_regions(configs) -> list[BeltRegion]:
     """``BeltRegion``s of ``measurement.camera.belts`` entries."""
     return [BeltRegion(np.asarray(b.center, float), np.asarray(b.direction, float), float(b.length),
                        float(b.width)) for b in configs]
-
 
 
 
