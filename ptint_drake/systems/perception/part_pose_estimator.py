@@ -10,8 +10,9 @@ the configured belts, ``PointCloud.VoxelizedDownSample`` (``VOXEL``), then ``par
 
 Data association (no truth): object i is looked for on belt ``object_belts[i]``; among the
 good fits there it takes the one nearest its last accepted position (within ``GATE``), or —
-never seen yet — the one farthest downstream.  Its yaw is unwrapped: the fit's yaw is known
-only up to the part's symmetry, and the sample reports the symmetric yaw nearest the last one.
+never seen yet — the one farthest downstream (the pick world: by tracks, ``track_system``).
+Its yaw is unwrapped: the fit's yaw is known only up to the part's symmetry, and the sample
+reports the symmetric yaw nearest the last one.
 A frame where object i has no good fit (not in view, occluded, a poor fit) is a dropout for it:
 its output keeps the last sample (same stamp), as the pose camera's does.
 
@@ -279,9 +280,8 @@ class PartPoseEstimator(LeafSystem):
 
 
 def MakeRgbdPerception(config: PerceptionConfig, estimator_type=None) -> tuple[Diagram, PartPoseEstimator]:
-    """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of
-    ``PartPoseEstimator`` (``measurement_i``, ``measured_rotation_i``, ``fits``) or of
-    ``estimator_type`` (a subclass: ``track_system.TrackingPartPoseEstimator``; its ``tracks``)."""
+    """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of the
+    ``PartPoseEstimator`` (or ``estimator_type``, e.g. ``track_system``'s: its ``tracks`` too)."""
     builder = DiagramBuilder()
     cloud = builder.AddNamedSystem("depth_to_cloud", DepthImageToPointCloud(  # (RENDER_PIXEL_SHIFT)
         cloud_camera_info(config.info), PixelType.kDepth32F, 1.0, BaseField.kXYZs))
