@@ -14,8 +14,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from ptint_drake.config.measurement import RgbdCameraConfig
-from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PerceptionConfig,
-                                                                belt_regions)
+from ptint_drake.systems.perception.belt_regions import belt_regions
+from ptint_drake.systems.perception.part_pose_estimator import MakeRgbdPerception, PerceptionConfig
 from ptint_drake.systems.perception.rgbd_camera import AddRgbdCamera
 from ptint_drake.systems.perception.scene_geometry import AddPartGeometry, visual_instance
 

@@ -26,6 +26,7 @@ from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.station import MakePickStation
 
 RGBD_PICK = "conveyor_pick_place_rgbd"
+CONFIRM_FRAMES = 3  # frames until a track is confirmed and its part gets samples (``tracks``)
 
 
 def _first_frame(scenario):
@@ -59,33 +60,39 @@ def _state(estimates, context) -> list:
 def test_a_frame_fitted_in_the_worker_leaves_the_estimator_as_its_own_update():
     scenario = load_scenario(RGBD_PICK)
     image = _first_frame(scenario)
-    latency = scenario.measurement.latency
-    # the one-process way: the estimator's update at t = 0 fits the frame
+    latency, period = scenario.measurement.latency, 1.0 / scenario.measurement.rate_hz
+    times = [k * period for k in range(CONFIRM_FRAMES)]
+    # the one-process way: the estimator's updates at t_k fit the frames (a track is confirmed,
+    # and its part's sample buffered, at its third: ``tracks``)
     diagram, estimates = _estimator(scenario, elsewhere=False)
     simulator = new_simulator(diagram)
     diagram.GetInputPort("depth_image").FixValue(simulator.get_mutable_context(), image)
-    simulator.AdvanceTo(latency)
+    simulator.AdvanceTo(times[-1] + latency)
     expected = _state(estimates, simulator.get_context())
-    assert expected[0].any()  # the frame's sample is in the buffer (the part was fitted)
-    # the drive's way: the frame's message as received to the worker, written when due
+    assert expected[0].any()  # the frames' sample is in the buffer (the part was fitted and tracked)
+    # the drive's way: each frame's message as received to the worker, written when due
     diagram, estimates = _estimator(scenario, elsewhere=True)
     frames = FrameProcess(estimates.estimator, estimates.config, 1e-3)
-    message = pack_depth_image(0.0, image, "camera")
     try:
         frames.start(decoder=FRAME_DECODER)
         simulator = new_simulator(diagram)
         start = time.perf_counter()
-        frames.submit(0.0, message, handshake=True)
+        frames.submit(0.0, pack_depth_image(0.0, image, "camera"), handshake=True)
         handed = time.perf_counter() - start
         frames.prefetch()
         frames.take_due(simulator.get_mutable_context(), latency - 1e-3)  # not due yet: not written
         assert not _state(estimates, simulator.get_context())[0].any()
-        frames.take_due(simulator.get_mutable_context(), latency)
-        simulator.AdvanceTo(latency)
+        for t in times[1:]:
+            frames.submit(t, pack_depth_image(t, image, "camera"))
+        time.sleep(10 * latency)  # the fits back before they are due, as in real time (the latency)
+        for t in times:
+            frames.take_due(simulator.get_mutable_context(), t + latency)
+            simulator.AdvanceTo(t + latency)
         got = _state(estimates, simulator.get_context())
-        frames.submit(0.033, b"not an image message")  # frame 1 (1/30 s, in the tick after 33 ms)
+        bad = times[-1] + period
+        frames.submit(bad, b"not an image message")  # the next frame, unreadable
         with pytest.raises(FrameError, match="camera frame rejected"):
-            frames.take_due(simulator.get_mutable_context(), 1.0 / 30.0 + latency)
+            frames.take_due(simulator.get_mutable_context(), bad + latency)
     finally:
         summary = frames.close()
     for a, b in zip(expected, got, strict=True):

@@ -15,9 +15,9 @@ from static_scene import StaticScene
 from ptint_drake.config.measurement import BeltRegionConfig, MeasurementConfig, RgbdCameraConfig
 from ptint_drake.systems.perception.camera import validate_measurement
 from ptint_drake.systems.perception.part_fit import fit_parts
+from ptint_drake.systems.perception.belt_regions import belt_regions, belts_under_paths
 from ptint_drake.systems.perception.part_pose_estimator import (MakeRgbdPerception, PartPoseEstimator,
-                                                                PerceptionConfig, belt_regions,
-                                                                belts_under_paths)
+                                                                PerceptionConfig)
 from ptint_drake.systems.perception.rgbd_camera import cloud_camera_info
 from ptint_drake.systems.task.targets import LinearTarget
 

@@ -85,6 +85,7 @@ class PartFit:
     ok: bool
     reason: str = ""
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    kind: int = 0  # the catalog class it was fitted as (``catalog_fit``; one known shape: 0)
 
     def rotation(self) -> np.ndarray:
         """R_WP: yaw about the fitted axis (vertical parts: about world z)."""

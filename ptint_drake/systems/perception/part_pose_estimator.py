@@ -10,8 +10,9 @@ the configured belts, ``PointCloud.VoxelizedDownSample`` (``VOXEL``), then ``par
 
 Data association (no truth): object i is looked for on belt ``object_belts[i]``; among the
 good fits there it takes the one nearest its last accepted position (within ``GATE``), or —
-never seen yet — the one farthest downstream.  Its yaw is unwrapped: the fit's yaw is known
-only up to the part's symmetry, and the sample reports the symmetric yaw nearest the last one.
+never seen yet — the one farthest downstream (the pick world: by tracks, ``track_system``).
+Its yaw is unwrapped: the fit's yaw is known only up to the part's symmetry, and the sample
+reports the symmetric yaw nearest the last one.
 A frame where object i has no good fit (not in view, occluded, a poor fit) is a dropout for it:
 its output keeps the last sample (same stamp), as the pose camera's does.
 
@@ -33,7 +34,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -43,8 +44,10 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Outpu
 from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
-from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, BeltRegion, belt_points, fit_parts,
-                                                     part_height, reach)
+from ptint_drake.systems.perception.belt_regions import perception_belts
+from ptint_drake.systems.perception.catalog_fit import catalog_points, fit_catalog
+from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, fit_parts, part_height,
+                                                     reach)
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
 
 # m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the
@@ -82,6 +85,13 @@ class PerceptionConfig:
     # the fits are made outside the diagram (``frame_process.FrameProcess``: a control loop that
     # must not wait for them) and written by ``write_frame``; the frame's event only marks its time
     fits_elsewhere: bool = False
+    # the kinds of part, (shape, size) each (issue 44: ``catalog_fit``); empty: (shape, size) alone
+    catalog: list = field(default_factory=list)
+    tracking: object = None  # ``tracks.TrackerSettings`` of ``track_system.TrackingPartPoseEstimator``
+
+    def kinds(self) -> list:
+        """The catalog, or the one known shape."""
+        return list(self.catalog) or [(self.shape, list(self.size))]
 
 
 class PartPoseEstimator(LeafSystem):
@@ -138,8 +148,8 @@ class PartPoseEstimator(LeafSystem):
         if not self._c.belts:
             return np.zeros(3), np.zeros(3)
         corners = []
-        r = reach(self._c.shape, self._c.size)
-        top = part_height(self._c.shape, self._c.size) + TOP_BAND
+        r = max(reach(shape, size) for shape, size in self._c.kinds())
+        top = max(part_height(shape, size) for shape, size in self._c.kinds()) + TOP_BAND
         for b in self._c.belts:
             u, v = b.frame()
             for su in (-1, 1):
@@ -158,7 +168,7 @@ class PartPoseEstimator(LeafSystem):
             z = xyz[2]
             boxed = xyz[:, np.flatnonzero((z >= self._lo[2]) & (z <= self._hi[2]))].T
             boxed = boxed[np.all((boxed >= self._lo) & (boxed <= self._hi), axis=1)]
-        points = belt_points(boxed, self._c.belts, self._c.shape, self._c.size)
+        points = catalog_points(boxed, self._c.belts, self._c.kinds())
         if len(points) == 0:
             return points
         kept = PointCloud(len(points))
@@ -166,20 +176,28 @@ class PartPoseEstimator(LeafSystem):
         return kept.VoxelizedDownSample(VOXEL).xyzs().T
 
     def fit_frame(self, cloud: PointCloud) -> list:
-        fits = fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size,
-                         footprint=self._footprint, spacing=max(VOXEL, 1.2 * self._footprint))
+        options = {"footprint": self._footprint, "spacing": max(VOXEL, 1.2 * self._footprint)}
+        if len(self._c.kinds()) > 1:
+            fits = fit_catalog(self.frame_points(cloud), self._c.belts, self._c.kinds(), **options)
+        else:
+            fits = fit_parts(self.frame_points(cloud), self._c.belts, self._c.shape, self._c.size, **options)
         if self._c.check_above and any(f.ok for f in fits):
             self._mark_covered(cloud, fits)
         return fits
 
     def _mark_covered(self, cloud: PointCloud, fits: list) -> None:
-        """``check_above``: a good fit with cloud points above it is a dropout."""
-        xyz = cloud.xyzs()
-        top = 0.5 * part_height(self._c.shape, self._c.size)
-        lo = min(f.position[2] for f in fits if f.ok) + top + OCCLUDER_GAP
+        """``check_above``: a good fit with cloud points above it is a dropout (not the points of
+        another good fit's part: a taller neighbour of another kind is not an occluder)."""
+        xyz, kinds = cloud.xyzs(), self._c.kinds()
+        tops = [0.5 * part_height(*kinds[f.kind]) for f in fits]
+        lo = min(f.position[2] + top for f, top in zip(fits, tops) if f.ok) + OCCLUDER_GAP
         with np.errstate(invalid="ignore"):
             high = xyz[:, np.flatnonzero((xyz[2] > lo) & (xyz[2] < lo + OCCLUDER_HEIGHT))].T
-        for f in fits:
+        for g, top in zip(fits, tops):
+            if g.ok and len(high) and len(kinds) > 1:
+                high = high[(np.hypot(*(high[:, 0:2] - g.position[0:2]).T) > reach(*kinds[g.kind]) + 0.003)
+                            | (high[:, 2] > g.position[2] + top + TOP_BAND)]
+        for f, top in zip(fits, tops):
             if not f.ok or len(high) == 0:
                 continue
             above = high[high[:, 2] > f.position[2] + top + OCCLUDER_GAP]
@@ -204,6 +222,11 @@ class PartPoseEstimator(LeafSystem):
             chosen.append(fit)
         return chosen
 
+    def _choose(self, context, state, t: float, fits: list, memory: np.ndarray) -> list:
+        """Per object: its fit of the frame taken at ``t``, or None (``track_system`` chooses by
+        tracks)."""
+        return self._associate(fits, memory)
+
     def _update(self, context, state) -> None:
         t = context.get_time()
         start = time.perf_counter()
@@ -222,7 +245,7 @@ class PartPoseEstimator(LeafSystem):
         """The frame at ``t``'s samples from ``fits`` into ``state`` (a State, or the context
         itself), associated with the memory in ``context``."""
         memory = context.get_discrete_state(self._memory).value().reshape(self._n, 5).copy()
-        chosen = self._associate(fits, memory)
+        chosen = self._choose(context, state, t, fits, memory)
         old = context.get_discrete_state(self._buffer).value()
         slot = old[:self._n * _WIDTH].reshape(self._n, _WIDTH).copy()  # a dropout holds the last sample
         for i, fit in enumerate(chosen):
@@ -273,15 +296,15 @@ class PartPoseEstimator(LeafSystem):
         return dict(context.get_abstract_state(self._timing).get_value())
 
 
-def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstimator]:
-    """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of
-    ``PartPoseEstimator`` (``measurement_i``, ``measured_rotation_i``, ``fits``)."""
+def MakeRgbdPerception(config: PerceptionConfig, estimator_type=None) -> tuple[Diagram, PartPoseEstimator]:
+    """The pipeline as one diagram: input ``depth_image`` (ImageDepth32F), outputs those of the
+    ``PartPoseEstimator`` (or ``estimator_type``, e.g. ``track_system``'s: its ``tracks`` too)."""
     builder = DiagramBuilder()
     cloud = builder.AddNamedSystem("depth_to_cloud", DepthImageToPointCloud(  # (RENDER_PIXEL_SHIFT)
         cloud_camera_info(config.info), PixelType.kDepth32F, 1.0, BaseField.kXYZs))
     pose = builder.AddNamedSystem("camera_pose", ConstantValueSource(AbstractValue.Make(config.X_WC)))
     builder.Connect(pose.get_output_port(), cloud.camera_pose_input_port())
-    estimator = builder.AddNamedSystem("part_poses", PartPoseEstimator(config))
+    estimator = builder.AddNamedSystem("part_poses", (estimator_type or PartPoseEstimator)(config))
     builder.Connect(cloud.point_cloud_output_port(), estimator.GetInputPort("point_cloud"))
     builder.ExportInput(cloud.depth_image_input_port(), "depth_image")
     for i in range(len(config.object_belts)):
@@ -289,6 +312,8 @@ def MakeRgbdPerception(config: PerceptionConfig) -> tuple[Diagram, PartPoseEstim
         builder.ExportOutput(estimator.GetOutputPort(f"measured_rotation_{i}"), f"measured_rotation_{i}")
         builder.ExportOutput(estimator.GetOutputPort(f"quality_{i}"), f"quality_{i}")
     builder.ExportOutput(estimator.GetOutputPort("fits"), "fits")
+    if estimator.HasOutputPort("tracks"):
+        builder.ExportOutput(estimator.GetOutputPort("tracks"), "tracks")
     diagram = builder.Build()
     diagram.set_name("rgbd_perception")
     return diagram, estimator
@@ -315,65 +340,6 @@ class SeenObject:
 
     def pre_run_rotations(self, visible_by: float = 0.0) -> list:
         return []
-
-
-def belt_regions(configs) -> list[BeltRegion]:
-    """``BeltRegion``s of ``measurement.camera.belts`` entries."""
-    return [BeltRegion(np.asarray(b.center, float), np.asarray(b.direction, float), float(b.length),
-                       float(b.width)) for b in configs]
-
-
-
-
-# m, a derived belt's extra width beside its part's footprint (each side; narrow, so that the belts
-# of two objects on parallel paths do not take each other's parts) and length (each end)
-BELT_MARGIN = 0.005
-BELT_END_MARGIN = 0.03
-
-
-def belts_under_paths(targets, duration: float, shape: str, size) -> tuple[list[BeltRegion], list[int]]:
-    """A belt under each object's straight horizontal path over [0, duration] (the conveyor the
-    scenario's ``linear`` target describes: its top surface half the part's height below the
-    centre), and the belt of each object; ``ValueError`` naming the object otherwise."""
-    belts, of = [], []
-    half = 0.5 * part_height(shape, size)
-    for i, target in enumerate(targets):
-        target = getattr(target, "position", target)  # an oriented target: its motion
-        start, velocity = getattr(target, "start", None), getattr(target, "velocity", None)
-        if start is None or velocity is None or getattr(target, "compiled", None) is None:
-            raise ValueError(f"interceptions[{i}].target: an rgbd camera sees parts on conveyors: "
-                             "the target must be linear")
-        speed = float(np.linalg.norm(velocity[0:2]))
-        if abs(float(velocity[2])) > 1e-12 or speed <= 0.0:
-            raise ValueError(f"interceptions[{i}].target.linear.velocity: an rgbd camera sees parts on "
-                             f"conveyors: the motion must be horizontal and non-zero, got {list(velocity)}")
-        end = start + velocity * duration
-        centre = 0.5 * (start + end) - [0.0, 0.0, half]
-        diagonal = float(np.hypot(*np.asarray(size, float)[:2])) if shape == "box" else float(size[0])
-        belts.append(BeltRegion(centre, velocity / np.linalg.norm(velocity), speed * duration + diagonal
-                                + 2 * BELT_END_MARGIN, diagonal + 2 * BELT_MARGIN))
-        of.append(i)
-    return belts, of
-
-
-def perception_belts(measurement, targets, duration: float) -> tuple[list[BeltRegion], list[int]]:
-    """The belts the perception knows (``measurement.camera.belts``, or one under each object's
-    path: ``belts_under_paths``) and the belt of each object (configured belts: the one whose
-    centre line passes nearest the object's start, below it)."""
-    c = measurement.camera
-    if not c.belts:
-        return belts_under_paths(targets, duration, c.part_shape, c.part_size)
-    belts = belt_regions(c.belts)
-    of = []
-    for target in targets:
-        start = np.asarray(target.evaluate(0.0), float)[0:3]
-        distances = []
-        for b in belts:
-            u, v = b.frame()
-            d = start - b.center
-            distances.append(abs(d @ v) + max(abs(d @ u) - 0.5 * b.length, 0.0) + abs(d[2]))
-        of.append(int(np.argmin(distances)))
-    return belts, of
 
 
 def AddRgbdPerception(builder: DiagramBuilder, depth_image: OutputPort, measurement, targets,

@@ -8,7 +8,7 @@ import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.fields import positive, vector3
-from ptint_drake.systems.perception.part_pose_estimator import perception_belts
+from ptint_drake.systems.perception.belt_regions import perception_belts
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, describe_pose, in_view
 from ptint_drake.systems.task.orientation import has_orientation
 from ptint_drake.systems.task.targets import WaypointTarget

@@ -31,7 +31,7 @@ port                   size    meaning
 With an RGB-D camera the station also holds a ``SceneGraph`` drawing the arm's visual
 geometry where the plant is (a never-simulated copy of the model posed from ``state``: the
 arm occludes), the objects (the camera's ``part_shape`` and ``part_size``) posed by their
-motion, and the belts the perception knows (``perception.perception_belts``).
+motion, and the belts the perception knows (``perception.belt_regions.perception_belts``).
 
 The station may use the model (it *is* the model); the model-free controllers
 only see ``state`` (through the kinematics) and a target.
@@ -50,7 +50,7 @@ from pydrake.systems.primitives import Saturation
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.robot.plant import actuator_effort_limits, effort_limits, make_plant, resolve_model
-from ptint_drake.systems.perception.part_pose_estimator import perception_belts
+from ptint_drake.systems.perception.belt_regions import perception_belts
 from ptint_drake.systems.perception.rgbd_camera import AddRgbdCamera
 from ptint_drake.systems.perception.scene_geometry import AddArmVisuals, AddPartGeometry
 from ptint_drake.systems.task.orientation import ObjectRotations

@@ -48,11 +48,13 @@ from ptint_drake.systems.estimation.imm import AdaptiveTargetEstimator
 from ptint_drake.systems.estimation.kalman import TargetKalmanFilter
 from ptint_drake.systems.estimation.rotation_estimator import RotationEstimator
 from ptint_drake.systems.perception.part_fit import BeltRegion, fold_yaw, yaw_symmetry
+from ptint_drake.systems.perception.belt_regions import belt_regions
 from ptint_drake.systems.perception.part_pose_estimator import (FIT_NOISE_STD, MakeRgbdPerception,
-                                                                PartPoseEstimator, PerceptionConfig,
-                                                                belt_regions)
+                                                                PartPoseEstimator, PerceptionConfig)
 from ptint_drake.systems.perception.rgbd_camera import (AddRgbdCamera, RgbdCamera, camera_info, camera_pose,
                                                         describe_pose, in_view)
+from ptint_drake.systems.perception.track_system import TrackingPartPoseEstimator
+from ptint_drake.worlds.pick.part_tracks import catalog, tracker_settings
 from ptint_drake.worlds.pick.placement import nominal_parts
 
 # a part is aimed at only after this many accepted fits (``world.PickRun``; fewer: ``pick k: part
@@ -111,18 +113,12 @@ def nominal_paths(pick: PickConfig) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def check_pick_camera(scenario) -> None:
-    """ScenarioError (one line) for a camera a pick cannot use: parts of different shapes or
-    sizes (the perception fits one known shape), or a part not in the camera's view at its task's
-    start (nothing to see; its nominal place)."""
+    """ScenarioError (one line) for a camera a pick cannot use: a part not in the camera's view
+    at its task's start (nothing to see; its nominal place).  Parts of different shapes and sizes
+    are classified against the scenario's catalog (``part_tracks.catalog``)."""
     m, pick = scenario.measurement, scenario.pick
     if m is None or m.sensor != "rgbd" or m.camera is None:
         return
-    first = pick.parts[0]
-    for k, part in enumerate(pick.parts):
-        if part.shape != first.shape or list(part.size) != list(first.size):
-            raise ScenarioError(f"pick.parts[{k}]: with an rgbd camera every part has the shape and size "
-                                f"of pick.parts[0] ({first.shape} {list(first.size)}): the perception "
-                                f"fits one shape")
     from ptint_drake.worlds.pick.tasks import pick_plan  # noqa: PLC0415
 
     plan = pick_plan(pick)
@@ -223,10 +219,12 @@ def AddPartEstimates(builder: DiagramBuilder, depth_image, scenario, fits_elsewh
     camera = camera_of(m, pick)
     belts = belt_regions(camera.belts)
     of = part_belts(pick) if not m.camera.belts else _nearest_belts(belts, pick)
-    config = PerceptionConfig(camera_info(camera), camera_pose(camera), belts, camera.part_shape,
-                              list(camera.part_size), of, float(m.rate_hz), float(m.latency),
-                              check_above=True, fits_elsewhere=fits_elsewhere)
-    perception, estimator = MakeRgbdPerception(config)
+    X_WC, info = camera_pose(camera), camera_info(camera)
+    config = PerceptionConfig(info, X_WC, belts, camera.part_shape, list(camera.part_size), of,
+                              float(m.rate_hz), float(m.latency), check_above=True,
+                              fits_elsewhere=fits_elsewhere, catalog=catalog(pick)[0],
+                              tracking=tracker_settings(pick, belts, of, nominal_paths(pick), X_WC, info))
+    perception, estimator = MakeRgbdPerception(config, TrackingPartPoseEstimator)
     builder.AddNamedSystem("rgbd_perception", perception)
     builder.Connect(depth_image, perception.get_input_port())
     filter_config = m if m.noise_std else dataclasses.replace(m, noise_std=FIT_NOISE_STD)

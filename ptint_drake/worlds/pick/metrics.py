@@ -40,6 +40,9 @@ observer's log (``systems.hand.gripper.GraspObserver``: what the gripper sensed)
   runaway tests of the task's window (``runaway.runaway_metrics``, added by the world after the
   series are made).
 
+``tracking`` (with a camera) — the identity switches of the perception's tracks against the
+truth (``part_tracks.track_metrics``: ``idsw`` must be 0).
+
 ``pick_reasons`` — the verdict's reasons: first a runaway in the task's window, ``pick k:
 saturated`` and ``pick k: joint speed beyond limit`` (``runaway``); ``pick k: collision with
 <body>``;
@@ -58,6 +61,7 @@ from pydrake.math import RotationMatrix
 
 from ptint_drake.systems.task.orientation import rotation_angle, tool_yaw, top_down_reference
 from ptint_drake.worlds.pick.collisions import pick_collisions, touched_before_close
+from ptint_drake.worlds.pick.part_tracks import track_metrics
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.worlds.pick.runaway import runaway_reasons
 
@@ -218,7 +222,11 @@ def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> 
                               and pick["place_error_mm"] <= scenario.criteria.place_mm
                               and pick["place_error_deg"] <= scenario.criteria.place_deg)
         picks.append(pick)
-    return {"scenario": scenario.name, "duration": outcome["end"], "segments": segments, "picks": picks}
+    out = {"scenario": scenario.name, "duration": outcome["end"], "segments": segments, "picks": picks}
+    if "tracks" in logs:  # with a camera: the identity switches against the truth (part_tracks)
+        out["tracking"] = track_metrics(logs["tracks"], [logs[f"part_true_{k}"] for k in range(len(
+            scenario.pick.parts))], [p.name for p in scenario.pick.parts])
+    return out
 
 
 def pick_reasons(picks: list) -> list:
@@ -229,8 +237,8 @@ def pick_reasons(picks: list) -> list:
         if p["collision"]:
             out.append((k, "collision with " + ", ".join(p["collision_with"]) if p.get("collision_with")
                         else "collision"))
-        if p.get("retry_refused") == "part not seen":  # (an rgbd camera never saw it: no grasp)
-            out.append((k, "part not seen"))
+        if p.get("retry_refused") in ("part not seen", "blocked"):  # (rgbd: not seen, or no room: no grasp)
+            out.append((k, p["retry_refused"]))
             continue
         if not p["grasp_confirmed"]:
             alone = p["attempts"] == 1 and p["retry_refused"] == "out of retries"

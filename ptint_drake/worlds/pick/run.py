@@ -146,6 +146,8 @@ def _camera_loggers(builder: DiagramBuilder, st, estimates: PartEstimates, true_
                            (f"fit_{k}", fits.GetOutputPort(f"measurement_{k}")),
                            (f"fit_rotation_{k}", fits.GetOutputPort(f"measured_rotation_{k}"))):
             out[name] = LogVectorOutput(port, builder, PROBE_PERIOD)
+    if fits.HasOutputPort("tracks"):  # every frame's tracks (part_tracks.track_metrics: the IDSW)
+        out["tracks"] = LogVectorOutput(fits.GetOutputPort("tracks"), builder, PROBE_PERIOD)
     return out
 
 

@@ -46,6 +46,7 @@ from ptint_drake.worlds.pick.clearance import arm_warnings, check_pick_clearance
 from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLANT_FIELDS, check_pick_parts,
                                             check_plant_settings)
 from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
+from ptint_drake.worlds.pick.grasp_gate import grasp_refusal
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.route import routed_plan
@@ -131,23 +132,21 @@ class PickRun(WorldRun):
                     self._check(context, k, t, state)
 
     def _unseen(self, context, k: int, t: float) -> bool:
-        """With a camera, at task k's descend start: record its part's estimate against the truth
-        (``estimates``); if the part was never seen — or fitted fewer than ``camera.MIN_FITS``
-        times, too few for a velocity to aim at — no grasp: the task backs off at once (no close
-        command) and its check reads ``part not seen``.  True when it did."""
+        """With a camera, at task k's descend start: if the part was never seen — or fitted fewer
+        than ``camera.MIN_FITS`` times, too few for a velocity to aim at — or the open fingers
+        would not fit beside a neighbour (``grasp_gate``), no grasp: the task backs off at once
+        (no close command) and its check reads ``part not seen`` or ``blocked``.  True when it did."""
         plan = self.built.plan
         i = plan.segment_index(k, "descend")
         last = plan.segments[i].attempt == len(plan.attempts[k]) - 1
         if not last or abs(plan.schedule.segments[i].start - t) > 1e-9:
             return False
-        part = plan.segments[i].index
-        parts, estimator = self.built.estimates.parts, self.built.estimates.estimator
-        fits = int(estimator.GetOutputPort("fit_counts").Eval(estimator.GetMyContextFromRoot(context))[part])
-        seen = parts.GetOutputPort("seen").Eval(parts.GetMyContextFromRoot(context))[part] > 0.5
-        if seen and fits >= MIN_FITS:
+        why = grasp_refusal(self.built, context, k, plan.segments[i].index, t, MIN_FITS,
+                            self.scenario.pick.tasks[k].margin)
+        if why is None:
             return False
-        self.checks[k].append({"state": "not seen", "t": t, "fits": fits})
-        self.refused[k] = "part not seen"
+        self.refused[k] = why[0]
+        self.checks[k].append(why[1])
         self.replans[k] = Replan(self.replans[k].retries, 0.0, abort=t)
         self._rebuild()
         return True
