@@ -67,7 +67,7 @@ def test_the_estimates_figure_explains_its_marks_and_why_the_fits_stop(tmp_path,
     from conftest import run_cached
 
     from ptint_drake.worlds.pick.views import estimate_figure
-    from ptint_drake.worlds.pick.world import belt_frames
+    from ptint_drake.worlds.pick.views import belt_frames
 
     result = run_cached("conveyor_pick_place_rgbd")
     kept = _drawn_figure(monkeypatch)

@@ -270,7 +270,8 @@ def pick_series(built: PickBuilt, logs: dict) -> dict:
     With a camera also: ``target_true``, ``e_estimate`` / ``edot_estimate`` (against what the
     controller aimed at, the estimate) and per part k, on the same times, ``part_true_k`` /
     ``part_estimate_k`` ([x (3), R row-major (9)]) and ``fit_k`` ([stamp, x, y, z, valid, R (9)]:
-    the last fit the estimators were given)."""
+    the last fit the estimators were given), and ``tracks_t`` / ``tracks``: the perception's tracks
+    log (``track_system.TrackingPartPoseEstimator``'s ``tracks`` output, when it has one)."""
     t, state = logs["state"]
     nq = built.arm.num_positions()
     kinematics = FrameKinematics(built.arm, built.arm.GetFrameByName(built.station.config.end_effector))
@@ -298,6 +299,8 @@ def pick_series(built: PickBuilt, logs: dict) -> dict:
             series[f"part_estimate_{k}"] = np.hstack([logs[f"part_estimate_{k}"][1][:, 0:3],
                                                       logs[f"part_estimate_rotation_{k}"][1][:, 0:9]])
             series[f"fit_{k}"] = np.hstack([logs[f"fit_{k}"][1], logs[f"fit_rotation_{k}"][1][:, 1:10]])
+    if "tracks" in logs:  # the perception's tracks (track_system: stamp, per slot id … class)
+        series["tracks_t"], series["tracks"] = logs["tracks"]
     return series
 
 

@@ -2,7 +2,9 @@
 
 The figures, ``pick_figure`` (``picks.png``) and ``estimate_figure`` (``estimates.png``, for a run
 with an RGB-D camera), are drawn by ``worlds.pick.figures`` (its docstring says what each shows)
-and re-exported here with ``GRASP_TAIL``, which the replay shares.
+and re-exported here with ``GRASP_TAIL``, which the replay shares; ``timeline.png``, each part's
+seen → scheduled → grasped → placed or failed, by ``worlds.pick.timeline``.  ``draw_pick_view``
+draws one of them (or the replay, or the camera's frames) by name.
 
 ``write_pick_replay`` — ``replay.html``: the whole plant (arm, fingers, belts, parts, tray) rebuilt
 from the scenario and replayed from its logged [q; v] at 30 frames per second into a Meshcat
@@ -13,7 +15,9 @@ grasp (violet) — the frame re-rendered, cropped and downsampled as the percept
 grasp's: ``GRASP_TAIL``; ``cloud_intervals``), and per part its
 estimate (series ``part_estimate_k``, what the approach and the grasp aimed at) as a yellow outline
 of its known shape with a frame triad, beside the simulated part, until ``GRASP_TAIL`` past its
-pick's prescribed grasp (the part is in the hand then; the estimate runs on along the belt).
+pick's prescribed grasp (the part is in the hand then; the estimate runs on along the belt), and
+each confirmed track of the perception as a small sphere of its own colour over its part at its
+estimated centre, from its confirmation to its end (``track_markers``, issue 44).
 The floor is drawn under the whole scene (``draw_pick_floor``), Meshcat's grid and axes hidden, and
 the page loops with the time, a pause / play button and a legend (``replay.finish_page``).
 """
@@ -107,7 +111,9 @@ def pick_legend(scenario, camera: bool) -> list:
                     "first fit (shown until the grasp's frame; it stays where the part was)"),
                    (rgba["grasp"], "violet points: the cloud at the prescribed grasp"),
                    ("rgba(255, 217, 0, 1)", "yellow outline and axes: the part's estimate, what the arm aims "
-                    f"at (until {GRASP_TAIL:g} s past the grasp)")]
+                    f"at (until {GRASP_TAIL:g} s past the grasp)"),
+                   ("rgba(26, 204, 230, 1)", "small spheres, a colour per track: the perception's "
+                    "confirmed tracks, each over its part at its estimated centre")]
     legend.append((css_color(FLOOR_COLOR), "floor, 10 cm grid"))
     return legend
 
@@ -160,18 +166,29 @@ def estimate_pose(series: dict, part: int, t: float):
 
 def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: str = "") -> int:
     """Write ``replay.html`` (module docstring); returns its size in bytes."""
+    from pydrake.math import RigidTransform  # noqa: PLC0415
+
     from ptint_drake.views.replay import finish_page  # noqa: PLC0415
+    from ptint_drake.worlds.pick.track_markers import (  # noqa: PLC0415
+        class_heights,
+        confirmed_tracks,
+        draw_track_markers,
+        track_poses,
+    )
+
     plant, viz, meshcat, context = replay_world(scenario)
     plant_context = plant.GetMyMutableContextFromRoot(context)
     times, states = series["replay_t"], series["plant_state"]
     plant.SetPositions(plant_context, states[0][:plant.num_positions()])
     draw_pick_floor(meshcat, plant, context)
-    clouds, until, visible = [], [], {}
+    clouds, until, visible, tracks, heights = [], [], {}, [], []
     camera = scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
     if camera:
         clouds = cloud_intervals(draw_camera_clouds(meshcat, scenario, series, metrics))
         draw_estimates(meshcat, scenario)
         until = estimate_shown_until(scenario, metrics)
+        tracks, heights = confirmed_tracks(series), class_heights(scenario)
+        draw_track_markers(meshcat, tracks)
     meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
     for t, x in zip(times, states):
         plant.SetPositions(plant_context, x[:plant.num_positions()])
@@ -179,6 +196,9 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: 
         viz.ForcedPublish(viz.GetMyContextFromRoot(context))
         shown = [(cloud, on - 1e-6 <= t < off) for cloud, on, off in clouds]
         shown += [(f"estimates/part_{k}", t <= end) for k, end in enumerate(until)]
+        for name, on, p in track_poses(tracks, heights, float(t)):  # the tracks' centres
+            shown.append((name, on))
+            meshcat.SetTransform(name, RigidTransform(p), time_in_recording=float(t))
         for name, on in shown:  # a key where it changes (a visibility track holds its last key)
             if visible.get(name) != on:
                 meshcat.SetProperty(name, "visible", bool(on), time_in_recording=float(t))
@@ -194,3 +214,36 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: 
     html = finish_page(meshcat, heading, pick_legend(scenario, camera))
     Path(path).write_text(html, encoding="utf-8")
     return len(html.encode("utf-8"))
+
+
+def draw_pick_view(name: str, scenario, series: dict, metrics: dict, stage: Path, title: str) -> str:
+    """Draw the pick run's view ``name`` into ``stage`` (``PickWorld.draw_view``): ``picks``
+    (``picks.png``), ``timeline`` (``timeline.png``: ``timeline``), ``estimates``
+    (``estimates.png``), ``camera_frames`` (``frames/``) or the replay (``replay.html``)."""
+    if name == "picks":
+        pick_figure(series, metrics, stage / "picks.png", title)
+    elif name == "timeline":
+        from ptint_drake.worlds.pick.timeline import part_timelines, timeline_figure  # noqa: PLC0415
+
+        camera = scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
+        lines = part_timelines([p.name for p in scenario.pick.parts], series, metrics, camera)
+        timeline_figure(lines, metrics, stage / "timeline.png", title)
+    elif name == "estimates":
+        estimate_figure(series, metrics, *belt_frames(scenario), stage / "estimates.png", title)
+    elif name == "camera_frames":
+        from ptint_drake.worlds.pick.camera_frames import write_pick_camera_frames  # noqa: PLC0415
+
+        write_pick_camera_frames(scenario, series, metrics, stage)
+    else:
+        write_pick_replay(scenario, series, metrics, stage / "replay.html", title=title)
+    return name
+
+
+def belt_frames(scenario) -> tuple[list, list]:
+    """Per part: its belt's unit direction and its yaw symmetry (rad; ``part_fit.yaw_symmetry``)."""
+    from ptint_drake.systems.perception.part_fit import yaw_symmetry  # noqa: PLC0415
+
+    pick = scenario.pick
+    belts = {b.name: np.asarray(b.direction, float) for b in pick.belts}
+    return ([belts[p.belt] / np.linalg.norm(belts[p.belt]) for p in pick.parts],
+            [yaw_symmetry(p.shape, p.size) for p in pick.parts])

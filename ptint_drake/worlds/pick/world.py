@@ -315,32 +315,21 @@ class PickWorld(World):
         return [Reason(None, code, f"pick {k}: {code}") for k, code in pick_reasons(metrics["picks"])]
 
     def figure_files(self, scenario: Scenario) -> list[str]:
-        return ["picks.png", "estimates.png"] if _has_camera(scenario) else ["picks.png"]
+        return ["picks.png", "timeline.png"] + (["estimates.png"] if _has_camera(scenario) else [])
 
     def view_tasks(self, scenario: Scenario, series: dict, metrics: dict, stage: Path, figures: bool,
                    replay: bool, svg: bool) -> list[tuple]:
         camera = figures and _has_camera(scenario)  # the estimates' figure and the camera's frames
-        names = [n for n, on in (("pick_replay", replay), ("picks", figures), ("estimates", camera),
-                                 ("camera_frames", camera)) if on]
+        names = [n for n, on in (("pick_replay", replay), ("picks", figures), ("timeline", figures),
+                                 ("estimates", camera), ("camera_frames", camera)) if on]
         text = dump_yaml(scenario)  # picklable, for a worker process
         return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
 
     def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:
-        from ptint_drake.worlds.pick.views import estimate_figure, pick_figure, write_pick_replay  # noqa: PLC0415
+        from ptint_drake.worlds.pick.views import draw_pick_view  # noqa: PLC0415
 
-        if name == "picks":
-            pick_figure(series, metrics, stage / "picks.png", title)
-        elif name == "estimates":
-            scenario = yaml_load_typed(schema=Scenario, data=args[0])
-            estimate_figure(series, metrics, *belt_frames(scenario), stage / "estimates.png", title)
-        elif name == "camera_frames":
-            from ptint_drake.worlds.pick.camera_frames import write_pick_camera_frames  # noqa: PLC0415
-
-            write_pick_camera_frames(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics, stage)
-        else:
-            write_pick_replay(yaml_load_typed(schema=Scenario, data=args[0]), series, metrics,
-                              stage / "replay.html", title=title)
-        return name
+        scenario = yaml_load_typed(schema=Scenario, data=args[0])
+        return draw_pick_view(name, scenario, series, metrics, stage, title)
 
     def simulator_config(self, scenario: Scenario):
         return pick_simulator(scenario)
@@ -386,13 +375,3 @@ class PickWorld(World):
 
 def _has_camera(scenario: Scenario) -> bool:
     return scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
-
-
-def belt_frames(scenario: Scenario) -> tuple[list, list]:
-    """Per part: its belt's unit direction and its yaw symmetry (rad; ``part_fit.yaw_symmetry``)."""
-    from ptint_drake.systems.perception.part_fit import yaw_symmetry  # noqa: PLC0415
-
-    pick = scenario.pick
-    belts = {b.name: np.asarray(b.direction, float) for b in pick.belts}
-    return ([belts[p.belt] / np.linalg.norm(belts[p.belt]) for p in pick.parts],
-            [yaw_symmetry(p.shape, p.size) for p in pick.parts])
