@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from ptint_drake.worlds.pick.runaway import runaway_reasons
+from ptint_drake.worlds.pick.timeline import part_timelines
 
 SCENARIO = str(Path(__file__).resolve().parents[1] / "two_parts_one_belt.yaml")
 CASES = {
@@ -44,8 +45,9 @@ def test_two_parts_on_one_belt_go_each_to_its_own_slot(run, case):
 def test_a_part_the_open_fingers_cannot_reach_beside_its_neighbour_is_blocked(run):
     # a 40 x 30 mm box turned 90°: its fingers close along the belt, and open (52 mm) their outer faces
     # reach 32 mm up the belt, where the cube 50 mm behind it begins: no grasp, the task backs off
-    m = run(SCENARIO, ("pick.parts[0].size=[0.04, 0.03, 0.03]", "pick.parts[0].yaw_deg=90.0",
-                       "pick.parts[1].offset=-0.29")).metrics
+    result = run(SCENARIO, ("pick.parts[0].size=[0.04, 0.03, 0.03]", "pick.parts[0].yaw_deg=90.0",
+                            "pick.parts[1].offset=-0.29"))
+    m = result.metrics
     blocked, cube = m["picks"]
     assert m["reasons"] == ["pick 0: blocked"]
     assert blocked["retry_refused"] == "blocked" and not blocked["grasped"]
@@ -53,3 +55,7 @@ def test_a_part_the_open_fingers_cannot_reach_beside_its_neighbour_is_blocked(ru
     assert cube["placed"] and not cube["collision"]
     assert m["tracking"]["idsw"] == 0
     _no_runaway(m)
+    # the timeline (timeline.png) names the blocked part's failure and places the cube
+    first, second = part_timelines(["first", "second"], result.series, m, True)
+    assert first.failed == ["blocked"] and first.placed is None and first.grasped is None
+    assert second.failed == [] and second.placed is not None

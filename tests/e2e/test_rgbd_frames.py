@@ -44,12 +44,12 @@ def test_a_camera_pick_writes_its_estimates_figure_and_frames_at_the_first_fit_a
 
     result = run_cached("conveyor_pick_place_rgbd")
     world = world_of(result.scenario)
-    assert world.figure_files(result.scenario) == ["picks.png", "estimates.png"]
+    assert world.figure_files(result.scenario) == ["picks.png", "timeline.png", "estimates.png"]
     tasks = world.view_tasks(result.scenario, result.series, result.metrics, tmp_path, True, False, False)
-    assert [task[0] for task in tasks] == ["picks", "estimates", "camera_frames"]
+    assert [task[0] for task in tasks] == ["picks", "timeline", "estimates", "camera_frames"]
     for task in tasks[1:]:
         world.draw_view(*task)
-    assert (tmp_path / "estimates.png").stat().st_size > 10_000
+    assert (tmp_path / "estimates.png").stat().st_size > 10_000 and (tmp_path / "timeline.png").is_file()
     assert 0.0 <= first_fit_time(result.series, 0) < 0.2  # the part is in view from the start
     # the first frame's good fit and, in both, the estimate the pick aimed at (at the grasp the
     # fingers hide the part: no good fit there)

@@ -141,7 +141,8 @@ def _timeline_row(ax, row: int, line: PartTimeline) -> None:
         ax.plot([min(times), max(times)], [row, row], color="0.6", lw=1.5, zorder=1)
     for name, t in events.items():
         marker, color = MARKS[name]
-        ax.plot([t], [row], marker=marker, color=color, ms=10, ls="none", label=name, zorder=3)
+        hollow = {"markerfacecolor": "none", "ms": 15, "mew": 2} if name == "seen" else {"ms": 10}
+        ax.plot([t], [row], marker=marker, color=color, ls="none", label=name, zorder=3, **hollow)
     if line.failed:
         t = line.ended if line.ended is not None else (max(times) if times else 0.0)
         ax.plot([t], [row], marker="X", color="tab:red", ms=11, ls="none", label="failed", zorder=3)

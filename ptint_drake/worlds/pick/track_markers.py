@@ -44,8 +44,8 @@ def _frames(series: dict) -> np.ndarray:
     """The tracks log's rows, one per frame (the log samples every probe period: a frame's row
     repeats until the next frame's), the empty rows before the first frame left out."""
     rows = np.asarray(series["tracks"])
-    keep = np.r_[True, np.diff(rows[:, 0]) != 0] & np.any(rows[:, 1:] != 0, axis=1)
-    return rows[keep]
+    rows = rows[np.any(rows[:, 1:] != 0, axis=1)]
+    return rows[np.r_[True, np.diff(rows[:, 0]) != 0]] if len(rows) else rows
 
 
 def confirmed_tracks(series: dict) -> list[TrackPath]:
