@@ -54,11 +54,10 @@ class PartTimeline:
         return {name: getattr(self, name) for name in MARKS if getattr(self, name) is not None}
 
 
-def first_track_fit(tracks_t, tracks, part: int) -> Optional[float]:
+def first_track_fit(tracks, part: int) -> Optional[float]:
     """The frame time of the first fit taken by the track bound to declared ``part`` in the
     perception's tracks log (rows: [stamp, per slot: id, bound part, took a fit, x, y, z,
     class]); None when no track was bound to it."""
-    del tracks_t  # the rows carry their frame's stamp
     rows = np.asarray(tracks)
     slots = rows[:, 1:].reshape(len(rows), MAX_TRACKS, ROW)
     bound = slots[(slots[:, :, 0] > 0) & (np.rint(slots[:, :, 1]) == part)]
@@ -88,7 +87,7 @@ def part_timelines(names: list[str], series: dict, metrics: dict, camera: bool) 
         if not camera:
             line.seen = 0.0
         elif "tracks" in series:
-            line.seen = first_track_fit(series.get("tracks_t"), series["tracks"], k)
+            line.seen = first_track_fit(series["tracks"], k)
     reasons = task_reasons(metrics)
     for task, pick in enumerate(metrics["picks"]):
         line = lines[pick["part_index"]]
