@@ -5,8 +5,9 @@ the hand's orientation, and the close command.
 start pose.  From t_plan on, the prescribed-time law aims at a *moving* target that reaches the
 ball's predicted centre at exactly t_catch:
 
-    p_c(t)  = p̂ + v̂ T + ½ â T²,  T = t_catch − t    (the estimate's catch point; with a
-                                                       ballistic estimate d/dt p_c = 0)
+    p_c(t)  = the estimate's flight at T = t_catch − t   (``flight.propagate`` from [p̂, v̂]
+                                                        with the drag c of â; along that
+                                                        flight d/dt p_c = 0)
     x_r(t)  = p_c + m w(t) (p̂ − p_c),  w = exp(−T / τ_m)
     ẋ_r     = m (w v̂ + (w / τ_m)(p̂ − p_c)),   ẍ_r = m (w â + 2 (w / τ_m) v̂ + (w / τ_m²)(p̂ − p_c))
 
@@ -35,6 +36,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from ptint_drake.controllers.slot import TargetView
+from ptint_drake.worlds.catch.flight import from_estimate, propagate
 
 BRAKE_TIME = 0.04  # s
 
@@ -43,7 +45,7 @@ def catch_reference(estimate: np.ndarray, T: float, m: float, tau_m: float) -> n
     """[x_r, ẋ_r, ẍ_r] (9) of the module docstring from an estimate [p̂, v̂, â], T = t_catch − t."""
     p, v, a = estimate[0:3], estimate[3:6], estimate[6:9]
     T = max(T, 0.0)
-    p_c = p + v * T + 0.5 * a * T * T
+    p_c = propagate(p, v, from_estimate(estimate), 0.0, [T])[0, 0:3] if T > 0.0 else p
     w, d = np.exp(-T / tau_m), p - p_c
     x = p_c + m * w * d
     xd = m * (w * v + (w / tau_m) * d)
