@@ -38,6 +38,6 @@ class CatchConfig:
     held_for: float = 0.5
     time_step: float = 0.001
     match: float = 0.3
-    match_time: float = 0.05
+    match_time: float = 0.2
     freeze: float = 0.02
     final: float = 0.0

@@ -14,7 +14,11 @@ the one nearest the hand's present tip (least motion) is chosen.  None: the plan
 turned to it, whatever the time: the ball may still come), i.e. whether to try again later.
 
 ``Planner.holds`` re-checks a standing plan against a newer estimate: its catch time's point and
-incoming direction re-predicted, reachable (IK from the plan's posture) in the time left.
+incoming direction re-predicted, still above the floor and reachable (IK from the plan's
+posture).  Its timing is not re-checked: the speed bound of ``tf_needed`` is the whole profile's
+from rest, not the rest of a profile under way (checked so, mid-way, it refused plans the arm
+then met, and each replacement, nearest the hand, was an earlier, shorter catch).  A plan that
+replaces one takes the candidate times nearest the old catch time first.
 
 What the controller and the hand are then given is ``target``'s.
 """
@@ -93,21 +97,24 @@ class Planner:
         """The planner's minimum tf from posture ``q_from`` to ``q_to`` (module docstring)."""
         return TORQUE_MARGIN * self.xi_d_max * float(np.max(np.abs(q_to[:7] - q_from[:7]) / self.v_max))
 
-    def candidates(self, estimate: np.ndarray, t_plan: float, x_now: np.ndarray) -> list:
+    def candidates(self, estimate: np.ndarray, t_plan: float, x_now: np.ndarray, near=None) -> list:
         """(t_c, point, velocity) on the grid, above the floor and within ``REACH`` of ``x_now``,
-        nearest first."""
+        nearest first (or nearest the time ``near``)."""
         times = t_plan + np.arange(GRID, HORIZON, GRID)
         states = flight_states(estimate, times - t_plan)
         kept = [(t, s[0:3], s[3:6]) for t, s in zip(times, states)
                 if s[2] >= FLOOR_Z and np.linalg.norm(s[0:3] - x_now) <= REACH]
+        if near is not None:
+            return sorted(kept, key=lambda c: abs(c[0] - near))
         return sorted(kept, key=lambda c: np.linalg.norm(c[1] - x_now))
 
-    def plan(self, estimate: np.ndarray, t_plan: float, q_arm: np.ndarray) -> Optional[Plan]:
+    def plan(self, estimate: np.ndarray, t_plan: float, q_arm: np.ndarray, near=None) -> Optional[Plan]:
         """The catch of the module docstring from ``estimate`` at ``t_plan`` with the arm at
-        ``q_arm``, or None (refused now)."""
+        ``q_arm``, or None (refused now); ``near``: the catch time of a plan it replaces (the
+        candidates nearest it first, not the nearest points)."""
         q_now = np.asarray(q_arm, float)
         self._left = False
-        for t_c, p, v in self.candidates(estimate, t_plan, self.tip(q_now)[0]):
+        for t_c, p, v in self.candidates(estimate, t_plan, self.tip(q_now)[0], near):
             q = self.ik(p, -v / np.linalg.norm(v), q_now)
             if q is None:
                 continue
@@ -121,12 +128,9 @@ class Planner:
         """After a refused ``plan``: no candidate was in reach at all (no point to try again)."""
         return not self._left
 
-    def holds(self, plan: Plan, estimate: np.ndarray, t: float, q_arm: np.ndarray) -> bool:
-        """Whether ``plan`` is still feasible at ``t`` with the newer ``estimate`` (module docstring)."""
+    def holds(self, plan: Plan, estimate: np.ndarray, t: float) -> bool:
+        """Whether ``plan`` still holds at ``t`` with the newer ``estimate`` (module docstring)."""
         if plan.t_catch - t < 1e-9:
             return True
         p, v = np.split(flight_states(estimate, [plan.t_catch - t])[0], 2)
-        if p[2] < FLOOR_Z:
-            return False
-        q = self.ik(p, -v / np.linalg.norm(v), plan.q)
-        return q is not None and self.tf_needed(q_arm, q) <= plan.t_catch - t
+        return p[2] >= FLOOR_Z and self.ik(p, -v / np.linalg.norm(v), plan.q) is not None

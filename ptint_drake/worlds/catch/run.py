@@ -83,7 +83,7 @@ class CatchRun(WorldRun):
             return Schedule([Segment(0.0, c.sensing, c.beta), Segment(c.sensing, 0.6, c.beta)])
         starts = sorted({0.0, c.sensing, *(p.t_plan for p in self.plans)})
         ends = starts[1:] + [self.plan.t_catch]
-        segments = [Segment(a, b - a, c.beta) for a, b in zip(starts, ends)]
+        segments = [Segment(a, _span(a, b), c.beta) for a, b in zip(starts, ends)]
         last = segments[-1]
         if c.final > 0.0 and last.tf >= 2.0 * c.final:
             segments[-1:] = [Segment(last.start, last.tf - c.final, c.beta),
@@ -159,9 +159,9 @@ class CatchRun(WorldRun):
         """Plan, or revise the plan, at ``t`` (module docstring)."""
         if not np.any(estimate[3:6]):
             return
-        if self.plan is not None and self.planner.holds(self.plan, estimate, t, q):
+        if self.plan is not None and self.planner.holds(self.plan, estimate, t):
             return
-        new = self.planner.plan(estimate, t, q)
+        new = self.planner.plan(estimate, t, q, None if self.plan is None else self.plan.t_catch)
         if new is None:
             if self.plan is None and estimate[2] < FLOOR_Z and estimate[5] < 0.0:
                 self.gave_up = t  # the ball is gone
@@ -203,6 +203,14 @@ class CatchRun(WorldRun):
 
     def _logs(self) -> tuple:
         return self.logger, self.estimate_log, self.target_log
+
+
+def _span(a: float, b: float) -> float:
+    """b − a, rounded down so that a + (b − a) ≤ b (a segment ends before the next one starts)."""
+    tf = b - a
+    while a + tf > b:
+        tf = np.nextafter(tf, 0.0)
+    return float(tf)
 
 
 def _plan_row(plan) -> dict:
