@@ -9,9 +9,10 @@ drag has bent the path by centimetres, it weighs in its other models; measured o
 (median; max 9.1), and 42 mm (max 344) at 0.15 s.  The fit of the flight's own model (seven
 numbers over all the samples) gives 2.2 mm (max 7.6) and 38 mm (max 69): ``docs/catch.md``.
 
-Output ``target`` (9) = [p + vΔt + ½aΔt², v + aΔt, a] of the fitted [p, v] at the newest
-sample's time, a = g − c|v|v, Δt = t − that time (the same layout as the other estimators, so
-``flight.from_estimate`` recovers c from it).  With fewer than ``MIN_SAMPLES`` samples: the
+Output ``target`` (9) = [p + vΔt + ½aΔt², v' = v + aΔt, g − c|v'|v'] of the fitted [p, v] at the
+newest sample's time, a = g − c|v|v, Δt = t − that time (the same layout as the other
+estimators; the acceleration is the model's at v', so that ``flight.from_estimate`` recovers c
+from the output at any time).  With fewer than ``MIN_SAMPLES`` samples: the
 newest sample, at rest.  The buffer holds ``CAPACITY`` samples (1.6 s at 60 Hz); later samples
 are not taken (the catch is over by then).
 """
@@ -84,4 +85,6 @@ class FlightEstimator(SampledEstimator):
         p, v, c = fit[2:5], fit[5:8], fit[8]
         a = flight.acceleration(v, c) if fit[0] >= MIN_SAMPLES else np.zeros(3)
         dt = context.get_time() - fit[1]
-        return np.concatenate([p + v * dt + 0.5 * a * dt * dt, v + a * dt, a])
+        v_t = v + a * dt
+        a_t = flight.acceleration(v_t, c) if fit[0] >= MIN_SAMPLES else a
+        return np.concatenate([p + v * dt + 0.5 * a * dt * dt, v_t, a_t])
