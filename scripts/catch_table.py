@@ -84,7 +84,7 @@ def figure(rows: list, path: str) -> None:
     ax.set_xlabel("launch speed (m/s)")
     ax.set_ylabel("% of the throws in the bin")
     ax.set_ylim(0, 105)
-    ax.legend(loc="lower left")
+    ax.legend(loc="center left")
     ax.set_title(f"catch rate against throw speed ({len(rows)} throws; bin counts at the bottom)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -14,7 +14,8 @@ ball's predicted centre at exactly t_catch:
     S(x)    = ∫₀ˣ g = x − 2.5x⁴ + 3x⁵ − x⁶  (S(1) = ½)
 
 so that x_r(t_catch) = p_c, the ball's estimated centre, and ẋ_r(t_catch) = m v_c: the hand
-arrives moving with the ball at the fraction m (``catch.match``; 0: it waits at the point) and
+arrives moving with the ball at the fraction m (the plan's: ``catch.match`` within the joints'
+speed limits, ``planner.Planner.matchable``; 0: it waits at the point) and
 the ball enters between the jaws at (1 − m) of its speed.  Before the last τ_m
 (``catch.match_time``) the target is the point ½ m τ_m |v_c| back along the ball's path;
 in the last τ_m the hand speeds up along the path to m v_c, with no jump in its reference's
@@ -79,7 +80,7 @@ class CatchTarget(LeafSystem):
     def __init__(self, start: np.ndarray, R_start: np.ndarray, plan, catch):
         super().__init__()
         self._plan, self._start, self._R0 = plan, np.asarray(start, float), np.asarray(R_start, float)
-        self._m, self._tau_m, self._freeze = float(catch.match), float(catch.match_time), float(catch.freeze)
+        self._tau_m, self._freeze = float(catch.match_time), float(catch.freeze)
         self._in = self.DeclareVectorInputPort("estimate", 9)
         self._held = self.DeclareDiscreteState(BasicVector(np.zeros(10)))  # [held?, estimate]
         if plan is not None:
@@ -100,8 +101,8 @@ class CatchTarget(LeafSystem):
         live = t < plan.t_catch - self._freeze or held[0] == 0.0
         estimate = self._in.Eval(context) if live else self._extrapolated(held[1:], t)
         if t <= plan.t_catch:
-            return catch_reference(estimate, plan.t_catch - t, self._m, self._tau_m)
-        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, self._m, self._tau_m)
+            return catch_reference(estimate, plan.t_catch - t, plan.match, self._tau_m)
+        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, plan.match, self._tau_m)
         return braking(at_catch, t - plan.t_catch)
 
     def _extrapolated(self, held: np.ndarray, t: float) -> np.ndarray:
