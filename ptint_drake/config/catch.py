@@ -16,10 +16,13 @@ def _wsg() -> GripperConfig:
 
 @dataclass
 class CatchConfig:
-    """A catch: ``throw`` (the thrower's seed), the ``gripper``, ``sensing`` (s of flight seen
+    """A catch: ``throw`` (the thrower's seed), the ``gripper``, ``predictor`` (the ball's
+    estimator: ``fit``, the dragged flight fitted to the samples, or ``auto``, the scenario's
+    camera estimator), ``sensing`` (s of flight seen
     before the plan), ``replan_every`` (s between the revisions of the catch time),
     ``commit`` (s before the catch time after which the plan stays), ``beta`` (the TBG's β),
-    ``held_for`` (s after the catch at which the ball must still be held); the moving target
+    ``held_for`` (s after the catch at which the ball must still be held), ``time_step`` (s, the
+    station's plant step: 1 ms; halved to check the impact's convergence); the moving target
     (``worlds.catch.target``): ``match`` (the fraction of the ball's velocity the hand has at the
     catch), ``match_time`` (s, how long before the catch the matching sets in), ``freeze`` (s
     before the catch from which the estimate is held); ``final`` (s: the catch segment split in two,
@@ -27,12 +30,14 @@ class CatchConfig:
 
     throw: int = 0
     gripper: GripperConfig = field(default_factory=_wsg)
+    predictor: str = "fit"
     sensing: float = 0.15
-    replan_every: float = 0.1
+    replan_every: float = 0.02
     commit: float = 0.15
     beta: float = 0.75
     held_for: float = 0.5
+    time_step: float = 0.001
     match: float = 0.3
-    match_time: float = 0.05
+    match_time: float = 0.2
     freeze: float = 0.02
     final: float = 0.0

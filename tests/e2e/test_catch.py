@@ -1,7 +1,7 @@
 """The catch world end to end (issue 46), on the real station (iiwa 14, WSG 50-110, the foam
-ball with drag, SAP contact, the formula camera and the ``auto`` estimator): the arm waits at
-rest, a real throw is caught and still held 0.5 s later, and a throw the frozen oracle calls
-too fast is refused before the arm moves (``not reachable``)."""
+ball with drag, SAP contact, the formula camera and the fit of the ball's dragged flight): the arm
+waits at rest, a real throw is caught and still held 0.5 s later, and a throw the frozen oracle calls
+too fast is refused, at every revision, and the arm never moves (``not reachable``)."""
 
 from __future__ import annotations
 

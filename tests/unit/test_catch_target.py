@@ -1,8 +1,9 @@
 """The catch world's moving target (issue 46, ``worlds.catch.target``): it reaches the ball's
 estimated centre at exactly t_catch with the matched fraction of its velocity, its velocity and
 acceleration are the derivatives of its position along a ballistic estimate (what the
-prescribed-time law needs of a moving target), the brake after the catch starts where the catch
-ended and stops; and the held rule of ``outcome`` takes the squeezed foam ball."""
+prescribed-time law needs of a moving target), its matching ramp starts from rest on the ball's
+path and asks for no more acceleration than its stated bound, the brake after the catch starts
+where the catch ended and stops; and the held rule of ``outcome`` takes the squeezed foam ball."""
 
 from __future__ import annotations
 
@@ -29,14 +30,25 @@ def test_the_target_meets_the_ball_at_t_catch_with_the_matched_velocity(m):
     ref = catch_reference(ballistic(t_c), 0.0, m, 0.05)
     assert np.allclose(ref[0:3], ballistic(t_c)[0:3], atol=1e-12)
     assert np.allclose(ref[3:6], m * ballistic(t_c)[3:6], atol=1e-12)
-    early = catch_reference(ballistic(0.2), t_c - 0.2, m, 0.05)  # 10 τ_m before: the catch point
-    assert np.linalg.norm(early[0:3] - ballistic(t_c)[0:3]) < 1e-4 + m * 1e-3
+    assert np.allclose(ref[6:9], 0.0)  # no acceleration left at the catch
+    early = catch_reference(ballistic(0.2), t_c - 0.2, m, 0.2)  # before the ramp: at rest, on the path
+    v_c = ballistic(t_c)[3:6]
+    assert np.allclose(early[0:3], ballistic(t_c)[0:3] - 0.5 * m * 0.2 * v_c, atol=1e-9)
+    assert np.allclose(early[3:9], 0.0)
+
+
+def test_the_matching_ramp_asks_for_no_more_than_its_bound():
+    t_c, m, tau = 0.7, 0.3, 0.2
+    peak = max(np.linalg.norm(catch_reference(ballistic(t), t_c - t, m, tau)[6:9])
+               for t in np.linspace(t_c - tau, t_c, 201))
+    bound = 1.875 * m * np.linalg.norm(ballistic(t_c)[3:6]) / tau  # the docstring's
+    assert bound * 0.99 < peak <= bound * (1 + 1e-9)
 
 
 def test_the_targets_velocity_and_acceleration_are_its_derivatives():
     t_c, m, h = 0.7, 0.4, 1e-5
-    ref = lambda t: catch_reference(ballistic(t), t_c - t, m, 0.05)  # noqa: E731
-    for t in (0.5, 0.62, 0.68):
+    ref = lambda t: catch_reference(ballistic(t), t_c - t, m, 0.2)  # noqa: E731
+    for t in (0.45, 0.55, 0.62, 0.68):
         numeric_v = (ref(t + h)[0:3] - ref(t - h)[0:3]) / (2 * h)
         numeric_a = (ref(t + h)[3:6] - ref(t - h)[3:6]) / (2 * h)
         assert np.allclose(numeric_v, ref(t)[3:6], atol=1e-5)
@@ -44,11 +56,16 @@ def test_the_targets_velocity_and_acceleration_are_its_derivatives():
 
 
 def test_the_brake_starts_where_the_catch_ends_and_stops():
-    at_catch = catch_reference(ballistic(0.7), 0.0, 0.3, 0.05)
-    assert np.allclose(braking(at_catch, 0.0)[0:6], at_catch[0:6])
-    late = braking(at_catch, 10 * BRAKE_TIME)
-    assert np.linalg.norm(late[3:6]) < 1e-4 * np.linalg.norm(at_catch[3:6])
-    assert np.allclose(late[0:3], at_catch[0:3] + at_catch[3:6] * BRAKE_TIME, atol=1e-4)
+    at_catch = catch_reference(ballistic(0.7), 0.0, 0.3, 0.2)
+    assert np.allclose(braking(at_catch, 0.0), at_catch)
+    late = braking(at_catch, BRAKE_TIME)
+    assert np.allclose(late[3:9], 0.0)
+    assert np.allclose(late[0:3], at_catch[0:3] + 0.5 * at_catch[3:6] * BRAKE_TIME, atol=1e-12)
+    h = 1e-6
+    for tau in (0.2, 0.5, 0.8):
+        step = braking(at_catch, (tau + h) * BRAKE_TIME) - braking(at_catch, (tau - h) * BRAKE_TIME)
+        exact = braking(at_catch, tau * BRAKE_TIME)[3:9]
+        assert np.allclose(step[0:6] / (2 * h * BRAKE_TIME), exact, atol=1e-5)
 
 
 def test_held_takes_the_squeezed_ball_and_refuses_an_empty_or_open_hand():

@@ -12,14 +12,14 @@ from ptint_drake.worlds.catch.ball import BALL_DIAMETER
 
 
 class BallContacts(LeafSystem):
-    """Every millisecond, the bodies touching the ball and the peak normal force on it by body
+    """At every step of the plant, the bodies touching the ball and the peak normal force on it by body
     (``touched``: name → N, a dict shared across the run's diagrams)."""
 
     def __init__(self, plant, ball, touched: dict):
         super().__init__()
         self._plant, self._ball, self.touched = plant, ball.index(), touched
         self.DeclareAbstractInputPort("contact_results", AbstractValue.Make(ContactResults()))
-        self.DeclarePeriodicPublishEvent(0.001, 0.0, self._record)
+        self.DeclarePeriodicPublishEvent(plant.time_step(), 0.0, self._record)
 
     def _record(self, context) -> None:
         results = self.get_input_port().Eval(context)

@@ -1,14 +1,33 @@
 """The catch planner (issue 46): from the ball's estimate, the catch time and point, the hand's
 orientation, and what the controller and the gripper are given.
 
-``Planner.plan`` (at the end of the sensing, t_plan): the ball's predicted centre
-p(t) = p̂ + v̂ Δ + ½ â Δ² on a 10 ms grid of candidate catch times; a candidate is kept when the
-hand reaches it with its approach axis within ``APPROACH_CONE_DEG`` of the ball's incoming
-direction (Drake's ``InverseKinematics`` with the joint limits, nearest the present posture), above
-``FLOOR_Z``, and when t_c − t_plan ≥ tf_min: the joint-speed bound max_j |Δq_j| ξ̇_max / q̇_max,j
-(ξ̇_max of the TBG with the catch's β) × ``TORQUE_MARGIN`` (the torque term of the oracle's
-feasibility model, which is not binding on the arm's tf at these speeds, as a margin).  Of those, the
-one nearest the hand's present tip (least motion) is chosen; none: ``not reachable``.
+``Planner.plan`` (at a time t_plan): the ball's predicted centre and velocity along the estimate's
+dragged flight (``flight.propagate`` from [p̂, v̂] with the drag c the estimate's â carries) on a
+10 ms grid of candidate catch times; a candidate is kept when the hand reaches it with its
+approach axis within ``APPROACH_CONE_DEG`` of the ball's incoming direction (Drake's
+``InverseKinematics`` with the joint limits, nearest the present posture), above ``FLOOR_Z``, and
+when t_c − t_plan ≥ tf_min: the joint-speed bound max_j |Δq_j| ξ̇_max / q̇_max,j (ξ̇_max of the TBG
+with the catch's β) × ``TORQUE_MARGIN``, and at least ``MIN_TF``.  The margin is 1: the torque
+term of the oracle's feasibility model is not binding on the arm's tf at these speeds, and a
+margin of 1.25 (as first set) refused throws 58, 67 and 147, which the oracle calls reachable
+(the straight joint-space bound is already above the oracle's tf on them) and which are caught
+without it.  Of those,
+the one nearest the hand's present tip (least motion) is chosen.  None: the plan is refused now;
+``Planner.hopeless`` tells whether any candidate is left at all (a point in reach with the hand
+turned to it, whatever the time: the ball may still come), i.e. whether to try again later.
+
+``Planner.holds`` re-checks a standing plan against a newer estimate: its catch time's point and
+incoming direction re-predicted, still above the floor and reachable (IK from the plan's
+posture).  Its timing is not re-checked: the speed bound of ``tf_needed`` is the whole profile's
+from rest, not the rest of a profile under way (checked so, mid-way, it refused plans the arm
+then met, and each replacement, nearest the hand, was an earlier, shorter catch).  A plan that
+replaces one takes the candidate times nearest the old catch time first.
+
+The velocity the hand matches at the catch (``target``) is the plan's ``match``: ``catch.match``,
+capped by ``matchable`` so that the matched velocity alone takes at most ``SPEED_SHARE`` of any
+joint's speed limit (uncapped, 0.3 of a 4 m/s ball asked the iiwa's elbow for 1.8–2.3 times its
+limit at the catch postures: measured on throws 0, 1, 58, 147; the simulated plant does not
+enforce speed limits, so nothing else would show it).
 
 What the controller and the hand are then given is ``target``'s.
 """
@@ -20,15 +39,21 @@ from typing import Optional
 
 import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.solvers import Solve
 
 from ptint_drake.systems.task.tbg import tbg_profile
+from ptint_drake.worlds.catch.flight import from_estimate, propagate
 
 APPROACH_CONE_DEG = 25.0
 FLOOR_Z = 0.2
-TORQUE_MARGIN = 1.25
+TORQUE_MARGIN = 1.0
 GRID = 0.01
 HORIZON = 1.0
+MIN_TF = 0.1  # s
+REACH = 0.5  # m: candidates farther than this from the hand's tip are not tried
+ROT_SCALE = 0.1  # m/rad: the controller's weighing of the rotation (the catch scenario's)
+SPEED_SHARE = 0.8  # of a joint's speed limit the matched velocity may take
 
 
 @dataclass(frozen=True)
@@ -41,19 +66,26 @@ class Plan:
     R: np.ndarray
     q: np.ndarray
     tf_min: float
+    match: float = 0.0
 
 
 def predict(estimate: np.ndarray, dt) -> np.ndarray:
-    """The ball's centre ``dt`` after the estimate [p, v, a] (a: the estimate's, gravity with drag)."""
-    p, v, a = estimate[0:3], estimate[3:6], estimate[6:9]
-    return p + np.outer(dt, v) + 0.5 * np.outer(np.square(dt), a)
+    """The ball's centre ``dt`` (s, one or many) after the estimate [p, v, a] along its dragged
+    flight (c from â: ``flight.from_estimate``)."""
+    return flight_states(estimate, dt)[:, 0:3]
+
+
+def flight_states(estimate: np.ndarray, dt) -> np.ndarray:
+    """[p, v] (len(dt) × 6) ``dt`` after the estimate [p, v, a] along its dragged flight."""
+    estimate = np.asarray(estimate, float)
+    return propagate(estimate[0:3], estimate[3:6], from_estimate(estimate), 0.0, dt)
 
 
 class Planner:
     """Catch plans for one arm with its hand (module docstring)."""
 
-    def __init__(self, plant, tip: str, beta: float):
-        self.plant, self.frame = plant, plant.GetFrameByName(tip)
+    def __init__(self, plant, tip: str, beta: float, match: float = 0.0):
+        self.plant, self.frame, self.match = plant, plant.GetFrameByName(tip), float(match)
         self.context = plant.CreateDefaultContext()
         self.v_max = plant.GetVelocityUpperLimits()[:7]
         f = np.linspace(0.0, 1.0, 401)
@@ -74,21 +106,59 @@ class Planner:
         X = self.frame.CalcPoseInWorld(self.context)
         return X.translation(), X.rotation().matrix()
 
-    def plan(self, estimate: np.ndarray, t_plan: float, q_arm: np.ndarray) -> Optional[Plan]:
-        q_now = np.asarray(q_arm, float)
-        x_now = self.tip(q_now)[0]
+    def tf_needed(self, q_from, q_to) -> float:
+        """The planner's minimum tf from posture ``q_from`` to ``q_to`` (module docstring)."""
+        return TORQUE_MARGIN * self.xi_d_max * float(np.max(np.abs(q_to[:7] - q_from[:7]) / self.v_max))
+
+    def candidates(self, estimate: np.ndarray, t_plan: float, x_now: np.ndarray, near=None) -> list:
+        """(t_c, point, velocity) on the grid, above the floor and within ``REACH`` of ``x_now``,
+        nearest first (or nearest the time ``near``)."""
         times = t_plan + np.arange(GRID, HORIZON, GRID)
-        points = predict(estimate, times - t_plan)
-        velocities = estimate[3:6] + np.outer(times - t_plan, estimate[6:9])
-        best = None
-        for t_c, p, v in sorted(zip(times, points, velocities), key=lambda c: np.linalg.norm(c[1] - x_now)):
-            if p[2] < FLOOR_Z or np.linalg.norm(p - x_now) > 0.5:
-                continue
+        states = flight_states(estimate, times - t_plan)
+        kept = [(t, s[0:3], s[3:6]) for t, s in zip(times, states)
+                if s[2] >= FLOOR_Z and np.linalg.norm(s[0:3] - x_now) <= REACH]
+        if near is not None:
+            return sorted(kept, key=lambda c: abs(c[0] - near))
+        return sorted(kept, key=lambda c: np.linalg.norm(c[1] - x_now))
+
+    def plan(self, estimate: np.ndarray, t_plan: float, q_arm: np.ndarray, near=None) -> Optional[Plan]:
+        """The catch of the module docstring from ``estimate`` at ``t_plan`` with the arm at
+        ``q_arm``, or None (refused now); ``near``: the catch time of a plan it replaces (the
+        candidates nearest it first, not the nearest points)."""
+        q_now = np.asarray(q_arm, float)
+        self._left = False
+        for t_c, p, v in self.candidates(estimate, t_plan, self.tip(q_now)[0], near):
             q = self.ik(p, -v / np.linalg.norm(v), q_now)
             if q is None:
                 continue
-            tf = TORQUE_MARGIN * self.xi_d_max * float(np.max(np.abs(q[:7] - q_now[:7]) / self.v_max))
-            if t_c - t_plan >= max(tf, 0.1):
-                best = Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf)
-                break
-        return best
+            self._left = True
+            tf = self.tf_needed(q_now, q)
+            if t_c - t_plan >= max(tf, MIN_TF):
+                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, self.matchable(q, v))
+        return None
+
+    def matchable(self, q, v) -> float:
+        """The fraction of the ball's velocity ``v`` the hand may match at posture ``q``: the
+        configured one, or less, so that the joint speeds of the matched hand velocity alone
+        (J⁺ with the controller's rotation weighing, the orientation held) stay within
+        ``SPEED_SHARE`` of the joints' limits."""
+        if self.match <= 0.0:
+            return 0.0
+        self.plant.SetPositions(self.context, q)
+        world = self.plant.world_frame()
+        J = self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
+                                                   np.zeros(3), world, world)[:, :7]
+        J = np.vstack([ROT_SCALE * J[:3], J[3:]])
+        qd = np.linalg.lstsq(J, np.concatenate([np.zeros(3), v]), rcond=None)[0]
+        return float(min(self.match, SPEED_SHARE / np.max(np.abs(qd) / self.v_max)))
+
+    def hopeless(self) -> bool:
+        """After a refused ``plan``: no candidate was in reach at all (no point to try again)."""
+        return not self._left
+
+    def holds(self, plan: Plan, estimate: np.ndarray, t: float) -> bool:
+        """Whether ``plan`` still holds at ``t`` with the newer ``estimate`` (module docstring)."""
+        if plan.t_catch - t < 1e-9:
+            return True
+        p, v = np.split(flight_states(estimate, [plan.t_catch - t])[0], 2)
+        return p[2] >= FLOOR_Z and self.ik(p, -v / np.linalg.norm(v), plan.q) is not None

@@ -1,8 +1,18 @@
 """One catch run (issue 46): the station, the planner's target and close command, the controller
-in its slot; started from the arm settled at its start pose (``settle``); planned once at the
-end of the sensing (a new diagram resumed from the old state), the catch segment's null-space
-posture the planned catch posture (the redundant arm's self-motion led to where the planner's IK
-found the catch within the joint limits).
+in its slot; started from the arm settled at its start pose (``settle``).
+
+Planning (``revision_times``): from the end of the sensing, every ``catch.replan_every`` s, the
+planner looks at the newest estimate.  Without a plan it tries to make one; a refused plan is
+tried again at the next revision, until the ball (as estimated) has fallen below the floor
+height or no time is left for a catch and its hold.  With a plan it re-checks it
+(``Planner.holds``: the catch time's point re-predicted, still in reach in the time left) and
+replaces it only when it no longer holds and a new one exists.  The last revision is
+``catch.commit`` s before the catch time.  A new plan is a new diagram resumed from the old
+state (``replan``/``resume``) whose schedule ends the running segment there and starts a new TBG
+segment to the new catch time: the sliding surface captures s(t0) at a segment's start, so the
+law's torque does not jump with the target (only the null-space term does, by its posture's
+change: the catch segment's null-space posture is the plan's catch posture, so that the redundant
+arm's self-motion leads to where the planner's IK found the catch within the joint limits).
 
 Outcomes, each a truth test of the finished run (``outcome``), in this order:
 ``not reachable`` (no plan: the arm never moved); ``collision with <body>`` (the ball touched a
@@ -29,7 +39,7 @@ from ptint_drake.controllers import AddControllerTo
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.worlds.base import WorldRun
 from ptint_drake.worlds.catch.ball import BALL_DIAMETER
-from ptint_drake.worlds.catch.planner import Planner
+from ptint_drake.worlds.catch.planner import FLOOR_Z, MIN_TF, Planner
 from ptint_drake.worlds.catch.settle import SETTLE_STARTS, SETTLE_TF, snapshot, start_from
 from ptint_drake.worlds.catch.station import TIP, AddCatchStation, arm_plant
 from ptint_drake.worlds.catch.outcome import BallContacts, outcome
@@ -53,15 +63,16 @@ class CatchRun(WorldRun):
     def __init__(self, scenario, log: bool = True, settling: bool = False):
         self.scenario, c, self.settling = scenario, scenario.catch, settling
         self.arm = arm_plant()
-        self.planner = Planner(self.arm, TIP, c.beta)
+        self.planner = Planner(self.arm, TIP, c.beta, c.match)
         self.q0 = np.radians(scenario.robot.initial_q_deg)
         self.x0, self.R0 = self.planner.tip(self.q0)
         self.throw = throw(c.throw, self.x0)
         self.parked = RigidTransform([self.throw.launch[0], self.throw.launch[1], -10.0])
-        self.plan, self.planned, self._pieces, self.touched, self._at = None, False, [], {}, {}
+        self.plan, self.plans, self.gave_up, self._replan = None, [], None, False
+        self._pieces, self.touched, self._at = [], {}, {}
         self.simulator_config = SimulatorConfig(integration_scheme="explicit_euler", use_error_control=False,
                                                 max_step_size=0.001)
-        self.plant_time_step = 0.001
+        self.plant_time_step = c.time_step
         self._build()
 
     def schedule(self) -> Schedule:
@@ -70,12 +81,14 @@ class CatchRun(WorldRun):
             return Schedule([Segment(start, SETTLE_TF, c.beta) for start in SETTLE_STARTS])
         if self.plan is None:
             return Schedule([Segment(0.0, c.sensing, c.beta), Segment(c.sensing, 0.6, c.beta)])
-        t_plan, t_c = self.plan.t_plan, self.plan.t_catch
-        t_mid = t_c - c.final
-        if c.final <= 0.0 or t_mid - t_plan < c.final:
-            return Schedule([Segment(0.0, t_plan, c.beta), Segment(t_plan, t_c - t_plan, c.beta)])
-        return Schedule([Segment(0.0, t_plan, c.beta), Segment(t_plan, t_mid - t_plan, c.beta),
-                         Segment(t_mid, c.final, c.beta)])
+        starts = sorted({0.0, c.sensing, *(p.t_plan for p in self.plans)})
+        ends = starts[1:] + [self.plan.t_catch]
+        segments = [Segment(a, _span(a, b), c.beta) for a, b in zip(starts, ends)]
+        last = segments[-1]
+        if c.final > 0.0 and last.tf >= 2.0 * c.final:
+            segments[-1:] = [Segment(last.start, last.tf - c.final, c.beta),
+                             Segment(last.end - c.final, c.final, c.beta)]
+        return Schedule(segments)
 
     def _build(self) -> None:
         c, builder = self.scenario.catch, DiagramBuilder()
@@ -113,9 +126,21 @@ class CatchRun(WorldRun):
         v0 = SpatialVelocity(np.zeros(3), np.array(self.throw.velocity))
         st.plant.SetFreeBodySpatialVelocity(pc, st.ball, v0)
 
+    def revision_times(self) -> list[float]:
+        """When the plan is made or revised (module docstring): from the sensing's end every
+        ``replan_every`` s, until the commit time of a plan, else until the planner has nothing
+        left to try or the run has no time left for a catch."""
+        c = self.scenario.catch
+        if self.plan is not None:
+            end = self.plan.t_catch - c.commit
+        else:
+            end = self.gave_up if self.gave_up is not None else self.scenario.duration - c.held_for - MIN_TF
+        n = int(np.floor((end - c.sensing) / c.replan_every + 1e-9)) + 1
+        return [round(c.sensing + k * c.replan_every, 9) for k in range(max(n, 1))]
+
     def stops(self) -> list[float]:
         c = self.scenario.catch
-        ends = [self.scenario.duration, c.sensing]
+        ends = [self.scenario.duration, *self.revision_times()]
         if self.plan is not None:
             ends += [self.plan.t_catch, self.plan.t_catch + 0.1, self.plan.t_catch + c.held_for]
         return sorted(set(t for t in ends if t <= self.scenario.duration))
@@ -126,16 +151,28 @@ class CatchRun(WorldRun):
         tip = self.planner.tip(st.plant.GetPositions(pc, st.arm))[0]
         ball = st.plant.EvalBodyPoseInWorld(pc, st.ball).translation()
         self._at[t] = (float(np.linalg.norm(tip - ball)), float(np.sum(st.plant.GetPositions(pc, st.hand))))
-        if t == self.scenario.catch.sensing and not self.planned:
-            estimate = st.estimate.Eval(st.estimator.GetMyContextFromRoot(context))
-            q = st.plant.GetPositions(st.plant.GetMyContextFromRoot(context), st.arm)
-            self.plan = self.planner.plan(np.asarray(estimate), t, q) if np.any(estimate[3:6]) else None
-            self._replan = True
+        if self.gave_up is None and t in self.revision_times():
+            estimate = np.asarray(st.estimate.Eval(st.estimator.GetMyContextFromRoot(context)))
+            self._revise(estimate, t, st.plant.GetPositions(pc, st.arm))
+
+    def _revise(self, estimate: np.ndarray, t: float, q: np.ndarray) -> None:
+        """Plan, or revise the plan, at ``t`` (module docstring)."""
+        if not np.any(estimate[3:6]):
+            return
+        if self.plan is not None and self.planner.holds(self.plan, estimate, t):
+            return
+        new = self.planner.plan(estimate, t, q, None if self.plan is None else self.plan.t_catch)
+        if new is None:
+            if self.plan is None and estimate[2] < FLOOR_Z and estimate[5] < 0.0:
+                self.gave_up = t  # the ball is gone
+            return
+        self.plan, self._replan = new, True
+        self.plans.append(new)
 
     def replan(self, context, t: float) -> bool:
-        if not getattr(self, "_replan", False):
+        if not self._replan:
             return False
-        self._replan, self.planned = False, True
+        self._replan = False
         self._pieces.append(tuple(log.FindLog(context) for log in self._logs()))
         self._build()
         return True
@@ -156,6 +193,7 @@ class CatchRun(WorldRun):
                    "catch": {"throw": self.throw.seed, "outcome": name, "caught": name == "caught",
                              "t_catch": plan.t_catch if plan else None,
                              "tf_min": plan.tf_min if plan else None,
+                             "plans": [_plan_row(p) for p in self.plans],
                              "catch_point": plan.point.tolist() if plan else None,
                              "catch_posture_deg": np.degrees(plan.q[:7]).tolist() if plan else None,
                              "error_at_catch_m": at_catch[0] if at_catch else None,
@@ -165,3 +203,17 @@ class CatchRun(WorldRun):
 
     def _logs(self) -> tuple:
         return self.logger, self.estimate_log, self.target_log
+
+
+def _span(a: float, b: float) -> float:
+    """b − a, rounded down so that a + (b − a) ≤ b (a segment ends before the next one starts)."""
+    tf = b - a
+    while a + tf > b:
+        tf = np.nextafter(tf, 0.0)
+    return float(tf)
+
+
+def _plan_row(plan) -> dict:
+    """A plan as the metrics list the revisions: when it was made, its catch time and point."""
+    return {"t_plan": round(plan.t_plan, 6), "t_catch": round(plan.t_catch, 6), "match": round(plan.match, 3),
+            "point": np.round(plan.point, 5).tolist(), "tf_min": round(plan.tf_min, 4)}

@@ -1,12 +1,21 @@
 """The catch station (issue 46): the KUKA iiwa 14, the full-size WSG 50-110 welded at its tip
 frame, the foam ball with the truth side's air drag, on one discrete plant (1 ms, point contact,
-SAP), the gripper's driver, and the formula camera (60 Hz) on the ball feeding the ballistic
-estimator (``estimator: auto``).
+SAP), the gripper's driver, and the formula camera (60 Hz) on the ball feeding the ball's
+estimator: the fit of its dragged flight (``flight_estimator``; ``catch.predictor: fit``, the
+default) or the scenario's camera estimator (``catch.predictor: auto``, the IMM).
 
 ``AddCatchStation`` adds it to a builder and returns the handles: the arm's ``state`` and
 ``actuation`` ports (the controller's only wiring to the plant), the gripper's ``command`` input,
 the estimate's port ([p, v, a] of the ball, what the planner reads) and, for the metrics only,
-the whole plant's state.  ``arm_plant`` is the arm alone (continuous): the
+the whole plant's state.  The plant's step is ``catch.time_step`` (1 ms).
+
+The hand's contact.  Its model gives its geometries no relaxation time (SAP's dissipation), and
+SAP's default then (0.1 s, measured: the same as 0.1 given) makes a contact of the ball with the
+hand a dead impact that stops the ball's approach speed within one step, a force of m Δv / h
+that doubles when the step is halved (a 3 m/s drop on such a box: 110.8 N at 1 ms, 205.7 N at
+0.5 ms).  The station gives them ``HAND_RELAXATION_TIME`` = 1 ms, so that the foam ball's impact
+lasts ~8 ms, its force set by the ball's compliance (the same drop: 37.5 / 34.8 / 33.9 N at
+1 / 0.5 / 0.25 ms, a rebound of 0.43–0.49).  ``arm_plant`` is the arm alone (continuous): the
 controller's and the planner's kinematics.
 """
 
@@ -15,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, ProximityProperties, RoleAssign
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, MultibodyPlantConfig
@@ -28,8 +37,10 @@ from ptint_drake.systems.estimation.imm import AdaptiveTargetEstimator
 from ptint_drake.systems.hand.gripper import GripperDriver
 from ptint_drake.systems.perception.camera import Camera
 from ptint_drake.worlds.catch.ball import AddAirDrag, AddBall
+from ptint_drake.worlds.catch.flight_estimator import FlightEstimator
 
 FINGERS = ("left_finger_joint", "right_finger_joint")
+HAND_RELAXATION_TIME = 0.001  # s (module docstring)
 TIP = "schunk_wsg_50_110_full_tip"
 
 
@@ -40,6 +51,19 @@ def _add_arm_and_hand(plant: MultibodyPlant, gripper):
     plant.WeldFrames(plant.GetFrameByName(TIP, arm), plant.GetFrameByName("fingertip_center", hand),
                      RigidTransform())
     return arm, hand
+
+
+def _relax_hand(plant: MultibodyPlant, scene_graph, hand) -> None:
+    """Give the hand's collision geometries ``HAND_RELAXATION_TIME`` (module docstring)."""
+    inspector = scene_graph.model_inspector()
+    for body in plant.GetBodyIndices(hand):
+        for gid in plant.GetCollisionGeometriesForBody(plant.get_body(body)):
+            props = ProximityProperties(inspector.GetProximityProperties(gid))
+            if props.HasProperty("material", "relaxation_time"):
+                props.UpdateProperty("material", "relaxation_time", HAND_RELAXATION_TIME)
+            else:
+                props.AddProperty("material", "relaxation_time", HAND_RELAXATION_TIME)
+            scene_graph.AssignRole(plant.get_source_id(), gid, props, RoleAssign.kReplace)
 
 
 def arm_plant() -> MultibodyPlant:
@@ -59,7 +83,7 @@ class CatchStation:
     ball: object
     driver: GripperDriver
     camera: Camera
-    estimator: AdaptiveTargetEstimator
+    estimator: object  # a FlightEstimator or an AdaptiveTargetEstimator
     state: object  # the arm's [q; v] output
     actuation: object  # the arm's torque input
     command: object  # the gripper's opening command input
@@ -70,9 +94,11 @@ class CatchStation:
 def AddCatchStation(builder: DiagramBuilder, scenario) -> CatchStation:
     """The station of ``scenario`` (module docstring) in ``builder``."""
     g = scenario.catch.gripper
+    step = scenario.catch.time_step
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(
-        time_step=0.001, contact_model="point", discrete_contact_approximation="sap"), builder)
+        time_step=step, contact_model="point", discrete_contact_approximation="sap"), builder)
     arm, hand = _add_arm_and_hand(plant, g)
+    _relax_hand(plant, scene_graph, hand)
     ball = AddBall(plant)
     stroke = 0.0
     for name in FINGERS:
@@ -95,15 +121,16 @@ def AddCatchStation(builder: DiagramBuilder, scenario) -> CatchStation:
     plant.SetDefaultPositions(arm, np.radians(scenario.robot.initial_q_deg))
     AddAirDrag(builder, plant, ball)
     driver = builder.AddNamedSystem("gripper_driver", GripperDriver(stroke, g.speed, g.max_force, g.kp,
-                                                                     g.initial_opening, 0.001))
+                                                                     g.initial_opening, step))
     builder.Connect(driver.GetOutputPort("desired_state"), plant.get_desired_state_input_port(hand))
     builder.Connect(plant.get_state_output_port(hand), driver.GetInputPort("finger_state"))
     split = builder.AddNamedSystem("ball_state", Demultiplexer([4, 3, 6]))
     builder.Connect(plant.get_state_output_port(ball.model_instance()), split.get_input_port())
     camera = builder.AddNamedSystem("camera_0", Camera(config=scenario.measurement, seed_offset=0))
     builder.Connect(split.get_output_port(1), camera.get_x_true_input_port())
-    estimator = builder.AddNamedSystem("ball_estimator", AdaptiveTargetEstimator(config=scenario.measurement))
+    chosen = (FlightEstimator if scenario.catch.predictor == "fit" else AdaptiveTargetEstimator)
+    estimator = builder.AddNamedSystem("ball_estimator", chosen(config=scenario.measurement))
     builder.Connect(camera.get_measurement_output_port(), estimator.get_measurement_input_port())
     return CatchStation(plant, arm, hand, ball, driver, camera, estimator, plant.get_state_output_port(arm),
                         plant.get_actuation_input_port(arm), driver.GetInputPort("command"),
-                        estimator.GetOutputPort("target"), stroke)
+                        estimator.get_target_output_port(), stroke)

@@ -5,24 +5,32 @@ the hand's orientation, and the close command.
 start pose.  From t_plan on, the prescribed-time law aims at a *moving* target that reaches the
 ball's predicted centre at exactly t_catch:
 
-    p_c(t)  = p̂ + v̂ T + ½ â T²,  T = t_catch − t    (the estimate's catch point; with a
-                                                       ballistic estimate d/dt p_c = 0)
-    x_r(t)  = p_c + m w(t) (p̂ − p_c),  w = exp(−T / τ_m)
-    ẋ_r     = m (w v̂ + (w / τ_m)(p̂ − p_c)),   ẍ_r = m (w â + 2 (w / τ_m) v̂ + (w / τ_m²)(p̂ − p_c))
+    p_c(t)  = the estimate's flight at T = t_catch − t   (``flight.propagate`` from [p̂, v̂]
+                                                        with the drag c of â; along that
+                                                        flight d/dt p_c = 0)
+    v_c(t)  = the ball's velocity there
+    x_r(t)  = p_c − m v_c τ_m S(x),  ẋ_r = m v_c g(x),  ẍ_r = −(m v_c / τ_m) g'(x),  x = min(T / τ_m, 1)
+    g(x)    = 1 − 10x³ + 15x⁴ − 6x⁵  (from 1 at x = 0 to 0 at x = 1, flat at both ends),
+    S(x)    = ∫₀ˣ g = x − 2.5x⁴ + 3x⁵ − x⁶  (S(1) = ½)
 
-so that x_r(t_catch) = p̂(t_catch), the ball's estimated centre, and ẋ_r(t_catch) = m v̂: the
-hand arrives moving with the ball at the fraction m (``catch.match``; 0: it waits at the
-point) and the ball enters between the jaws at (1 − m) of its speed.  w switches the matching on
-only in the last few τ_m (``catch.match_time``): earlier, x_r is the catch point itself (the
-largest offset, m |v| τ_m / e, at T = τ_m).  Every term is recomputed from the estimate each
-time the controller reads it, so the law tracks the catch point as the estimate converges (the
-paper's interception of a known moving target, the knowledge improving as frames come in);
-from ``freeze`` s before t_catch (``catch.freeze``) the estimate is held: the hand then
-occludes the ball and the ball, once held, moves with the hand.
+so that x_r(t_catch) = p_c, the ball's estimated centre, and ẋ_r(t_catch) = m v_c: the hand
+arrives moving with the ball at the fraction m (the plan's: ``catch.match`` within the joints'
+speed limits, ``planner.Planner.matchable``; 0: it waits at the point) and
+the ball enters between the jaws at (1 − m) of its speed.  Before the last τ_m
+(``catch.match_time``) the target is the point ½ m τ_m |v_c| back along the ball's path;
+in the last τ_m the hand speeds up along the path to m v_c, with no jump in its reference's
+acceleration at either end and the largest, 1.875 m |v_c| / τ_m, half way (an exponential
+onset instead, as first tried, asked for 2 m |v_c| / τ_m at the catch itself: 48 m/s² at
+τ_m = 0.05 s and 4 m/s, which the arm did not follow: the hand 7–10 mm behind its target at
+the catch).  Every term is recomputed from the estimate each time the controller reads it, so
+the law tracks the catch point as the estimate converges (the paper's interception of a known
+moving target, the knowledge improving as frames come in); from ``freeze`` s before t_catch
+(``catch.freeze``) the estimate is held: the hand then occludes the ball and the ball, once
+held, moves with the hand.
 
-After t_catch the target brakes: x_r = x_c + u τ_b (1 − e^(−τ/τ_b)), ẋ_r = u e^(−τ/τ_b),
-u = ẋ_r(t_catch), τ = t − t_catch, τ_b = ``BRAKE_TIME`` (the hand and the ball come to rest
-within ~4 τ_b, m |v| τ_b further on).
+After t_catch the target brakes the same way: ẋ_r = u g(y), x_r = x_c + u τ_b S(y),
+y = min((t − t_catch) / τ_b, 1), u = ẋ_r(t_catch), τ_b = ``BRAKE_TIME``: at rest after τ_b,
+½ u τ_b further on.
 
 ``CloseCommand`` opens the hand to its pre-shape and closes it at ``close_time``: t_catch −
 (pre-shape − ball) / 2 / jaw speed (each jaw moves at the driver's speed), so the jaws reach the
@@ -35,27 +43,34 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from ptint_drake.controllers.slot import TargetView
+from ptint_drake.worlds.catch.flight import from_estimate, propagate
 
-BRAKE_TIME = 0.04  # s
+BRAKE_TIME = 0.1  # s
+
+
+def _ramp(x: float) -> tuple:
+    """(S, g, g') of the module docstring at x (clipped to [0, 1])."""
+    x = min(max(x, 0.0), 1.0)
+    x3 = x * x * x
+    return (x - 2.5 * x3 * x + 3.0 * x3 * x * x - x3 * x3, 1.0 - 10.0 * x3 + 15.0 * x3 * x - 6.0 * x3 * x * x,
+            -30.0 * x * x + 60.0 * x3 - 30.0 * x3 * x)
 
 
 def catch_reference(estimate: np.ndarray, T: float, m: float, tau_m: float) -> np.ndarray:
     """[x_r, ẋ_r, ẍ_r] (9) of the module docstring from an estimate [p̂, v̂, â], T = t_catch − t."""
-    p, v, a = estimate[0:3], estimate[3:6], estimate[6:9]
+    p, v = estimate[0:3], estimate[3:6]
     T = max(T, 0.0)
-    p_c = p + v * T + 0.5 * a * T * T
-    w, d = np.exp(-T / tau_m), p - p_c
-    x = p_c + m * w * d
-    xd = m * (w * v + (w / tau_m) * d)
-    xdd = m * (w * a + 2.0 * (w / tau_m) * v + (w / tau_m ** 2) * d)
-    return np.concatenate([x, xd, xdd])
+    state = propagate(p, v, from_estimate(estimate), 0.0, [T])[0] if T > 0.0 else np.concatenate([p, v])
+    p_c, v_c = state[0:3], state[3:6]
+    S, g, g1 = _ramp(T / tau_m)
+    return np.concatenate([p_c - m * tau_m * S * v_c, m * g * v_c, -(m / tau_m) * g1 * v_c])
 
 
 def braking(at_catch: np.ndarray, tau: float) -> np.ndarray:
     """[x_r, ẋ_r, ẍ_r] ``tau`` s after the catch from the reference there (module docstring)."""
     x, u = at_catch[0:3], at_catch[3:6]
-    f = np.exp(-tau / BRAKE_TIME)
-    return np.concatenate([x + u * BRAKE_TIME * (1.0 - f), u * f, -u * f / BRAKE_TIME])
+    S, g, g1 = _ramp(tau / BRAKE_TIME)
+    return np.concatenate([x + BRAKE_TIME * S * u, g * u, (g1 / BRAKE_TIME) * u])
 
 
 class CatchTarget(LeafSystem):
@@ -65,7 +80,7 @@ class CatchTarget(LeafSystem):
     def __init__(self, start: np.ndarray, R_start: np.ndarray, plan, catch):
         super().__init__()
         self._plan, self._start, self._R0 = plan, np.asarray(start, float), np.asarray(R_start, float)
-        self._m, self._tau_m, self._freeze = float(catch.match), float(catch.match_time), float(catch.freeze)
+        self._tau_m, self._freeze = float(catch.match_time), float(catch.freeze)
         self._in = self.DeclareVectorInputPort("estimate", 9)
         self._held = self.DeclareDiscreteState(BasicVector(np.zeros(10)))  # [held?, estimate]
         if plan is not None:
@@ -86,8 +101,8 @@ class CatchTarget(LeafSystem):
         live = t < plan.t_catch - self._freeze or held[0] == 0.0
         estimate = self._in.Eval(context) if live else self._extrapolated(held[1:], t)
         if t <= plan.t_catch:
-            return catch_reference(estimate, plan.t_catch - t, self._m, self._tau_m)
-        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, self._m, self._tau_m)
+            return catch_reference(estimate, plan.t_catch - t, plan.match, self._tau_m)
+        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, plan.match, self._tau_m)
         return braking(at_catch, t - plan.t_catch)
 
     def _extrapolated(self, held: np.ndarray, t: float) -> np.ndarray:

@@ -35,7 +35,7 @@ class CatchWorld(World):
         return [] if name == "caught" else [Reason(None, "catch", f"not caught: {name}")]
 
     def own_plant_step(self, scenario) -> float:
-        return 0.001
+        return scenario.catch.time_step
 
     def robust_sample(self, scenario, name: str, seed: int, u) -> tuple:
         scenario.catch.throw = int(seed)
