@@ -14,7 +14,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.catch import ball
-from tests.script_module import load_script
+from script_module import load_script
 
 
 def test_the_drop_test_gives_the_tuned_restitution_and_the_dissipation_sets_it():

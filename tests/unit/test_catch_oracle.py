@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.script_module import load_script
+from script_module import load_script
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,7 @@ import numpy as np
 from ptint_drake.worlds.catch import thrower
 from ptint_drake.worlds.catch.planner import Planner
 from ptint_drake.worlds.catch.station import TIP, arm_plant
-from tests.script_module import load_script
+from script_module import load_script
 
 Q0 = np.radians([0.0, 30.0, 0.0, -95.0, 0.0, -95.0, 90.0])
 

@@ -121,6 +121,8 @@ class PlanningScene:
             body = plant.GetBodyFromFrameId(inspector.GetFrameId(g))
             self.names[g] = inspector.GetName(g).split("::")[-1] if body.index() == 0 else body.name()
         self.part_ids = [set(plant.GetCollisionGeometriesForBody(b)) for b in self.parts]
+        hands = {g for body in self.hands.values() for g in plant.GetCollisionGeometriesForBody(body)}
+        self.obstacles = [g for g in inspector.GetAllGeometryIds() if g not in hands]
 
     def nearest(self, world: Nominal, tool: np.ndarray, t: float, held: "int | None", radius: float) -> tuple:
         """(distance, (mover, obstacle)) of the hand of ``radius`` at ``tool`` — and the ``held``
@@ -140,14 +142,16 @@ class PlanningScene:
         movers = hand_ids | (self.part_ids[held] if held is not None else set())
         query = self.scene_graph.get_query_output_port().Eval(self.sg_context)
         best = (np.inf, ("hand", ""))
-        for pair in query.ComputeSignedDistancePairwiseClosestPoints(HAND_MARGIN):
-            a, b = pair.id_A, pair.id_B
-            if (a in movers) == (b in movers):  # the parked hands are far from all and only near each other
-                continue
-            mover, other = (a, b) if a in movers else (b, a)
-            if pair.distance < best[0]:
-                best = (pair.distance, ("hand" if mover in hand_ids else f"held {self.names[mover]}",
-                                        self.names[other]))
+        # mover against obstacle only, pair by pair: the obstacles touch each other (a part resting
+        # on its belt), and Drake's box-box gradient of two touching boxes fails its own check
+        for mover in movers:
+            for other in self.obstacles:
+                if other in movers:
+                    continue
+                pair = query.ComputeSignedDistancePairClosestPoints(mover, other)
+                if pair.distance < best[0]:
+                    best = (pair.distance, ("hand" if mover in hand_ids else f"held {self.names[mover]}",
+                                            self.names[other]))
         return best
 
 
