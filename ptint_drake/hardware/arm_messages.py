@@ -73,13 +73,7 @@ def panda_status(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> byt
 
 def panda_unpack_status(data: bytes, n: int) -> tuple[int, np.ndarray, np.ndarray]:
     """(utime, q, v) of an ``lcmt_panda_status``; ValueError naming what is wrong."""
-    try:
-        m = lcmt_panda_status.decode(data)
-    except Exception as exc:  # noqa: BLE001  (the decoder raises ValueError or struct.error)
-        raise ValueError(f"an undecodable status message ({type(exc).__name__})") from None
-    if m.num_joints != n or len(m.joint_position) != n or len(m.joint_velocity) != n:
-        raise ValueError(f"a status of {m.num_joints} joints, the scenario's arm has {n}")
-    return m.utime, np.array(m.joint_position), np.array(m.joint_velocity)
+    return link.decoded_status(lcmt_panda_status, data, n, "joint_position", "joint_velocity")
 
 
 def panda_command(utime: int, tau: np.ndarray, positions: Optional[np.ndarray],

@@ -235,15 +235,22 @@ def pack_status(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> byte
     return m.encode()
 
 
-def unpack_status(data: bytes, n: int) -> tuple[int, np.ndarray, np.ndarray]:
-    """(utime, q, v) of an ``lcmt_iiwa_status``; ValueError naming what is wrong."""
+def decoded_status(message_type, data: bytes, n: int, position: str, velocity: str) -> tuple:
+    """(utime, q, v) of a status message of ``message_type`` whose fields ``position`` and
+    ``velocity`` hold q and v; ValueError naming what is wrong (undecodable, another joint count)."""
     try:
-        m = lcmt_iiwa_status.decode(data)
+        m = message_type.decode(data)
     except Exception as exc:  # noqa: BLE001  (the decoder raises ValueError or struct.error)
         raise ValueError(f"an undecodable status message ({type(exc).__name__})") from None
-    if m.num_joints != n or len(m.joint_position_measured) != n or len(m.joint_velocity_estimated) != n:
+    q, v = getattr(m, position), getattr(m, velocity)
+    if m.num_joints != n or len(q) != n or len(v) != n:
         raise ValueError(f"a status of {m.num_joints} joints, the scenario's arm has {n}")
-    return m.utime, np.array(m.joint_position_measured), np.array(m.joint_velocity_estimated)
+    return m.utime, np.array(q), np.array(v)
+
+
+def unpack_status(data: bytes, n: int) -> tuple[int, np.ndarray, np.ndarray]:
+    """(utime, q, v) of an ``lcmt_iiwa_status``; ValueError naming what is wrong."""
+    return decoded_status(lcmt_iiwa_status, data, n, "joint_position_measured", "joint_velocity_estimated")
 
 
 def status_torque(data: bytes) -> np.ndarray:

@@ -217,8 +217,8 @@ def obstacle_vias(scenario, world: Nominal, replans: tuple, vias: tuple) -> tupl
     obstacle and has no via yet, where one clears (module docstring)."""
     pick = scenario.pick
     scene = PlanningScene(scenario)
-    checked = [(s.task, s.phase) for s in (pick_plan(pick, replans, vias).segments[i]
-                                          for i in checked_segments(pick_plan(pick, replans, vias)))]
+    plan = pick_plan(pick, replans, vias)
+    checked = [(plan.segments[i].task, plan.segments[i].phase) for i in checked_segments(plan)]
     for task, phase in checked:
         if any(v.task == task and v.phase == phase for v in vias):
             continue
