@@ -84,7 +84,7 @@ def test_a_frame_fitted_in_the_worker_leaves_the_estimator_as_its_own_update():
         assert not _state(estimates, simulator.get_context())[0].any()
         for t in times[1:]:
             frames.submit(t, pack_depth_image(t, image, "camera"))
-        time.sleep(10 * latency)  # the fits back before they are due, as in real time (the latency)
+        frames.prefetch()  # the fits back before they are due, as in real time (the latency)
         for t in times:
             frames.take_due(simulator.get_mutable_context(), t + latency)
             simulator.AdvanceTo(t + latency)
