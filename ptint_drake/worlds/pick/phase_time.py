@@ -46,6 +46,7 @@ from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.feasibility import Way, way_motion, way_postures, way_profile
 from ptint_drake.worlds.pick.route import nearest_branch
 from ptint_drake.worlds.pick.station import MakePickStation
+from ptint_drake.worlds.pick.tasks import place_target
 from ptint_drake.worlds.pick.ways import nominal
 
 MARGIN = 1.15  # over the model's shortest tf (module docstring)
@@ -254,7 +255,7 @@ def task_cycles(scenario, model: Optional[PhaseTimes] = None) -> list:
         t = max(t, task.start)
         j = names.index(task.part)
         p0, ride = world.parts[j]
-        place_yaw = float(np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg))
+        place_yaw = place_target(pick, task)[2]
         cycle = cycle_time(model, p0 + ride * t, ride, world.places[k], place_yaw, world.part_yaws[j],
                            pick.parts[j].mass, task, x, yaw)
         out.append(cycle)

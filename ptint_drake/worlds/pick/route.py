@@ -48,7 +48,7 @@ import numpy as np
 
 from ptint_drake.worlds.pick.obstacles import obstacle_vias
 from ptint_drake.robot.reachability import inverse_kinematics
-from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
+from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, nominal, nominal_paths
 
 INNER_MARGIN = 0.04  # m: a way closer than this to the inner edge of the top-down workspace is too near
@@ -152,7 +152,7 @@ def tool_yaws(world: Nominal, plan: PickPlan) -> list:
     R = world.frame.CalcPoseInWorld(context).rotation().matrix()
     yaw, out = float(np.arctan2(R[1, 0], R[0, 0])), []
     for seg in plan.segments:
-        target = seg.yaw if seg.kind in ("slot", VIA_SLOT) else world.part_yaws[seg.index]
+        target = seg.yaw if seg.kind in (*PLACES, VIA_SLOT) else world.part_yaws[seg.index]
         end = nearest_branch(yaw, target)
         out.append((yaw, end))
         yaw = end
