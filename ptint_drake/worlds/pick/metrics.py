@@ -150,6 +150,19 @@ def _at(t: np.ndarray, when: float) -> int:
     return min(max(int(np.searchsorted(t, when + 1e-9, side="right")) - 1, 0), len(t) - 1)
 
 
+def _destination(built, k: int, part, end: np.ndarray) -> tuple:
+    """Task k's place as metrics: ({"slot": its slot} or {"slot": None, "bin", "in_bin"},
+    {"place_error_mm", "place_error_deg"}) from the part's probe row at the end, ``end``."""
+    plan = built.plan
+    i = plan.segment_index(k, "place")
+    into = plan.segments[i]
+    box = built.station.config.bins[into.index] if into.kind == "bin" else None
+    where = ({"slot": into.index} if box is None
+             else {"slot": None, "bin": box.name, "in_bin": in_bin(box, end[0:3])})
+    return where, {"place_error_mm": float(1e3 * np.linalg.norm(end[0:3] - built.targets.places[i])),
+                   "place_error_deg": _place_angle(rotation_of(end[3:7]), into.yaw, part.shape, part.size)}
+
+
 def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
     from ptint_drake.systems.hand.gripper import GRASP_STATES, HOLDING  # noqa: PLC0415
 
@@ -194,14 +207,8 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
         details.append({"t_close_command": a.close, "t_grasp_prescribed": a.grasp, "t_check": t_check,
                         "state": checks[j]["state"] if j < len(checks) else None,
                         "peak_grip_force_N": float(np.max(grip[span])) if np.any(span) else 0.0})
-    i_place_seg = plan.segment_index(k, "place")
-    place, place_yaw = built.targets.places[i_place_seg], plan.segments[i_place_seg].yaw
-    R_end = rotation_of(block[-1, 3:7])
-    into = plan.segments[i_place_seg]
-    box = built.station.config.bins[into.index] if into.kind == "bin" else None
-    into_bin = {} if box is None else {"bin": box.name, "in_bin": in_bin(box, block[-1, 0:3])}
-    return {"part": part.name, "part_index": part_index, "slot": into.index if box is None else None,
-            **into_bin,
+    where, error = _destination(built, k, part, block[-1])
+    return {"part": part.name, "part_index": part_index, **where,
             "grasped": grasped, "t_grasp": t_grasp, "t_grasp_prescribed": last.grasp,
             "t_close_command": last.close, "attempts": len(attempts), "attempt_details": details,
             "grasp_confirmed": confirmed,
@@ -211,9 +218,7 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
             "grip_force_N": float(grip[i_lift]),
             "slip_mm": None if slip is None else 1e3 * slip,
             "peak_grip_force_N": float(np.max(grip[in_carry])) if np.any(in_carry) else 0.0,
-            "place_error_mm": float(1e3 * np.linalg.norm(block[-1, 0:3] - place)),
-            "place_error_deg": _place_angle(R_end, place_yaw, part.shape, part.size),
-            "collision": collision, "collision_before_close": early}
+            **error, "collision": collision, "collision_before_close": early}
 
 
 def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> dict:
