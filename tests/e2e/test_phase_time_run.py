@@ -6,10 +6,8 @@ cycle estimate."""
 
 from pathlib import Path
 
-import numpy as np
-
 from ptint_drake.simulation.scenario import load_scenario
-from ptint_drake.worlds.pick.phase_time import MARGIN, task_cycles
+from ptint_drake.worlds.pick.phase_time import MARGIN, capacity, task_cycles
 
 SCENARIO = str(Path(__file__).resolve().parents[1] / "min_tf_pick.yaml")
 
@@ -26,5 +24,5 @@ def test_a_run_at_the_model_tfs_places_every_part_within_the_joint_limits(run):
     rows = m["segments"]
     end = max(r["start"] + r["tf"] for r in rows)
     measured = 60.0 * len(m["picks"]) / end  # picks per minute, the first approach to the last retreat
-    estimate = float(np.mean([c.capacity for c in task_cycles(load_scenario(SCENARIO))]))
+    estimate = capacity(task_cycles(load_scenario(SCENARIO)))
     assert abs(measured / estimate - 1.0) <= 0.2, (measured, estimate)

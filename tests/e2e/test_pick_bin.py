@@ -42,6 +42,7 @@ BAD = {
     "no such bin": (("pick.tasks[0].bin=crate",), "pick.tasks[0].bin", "no bin named 'crate'"),
     "a bin out of reach": (("pick.bins[0].center=[0.6, 0.6, 0.06]",), "pick.bins[0]", "outside what the arm"),
     "a bin of two sizes": (("pick.bins[0].size=[0.1, 0.1]",), "pick.bins[0].size", "needs 3 values"),
+    "a bin without walls": (("pick.bins[0].wall=0",), "pick.bins[0].wall", "must be positive"),
     "a bin named as the belt": (("pick.bins[0].name=belt", "pick.tasks[0].bin=belt"), "pick.bins[0].name",
                                 "taken"),
 }

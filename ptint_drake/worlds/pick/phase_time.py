@@ -29,7 +29,8 @@ and during the run", and the torque bound sits on the unmodelled contact and gri
 to ``clearance`` above a part riding its belt, the descend, the close dwell, the lift, the carry to
 ``lift_height`` above the place, the place, the open dwell and the retreat, each phase's way
 starting where the previous one ended (the straight way: a via, ``route``, shares its phase's
-tf); ``capacity`` = 60 / cycle, picks per minute.
+tf); ``Cycle.capacity`` = 60 / cycle, picks per minute, and ``capacity`` of a sequence of cycles
+(``task_cycles``: a scenario's tasks one after the other).
 """
 
 from __future__ import annotations
@@ -263,6 +264,11 @@ def task_cycles(scenario, model: Optional[PhaseTimes] = None) -> list:
         x, yaw = world.places[k] + [0.0, 0.0, task.clearance], nearest_branch(nearest_branch(
             yaw, world.part_yaws[j]), place_yaw)
     return out
+
+
+def capacity(cycles: list) -> float:
+    """Picks per minute of ``cycles`` (``Cycle``) run one after the other: 60 · n / their total time."""
+    return 60.0 * len(cycles) / sum(c.total for c in cycles)
 
 
 def rounded_up(tf: float, step: float = 0.01) -> float:
