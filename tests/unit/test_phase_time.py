@@ -68,9 +68,9 @@ def test_the_scenario_runs_the_model_tfs_unwarned_and_seven_tenths_of_them_are_w
     floor is the fingers' close)."""
     scenario = load_scenario(MIN_TF_PICK)
     cycles = task_cycles(scenario)
-    for task, cycle in zip(scenario.pick.tasks, cycles):
-        model_tfs = {p: rounded_up(tf) for p, tf in cycle.phases.items()}
-        assert {p: getattr(task, p).tf for p in PHASES} == model_tfs
+    for task, cycle in zip(scenario.pick.tasks, cycles):  # rounded up (1 ms either side: other Drakes)
+        for phase, tf in cycle.phases.items():
+            assert tf - 0.001 <= getattr(task, phase).tf <= rounded_up(tf) + 0.001, (phase, tf)
     assert feasibility_warnings(scenario, build_pick(scenario)) == []
     for task in scenario.pick.tasks:
         for phase in PHASES:
