@@ -156,6 +156,7 @@ class HardwareSession:
             self.record.accepted += 1
             self.record.last_command_t = utime * 1e-6
             self.record.rtt.append(t_recv - self._sent[utime])
+            self._answer_wall = t_recv
             return None
         if self._answered is not None and utime < self._answered:
             return self._fail(
@@ -167,14 +168,19 @@ class HardwareSession:
                 f"restarted controller",
             )
         if utime in self._sent and (self._pending is None or utime < self._pending):
-            self.record.late_commands += 1  # real time: an answer after its tick
-            return None
+            return self._late(utime, t_recv)
         return self._fail(
             t,
             "second sender",
             f"a command for t = {utime * 1e-6:.6g} s that no status asked "
             f"for, at t = {t:.3f} s: a second sender on {self.endpoint.listen}",
         )
+
+    def _late(self, utime: int, t_recv: float) -> None:
+        """Real time: an answer to an older status than the pending one, after its tick."""
+        self.record.late_commands += 1
+        self.record.late_utime.append(utime)
+        self.record.late_wall.append(t_recv)
 
     def _check_gripper(self, t: float, data: bytes) -> None:
         """One received gripper command against the checks: finite, a force within [0, the
@@ -328,6 +334,11 @@ class HardwareSession:
             if now - last >= QUIET or now - start >= QUIET_MAX:
                 return
 
+    def _waited(self) -> None:
+        """The tick's wait ended: when, and when its answer came (NaN: it did not)."""
+        self.record.tick_answered.append(self._answer_wall)
+        self.record.tick_waited.append(time.perf_counter())
+
     def exchange(
         self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
     ) -> Optional[np.ndarray]:
@@ -349,11 +360,15 @@ class HardwareSession:
         self._set_companions(t, extras)
         self._pending, self._pending_q = utime, np.array(q, dtype=float)
         self._sent[utime] = self._publish(data)
+        self._answer_wall = float("nan")
+        self.record.tick_sent.append(self._sent[utime])
         if len(self._sent) > 4096:
             for key in sorted(self._sent)[:2048]:
                 del self._sent[key]
         if self.s.lockstep:
-            if self._wait(t, utime, self.s.command_timeout, data, resend=True, wsg=wsg):
+            came = self._wait(t, utime, self.s.command_timeout, data, resend=True, wsg=wsg)
+            self._waited()
+            if came:
                 return self._answered_tau
             self._fail(
                 t,
@@ -361,7 +376,9 @@ class HardwareSession:
                 f"command timeout at t = {t:.3f} s (no command for {self.s.command_timeout * 1e3:.0f} ms)",
             )
             return None
-        if self._wait(t, utime, self.s.budget * self.s.period / self.s.realtime_rate, data, resend=False):
+        came = self._wait(t, utime, self.s.budget * self.s.period / self.s.realtime_rate, data, resend=False)
+        self._waited()
+        if came:
             self._consecutive_late = 0
             return self._answered_tau
         if self.record.fault is None:

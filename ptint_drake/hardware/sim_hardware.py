@@ -27,6 +27,7 @@ from ptint_drake.hardware.camera_link import image_channel, with_receive_buffer
 from ptint_drake.hardware.arm_messages import arm_messages
 from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
                                        SenderWatch, spread, url_warning)
+from ptint_drake.hardware.link_record import link_series
 from ptint_drake.hardware.process import scheduler_name, stop_on_signals
 from ptint_drake.hardware.session import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
 from ptint_drake.outputs.folder import METRICS, SERIES, save_series, staged_output, write_json_atomic
@@ -128,6 +129,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "silent_periods": None if settings.lockstep else settings.silent_periods,
         "sender_check": "source address" if session.watch is not None else "stamps only",
         "scheduler": scheduler_name(),
+        "receive_thread_scheduler": [scheduler_name(tid) for tid in session.endpoint.threads],
         "handshake_s": handshake_s,
         "round_trip_ms": spread(r.rtt, 1e3),
         "achieved_period_ms": spread(periods, 1e3),
@@ -230,7 +232,7 @@ def run_hardware(
             session.watch.close()
     run_json = run_metrics(hw, link_metrics(result, session, settings, n), figures=False)
     with staged_output(out) as stage:
-        save_series(stage / SERIES, result.series)
+        save_series(stage / SERIES, result.series | link_series(session.record))
         write_json_atomic(stage / METRICS, run_json)
     return run_json
 
