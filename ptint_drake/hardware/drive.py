@@ -332,7 +332,8 @@ class _DriveLoop:
         drive started mid-run held the arm as a silent controller that way, instead of being
         named as the second sender)."""
         quiet_collector()
-        refused = request_realtime(self.settings.priority) if not self.in_memory else None
+        refused = (request_realtime(self.settings.priority, self.endpoint.threads)
+                   if not self.in_memory else None)
         if refused:
             self.warn(refused)
 

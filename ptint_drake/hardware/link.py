@@ -154,8 +154,8 @@ class Endpoint:
                 and time.perf_counter() < deadline
             ):  # (the other side's thread may have handled them)
                 time.sleep(MEMQ_NAP)
-        else:
-            self._handle(max(0, int(round(timeout_s * 1e3))))
+        else:  # (whole ms, rounded down: a wait never ends past its deadline)
+            self._handle(max(0, int(timeout_s * 1e3)))
         while self._handle() > 0:
             pass
         out, self.inbox = self.inbox, []

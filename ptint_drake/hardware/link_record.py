@@ -58,6 +58,7 @@ class LinkRecord:
     late_commands: int = 0  # commands that arrived after their tick
     gripper_commands: int = 0  # gripper commands taken (a station with a gripper)
     last_command_t: Optional[float] = None  # simulated t of the last command accepted
+    last_heard_t: Optional[float] = None  # simulated t of the tick the last command (late ones too) came in
     frames_sent: int = 0  # depth frames published (a station with a camera; re-sends not counted)
     fault: Optional[str] = None
     fault_time: Optional[float] = None

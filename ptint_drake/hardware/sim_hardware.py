@@ -62,7 +62,8 @@ def check_link_scenario(scenario: Scenario) -> None:
 
 def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
     """``scenario`` with ``CommandLink`` in the controller slot (no hold of its own: the link is
-    the hold), the plant discrete at T, and the simulator paced in real time unless lockstep."""
+    the hold), the plant discrete at T, and the simulator unpaced: in real time the link paces
+    its ticks from the first tick after the hand-shake (``realtime.TickPacer``)."""
     out = copy.copy(scenario)
     out.controller = dataclasses.replace(scenario.controller, type=LINK_TYPE, params={}, control_period=0.0)
     world = world_of(scenario)
@@ -89,7 +90,7 @@ def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
     # although the slot runs unsampled here: the link is the hold
     config = world.simulator_config(scenario)
     out.simulator = copy.copy(config if config is not None else scenario.simulator)
-    out.simulator.target_realtime_rate = 0.0 if settings.lockstep else settings.realtime_rate
+    out.simulator.target_realtime_rate = 0.0  # real time: the link paces its ticks (``realtime.TickPacer``)
     return out
 
 
@@ -141,12 +142,18 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "commands_duplicated": r.duplicates,
         "ticks_late": r.late,
         "late_run_max": r.late_run_max,
+        "silent_run_max": None if settings.lockstep else session.silence.count_max,
+        "ticks_skipped": None if settings.lockstep else session.pacer.skipped,
+        "skipped_run_max": None if settings.lockstep else session.pacer.skipped_run_max,
+        "clock_rebased": None if settings.lockstep else session.pacer.rebased,
+        "status_late_max_ms": None if settings.lockstep else 1e3 * session.pacer.late_max,
         "commands_late": r.late_commands,
         "fault": r.fault,
         "fault_kind": r.fault_kind,
         "fault_time": r.fault_time,
         "stop_signal": None if r.stop_signal is None else signal.Signals(r.stop_signal).name,
         "last_command_t": r.last_command_t,
+        "last_heard_t": r.last_heard_t,
     }
     ports = session.ports
     if ports is not None:
