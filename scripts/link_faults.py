@@ -55,15 +55,19 @@ def row(name: str, out: dict, folder: Path, proc: str = "hw") -> dict:
     link = json.loads(metrics.read_text())["hardware"] if metrics.is_file() else {}
     period = link.get("period") or 1e-3
     reaction = None
-    if link.get("fault_time") is not None and link.get("last_command_t") is not None:
-        reaction = round((link["fault_time"] - link["last_command_t"]) / period, 1)
+    heard = link.get("last_heard_t", link.get("last_command_t"))
+    if link.get("fault_time") is not None and heard is not None:
+        reaction = round((link["fault_time"] - heard) / period, 1)
     hold = link.get("hold") or {}
     return {
         "fault": name,
         "exit": {k: v["rc"] for k, v in out.items()},
         "fault_kind": link.get("fault_kind"),
         "message": link.get("fault"),
-        "reaction_periods": reaction,
+        "reaction_periods": reaction,  # simulated periods from the tick the last command came in
+        "silent_statuses": link.get("silent_run_max"),
+        "signal_to_hold_ms": _signal_to_hold(out, folder, proc),
+        "ticks_skipped": link.get("ticks_skipped"),
         "held": hold.get("speed_at_end") is not None and hold["speed_at_end"] < 0.05,
         "settled_s_after_fault": hold.get("settled_s_after_fault"),
         "ticks_late": link.get("ticks_late"),
@@ -116,6 +120,19 @@ def _side(sent: float, deadline: float, answer: Optional[tuple], previous: Optio
     if received > deadline:
         return "drive busy" if previous is not None and previous[1] > sent else "drive woke late"
     return "drive computed late" if answered > deadline else "hardware handled late"
+
+
+def _signal_to_hold(out: dict, folder: Path, proc: str) -> Optional[float]:
+    """Wall ms from the signal sent to a process of the plan (the drive killed) to the end of the
+    hardware tick that held the arm (series.npz ``link_tick_waited``: one clock, CLOCK_MONOTONIC)."""
+    killed = [v for k, v in out.items() if k != proc and v.get("killed") is not None]
+    series = folder / "hw" / "series.npz"
+    if not killed or not series.is_file():
+        return None
+    waited = np.load(series)["link_tick_waited"]
+    if not waited.size:
+        return None
+    return round(1e3 * (float(waited[-1]) - (killed[0]["origin"] + killed[0]["killed"])), 2)
 
 
 def _drive(folder: Path) -> dict:
