@@ -4,10 +4,11 @@ and checks, the timing it records; ``command_link.CommandLink`` calls it at each
 - **Lockstep** (``lockstep``): each tick waits for its command (re-sending the status every
   ``resend`` s of wall time, so a lost status costs time, not the run), up to ``command_timeout``
   of wall time.
-- **Real time**: the simulator paces the ticks; each tick waits at most ``budget`` × T for its
-  command, otherwise the previous torque stays (``late``); ``silent_periods`` ticks in a row
-  without a command (5: a dead or silent controller) is the timeout, so the arm is held within
-  that many control periods of the last command.
+- **Real time**: the link paces the ticks and skips those of its own stalls (``realtime.TickPacer``);
+  each tick waits at most ``budget`` × T for its command, otherwise the newest command that
+  came stays (``late``); ``silent_periods`` statuses in a row without any command of the
+  controller (5: a dead or silent controller; ``realtime.Silence``) is the timeout, so the arm
+  is held that many control periods after the tick the controller was last heard in.
 
 Every command passes the checks before it reaches the plant (``HardwareSession._check``): its
 size, finite torques within the actuators' effort limits, positions (if any) equal to the status's
