@@ -5,8 +5,9 @@ silent (``Silence``).
 **Pacing.**  The link paces the simulation itself (the simulator runs unpaced,
 ``sim_hardware.hardware_scenario``): the tick at t is due at wall time w₀ + (t − t₀) / rate, where
 (w₀, t₀) is the first tick after the hand-shake.  (Drake's own pacing counts from the
-simulator's ``Initialize``, which holds the hand-shake: the run then went through its first
-0.4-0.9 s of wall time as a burst of statuses at the drive's pace, not in real time, measured.)
+simulator's ``Initialize``, which holds the hand-shake: the simulator then made up the
+hand-shake's 0.4-0.9 s in a burst of statuses at the drive's pace that lasted most of a 3 s run,
+measured.)
 A tick that finds the hardware more than one period late — its own process stalled — is
 *skipped*: the plant steps on under the torque it has, and no status goes out, as a robot's
 physics go on while its driver stalls; the next status is the current tick's, not a burst of

@@ -67,6 +67,7 @@ class HardwareSession:
         self._pending: Optional[int] = None
         self._measured: dict[int, np.ndarray] = {}  # utime → the measured positions of a status sent
         self._late_taken = False  # real time: a late answer's torque taken during this tick's wait
+        self._answer_wall = float("nan")  # perf_counter of this tick's answer handled (``_waited``)
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
         self.pacer = TickPacer(settings.period, settings.realtime_rate)  # real time (``realtime``)
