@@ -23,11 +23,17 @@ from rest, not the rest of a profile under way (checked so, mid-way, it refused 
 then met, and each replacement, nearest the hand, was an earlier, shorter catch).  A plan that
 replaces one takes the candidate times nearest the old catch time first.
 
-The velocity the hand matches at the catch (``target``) is the plan's ``match``: ``catch.match``,
-capped by ``matchable`` so that the matched velocity alone takes at most ``SPEED_SHARE`` of any
-joint's speed limit (uncapped, 0.3 of a 4 m/s ball asked the iiwa's elbow for 1.8–2.3 times its
-limit at the catch postures: measured on throws 0, 1, 58, 147; the simulated plant does not
-enforce speed limits, so nothing else would show it).
+The hand's velocity at the catch (``target``) is the plan's ``velocity`` u
+(``matched_velocity``): the nearest to ``catch.match`` × v_c that joint speeds within
+``SPEED_SHARE`` of each joint's limit give at the catch posture with the orientation held.  A
+fraction of v_c alone (as first done: the matched velocity's J⁺ joint speeds scaled into the
+limits) was capped at m = 0.12–0.20 by the elbow's 75 °/s, which binds along the ball's path at
+every catch posture (an LP over the posture's self-motion, and 30 other IK postures per catch
+point on throws 0–9, moved that bound by ≤ 0.01); the other joints can still match v_c's
+components across the path, so u, not parallel to v_c, takes 16–25 % off the ball's speed
+relative to the hand where m v_c took 12–18 % (throws 0–7 at their plans' postures; uncapped,
+0.3 of v_c asked the elbow for 1.8–2.3 times its limit, which the simulated plant does not
+enforce: nothing else would show it).  ``match`` is u's component along v_c over |v_c|.
 
 What the controller and the hand are then given is ``target``'s.
 """
@@ -41,6 +47,7 @@ import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.solvers import Solve
+from scipy.optimize import minimize
 
 from ptint_drake.systems.task.tbg import tbg_profile
 from ptint_drake.worlds.catch.flight import from_estimate, propagate
@@ -52,7 +59,6 @@ GRID = 0.01
 HORIZON = 1.0
 MIN_TF = 0.1  # s
 REACH = 0.5  # m: candidates farther than this from the hand's tip are not tried
-ROT_SCALE = 0.1  # m/rad: the controller's weighing of the rotation (the catch scenario's)
 SPEED_SHARE = 0.8  # of a joint's speed limit the matched velocity may take
 
 
@@ -66,7 +72,8 @@ class Plan:
     R: np.ndarray
     q: np.ndarray
     tf_min: float
-    match: float = 0.0
+    match: float = 0.0  # the hand's velocity at the catch along the ball's, over the ball's speed
+    velocity: Optional[np.ndarray] = None  # the hand's velocity at the catch (m/s, world); None: 0
 
 
 def predict(estimate: np.ndarray, dt) -> np.ndarray:
@@ -134,23 +141,30 @@ class Planner:
             self._left = True
             tf = self.tf_needed(q_now, q)
             if t_c - t_plan >= max(tf, MIN_TF):
-                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, self.matchable(q, v))
+                u = self.matched_velocity(q, v)
+                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, float(u @ v / (v @ v)), u)
         return None
 
-    def matchable(self, q, v) -> float:
-        """The fraction of the ball's velocity ``v`` the hand may match at posture ``q``: the
-        configured one, or less, so that the joint speeds of the matched hand velocity alone
-        (J⁺ with the controller's rotation weighing, the orientation held) stay within
-        ``SPEED_SHARE`` of the joints' limits."""
+    def matched_velocity(self, q, v) -> np.ndarray:
+        """The hand's velocity at the catch at posture ``q`` for the ball's velocity ``v``: the
+        nearest to ``catch.match`` × v that joint speeds within ``SPEED_SHARE`` of each joint's
+        limit give with the orientation held, u = J_v q̇ with J_ω q̇ = 0 and |q̇_j| ≤ share ×
+        q̇_max,j (``scipy.optimize.minimize``, SLSQP; a 1e-6 weight on |q̇|² makes it unique).
+        Not a fraction of v: where the elbow's limit caps the speed along v, the other joints
+        still match the components of v across it (module docstring)."""
         if self.match <= 0.0:
-            return 0.0
+            return np.zeros(3)
         self.plant.SetPositions(self.context, q)
         world = self.plant.world_frame()
         J = self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
                                                    np.zeros(3), world, world)[:, :7]
-        J = np.vstack([ROT_SCALE * J[:3], J[3:]])
-        qd = np.linalg.lstsq(J, np.concatenate([np.zeros(3), v]), rcond=None)[0]
-        return float(min(self.match, SPEED_SHARE / np.max(np.abs(qd) / self.v_max)))
+        goal = self.match * np.asarray(v, float)
+        bounds = [(-SPEED_SHARE * m, SPEED_SHARE * m) for m in self.v_max]
+        result = minimize(lambda qd: np.sum((J[3:] @ qd - goal) ** 2) + 1e-6 * qd @ qd, np.zeros(7),
+                          jac=lambda qd: 2.0 * J[3:].T @ (J[3:] @ qd - goal) + 2e-6 * qd,
+                          bounds=bounds, constraints=[{"type": "eq", "fun": lambda qd: J[:3] @ qd,
+                                                       "jac": lambda qd: J[:3]}], method="SLSQP")
+        return J[3:] @ result.x
 
     def hopeless(self) -> bool:
         """After a refused ``plan``: no candidate was in reach at all (no point to try again)."""

@@ -3,7 +3,8 @@ frame, the foam ball with the truth side's air drag, on one discrete plant (1 ms
 SAP), the gripper's driver, and the formula camera (60 Hz) on the ball (with
 ``measurement.sensor: rgbd``: the rendered RGB-D camera and ``ball_camera``'s sphere fit in each
 depth frame) feeding the ball's estimator: the fit of its dragged flight (``flight_estimator``;
-``catch.predictor: fit``, the default) or the scenario's camera estimator (``catch.predictor: auto``, the IMM).
+``catch.predictor: fit``, the default) or the scenario's camera estimator
+(``catch.predictor: auto``, the IMM).
 
 ``AddCatchStation`` adds it to a builder and returns the handles: the arm's ``state`` and
 ``actuation`` ports (the controller's only wiring to the plant), the gripper's ``command`` input,
@@ -48,7 +49,7 @@ HAND_RELAXATION_TIME = 0.001  # s (module docstring)
 TIP = "schunk_wsg_50_110_full_tip"
 
 
-def _add_arm_and_hand(plant: MultibodyPlant, gripper):
+def add_arm_and_hand(plant: MultibodyPlant, gripper):
     (arm,) = Parser(plant, "arm").AddModels(str(resolve_model("iiwa14")))
     path = resolve_model("iiwa14").parent / f"{gripper.model}.sdf"
     (hand,) = Parser(plant, "gripper").AddModels(str(path))
@@ -111,7 +112,7 @@ def AddCatchStation(builder: DiagramBuilder, scenario) -> CatchStation:
     step = scenario.catch.time_step
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(
         time_step=step, contact_model="point", discrete_contact_approximation="sap"), builder)
-    arm, hand = _add_arm_and_hand(plant, g)
+    arm, hand = add_arm_and_hand(plant, g)
     _relax_hand(plant, scene_graph, hand)
     ball = AddBall(plant)
     stroke = 0.0

@@ -9,6 +9,12 @@ rate over the reachable throws and the failures by reason (``oracle.summary``)."
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from pydrake.common.yaml import yaml_load_typed
+
+from ptint_drake.config.schema import Scenario
+from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.verdict.metrics import Reason
 from ptint_drake.worlds.base import World
@@ -33,6 +39,20 @@ class CatchWorld(World):
     def reasons(self, metrics: dict, criteria) -> list:
         name = metrics.get("catch", {}).get("outcome")
         return [] if name == "caught" else [Reason(None, "catch", f"not caught: {name}")]
+
+    def view_tasks(self, scenario, series: dict, metrics: dict, stage: Path, figures: bool,
+                   replay: bool, svg: bool) -> list[tuple]:
+        """The replay (``views``), when asked for."""
+        if not replay:
+            return []
+        return [("catch_replay", series, metrics, stage, scenario.name, (dump_yaml(scenario),))]
+
+    def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:
+        from ptint_drake.worlds.catch.views import write_catch_replay  # noqa: PLC0415
+
+        scenario = yaml_load_typed(schema=Scenario, data=args[0])
+        write_catch_replay(scenario, series, metrics, stage / "replay.html", title=title)
+        return name
 
     def own_plant_step(self, scenario) -> float:
         return scenario.catch.time_step
