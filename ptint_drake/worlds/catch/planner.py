@@ -7,7 +7,11 @@ dragged flight (``flight.propagate`` from [p̂, v̂] with the drag c the estimat
 approach axis within ``APPROACH_CONE_DEG`` of the ball's incoming direction (Drake's
 ``InverseKinematics`` with the joint limits, nearest the present posture), above ``FLOOR_Z``, and
 when t_c − t_plan ≥ tf_min: the joint-speed bound max_j |Δq_j| ξ̇_max / q̇_max,j (ξ̇_max of the TBG
-with the catch's β) × ``TORQUE_MARGIN``, and at least ``MIN_TF``.  The margin is 1: the torque
+with the catch's β) × ``TORQUE_MARGIN``, and at least ``MIN_TF``; Δq to the catch posture and,
+with velocity matching, to the posture where the matching starts (½ τ_m u before the catch
+point: the approach goes there first; on throw 58 its elbow ran at 1.25 of its limit half way
+when only the catch posture was bounded, 0.90 without matching); where that is too late, the
+candidate is tried with half the matched velocity, then none (the catch before the matching).  The margin is 1: the torque
 term of the oracle's feasibility model is not binding on the arm's tf at these speeds, and a
 margin of 1.25 (as first set) refused throws 58, 67 and 147, which the oracle calls reachable
 (the straight joint-space bound is already above the oracle's tf on them) and which are caught
@@ -91,8 +95,9 @@ def flight_states(estimate: np.ndarray, dt) -> np.ndarray:
 class Planner:
     """Catch plans for one arm with its hand (module docstring)."""
 
-    def __init__(self, plant, tip: str, beta: float, match: float = 0.0):
+    def __init__(self, plant, tip: str, beta: float, match: float = 0.0, match_time: float = 0.2):
         self.plant, self.frame, self.match = plant, plant.GetFrameByName(tip), float(match)
+        self.match_time = float(match_time)
         self.context = plant.CreateDefaultContext()
         self.v_max = plant.GetVelocityUpperLimits()[:7]
         f = np.linspace(0.0, 1.0, 401)
@@ -140,10 +145,23 @@ class Planner:
                 continue
             self._left = True
             tf = self.tf_needed(q_now, q)
-            if t_c - t_plan >= max(tf, MIN_TF):
-                u = self.matched_velocity(q, v)
-                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, float(u @ v / (v @ v)), u)
+            if t_c - t_plan < max(tf, MIN_TF):
+                continue
+            full = self.matched_velocity(q, v)
+            for u in (full, 0.5 * full, 0.0 * full):  # as much matching as the time allows
+                tf_u = max(tf, self._tf_to_ramp(q_now, q, p, v, u))
+                if t_c - t_plan >= max(tf_u, MIN_TF):
+                    return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf_u, float(u @ v / (v @ v)), u)
         return None
+
+    def _tf_to_ramp(self, q_now, q, p, v, u) -> float:
+        """``tf_needed`` to the posture at the matching's start, ½ τ_m u before the catch point
+        (``target``: the reference waits there until the last τ_m); 0 without matching or when
+        that point has no IK solution (the catch posture's bound then stands alone)."""
+        if not np.any(u):
+            return 0.0
+        q_ramp = self.ik(p - 0.5 * self.match_time * u, -v / np.linalg.norm(v), q)
+        return 0.0 if q_ramp is None else self.tf_needed(q_now, q_ramp)
 
     def matched_velocity(self, q, v) -> np.ndarray:
         """The hand's velocity at the catch at posture ``q`` for the ball's velocity ``v``: the

@@ -63,7 +63,7 @@ class CatchRun(WorldRun):
     def __init__(self, scenario, log: bool = True, settling: bool = False):
         self.scenario, c, self.settling = scenario, scenario.catch, settling
         self.arm = arm_plant()
-        self.planner = Planner(self.arm, TIP, c.beta, c.match)
+        self.planner = Planner(self.arm, TIP, c.beta, c.match, c.match_time)
         self.q0 = np.radians(scenario.robot.initial_q_deg)
         self.x0, self.R0 = self.planner.tip(self.q0)
         self.throw = throw(c.throw, self.x0)
