@@ -7,11 +7,7 @@ dragged flight (``flight.propagate`` from [p̂, v̂] with the drag c the estimat
 approach axis within ``APPROACH_CONE_DEG`` of the ball's incoming direction (Drake's
 ``InverseKinematics`` with the joint limits, nearest the present posture), above ``FLOOR_Z``, and
 when t_c − t_plan ≥ tf_min: the joint-speed bound max_j |Δq_j| ξ̇_max / q̇_max,j (ξ̇_max of the TBG
-with the catch's β) × ``TORQUE_MARGIN``, and at least ``MIN_TF``; Δq to the catch posture and,
-with velocity matching, to the posture where the matching starts (½ τ_m u before the catch
-point: the approach goes there first; on throw 58 its elbow ran at 1.25 of its limit half way
-when only the catch posture was bounded, 0.90 without matching); where that is too late, the
-candidate is tried with half the matched velocity, then none (the catch before the matching).  The margin is 1: the torque
+with the catch's β) × ``TORQUE_MARGIN``, and at least ``MIN_TF``.  The margin is 1: the torque
 term of the oracle's feasibility model is not binding on the arm's tf at these speeds, and a
 margin of 1.25 (as first set) refused throws 58, 67 and 147, which the oracle calls reachable
 (the straight joint-space bound is already above the oracle's tf on them) and which are caught
@@ -27,17 +23,11 @@ from rest, not the rest of a profile under way (checked so, mid-way, it refused 
 then met, and each replacement, nearest the hand, was an earlier, shorter catch).  A plan that
 replaces one takes the candidate times nearest the old catch time first.
 
-The hand's velocity at the catch (``target``) is the plan's ``velocity`` u
-(``matched_velocity``): the nearest to ``catch.match`` × v_c that joint speeds within
-``SPEED_SHARE`` of each joint's limit give at the catch posture with the orientation held.  A
-fraction of v_c alone (as first done: the matched velocity's J⁺ joint speeds scaled into the
-limits) was capped at m = 0.12–0.20 by the elbow's 75 °/s, which binds along the ball's path at
-every catch posture (an LP over the posture's self-motion, and 30 other IK postures per catch
-point on throws 0–9, moved that bound by ≤ 0.01); the other joints can still match v_c's
-components across the path, so u, not parallel to v_c, takes 16–25 % off the ball's speed
-relative to the hand where m v_c took 12–18 % (throws 0–7 at their plans' postures; uncapped,
-0.3 of v_c asked the elbow for 1.8–2.3 times its limit, which the simulated plant does not
-enforce: nothing else would show it).  ``match`` is u's component along v_c over |v_c|.
+The velocity the hand matches at the catch (``target``) is the plan's ``match``: ``catch.match``,
+capped by ``matchable`` so that the matched velocity alone takes at most ``SPEED_SHARE`` of any
+joint's speed limit (uncapped, 0.3 of a 4 m/s ball asked the iiwa's elbow for 1.8–2.3 times its
+limit at the catch postures: measured on throws 0, 1, 58, 147; the simulated plant does not
+enforce speed limits, so nothing else would show it).
 
 What the controller and the hand are then given is ``target``'s.
 """
@@ -51,7 +41,6 @@ import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.solvers import Solve
-from scipy.optimize import minimize
 
 from ptint_drake.systems.task.tbg import tbg_profile
 from ptint_drake.worlds.catch.flight import from_estimate, propagate
@@ -63,6 +52,7 @@ GRID = 0.01
 HORIZON = 1.0
 MIN_TF = 0.1  # s
 REACH = 0.5  # m: candidates farther than this from the hand's tip are not tried
+ROT_SCALE = 0.1  # m/rad: the controller's weighing of the rotation (the catch scenario's)
 SPEED_SHARE = 0.8  # of a joint's speed limit the matched velocity may take
 
 
@@ -76,8 +66,7 @@ class Plan:
     R: np.ndarray
     q: np.ndarray
     tf_min: float
-    match: float = 0.0  # the hand's velocity at the catch along the ball's, over the ball's speed
-    velocity: Optional[np.ndarray] = None  # the hand's velocity at the catch (m/s, world); None: 0
+    match: float = 0.0
 
 
 def predict(estimate: np.ndarray, dt) -> np.ndarray:
@@ -95,9 +84,8 @@ def flight_states(estimate: np.ndarray, dt) -> np.ndarray:
 class Planner:
     """Catch plans for one arm with its hand (module docstring)."""
 
-    def __init__(self, plant, tip: str, beta: float, match: float = 0.0, match_time: float = 0.2):
+    def __init__(self, plant, tip: str, beta: float, match: float = 0.0):
         self.plant, self.frame, self.match = plant, plant.GetFrameByName(tip), float(match)
-        self.match_time = float(match_time)
         self.context = plant.CreateDefaultContext()
         self.v_max = plant.GetVelocityUpperLimits()[:7]
         f = np.linspace(0.0, 1.0, 401)
@@ -145,44 +133,24 @@ class Planner:
                 continue
             self._left = True
             tf = self.tf_needed(q_now, q)
-            if t_c - t_plan < max(tf, MIN_TF):
-                continue
-            full = self.matched_velocity(q, v)
-            for u in (full, 0.5 * full, 0.0 * full):  # as much matching as the time allows
-                tf_u = max(tf, self._tf_to_ramp(q_now, q, p, v, u))
-                if t_c - t_plan >= max(tf_u, MIN_TF):
-                    return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf_u, float(u @ v / (v @ v)), u)
+            if t_c - t_plan >= max(tf, MIN_TF):
+                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, self.matchable(q, v))
         return None
 
-    def _tf_to_ramp(self, q_now, q, p, v, u) -> float:
-        """``tf_needed`` to the posture at the matching's start, ½ τ_m u before the catch point
-        (``target``: the reference waits there until the last τ_m); 0 without matching or when
-        that point has no IK solution (the catch posture's bound then stands alone)."""
-        if not np.any(u):
-            return 0.0
-        q_ramp = self.ik(p - 0.5 * self.match_time * u, -v / np.linalg.norm(v), q)
-        return 0.0 if q_ramp is None else self.tf_needed(q_now, q_ramp)
-
-    def matched_velocity(self, q, v) -> np.ndarray:
-        """The hand's velocity at the catch at posture ``q`` for the ball's velocity ``v``: the
-        nearest to ``catch.match`` × v that joint speeds within ``SPEED_SHARE`` of each joint's
-        limit give with the orientation held, u = J_v q̇ with J_ω q̇ = 0 and |q̇_j| ≤ share ×
-        q̇_max,j (``scipy.optimize.minimize``, SLSQP; a 1e-6 weight on |q̇|² makes it unique).
-        Not a fraction of v: where the elbow's limit caps the speed along v, the other joints
-        still match the components of v across it (module docstring)."""
+    def matchable(self, q, v) -> float:
+        """The fraction of the ball's velocity ``v`` the hand may match at posture ``q``: the
+        configured one, or less, so that the joint speeds of the matched hand velocity alone
+        (J⁺ with the controller's rotation weighing, the orientation held) stay within
+        ``SPEED_SHARE`` of the joints' limits."""
         if self.match <= 0.0:
-            return np.zeros(3)
+            return 0.0
         self.plant.SetPositions(self.context, q)
         world = self.plant.world_frame()
         J = self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
                                                    np.zeros(3), world, world)[:, :7]
-        goal = self.match * np.asarray(v, float)
-        bounds = [(-SPEED_SHARE * m, SPEED_SHARE * m) for m in self.v_max]
-        result = minimize(lambda qd: np.sum((J[3:] @ qd - goal) ** 2) + 1e-6 * qd @ qd, np.zeros(7),
-                          jac=lambda qd: 2.0 * J[3:].T @ (J[3:] @ qd - goal) + 2e-6 * qd,
-                          bounds=bounds, constraints=[{"type": "eq", "fun": lambda qd: J[:3] @ qd,
-                                                       "jac": lambda qd: J[:3]}], method="SLSQP")
-        return J[3:] @ result.x
+        J = np.vstack([ROT_SCALE * J[:3], J[3:]])
+        qd = np.linalg.lstsq(J, np.concatenate([np.zeros(3), v]), rcond=None)[0]
+        return float(min(self.match, SPEED_SHARE / np.max(np.abs(qd) / self.v_max)))
 
     def hopeless(self) -> bool:
         """After a refused ``plan``: no candidate was in reach at all (no point to try again)."""

@@ -14,10 +14,9 @@ ball's predicted centre at exactly t_catch:
     S(x)    = ∫₀ˣ g = x − 2.5x⁴ + 3x⁵ − x⁶  (S(1) = ½)
 
 so that x_r(t_catch) = p_c, the ball's estimated centre, and ẋ_r(t_catch) = m v_c: the hand
-arrives moving with the ball at the fraction m (0: it waits at the point) and the ball enters
-between the jaws at (1 − m) of its speed.  A plan gives the hand's velocity u at the catch
-instead (``planner.Planner.matched_velocity``: the nearest to ``catch.match`` × v_c within the
-joints' speed limits): m v_c is then u, fixed at the plan's.  Before the last τ_m
+arrives moving with the ball at the fraction m (the plan's: ``catch.match`` within the joints'
+speed limits, ``planner.Planner.matchable``; 0: it waits at the point) and
+the ball enters between the jaws at (1 − m) of its speed.  Before the last τ_m
 (``catch.match_time``) the target is the point ½ m τ_m |v_c| back along the ball's path;
 in the last τ_m the hand speeds up along the path to m v_c, with no jump in its reference's
 acceleration at either end and the largest, 1.875 m |v_c| / τ_m, half way (an exponential
@@ -57,16 +56,14 @@ def _ramp(x: float) -> tuple:
             -30.0 * x * x + 60.0 * x3 - 30.0 * x3 * x)
 
 
-def catch_reference(estimate: np.ndarray, T: float, m: float, tau_m: float, u=None) -> np.ndarray:
-    """[x_r, ẋ_r, ẍ_r] (9) of the module docstring from an estimate [p̂, v̂, â], T = t_catch − t;
-    ``u``: the hand's velocity at the catch (the plan's), for m v_c."""
+def catch_reference(estimate: np.ndarray, T: float, m: float, tau_m: float) -> np.ndarray:
+    """[x_r, ẋ_r, ẍ_r] (9) of the module docstring from an estimate [p̂, v̂, â], T = t_catch − t."""
     p, v = estimate[0:3], estimate[3:6]
     T = max(T, 0.0)
     state = propagate(p, v, from_estimate(estimate), 0.0, [T])[0] if T > 0.0 else np.concatenate([p, v])
     p_c, v_c = state[0:3], state[3:6]
-    w = m * v_c if u is None else np.asarray(u, float)
     S, g, g1 = _ramp(T / tau_m)
-    return np.concatenate([p_c - tau_m * S * w, g * w, -(g1 / tau_m) * w])
+    return np.concatenate([p_c - m * tau_m * S * v_c, m * g * v_c, -(m / tau_m) * g1 * v_c])
 
 
 def braking(at_catch: np.ndarray, tau: float) -> np.ndarray:
@@ -104,9 +101,8 @@ class CatchTarget(LeafSystem):
         live = t < plan.t_catch - self._freeze or held[0] == 0.0
         estimate = self._in.Eval(context) if live else self._extrapolated(held[1:], t)
         if t <= plan.t_catch:
-            return catch_reference(estimate, plan.t_catch - t, plan.match, self._tau_m, plan.velocity)
-        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, plan.match, self._tau_m,
-                                   plan.velocity)
+            return catch_reference(estimate, plan.t_catch - t, plan.match, self._tau_m)
+        at_catch = catch_reference(self._extrapolated(held[1:], plan.t_catch), 0.0, plan.match, self._tau_m)
         return braking(at_catch, t - plan.t_catch)
 
     def _extrapolated(self, held: np.ndarray, t: float) -> np.ndarray:
