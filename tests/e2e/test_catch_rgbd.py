@@ -38,7 +38,8 @@ def _recording(html: str) -> tuple[set, dict]:
     """The page's drawn objects and its animation {path: {property: {frame: value}}}."""
     msgpack = pytest.importorskip("msgpack")
     payloads = re.findall(r'data:application/octet-binary;base64,([A-Za-z0-9+/=]+)"', html)
-    commands = [msgpack.unpackb(base64.b64decode(p), ext_hook=lambda code, data: (code, data)) for p in payloads]
+    commands = [msgpack.unpackb(base64.b64decode(p), ext_hook=lambda code, data: (code, data))
+                for p in payloads]
     animation = next(c for c in commands if c.get("type") == "set_animation")
     drawn = {c["path"] for c in commands if c.get("type") == "set_object"}
     return drawn, {a["path"]: {tr["name"]: {k["time"]: k["value"] for k in tr["keys"]}
