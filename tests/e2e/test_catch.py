@@ -13,6 +13,7 @@ import pytest
 from ptint_drake.simulation.scenario import LoadedScenario
 from ptint_drake.worlds.catch import oracle
 from ptint_drake.worlds.catch.outcome import HAND_BODIES, OUTCOMES
+from ptint_drake.worlds.catch.planner import predict
 from ptint_drake.worlds.catch.run import CatchRun, settled
 from ptint_drake.worlds.runner import simulate
 
@@ -72,3 +73,23 @@ def test_compare_puts_the_ct_quintic_baseline_with_the_same_planner_beside_ptsmc
     assert rows["ct_quintic"]["world"]["plans"] >= 1  # the planner's target drove it too
     table = (tmp_path / "compare.md").read_text()
     assert "| controller | variant | throw | outcome | plans | hand error (mm) | peak force (N) |" in table
+
+
+def test_the_catch_point_is_revised_as_the_estimate_improves_and_the_target_follows(caught):
+    """The plan's catch point is the estimate's at t_plan; the target re-predicts it from every
+    newer estimate (``target``: the law tracks it as the frames come in).  Measured: the planner
+    replaced no plan in 100 formula-camera and 200 RGB-D throws (``Planner.holds`` fails only when
+    the re-predicted point leaves the IK's reach), so this revision is the one that happens."""
+    c = caught.metrics["catch"]
+    t, x, estimate, target = (np.asarray(caught.series[k])
+                              for k in ("t", "plant_state", "estimate", "target"))
+    t_catch = c["t_catch"]
+    true = x[np.searchsorted(t, t_catch), 13:16]
+    first = np.asarray(c["plans"][0]["point"])
+    late = np.searchsorted(t, t_catch - 0.05)
+    revised = predict(estimate[late], t_catch - t[late])[0]
+    assert np.linalg.norm(first - revised) > 0.005  # revised by more than the hand's error budget
+    assert np.linalg.norm(revised - true) < np.linalg.norm(first - true)  # towards the true ball
+    aimed = target[np.searchsorted(t, t_catch), 0:3]  # where the law took the hand at t_catch
+    assert np.linalg.norm(aimed - revised) < np.linalg.norm(aimed - first)
+    assert c["outcome"] == "caught"
