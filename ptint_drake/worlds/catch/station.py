@@ -50,6 +50,8 @@ TIP = "schunk_wsg_50_110_full_tip"
 
 
 def add_arm_and_hand(plant: MultibodyPlant, gripper):
+    """The iiwa 14 and ``gripper``'s hand model welded at its tip frame, in ``plant`` (not
+    finalized): (arm, hand) model instances."""
     (arm,) = Parser(plant, "arm").AddModels(str(resolve_model("iiwa14")))
     path = resolve_model("iiwa14").parent / f"{gripper.model}.sdf"
     (hand,) = Parser(plant, "gripper").AddModels(str(path))
