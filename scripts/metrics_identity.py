@@ -358,10 +358,10 @@ def run_scenario(runner: Runner, side: Side, name: str, scratch: Path, cache: Pa
     stage.parent.mkdir(parents=True, exist_ok=True)
     code, tail, wall = runner.run(side.tree, ["run", name, "--out", str(stage), *side.flags])
     info = {"exit_code": code, "wall_s": round(wall, 3), "flags": side.flags, "sha": side.sha}
-    if code not in (0, 1):
+    if code not in (0, 1) or not stage.is_dir():  # a run that wrote nothing is an error, exit 1 too
         info["error"] = tail
     if stage != final:
-        if code in (0, 1):
+        if "error" not in info:
             shutil.rmtree(final, ignore_errors=True)
             stage.rename(final)
             (final.parent / f"{name}.json").write_text(json.dumps(info, indent=1) + "\n")
@@ -450,6 +450,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return args
 
 
+def _link_models(tree: Path) -> None:
+    """Trees from 3ac3433 to 5b2f558's parent look for the bundled models one folder too low
+    (``ptint_drake/models``: robot/ had moved down, fixed in 5b2f558) and found them only through
+    an editable install; the link puts the tree's own ``models/`` where they look."""
+    wrong = tree / "ptint_drake" / "models"
+    if (tree / "ptint_drake" / "robot" / "rvm1.py").is_file() and not wrong.exists():
+        wrong.symlink_to(Path("..") / "models", target_is_directory=True)
+
+
 def _positive(text: str) -> int:
     try:
         value = int(text)
@@ -509,6 +518,7 @@ def identity(args: argparse.Namespace, log: Callable[[str], None]) -> dict:
                 side.tree = scratch / f"tree_{side.label}"
                 worktrees.append(side.tree)
                 git("worktree", "add", "--detach", str(side.tree), side.sha)
+                _link_models(side.tree)
         pool = ThreadPoolExecutor(max_workers=args.jobs)
         try:
             for side, flags in zip(needed, pool.map(lambda s: run_flags(runner, s.tree), needed)):
