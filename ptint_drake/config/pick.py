@@ -10,7 +10,9 @@ task becomes six prescribed-time segments (``worlds.pick.tasks`` has the plan).
 """
 
 from dataclasses import dataclass, field
-from typing import List, Union
+from typing import List, Optional, Union
+
+from ptint_drake.config.line import LineConfig
 
 
 @dataclass
@@ -156,5 +158,7 @@ class PickConfig:
     # "closed on nothing" is reproducible (e.g. 0.3: the arm holds its pre-grasp pose until the
     # fingers have closed above the part, ``pick.tasks._closed_on_nothing``; negative: later, a late grasp)
     test_close_advance_s: float = 0.0
+    # a line that runs itself (issue 44, ``config.line``): parts arrive, the arm decides; None: the tasks
+    line: Optional[LineConfig] = None
 
 
