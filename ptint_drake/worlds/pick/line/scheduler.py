@@ -109,10 +109,12 @@ def grasp_time(track: Track, window: tuple, now: float, timing: Timing):
     leave = now + (s_out - track.s) / track.speed  # the part's centre leaves the window
     enter = now + (s_in - track.s) / track.speed
     deadline = leave - timing.slack
+    if enter - now > timing.horizon:
+        return None, "not in reach yet"
     earliest = max(now, enter) + timing.lead  # in reach from the approach's start on
     t = now + timing.step * math.ceil((earliest - now) / timing.step - 1e-9)
     if t > deadline:
-        return None, "not reachable in time" if enter - now <= timing.horizon else "not in reach yet"
+        return None, "not reachable in time"
     return t, deadline
 
 
