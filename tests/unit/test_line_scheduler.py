@@ -22,7 +22,9 @@ def test_earliest_deadline_first_and_every_other_candidate_named():
     assert d.track == 0 and d.slot == 3
     assert abs(d.grasp - 11.7) < 1e-9  # now + lead: already in reach
     assert abs(d.deadline - (10.0 + 0.3 / 0.1 - 0.5)) < 1e-9
-    assert d.skipped == [(1, "later deadline")]
+    assert d.skipped == [(1, "later deadline")] and d.rivals[1] > d.deadline
+    rival = {"track": 1, "reason": "later deadline", "deadline": round(d.rivals[1], 4)}
+    assert d.record()["skipped"] == [rival]
     assert np.allclose(d.point, [0.25, 0.17, 0.15])
 
 

@@ -12,7 +12,9 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   diagram rebuilt (the pick run's replan and resume).  A task whose cycle would end after the
   scenario's end is not started;
 - **while a task approaches** (before its descend), the grasp point predicted now is compared with
-  the committed one; beyond ``line.redecide_mm`` the window is checked at the committed time: still
+  the committed one; beyond ``line.redecide_mm`` (a belt without an encoder running faster or
+  slower than declared: its speed is then learned from the track, ``view.LineView.learned``) the
+  window is checked at the committed time with that speed: still
   in it, the task goes on (the targets follow the track: ``kept``); out of it, the scheduler
   decides again from now and the task is replaced (``replaced``: its approach restarts from the
   present state, its tf stretched to the new grasp time; nothing feasible: the task goes on).
@@ -22,6 +24,8 @@ nothing new are not repeated in it.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace as with_fields
 
 from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
@@ -137,9 +141,13 @@ class LineDriver:
         drift = drifted(track, grasp, point, t, 1e-3 * self.line.redecide_mm)
         if not drift:
             return False
+        if np.isfinite(track.measured) and not self._has_encoder(track.belt):
+            self.view.learned[track.belt] = track.measured  # the belt's speed, as its track shows it
+            track = with_fields(track, speed=track.measured)
         s_in, s_out = self.view.window(track)
         s = track.s + track.speed * (grasp - t)
-        entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2)}
+        entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
+                 "speed": round(track.speed, 4)}
         if s_in <= s <= s_out - track.speed * self.timing.slack:
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
@@ -151,6 +159,9 @@ class LineDriver:
         self.decisions.append(entry | {"redecide": "nothing feasible: kept"})
         self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
         return False
+
+    def _has_encoder(self, belt: str) -> bool:
+        return any(b.name == belt and b.encoder for b in self.line.belts)
 
     def _choose(self, run, context, t: float, replace=None) -> bool:
         """A decision from now; a task appended (or task ``replace`` replaced): True."""

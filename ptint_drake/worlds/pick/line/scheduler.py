@@ -24,7 +24,7 @@ finds its grasp time on a grid of ``Timing.step`` from the decision:
 
 Of the candidates left, the one whose window closes first (earliest deadline first), ties by the
 earlier grasp.  ``Decision.skipped`` holds every other track with its reason (the chosen one's
-rivals that were feasible read ``later deadline``).
+rivals that were feasible read ``later deadline``, their deadlines in ``rivals``).
 
 ``drifted``: the known prediction of a committed grasp point against the one the decision made:
 beyond the tolerance, the run decides again (``driver``).
@@ -46,7 +46,8 @@ class Track:
     """A part as the controller side knows it: its ``id`` (the sensor's), ``kind``, ``belt``,
     position (world, m), s: its coordinate along its belt (m), the belt's direction and known
     ``speed`` (m/s), its ``axis`` (the x axis the fingers close along, world), its ``width``
-    across the fingers and its top face's ``radius`` (m, any yaw)."""
+    across the fingers, its top face's ``radius`` (m, any yaw) and the ``measured`` speed along
+    the belt the sensor reports for it (m/s; what a drift is checked again with)."""
 
     id: int
     kind: str
@@ -58,6 +59,7 @@ class Track:
     axis: tuple
     width: float
     radius: float
+    measured: float = math.nan  # m/s along the belt: the sensor's own velocity of the part (if any)
 
     def at(self, t: float, now: float) -> np.ndarray:
         """The predicted position at ``t`` (the known belt velocity)."""
@@ -90,13 +92,16 @@ class Decision:
     deadline: Optional[float] = None
     point: Optional[tuple] = None
     skipped: list = field(default_factory=list)
+    rivals: dict = field(default_factory=dict)  # id → the deadline of a feasible track not chosen
 
     def record(self) -> dict:
         """The decision log's entry (metrics.json ``line.decisions``)."""
         return {"t": round(self.t, 4), "track": self.track,
                 "grasp": None if self.grasp is None else round(self.grasp, 4), "slot": self.slot,
                 "deadline": None if self.deadline is None else round(self.deadline, 4),
-                "skipped": [{"track": i, "reason": r} for i, r in self.skipped]}
+                "skipped": [{"track": i, "reason": r} | ({"deadline": round(self.rivals[i], 4)}
+                                                          if i in self.rivals else {})
+                            for i, r in self.skipped]}
 
 
 def grasp_time(track: Track, window: tuple, now: float, timing: Timing):
@@ -158,6 +163,7 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
     feasible.sort(key=lambda f: (f[0], f[1], f[2].id))
     deadline, grasp, chosen = feasible[0]
     decision.skipped += [(f[2].id, "later deadline") for f in feasible[1:]]
+    decision.rivals = {f[2].id: f[0] for f in feasible[1:]}
     decision.track, decision.grasp, decision.deadline = chosen.id, grasp, deadline
     decision.slot = free_slots[chosen.kind][0]
     decision.point = tuple(float(c) for c in chosen.at(grasp, now))

@@ -7,7 +7,9 @@ tracker's report, each belt's known speed, each track's reach window — never t
   shape and size (the pose sensor's object model, from the cell both sides build from; a camera
   would classify by the measured size);
 - **the known speed** of a belt: its encoder's reading (the drive joint's rate) where the line
-  declares ``encoder: true``, else the declared ``speed`` — a speed step is unknown then;
+  declares ``encoder: true``, else the declared ``speed`` — a speed step is unknown then, until
+  a track's drift shows it: the speed the sensor reports for that track is learned for the belt
+  (``learned``, set by ``driver``);
 - **the reach window** of a track (``window``): along its belt, at its lateral offset and height,
   the longest stretch where a top-down grasp and the lift above it are reachable (Drake's IK,
   ``robot.reachability.inverse_kinematics(down=True)``, every ``WINDOW_STEP``), cached per
@@ -38,6 +40,8 @@ class LineView:
         self.scenario, self.line = scenario, scenario.pick.line
         self._windows: dict = {}
         self.built = None
+        # belt → the speed learned from its tracks after a drift (no encoder: ``driver``)
+        self.learned: dict = {}
 
     def bind(self, built) -> None:
         self.built = built
@@ -47,7 +51,7 @@ class LineView:
     def _known_speed(self, context, belt) -> float:
         encoder = {b.name: b.encoder for b in self.line.belts}.get(belt.name, False)
         if not encoder:
-            return belt.speed
+            return self.learned.get(belt.name, belt.speed)
         station = self.built.station
         joint = station.belts[[b.name for b in station.config.belts].index(belt.name)]
         return float(joint.get_translation_rate(station.plant.GetMyContextFromRoot(context)))
@@ -76,7 +80,8 @@ class LineView:
                 continue
             out.append(Track(k, self._kind(part), belt.name, tuple(pose[0:3]), float(local[0]),
                              tuple(belt.direction), self._known_speed(context, belt), tuple(R[:, 0]),
-                             float(part.size[0]), reach(part.shape, part.size)))
+                             float(part.size[0]), reach(part.shape, part.size),
+                             float(np.dot(pose[3:6], belt.direction))))
         return out
 
     def window(self, track: Track) -> tuple:
