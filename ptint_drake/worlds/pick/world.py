@@ -51,7 +51,7 @@ from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLAN
 from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.grasp_gate import grasp_refusal
 from ptint_drake.worlds.pick.line.checks import check_line_scenario, line_plan, line_warnings
-from ptint_drake.worlds.pick.line.driver import LineDriver, NoLine
+from ptint_drake.worlds.pick.line.driver import LineDriver, NoLine, view_scenario
 from ptint_drake.worlds.pick.line.metrics import line_reasons
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
@@ -345,7 +345,7 @@ class PickWorld(World):
         camera = figures and _has_camera(scenario)  # the estimates' figure and the camera's frames
         names = [n for n, on in (("pick_replay", replay), ("picks", figures), ("timeline", figures),
                                  ("estimates", camera), ("camera_frames", camera)) if on]
-        text = dump_yaml(scenario)  # picklable, for a worker process
+        text = dump_yaml(view_scenario(scenario))  # picklable, for a worker process (a line's: its pool)
         return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
 
     def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:

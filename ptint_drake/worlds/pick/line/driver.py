@@ -46,6 +46,16 @@ def cycle_time(task: PickTaskConfig) -> float:
     return sum(m.tf for m in phases) + 2.0 * task.dwell
 
 
+def view_scenario(scenario):
+    """What a run's views draw: a line scenario as the pick scenario of its pool (no ``line``, no
+    tasks: the replay's plant holds every pool part, the timeline a row per part); else itself."""
+    if scenario.pick.line is None:
+        return scenario
+    expanded, _ = line_scenario(scenario)
+    expanded.pick.line = None
+    return expanded
+
+
 class NoLine:
     """The pick run of a task list: no line (``PickRun`` calls the same hooks; they do nothing)."""
 
