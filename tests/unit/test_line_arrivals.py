@@ -42,5 +42,5 @@ def test_the_pool_is_ordinary_parts_named_by_kind_in_release_order():
     scenario, releases = line_scenario(load_scenario("line_short"))
     assert [p.name for p in scenario.pick.parts] == [f"cube_{n}" for n in range(len(releases))]
     assert [r.t for r in releases] == sorted(r.t for r in releases)
-    assert all(r.t < 60.0 - 8.0 for r in releases) and scenario.pick.tasks == []
+    assert all(r.t < 60.0 - 12.0 for r in releases) and scenario.pick.tasks == []
     assert all(-0.015 <= p.lateral <= 0.015 and p.offset == -0.7 for p in scenario.pick.parts)

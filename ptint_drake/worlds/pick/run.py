@@ -66,14 +66,16 @@ class PickBuilt:
         return self.diagram.GetSubsystemByName("tracked_parts")
 
 
-def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuilt:
-    """The pick scenario's diagram (module docstring), its plan with the ``replans`` a run decided."""
+def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = (), planning=None) -> PickBuilt:
+    """The pick scenario's diagram (module docstring), its plan with the ``replans`` a run decided;
+    ``planning``: a line's plan is made from it, the scenario as the controller side believes it
+    (``line.driver.LineDriver.planning``: the tracked parts where they are seen)."""
     builder = DiagramBuilder()
     station = MakePickStation(world_config(scenario), scenario.measurement)
     st = builder.AddNamedSystem("pick_station", station.diagram)
     arm = nominal_plant(scenario)
     # the way around the base where one is needed (route); a line's begins with its idle segment
-    plan = (line_plan if scenario.pick.line is not None else routed_plan)(scenario, replans, arm)
+    plan = (line_plan if scenario.pick.line is not None else routed_plan)(planning or scenario, replans, arm)
     n = len(station.parts)
     places = place_positions(station.config, plan)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, places))

@@ -235,7 +235,7 @@ class PickRun(WorldRun):
             return False
         self._rebuilt = False
         self._pieces.append(pick_logs(self.built, context))  # the old diagram's loggers, up to now
-        self.built = build_pick(self.scenario, tuple(self.replans))
+        self.built = build_pick(self.scenario, tuple(self.replans), self.line.planning())
         self.diagram, self.controller = self.built.diagram, self.built.controller
         self.line.bind(self.built)
         self.end = max(self.scenario.duration, self.built.plan.end + self._tail)

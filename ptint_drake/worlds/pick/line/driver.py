@@ -25,7 +25,9 @@ nothing new are not repeated in it.
 
 from __future__ import annotations
 
-from dataclasses import replace as with_fields
+from dataclasses import replace
+
+import numpy as np
 
 from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
@@ -35,9 +37,10 @@ from ptint_drake.worlds.pick.line.plan import IDLE_TF
 from ptint_drake.worlds.pick.line.scheduler import Timing, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
+from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
 
-import numpy as np
+FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
 
 
 def cycle_time(task: PickTaskConfig) -> float:
@@ -82,6 +85,9 @@ class NoLine:
     def add_metrics(self, metrics: dict, series: dict) -> None:
         pass
 
+    def planning(self):
+        return None
+
 
 class LineDriver:
     """A line run's truth and decisions (module docstring); ``scenario``: the line scenario, of
@@ -99,6 +105,8 @@ class LineDriver:
         self.committed: dict = {}  # task → [track, grasp time, point]
         self.timing = None
         self._last_look = None
+        self._beliefs: dict = {}  # part → (offset, lateral, yaw_deg) as tracked at the last decision
+        self._speeds: dict = {}  # belt → its known speed then
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -118,6 +126,30 @@ class LineDriver:
     def restore(self, context) -> None:
         """In a rebuilt diagram's context: the parameters a replan does not carry (``truth``)."""
         self.truth.restore(context)
+
+    def planning(self):
+        """The scenario the plan is made from (``run.build_pick``): the expanded one with every
+        part where the controller side last saw it at a decision — its tracked position and yaw,
+        riding its belt at the known speed (an ``offset`` that puts it there at that time) — and
+        every part it never saw far upstream, so that the plan's vias (``obstacles``: the planning
+        model holds the parts riding their belts) go over the parts that are there, and each
+        task's approach is checked towards where its part was seen."""
+        pick = self.scenario.pick
+        far = {"offset": FAR_UPSTREAM, "lateral": 0.0}
+        parts = [replace(p, **(dict(zip(("offset", "lateral", "yaw_deg"), self._beliefs[k]))
+                               if k in self._beliefs else far)) for k, p in enumerate(pick.parts)]
+        belts = [replace(b, speed=self._speeds.get(b.name, b.speed)) for b in pick.belts]
+        return replace(self.scenario, pick=replace(pick, parts=parts, belts=belts))
+
+    def _believe(self, tracks: list, t: float) -> None:
+        """The tracked parts' places for ``planning`` (at time ``t``); a part no longer tracked
+        (picked, or gone) keeps where it was last seen — its task's approach is planned to it."""
+        for tr in tracks:
+            belt = next(b for b in self.scenario.pick.belts if b.name == tr.belt)
+            lateral = float(belt_frame(belt).inverse().multiply(np.asarray(tr.position))[1])
+            yaw = float(np.degrees(np.arctan2(tr.axis[1], tr.axis[0])))  # world (``scene.part_start_pose``)
+            self._beliefs[tr.id] = (tr.s - tr.speed * t, lateral, yaw)
+            self._speeds[tr.belt] = tr.speed
 
     def add_metrics(self, metrics: dict, series: dict) -> None:
         """metrics.json ``line`` (``metrics.line_metrics``)."""
@@ -153,7 +185,7 @@ class LineDriver:
             return False
         if np.isfinite(track.measured) and not self._has_encoder(track.belt):
             self.view.learned[track.belt] = track.measured  # the belt's speed, as its track shows it
-            track = with_fields(track, speed=track.measured)
+            track = replace(track, speed=track.measured)
         s_in, s_out = self.view.window(track)
         s = track.s + track.speed * (grasp - t)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
@@ -162,7 +194,7 @@ class LineDriver:
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False
-        if self._choose(run, context, t, replace=k):
+        if self._choose(run, context, t, replacing=k):
             self.replaced.append({"t": t, "task": k, "drift_mm": 1e3 * drift})
             self.decisions[-1]["redecide"] = "replaced"
             return True
@@ -173,14 +205,14 @@ class LineDriver:
     def _has_encoder(self, belt: str) -> bool:
         return any(b.name == belt and b.encoder for b in self.line.belts)
 
-    def _choose(self, run, context, t: float, replace=None) -> bool:
-        """A decision from now; a task appended (or task ``replace`` replaced): True."""
+    def _choose(self, run, context, t: float, replacing=None) -> bool:
+        """A decision from now; a task appended (or task ``replacing`` replaced): True."""
         tasks = self.scenario.pick.tasks
         if t + cycle_time(PickTaskConfig()) > self.scenario.duration:
             return False  # no cycle fits before the end
         tracks = self.view.tracks(context, t)
         windows = {tr.id: self.view.window(tr) for tr in tracks}
-        keep = [k for k in range(len(tasks)) if k != replace]
+        keep = [k for k in range(len(tasks)) if k != replacing]
         assigned = {self.committed[k][0] for k in keep}
         used = {tasks[k].slot for k in keep}
         free = {c.name: [j for j in c.slots if j not in used] for c in self.line.catalog}
@@ -199,15 +231,16 @@ class LineDriver:
             self._last_look = look
             return False
         self._last_look = None
-        self._commit(run, t, decision, replace)
-        self.decisions.append(record | {"task": replace if replace is not None else len(tasks) - 1})
+        self._believe(tracks, t)
+        self._commit(run, t, decision, replacing)
+        self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1})
         return True
 
-    def _commit(self, run, t: float, decision, replace) -> None:
+    def _commit(self, run, t: float, decision, replacing) -> None:
         """The decision's task into the run's tasks (and its per-task records)."""
         tasks, default = self.scenario.pick.tasks, PickTaskConfig()
         name = self.built.station.config.parts[decision.track].name
-        if replace is None:
+        if replacing is None:
             start = max(t, decision.grasp - self.timing.lead)
             task = PickTaskConfig(part=name, slot=decision.slot, start=start)
             tasks.append(task)
@@ -219,6 +252,6 @@ class LineDriver:
             tf = decision.grasp - default.descend.tf - t
             task = PickTaskConfig(part=name, slot=decision.slot, start=t,
                                   approach=MoveConfig(tf, default.approach.beta))
-            tasks[replace], k = task, replace
+            tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
         self.committed[k] = [decision.track, decision.grasp, decision.point]
