@@ -1,6 +1,7 @@
 """The catch table and figure of docs/catch.md (issue 46) from ``ptint robust`` folders of a catch
 scenario: the catch rate, the oracle's reachable rate, the rate over the reachable throws, the
-failures by reason, the hand's error and the peak contact force; ``--compare`` adds rows of other
+failures by reason, the hand's error, the peak contact force and the arm's largest joint speed over
+its limit (the realized one: the simulated plant does not enforce it); ``--compare`` adds rows of other
 runs on the same seeds (without velocity matching, at half the time step); ``--figure`` writes the
 catch rate against the throw's launch speed (the frozen thrower's, bins of 0.25 m/s).
 
@@ -45,7 +46,15 @@ def line(name: str, rows: list) -> str:
     return (f"| {name} | {len(rows)} | {len(caught)} ({100 * len(caught) / len(rows):.1f} %) | "
             f"{len(reach)} | {of_reach} ({100 * of_reach / max(len(reach), 1):.1f} %) | "
             f"{_median(r['error_at_catch_mm'] for r in rows)} | "
-            f"{_median(r['peak_contact_force_n'] for r in caught)} |")
+            f"{_median(r['peak_contact_force_n'] for r in caught)} | {_speeds(rows)} |")
+
+
+def _speeds(rows: list) -> str:
+    """The arm's largest joint speed over its limit per run: median (max), and how many runs > 1."""
+    values = [r["joint_speed_ratio_max"] for r in rows if r.get("joint_speed_ratio_max") is not None]
+    if not values:
+        return "–"
+    return f"{np.median(values):.2f} ({max(values):.2f}; {sum(v > 1.0 for v in values)} > 1)"
 
 
 def failures(rows: list) -> str:
@@ -109,8 +118,8 @@ def main(argv=None) -> int:
         print(exc, file=sys.stderr)
         return 2
     print("| run | throws | caught | reachable (oracle) | caught of reachable | hand error median (mm) "
-          "| peak force median, caught (N) |")
-    print("|---|---|---|---|---|---|---|")
+          "| peak force median, caught (N) | joint speed / limit, median (max; runs > 1) |")
+    print("|---|---|---|---|---|---|---|---|")
     print(line("default", rows))
     for name, other in others:
         seeds = {r["seed"] for r in other}

@@ -21,11 +21,18 @@ import json
 import sys
 import tempfile
 from pathlib import Path
+from typing import Optional
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 from lcm_link.netns import namespace_problem, run_in_netns  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from ptint_drake.hardware.link_record import LinkSettings  # noqa: E402
+
+BUDGET = LinkSettings.budget  # the part of T a real-time tick waits for its command
 
 PAIR = ROOT / "tests" / "lcm_link" / "pair.py"
 PATIENT = ("--startup-timeout", "60")
@@ -48,15 +55,19 @@ def row(name: str, out: dict, folder: Path, proc: str = "hw") -> dict:
     link = json.loads(metrics.read_text())["hardware"] if metrics.is_file() else {}
     period = link.get("period") or 1e-3
     reaction = None
-    if link.get("fault_time") is not None and link.get("last_command_t") is not None:
-        reaction = round((link["fault_time"] - link["last_command_t"]) / period, 1)
+    heard = link.get("last_heard_t", link.get("last_command_t"))
+    if link.get("fault_time") is not None and heard is not None:
+        reaction = round((link["fault_time"] - heard) / period, 1)
     hold = link.get("hold") or {}
     return {
         "fault": name,
         "exit": {k: v["rc"] for k, v in out.items()},
         "fault_kind": link.get("fault_kind"),
         "message": link.get("fault"),
-        "reaction_periods": reaction,
+        "reaction_periods": reaction,  # simulated periods from the tick the last command came in
+        "silent_statuses": link.get("silent_run_max"),
+        "signal_to_hold_ms": _signal_to_hold(out, folder, proc),
+        "ticks_skipped": link.get("ticks_skipped"),
         "held": hold.get("speed_at_end") is not None and hold["speed_at_end"] < 0.05,
         "settled_s_after_fault": hold.get("settled_s_after_fault"),
         "ticks_late": link.get("ticks_late"),
@@ -64,7 +75,64 @@ def row(name: str, out: dict, folder: Path, proc: str = "hw") -> dict:
         "files": sorted(p.name for p in (folder / "hw").glob("*")) if (folder / "hw").is_dir() else [],
         "ticks": link.get("ticks"),
         "drive": _drive(folder),
+        "late_sides": late_sides(folder, BUDGET * period / (link.get("realtime_rate") or 1.0)),
     }
+
+
+def late_sides(folder: Path, budget_s: float) -> Optional[dict]:
+    """On which side each late tick of a real-time run was late, from the hardware's per-tick
+    wall times (series.npz ``link_*``) and the drive's (drive_series.npz): ``drive woke late``
+    (the status reached the idle drive's loop after the tick's deadline), ``drive busy`` (it was
+    still answering older statuses), ``drive computed late`` (received in time, answered after
+    the deadline), ``hardware handled late`` (answered in time, handled by the hardware after
+    its wait ended), ``not answered`` (the drive never answered that status); with the count of
+    the late ticks in runs of 3 or more, and the median delay of each segment (ms)."""
+    hw, dr = folder / "hw" / "series.npz", folder / "dr" / "drive_series.npz"
+    if not hw.is_file() or not dr.is_file():
+        return None
+    h, d = np.load(hw), np.load(dr)
+    drive = {int(u): (r, x) for u, r, x in zip(d["stamp"], d["recv_wall"], d["sent_wall"])}
+    late_at = dict(zip(h["link_late_utime"].tolist(), h["link_late_wall"]))
+    late = np.flatnonzero(np.isnan(h["link_tick_answered"]))
+    runs = np.split(late, np.flatnonzero(np.diff(late) > 1) + 1) if late.size else []
+    sides, delays = {}, {"to_drive_ms": [], "drive_ms": [], "to_hardware_ms": []}
+    for k in late:
+        u, sent = int(round(h["link_tick_t"][k] * 1e6)), h["link_tick_sent"][k]
+        prev = drive.get(int(round(h["link_tick_t"][k - 1] * 1e6))) if k else None
+        side = _side(sent, sent + budget_s, drive.get(u), prev)
+        sides[side] = sides.get(side, 0) + 1
+        if u in drive:
+            r, x = drive[u]
+            delays["to_drive_ms"].append((r - sent) * 1e3)
+            delays["drive_ms"].append((x - r) * 1e3)
+            if u in late_at:
+                delays["to_hardware_ms"].append((late_at[u] - x) * 1e3)
+    return {"ticks_late": int(late.size), "in_runs_of_3_or_more": sum(len(r) for r in runs if len(r) >= 3),
+            "sides": sides,
+            "median_ms": {k: round(float(np.median(v)), 3) if v else None for k, v in delays.items()}}
+
+
+def _side(sent: float, deadline: float, answer: Optional[tuple], previous: Optional[tuple]) -> str:
+    """The side a late tick was late on (``late_sides``)."""
+    if answer is None:
+        return "not answered"
+    received, answered = answer
+    if received > deadline:
+        return "drive busy" if previous is not None and previous[1] > sent else "drive woke late"
+    return "drive computed late" if answered > deadline else "hardware handled late"
+
+
+def _signal_to_hold(out: dict, folder: Path, proc: str) -> Optional[float]:
+    """Wall ms from the signal sent to a process of the plan (the drive killed) to the end of the
+    hardware tick that held the arm (series.npz ``link_tick_waited``: one clock, CLOCK_MONOTONIC)."""
+    killed = [v for k, v in out.items() if k != proc and v.get("killed") is not None]
+    series = folder / "hw" / "series.npz"
+    if not killed or not series.is_file():
+        return None
+    waited = np.load(series)["link_tick_waited"]
+    if not waited.size:
+        return None
+    return round(1e3 * (float(waited[-1]) - (killed[0]["origin"] + killed[0]["killed"])), 2)
 
 
 def _drive(folder: Path) -> dict:
@@ -84,6 +152,7 @@ def main() -> None:
     parser.add_argument("--pick-scenario", default="conveyor_pick_place",
                         help="the lost-companion rows' scenario")
     parser.add_argument("--only", help="comma-separated rows: realtime,kill,sigterm,sigint,second,companion")
+    parser.add_argument("--out", help="keep each run's folders (hw/, dr/) here (default: a temporary folder)")
     args = parser.parse_args()
     problem = namespace_problem()
     if problem:
@@ -93,7 +162,8 @@ def main() -> None:
             else {"realtime", "kill", "sigterm", "sigint", "second", "companion"})
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        base = Path(tmp)
+        base = Path(args.out) if args.out else Path(tmp)
+        base.mkdir(parents=True, exist_ok=True)
 
         def case(label, plan_of):
             folder = base / f"{label}_{len(rows)}"
@@ -112,7 +182,7 @@ def main() -> None:
 
         if "realtime" in only:
             for _ in range(args.runs):
-                case("realtime (no fault)", lambda f: [hw(f, "--quiet"), drive()])
+                case("realtime (no fault)", lambda f: [hw(f, "--quiet"), drive(folder=f)])
         if "kill" in only:
             case("drive SIGKILL", lambda f: [hw(f), drive(kill_when=["hw", " 30 %"])])
         for sig in ("SIGTERM", "SIGINT"):

@@ -171,6 +171,44 @@ def compare(base: Any, head: Any, path: tuple = (),
     return []
 
 
+def additions_only(differences: list[dict], base: Any, head: Any) -> bool:
+    """True when every difference only adds to the base (``values_identical``): a key present in
+    the head alone (a new metric, a new configuration field echoed in ``scenario_config``), or
+    lines added to a ``warnings…`` list that keeps every base line in its order (or a count of
+    them, ``warnings_before_run``, that grew).  Every other value of the base is then the
+    head's, bit for bit."""
+    for d in differences:
+        if d["kind"] == "missing_in_base":
+            continue
+        keys = d["path"].replace("[", ".[").split(".")
+        at = next((i for i, k in enumerate(keys) if k.startswith("warnings")), None)
+        if at is None:
+            return False
+        key = ".".join(keys[:at + 1])
+        lines_base, lines_head = _at_text(base, key), _at_text(head, key)
+        if isinstance(lines_base, int) and isinstance(lines_head, int):  # a count of warnings
+            if lines_head < lines_base:
+                return False
+        elif not (isinstance(lines_base, list) and isinstance(lines_head, list)
+                  and _subsequence(lines_base, lines_head)):
+            return False
+    return True
+
+
+def _at_text(tree: Any, where: str) -> Any:
+    """The value at a ``_path_text`` path of dict keys (``a.b.warnings``)."""
+    for key in where.split("."):
+        if not isinstance(tree, dict) or key not in tree:
+            return None
+        tree = tree[key]
+    return tree
+
+
+def _subsequence(short: list, long: list) -> bool:
+    it = iter(long)
+    return all(any(x == y for y in it) for x in short)
+
+
 def max_relative_difference(differences: list[dict]) -> float | None:
     """The largest ``rel_diff`` of ``differences`` (None when none has one)."""
     values = [d["rel_diff"] for d in differences if "rel_diff" in d]
@@ -354,11 +392,12 @@ def compare_runs(base: dict, head: dict) -> dict:
     else:
         row["differences"] = compare(base_metrics, head_metrics)
         row["identical"] = not row["differences"]
+        row["values_identical"] = additions_only(row["differences"], base_metrics, head_metrics)
         row["max_rel_diff"] = max_relative_difference(row["differences"])
         row["ignored_values"] = {_path_text(p): [_get(base_metrics, p), _get(head_metrics, p)]
                                  for p in IGNORED if _get(base_metrics, p) is not None}
     if base["exit_code"] != head["exit_code"]:
-        row["identical"] = False
+        row["identical"] = row["values_identical"] = False
     files = {s: output_files(Path(r["folder"])) if Path(r["folder"]).is_dir() else []
              for s, r in (("base", base), ("head", head))}
     only_base = sorted(set(files["base"]) - set(files["head"]))
@@ -366,6 +405,7 @@ def compare_runs(base: dict, head: dict) -> dict:
     row["files"] = {"identical": not only_base and not only_head, "names": files["base"]}
     if only_base or only_head:
         row["identical"] = False
+        row["values_identical"] = row.get("values_identical", False) and not only_base
         row["files"] |= {"only_in_base": only_base, "only_in_head": only_head}
     row["exit_code"] = {"base": base["exit_code"], "head": head["exit_code"]}
     row["run_wall_s"] = {"base": base["wall_s"], "head": head["wall_s"]}
@@ -502,8 +542,8 @@ def identity(args: argparse.Namespace, log: Callable[[str], None]) -> dict:
 
 def report(sides: list[Side], wanted: list[str], runs: dict[tuple[str, str], dict], t_start: float) -> dict:
     """The JSON report: each scenario's comparison (``compare_runs``) and a summary."""
-    scenarios, summary = {}, {"identical": [], "differing": [], "only_in_base": [], "only_in_head": [],
-                              "could_not_run": []}
+    scenarios, summary = {}, {"identical": [], "differing": [], "values_identical": [], "only_in_base": [],
+                              "only_in_head": [], "could_not_run": []}
     for name in wanted:
         if ("base", name) not in runs or ("head", name) not in runs:
             side = "base" if ("base", name) in runs else "head"
@@ -515,6 +555,8 @@ def report(sides: list[Side], wanted: list[str], runs: dict[tuple[str, str], dic
         if "errors" in row:
             summary["could_not_run"].append(name)
         summary["identical" if row["identical"] else "differing"].append(name)
+        if row.get("values_identical"):
+            summary["values_identical"].append(name)
     walls = {name: row["run_wall_s"] for name, row in scenarios.items() if "run_wall_s" in row}
     return {
         "base": sides[0].description, "head": sides[1].description,

@@ -89,6 +89,18 @@ class TrayConfig:
 
 
 @dataclass
+class BinConfig:
+    """An open box welded to the world (a floor and four walls, ``scene.bin_boxes``): a part
+    dropped into it from above its walls counts "in the bin" (no place pose, no mm criterion)."""
+
+    name: str = "bin"  # body and model-instance name
+    center: List[float] = field(default_factory=lambda: [0.15, 0.22, 0.10])  # m, its inner floor's centre
+    size: List[float] = field(default_factory=lambda: [0.10, 0.10, 0.05])  # m, inner [x, y, depth]
+    wall: float = 0.005  # m, the thickness of its walls and floor
+    friction: float = 0.8  # 1, Coulomb friction of its surfaces
+
+
+@dataclass
 class PickWorldConfig:
     """Everything physical in a pick-and-place station besides the arm's own model file."""
 
@@ -105,6 +117,7 @@ class PickWorldConfig:
     belts: List[BeltConfig] = field(default_factory=list)
     parts: List[PartConfig] = field(default_factory=list)
     tray: TrayConfig = field(default_factory=TrayConfig)
+    bins: List[BinConfig] = field(default_factory=list)
 
 
 PHASES = ("approach", "descend", "lift", "carry", "place", "retreat")
@@ -120,10 +133,12 @@ class MoveConfig:
 
 @dataclass
 class PickTaskConfig:
-    """One part picked off its belt and placed in one tray slot (see the module docstring)."""
+    """One part picked off its belt and placed in one tray slot or dropped into one bin (see the
+    module docstring): exactly one of ``slot`` and ``bin``."""
 
     part: str = ""  # the part's name (pick.parts[*].name)
-    slot: int = 0  # index into pick.tray.slots
+    slot: Optional[int] = None  # index into pick.tray.slots
+    bin: str = ""  # or the name of a bin (pick.bins[*].name): the part dropped into it
     start: float = 0.0  # s, the approach's start (0: right after the previous task)
     approach: MoveConfig = field(default_factory=lambda: MoveConfig(1.2))
     descend: MoveConfig = field(default_factory=lambda: MoveConfig(0.5))
@@ -149,6 +164,7 @@ class PickConfig:
     belts: List[BeltConfig] = field(default_factory=list)
     parts: List[PartConfig] = field(default_factory=list)
     tray: TrayConfig = field(default_factory=TrayConfig)
+    bins: List[BinConfig] = field(default_factory=list)
     tasks: List[PickTaskConfig] = field(default_factory=list)
     # the confirmed grasp (``systems.hand.gripper.GraspObserver``, docs/pick_place.md "Grasp states"):
     retries: int = 1  # new approach + descend after an empty grasp or a timeout (0: none)

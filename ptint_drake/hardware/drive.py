@@ -118,7 +118,7 @@ class _DriveLoop:
                                         raw_frames=self.frames is not None)
         if self.frames is not None:
             self.frames.start(decoder=FRAME_DECODER)
-        record.url = self.endpoint.url
+        record.url, record.threads = self.endpoint.url, self.endpoint.threads
         risk = url_warning(self.endpoint.url)
         if risk:
             warn(risk)
@@ -299,6 +299,9 @@ class _DriveLoop:
         record = self.record
         record.commands += 1
         record.compute.append(sent - t_recv)
+        record.stamps.append(self.stamp)
+        record.received.append(t_recv)
+        record.sent.append(sent)
         record.first_t = t if record.first_t is None else record.first_t
         record.last_t = t
         record.t.append(t)
@@ -329,7 +332,8 @@ class _DriveLoop:
         drive started mid-run held the arm as a silent controller that way, instead of being
         named as the second sender)."""
         quiet_collector()
-        refused = request_realtime(self.settings.priority) if not self.in_memory else None
+        refused = (request_realtime(self.settings.priority, self.endpoint.threads)
+                   if not self.in_memory else None)
         if refused:
             self.warn(refused)
 

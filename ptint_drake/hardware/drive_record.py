@@ -37,6 +37,9 @@ class DriveRecord:
     companions_lost: int = 0  # statuses not answered: a companion of theirs lost (``companions``)
     commands: int = 0
     compute: list = field(default_factory=list)  # s wall: status received → command sent
+    stamps: list = field(default_factory=list)  # the answered statuses' stamps (the driver's utime)
+    received: list = field(default_factory=list)  # perf_counter s: each answered status handled
+    sent: list = field(default_factory=list)  # perf_counter s: its command handed to LCM
     perception: Optional[dict] = None  # a perception in its own process: its fits' and waits' times
     clipped: int = 0  # commands clipped to the actuators' effort limits
     url: Optional[str] = None  # the LCM URL in use
@@ -48,6 +51,7 @@ class DriveRecord:
     v: list = field(default_factory=list)
     tau: list = field(default_factory=list)
     clock: Optional[object] = None  # the ``status_clock.StatusClock`` of the driver's stamps
+    threads: list = field(default_factory=list)  # LCM's receive threads (``link.Endpoint.threads``)
 
 
 def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dict:
@@ -73,6 +77,7 @@ def drive_summary(record: DriveRecord, settings: DriveSettings, url: str) -> dic
         "perception": record.perception,
         "commands_clipped": record.clipped,
         "scheduler": scheduler_name(),
+        "receive_thread_scheduler": [scheduler_name(tid) for tid in record.threads],
         "driver_mode": settings.driver_mode,
         "clock": record.clock.summary() if record.clock is not None else None,
     }
@@ -86,4 +91,8 @@ def drive_series(record: DriveRecord) -> dict:
         "v": np.asarray(record.v),
         "tau": np.asarray(record.tau),
         "compute": np.asarray(record.compute),  # s wall: status received → command sent
+        # perf_counter s (CLOCK_MONOTONIC: the hardware's ``link_*`` series share the clock)
+        "stamp": np.asarray(record.stamps, dtype=np.int64),
+        "recv_wall": np.asarray(record.received, dtype=float),
+        "sent_wall": np.asarray(record.sent, dtype=float),
     }

@@ -54,6 +54,7 @@ from drake import (lcmt_iiwa_command, lcmt_iiwa_status, lcmt_schunk_wsg_command,
                    lcmt_scope)
 from pydrake.lcm import DrakeLcm
 
+from ptint_drake.hardware.process import new_threads, thread_ids
 from ptint_drake.worlds.base import TRACKED_SIZE
 
 STATUS_CHANNEL = "IIWA_STATUS"  # Drake's iiwa driver's channel names
@@ -92,6 +93,7 @@ class Endpoint:
     def __init__(
         self, url: Optional[str], listen: str, publish: str, lcm: Optional[DrakeLcm] = None, also: tuple = ()
     ):
+        before = thread_ids()
         self.lcm = lcm if lcm is not None else DrakeLcm(url) if url else DrakeLcm()
         self.url = self.lcm.get_lcm_url()
         self._guard = MEMQ_LOCK if self.url.startswith("memq") else contextlib.nullcontext()
@@ -102,6 +104,10 @@ class Endpoint:
         self.side: dict[str, list] = {c: [] for c in also}
         for channel in also:
             self.lcm.Subscribe(channel, lambda data, c=channel: self.side[c].append(bytes(data)))
+        # the threads LCM started for this endpoint (``udpm``: its receive thread, through which
+        # every message passes; none for a shared or ``memq`` LCM): scheduled with the loop's own
+        # (``process.request_realtime``)
+        self.threads = new_threads(before) if lcm is None else []
 
     def pump(self, timeout_s: float) -> None:
         """Handle what arrives within ``timeout_s`` into the inboxes (none drained here)."""
@@ -148,8 +154,8 @@ class Endpoint:
                 and time.perf_counter() < deadline
             ):  # (the other side's thread may have handled them)
                 time.sleep(MEMQ_NAP)
-        else:
-            self._handle(max(0, int(round(timeout_s * 1e3))))
+        else:  # (whole ms, rounded down: a wait never ends past its deadline)
+            self._handle(max(0, int(timeout_s * 1e3)))
         while self._handle() > 0:
             pass
         out, self.inbox = self.inbox, []

@@ -7,6 +7,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Optional
 
+import numpy as np
+
 from ptint_drake.hardware.process import DEFAULT_PRIORITY
 
 
@@ -38,6 +40,13 @@ class LinkRecord:
     rtt: list = field(default_factory=list)  # s wall: status published → its command received
     tick_wall: list = field(default_factory=list)  # perf_counter of each tick's first publish
     tick_time: list = field(default_factory=list)  # simulated t of each tick
+    # per tick (``link_series``), perf_counter s: the status handed to LCM, its answer handled
+    # (NaN: none within the tick's wait), the tick's wait ended
+    tick_sent: list = field(default_factory=list)
+    tick_answered: list = field(default_factory=list)
+    tick_waited: list = field(default_factory=list)
+    late_utime: list = field(default_factory=list)  # answers after their tick: the status's utime
+    late_wall: list = field(default_factory=list)  # ... and when they were handled (perf_counter s)
     statuses: int = 0  # status messages published (re-sends included)
     dropped: int = 0  # status messages not sent (``drop_status``)
     companions_dropped: int = 0  # gripper statuses not sent (``drop_companion``)
@@ -49,8 +58,23 @@ class LinkRecord:
     late_commands: int = 0  # commands that arrived after their tick
     gripper_commands: int = 0  # gripper commands taken (a station with a gripper)
     last_command_t: Optional[float] = None  # simulated t of the last command accepted
+    last_heard_t: Optional[float] = None  # simulated t of the tick the last command (late ones too) came in
     frames_sent: int = 0  # depth frames published (a station with a camera; re-sends not counted)
     fault: Optional[str] = None
     fault_time: Optional[float] = None
     fault_kind: Optional[str] = None
     stop_signal: Optional[int] = None  # SIGINT or SIGTERM received: the run was stopped (held)
+
+
+def link_series(record: LinkRecord) -> dict:
+    """The link's per-tick wall times as arrays (series.npz's ``link_*`` entries): with the drive's
+    (``drive_series``: ``stamp``, ``recv_wall``, ``sent_wall``) they say on which side a late tick
+    was late (``perf_counter`` is one clock for both processes: Linux's ``CLOCK_MONOTONIC``)."""
+    return {
+        "link_tick_t": np.asarray(record.tick_time, dtype=float),
+        "link_tick_sent": np.asarray(record.tick_sent, dtype=float),
+        "link_tick_answered": np.asarray(record.tick_answered, dtype=float),
+        "link_tick_waited": np.asarray(record.tick_waited, dtype=float),
+        "link_late_utime": np.asarray(record.late_utime, dtype=np.int64),
+        "link_late_wall": np.asarray(record.late_wall, dtype=float),
+    }

@@ -4,10 +4,11 @@ and checks, the timing it records; ``command_link.CommandLink`` calls it at each
 - **Lockstep** (``lockstep``): each tick waits for its command (re-sending the status every
   ``resend`` s of wall time, so a lost status costs time, not the run), up to ``command_timeout``
   of wall time.
-- **Real time**: the simulator paces the ticks; each tick waits at most ``budget`` × T for its
-  command, otherwise the previous torque stays (``late``); ``silent_periods`` ticks in a row
-  without a command (5: a dead or silent controller) is the timeout, so the arm is held within
-  that many control periods of the last command.
+- **Real time**: the link paces the ticks and skips those of its own stalls (``realtime.TickPacer``);
+  each tick waits at most ``budget`` × T for its command, otherwise the newest command that
+  came stays (``late``); ``silent_periods`` statuses in a row without any command of the
+  controller (5: a dead or silent controller; ``realtime.Silence``) is the timeout, so the arm
+  is held that many control periods after the tick the controller was last heard in.
 
 Every command passes the checks before it reaches the plant (``HardwareSession._check``): its
 size, finite torques within the actuators' effort limits, positions (if any) equal to the status's
@@ -31,15 +32,18 @@ import numpy as np
 
 from ptint_drake.hardware.camera_link import image_channel, pack_depth_image
 from ptint_drake.hardware.driver_modes import position_refusal
+from ptint_drake.hardware.gripper_commands import GripperCommands
 from ptint_drake.hardware.link_record import LinkRecord, LinkSettings
 from ptint_drake.hardware.process import quiet_collector, request_realtime
+from ptint_drake.hardware.realtime import Silence, TickPacer
 from ptint_drake.worlds.base import LinkPorts
 from ptint_drake.hardware.arm_messages import arm_messages
 from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
-                                       pack_tracked, pack_wsg_status, unpack_wsg_command, utime_of)
+                                       pack_tracked, pack_wsg_status, utime_of)
 
 SETTLED_SPEED = 0.05  # rad/s: the arm counts as held below this joint speed
 QUIET, QUIET_MAX = 0.1, 2.0  # s: the wait for the last answers to the hand-shake (``_quiet``)
+WAIT_NAP = 1e-4  # s: a nap of a wait's last millisecond (``Endpoint.poll`` waits whole ms)
 
 
 class LinkFault(Exception):
@@ -61,14 +65,16 @@ class HardwareSession:
         self._answered: Optional[int] = None  # utime of the last status answered
         self._answered_tau: Optional[np.ndarray] = None
         self._pending: Optional[int] = None
-        self._pending_q: Optional[np.ndarray] = None  # the measured positions of the pending status
+        self._measured: dict[int, np.ndarray] = {}  # utime → the measured positions of a status sent
+        self._late_taken = False  # real time: a late answer's torque taken during this tick's wait
+        self._answer_wall = float("nan")  # perf_counter of this tick's answer handled (``_waited``)
         self._sent: dict[int, float] = {}  # utime → wall time of its first publish
         self._consecutive_late = 0
+        self.pacer = TickPacer(settings.period, settings.realtime_rate)  # real time (``realtime``)
+        self.silence = Silence(settings.silent_periods)
         self._after_handshake = False
         self.ports: Optional[LinkPorts] = None  # the station's gripper and objects (``sim_hardware``)
-        self._wsg: dict[
-            int, tuple[float, float]
-        ] = {}  # gripper commands: driver's tick utime → (opening, force)
+        self._wsg = GripperCommands()  # gripper commands by the driver's tick (a station's gripper)
         self._companions: list = []  # this tick's gripper status, tracker report, frame (``ports``)
         self._drop_gripper = False  # ``drop_companion``: this tick's gripper status not sent once
         self.handshake_s: Optional[float] = None  # wall s the hand-shake took
@@ -112,9 +118,9 @@ class HardwareSession:
         """(the stamp of the status a command answers, why its positions are refused or None).
         Drake's ``IiwaCommandSender`` truncates t·10⁶: a stamp 1 µs short of the pending or
         answered status's is that status's answer (48 of 3001 stamps at 1 ms, measured)."""
-        if utime + 1 in (self._pending, self._answered):
+        if utime not in self._sent and utime + 1 in self._sent:
             utime += 1
-        return utime, position_refusal(positions, self._pending_q) if utime == self._pending else None
+        return utime, position_refusal(positions, self._measured.get(utime))
 
     def _check(self, t: float, data: bytes, t_recv: float) -> None:
         """One received command against the checks (module docstring); a fault or its use."""
@@ -156,6 +162,7 @@ class HardwareSession:
             self.record.accepted += 1
             self.record.last_command_t = utime * 1e-6
             self.record.rtt.append(t_recv - self._sent[utime])
+            self._answer_wall, self.record.last_heard_t = t_recv, t
             return None
         if self._answered is not None and utime < self._answered:
             return self._fail(
@@ -167,8 +174,7 @@ class HardwareSession:
                 f"restarted controller",
             )
         if utime in self._sent and (self._pending is None or utime < self._pending):
-            self.record.late_commands += 1  # real time: an answer after its tick
-            return None
+            return self._late(t, utime, tau, t_recv)
         return self._fail(
             t,
             "second sender",
@@ -176,39 +182,30 @@ class HardwareSession:
             f"for, at t = {t:.3f} s: a second sender on {self.endpoint.listen}",
         )
 
+    def _late(self, t: float, utime: int, tau: np.ndarray, t_recv: float) -> None:
+        """Real time: an answer to an older status than the pending one, after its tick, but newer
+        than the command in use: the controller's newest word, taken at this tick (a robot's
+        driver applies the latest command it has; the torque of an older status would stay
+        otherwise, and a controller one status behind would never steer the arm).  An answer to
+        one of the last ``silent_periods`` statuses is also a sign of life (``realtime``)."""
+        self.record.late_commands += 1
+        self._answered, self._answered_tau, self._late_taken = utime, tau, True
+        self.record.last_command_t = utime * 1e-6
+        if self._pending - utime <= self.s.silent_periods * utime_of(self.s.period):
+            self.silence.heard()
+            self.record.last_heard_t = t
+        self.record.late_utime.append(utime)
+        self.record.late_wall.append(t_recv)
+
     def _check_gripper(self, t: float, data: bytes) -> None:
-        """One received gripper command against the checks: finite, a force within [0, the
-        gripper's limit], one command per driver tick."""
-        try:
-            utime, opening, force = unpack_wsg_command(data)
-        except ValueError as exc:
-            return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: {exc}")
-        if not (np.isfinite(opening) and np.isfinite(force)):
-            return self._fail(t, "bad command", f"gripper command rejected at t = {t:.3f} s: not finite")
-        if not 0.0 <= force <= self.ports.gripper_max_force * (1 + 1e-9):
-            return self._fail(
-                t,
-                "bad command",
-                f"gripper command rejected at t = {t:.3f} s: force "
-                f"{force:.3g} N outside [0, {self.ports.gripper_max_force:g}] N",
-            )
-        if utime in self._wsg and self._wsg[utime] != (opening, force):
-            return self._fail(
-                t,
-                "second sender",
-                f"two different gripper commands for t = {utime * 1e-6:.3f} s "
-                f"at t = {t:.3f} s: a second sender on {WSG_COMMAND_CHANNEL}",
-            )
-        self._wsg[utime] = (opening, force)
-        if len(self._wsg) > 4096:
-            for key in sorted(self._wsg)[:2048]:
-                del self._wsg[key]
-        return None
+        """One received gripper command against the checks (``GripperCommands.check``)."""
+        fault = self._wsg.check(t, data, self.ports.gripper_max_force)
+        if fault is not None:
+            self._fail(t, *fault)
 
     def gripper_opening(self, utime: int) -> Optional[float]:
         """The gripper command (the wanted opening, m) for the driver's tick ``utime``, if received."""
-        got = self._wsg.get(utime)
-        return None if got is None else got[0]
+        return self._wsg.opening(utime)
 
     def _check_senders(self, t: float) -> None:
         """Every packet on the command channels must come from the controller's address (the first
@@ -261,6 +258,8 @@ class HardwareSession:
             if resend and now - last_sent >= self.s.resend:
                 self.record.resends += 1
                 last_sent = self._publish(data)
+            elif deadline - now < 1e-3:  # below LCM's millisecond waits: short naps to the deadline
+                time.sleep(min(deadline - now, WAIT_NAP))
 
     def _set_companions(self, t: float, extras) -> None:
         """The station's messages of the tick at ``t`` beside the arm's (``extras`` = fingers,
@@ -287,13 +286,13 @@ class HardwareSession:
         after the plant's first step (a second sample of t = 0, answered anew)."""
         quiet_collector()
         if not self.s.lockstep:  # after the diagram's build: the loop alone runs at that priority
-            refused = request_realtime(self.s.priority)
+            refused = request_realtime(self.s.priority, self.endpoint.threads)
             if refused and self.warn is not None:
                 self.warn(refused)
         start = time.perf_counter()
         data = self.messages.pack_status(0.0, q, v, tau)
         self._set_companions(0.0, extras)
-        self._pending, self._pending_q = 0, np.array(q, dtype=float)
+        self._pending, self._measured[0] = 0, np.array(q, dtype=float)
         self._sent[0] = self._publish(data)
         wsg = 0 if self.ports is not None else None  # the gripper command the driver takes at t = 0
         if not self._wait(0.0, 0, self.s.startup_timeout, data, resend=True, wsg=wsg):
@@ -328,6 +327,11 @@ class HardwareSession:
             if now - last >= QUIET or now - start >= QUIET_MAX:
                 return
 
+    def _waited(self) -> None:
+        """The tick's wait ended: when, and when its answer came (NaN: it did not)."""
+        self.record.tick_answered.append(self._answer_wall)
+        self.record.tick_waited.append(time.perf_counter())
+
     def exchange(
         self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, extras=None
     ) -> Optional[np.ndarray]:
@@ -340,6 +344,8 @@ class HardwareSession:
         self._check_stop(t)
         if self.record.fault is not None:
             return None
+        if not self.s.lockstep and not self.pacer.admit(t):
+            return None  # the hardware's own stall: this tick skipped, no status (``realtime``)
         self.record.tick_time.append(t)
         self.record.tick_wall.append(time.perf_counter())
         if self._after_handshake:  # answers to re-sent hand-shake statuses, before this status existed
@@ -347,13 +353,18 @@ class HardwareSession:
             self.record.duplicates += len(self.endpoint.poll(0.0))
         data = self.messages.pack_status(t, q, v, tau)
         self._set_companions(t, extras)
-        self._pending, self._pending_q = utime, np.array(q, dtype=float)
+        self._pending, self._measured[utime] = utime, np.array(q, dtype=float)
         self._sent[utime] = self._publish(data)
+        self._answer_wall = float("nan")
+        self.record.tick_sent.append(self._sent[utime])
         if len(self._sent) > 4096:
             for key in sorted(self._sent)[:2048]:
                 del self._sent[key]
+                self._measured.pop(key, None)
         if self.s.lockstep:
-            if self._wait(t, utime, self.s.command_timeout, data, resend=True, wsg=wsg):
+            came = self._wait(t, utime, self.s.command_timeout, data, resend=True, wsg=wsg)
+            self._waited()
+            if came:
                 return self._answered_tau
             self._fail(
                 t,
@@ -361,20 +372,28 @@ class HardwareSession:
                 f"command timeout at t = {t:.3f} s (no command for {self.s.command_timeout * 1e3:.0f} ms)",
             )
             return None
-        if self._wait(t, utime, self.s.budget * self.s.period / self.s.realtime_rate, data, resend=False):
-            self._consecutive_late = 0
-            return self._answered_tau
-        if self.record.fault is None:
+        return self._realtime_wait(t, utime, data)
+
+    def _realtime_wait(self, t: float, utime: int, data: bytes) -> Optional[np.ndarray]:
+        """Real time: the tick's wait for its command (``budget`` × T of wall time), then the
+        silence rule (``realtime.Silence``: ``silent_periods`` statuses in a row without any
+        command of the controller is the fault ``command timeout``)."""
+        self.silence.start_tick()
+        self._late_taken = False
+        came = self._wait(t, utime, self.s.budget * self.s.period / self.s.realtime_rate, data, resend=False)
+        self._waited()
+        if self.record.fault is not None:
+            return None
+        self._consecutive_late = 0 if came else self._consecutive_late + 1
+        if not came:
             self.record.late += 1
-            self._consecutive_late += 1
             self.record.late_run_max = max(self.record.late_run_max, self._consecutive_late)
-            if self._consecutive_late >= self.s.silent_periods:
-                self._fail(
-                    t,
-                    "command timeout",
-                    f"command timeout at t = {t:.3f} s (no command for {self._consecutive_late} "
-                    f"periods: the controller is silent or gone)",
-                )
-        return None
-
-
+        if self.silence.end_tick(came):
+            self._fail(
+                t,
+                "command timeout",
+                f"command timeout at t = {t:.3f} s (no command for {self.silence.count} statuses in a "
+                f"row: the controller is silent or gone)",
+            )
+            return None
+        return self._answered_tau if came or self._late_taken else None

@@ -27,6 +27,7 @@ from ptint_drake.hardware.camera_link import image_channel, with_receive_buffer
 from ptint_drake.hardware.arm_messages import arm_messages
 from ptint_drake.hardware.link import (TRACKER_CHANNEL, WSG_COMMAND_CHANNEL, WSG_STATUS_CHANNEL, Endpoint,
                                        SenderWatch, spread, url_warning)
+from ptint_drake.hardware.link_record import link_series
 from ptint_drake.hardware.process import scheduler_name, stop_on_signals
 from ptint_drake.hardware.session import ACTIVE, SETTLED_SPEED, HardwareSession, LinkFault, LinkSettings
 from ptint_drake.outputs.folder import METRICS, SERIES, save_series, staged_output, write_json_atomic
@@ -61,7 +62,8 @@ def check_link_scenario(scenario: Scenario) -> None:
 
 def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
     """``scenario`` with ``CommandLink`` in the controller slot (no hold of its own: the link is
-    the hold), the plant discrete at T, and the simulator paced in real time unless lockstep."""
+    the hold), the plant discrete at T, and the simulator unpaced: in real time the link paces
+    its ticks from the first tick after the hand-shake (``realtime.TickPacer``)."""
     out = copy.copy(scenario)
     out.controller = dataclasses.replace(scenario.controller, type=LINK_TYPE, params={}, control_period=0.0)
     world = world_of(scenario)
@@ -88,7 +90,7 @@ def hardware_scenario(scenario: Scenario, settings: LinkSettings) -> Scenario:
     # although the slot runs unsampled here: the link is the hold
     config = world.simulator_config(scenario)
     out.simulator = copy.copy(config if config is not None else scenario.simulator)
-    out.simulator.target_realtime_rate = 0.0 if settings.lockstep else settings.realtime_rate
+    out.simulator.target_realtime_rate = 0.0  # real time: the link paces its ticks (``realtime.TickPacer``)
     return out
 
 
@@ -128,6 +130,7 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "silent_periods": None if settings.lockstep else settings.silent_periods,
         "sender_check": "source address" if session.watch is not None else "stamps only",
         "scheduler": scheduler_name(),
+        "receive_thread_scheduler": [scheduler_name(tid) for tid in session.endpoint.threads],
         "handshake_s": handshake_s,
         "round_trip_ms": spread(r.rtt, 1e3),
         "achieved_period_ms": spread(periods, 1e3),
@@ -139,12 +142,18 @@ def link_block(session: HardwareSession, settings: LinkSettings, handshake_s: Op
         "commands_duplicated": r.duplicates,
         "ticks_late": r.late,
         "late_run_max": r.late_run_max,
+        "silent_run_max": None if settings.lockstep else session.silence.count_max,
+        "ticks_skipped": None if settings.lockstep else session.pacer.skipped,
+        "skipped_run_max": None if settings.lockstep else session.pacer.skipped_run_max,
+        "clock_rebased": None if settings.lockstep else session.pacer.rebased,
+        "status_late_max_ms": None if settings.lockstep else 1e3 * session.pacer.late_max,
         "commands_late": r.late_commands,
         "fault": r.fault,
         "fault_kind": r.fault_kind,
         "fault_time": r.fault_time,
         "stop_signal": None if r.stop_signal is None else signal.Signals(r.stop_signal).name,
         "last_command_t": r.last_command_t,
+        "last_heard_t": r.last_heard_t,
     }
     ports = session.ports
     if ports is not None:
@@ -230,7 +239,7 @@ def run_hardware(
             session.watch.close()
     run_json = run_metrics(hw, link_metrics(result, session, settings, n), figures=False)
     with staged_output(out) as stage:
-        save_series(stage / SERIES, result.series)
+        save_series(stage / SERIES, result.series | link_series(session.record))
         write_json_atomic(stage / METRICS, run_json)
     return run_json
 

@@ -30,6 +30,7 @@ from ptint_drake.simulation.scenario import LoadedScenario, ScenarioError, apply
 from ptint_drake.studies.runner import run_tasks
 from ptint_drake.verdict.metrics import ROTATION_KEYS, Reason
 from ptint_drake.views.plots import plt, save
+from ptint_drake.worlds.registry import world_of
 
 DEFAULT_CONTROLLERS = CONTROLLERS  # every registered controller
 DEFAULT_VARIANTS = ("nominal", "mass_x0.7", "mass_x1.5")
@@ -44,7 +45,7 @@ def with_controller(scenario, controller: str):
     out.controller.type = controller
     if controller in CONTROLLERS:
         out.controller.params = {}
-    return out
+    return world_of(out).compare_scenario(out, controller)
 
 
 def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
@@ -58,6 +59,9 @@ def compare_run(text: str, name: str, controller: str, variant: str) -> dict:
         return row | {"ok": False, "status": "error", "reasons": [str(reason)],
                       "reason_codes": [reason.as_dict()], "torque_peak_max": None, "segments": []}
     m, series = result.metrics, result.series
+    own = world_of(scenario).compare_row(m, series)
+    if own is not None:
+        return row | own
     t = series["t"]
     grid = np.linspace(0.0, scenario.duration, _GRID_POINTS)
     e_norm = np.linalg.norm(series["e_true"], axis=1)
@@ -146,6 +150,8 @@ def to_markdown(result: dict) -> str:
              "| controller | variant | seg | e0 | e(tf/2) | e(tf) | ė(tf) [mm/s] | hold max | t_arrive "
              "| prescribed | peak τ [N·m] | verdict |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    if result["rows"] and all(r.get("world") for r in result["rows"]):  # no segments: the world's table
+        return "\n".join([f"{result['scenario']}: controllers × plant variants"] + world_lines(result)) + "\n"
     for r in table_rows(result):
         seg = result["segments"][r["segment"]] if r["segment"] < len(result["segments"]) else {}
         prescribed = seg.get("start", math.nan) + seg.get("tf", math.nan)
@@ -156,7 +162,20 @@ def to_markdown(result: dict) -> str:
             f"{_mm(r['e_half_norm'])} | {_mm(r['e_tf_norm'])} | {_mm(r['edot_tf_norm'])} | "
             f"{_mm(r['e_hold_max_norm'])} | {_s(r['t_arrive'])} | {prescribed:.2f} | "
             f"{_torque(r['torque_peak_max'])} | {verdict} |")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + world_lines(result)) + "\n"
+
+
+def world_lines(result: dict) -> list[str]:
+    """A second table of the rows' ``world`` values (a world's own row, ``World.compare_row``)."""
+    rows = [r for r in result["rows"] if r.get("world")]
+    if not rows:
+        return []
+    keys = list(rows[0]["world"])
+    lines = ["", "| controller | variant | " + " | ".join(keys) + " |", "|---|---|" + "---|" * len(keys)]
+    for r in rows:
+        values = ["–" if r["world"].get(k) is None else str(r["world"][k]) for k in keys]
+        lines.append(f"| {r['controller']} | {r['variant']} | " + " | ".join(values) + " |")
+    return lines
 
 
 def figure(result: dict, out_dir: Path) -> None:
@@ -194,7 +213,8 @@ def write_compare(result: dict, out_dir: Path) -> None:
     with staged_output(out_dir) as stage:
         (stage / "compare.csv").write_text(to_csv(result))
         (stage / "compare.md").write_text(to_markdown(result))
-        figure(result, stage)
+        if any("curve" in r for r in result["rows"]):  # (a world's own rows have no curves)
+            figure(result, stage)
         summary = dict(result, rows=[{k: v for k, v in r.items() if k != "curve"} for r in result["rows"]])
         write_json_atomic(stage / "compare.json", summary)
 

@@ -197,9 +197,9 @@ SPEED_SAMPLES = 21  # samples of each segment's profile, from PROFILE_START · t
 PROFILE_START = 0.05
 
 
-def profile_times(tf: float) -> np.ndarray:
-    """The times since a segment's start at which its profile is sampled (s)."""
-    return tf * np.linspace(PROFILE_START, 1.0, SPEED_SAMPLES)
+def profile_times(tf: float, samples: int = SPEED_SAMPLES) -> np.ndarray:
+    """The times since a segment's start at which its profile is sampled (s): ``samples`` of them."""
+    return tf * np.linspace(PROFILE_START, 1.0, samples)
 
 
 @dataclass(frozen=True)
@@ -217,7 +217,14 @@ class Profile:
 
 def joint_demand(plant: MultibodyPlant, frame, profile: Profile, instance=None, rot_scale: float = 1.0,
                  damping: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """(speeds, torques), each samples × joints of ``instance`` (default: all of ``plant``):
+    """(speeds, torques): the magnitudes of ``joint_terms``, each samples × joints."""
+    speeds, torques = joint_terms(plant, frame, profile, instance, rot_scale, damping)
+    return np.abs(speeds), np.abs(torques)
+
+
+def joint_terms(plant: MultibodyPlant, frame, profile: Profile, instance=None, rot_scale: float = 1.0,
+                damping: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(q̇, τ), signed, each samples × joints of ``instance`` (default: all of ``plant``):
     q̇ = J⁺ ẋ and q̈ = J⁺ (ẍ − J̇q̇) of the task's Jacobian (spatial for a 6-D task, translational
     for a 3-D one) at each posture, and τ = M q̈ + C q̇ − g (Drake's inverse dynamics, every body of
     ``plant``, e.g. a gripper welded to the arm) + Jᵥᵀ m (a − g) for a payload m held at the
@@ -225,47 +232,58 @@ def joint_demand(plant: MultibodyPlant, frame, profile: Profile, instance=None, 
     and inverted as it inverts it: J⁺, or Jᵀ(JJᵀ + λ²I)⁻¹ with λ = ``damping``
     (``controller.pinv_damping``: near a singularity the exact J⁺ would ask for speeds the damped
     controller never commands).  A planning estimate from the model: the controller never sees it."""
+    motion = (profile.velocity, profile.acceleration)
+    return joint_terms_of(plant, frame, profile.q, [motion], profile.payload, instance, rot_scale, damping)[0]
+
+
+def joint_terms_of(plant: MultibodyPlant, frame, postures: np.ndarray, motions: list, payload: float = 0.0,
+                   instance=None, rot_scale: float = 1.0, damping: float = 0.0) -> list:
+    """``joint_terms`` of several motions of the tool on the same ``postures``: per motion
+    (velocity, acceleration), samples × 6 or × 3 each, its (q̇, τ); one Jacobian and its inverse per
+    posture for all of them."""
     context = plant.CreateDefaultContext()
     nv = plant.num_velocities()
     cols = (np.arange(nv) if instance is None
             else plant.GetVelocitiesFromArray(instance, np.arange(nv, dtype=float)).astype(int))
-    six = profile.velocity.shape[1] == 6
+    six = motions[0][0].shape[1] == 6
     world = plant.world_frame()
     gravity = plant.gravity_field().gravity_vector()
     forces = MultibodyForces(plant)
-    speeds, torques = [], []
-    for q, xd, xdd in zip(profile.q, profile.velocity, profile.acceleration):
-        v = np.zeros(nv)
+    weight = np.r_[np.full(3, rot_scale), np.ones(3)] if six else np.ones(3)
+    out = [(np.zeros((len(postures), len(cols))), np.zeros((len(postures), len(cols)))) for _ in motions]
+    for k, q in enumerate(postures):
         _set_positions(plant, context, instance, q)
+        plant.SetVelocities(context, np.zeros(nv))
         if six:
             J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3), world,
                                                   world)[:, cols]
         else:
             J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3),
                                                         world, world)[:, cols]
-        weight = np.r_[np.full(3, rot_scale), np.ones(3)] if six else np.ones(3)
         J = weight[:, None] * J
         Jp = (np.linalg.pinv(J) if damping <= 0.0
               else J.T @ np.linalg.inv(J @ J.T + damping ** 2 * np.eye(len(J))))
-        v[cols] = Jp @ (weight * xd)
-        plant.SetVelocities(context, v)
-        if six:
-            bias = plant.CalcBiasSpatialAcceleration(context, JacobianWrtVariable.kV, frame, np.zeros(3),
-                                                     world, world)
-            bias = np.concatenate([bias.rotational(), bias.translational()])
-        else:
-            bias = plant.CalcBiasTranslationalAcceleration(context, JacobianWrtVariable.kV, frame,
-                                                           np.zeros(3), world, world)[:, 0]
-        vdot = np.zeros(nv)
-        vdot[cols] = Jp @ (weight * (xdd - bias))
-        forces.SetZero()
-        tau = plant.CalcInverseDynamics(context, vdot, forces)[cols]
-        if profile.payload > 0.0:
-            Jv = J[3:] if six else J  # (the translational rows: weight 1)
-            tau = tau + Jv.T @ (profile.payload * (xdd[-3:] - gravity))
-        speeds.append(np.abs(v[cols]))
-        torques.append(np.abs(tau))
-    return np.array(speeds), np.array(torques)
+        for (velocity, acceleration), (speeds, torques) in zip(motions, out):
+            xd, xdd = velocity[k], acceleration[k]
+            v = np.zeros(nv)
+            v[cols] = Jp @ (weight * xd)
+            plant.SetVelocities(context, v)
+            if six:
+                bias = plant.CalcBiasSpatialAcceleration(context, JacobianWrtVariable.kV, frame, np.zeros(3),
+                                                         world, world)
+                bias = np.concatenate([bias.rotational(), bias.translational()])
+            else:
+                bias = plant.CalcBiasTranslationalAcceleration(context, JacobianWrtVariable.kV, frame,
+                                                               np.zeros(3), world, world)[:, 0]
+            vdot = np.zeros(nv)
+            vdot[cols] = Jp @ (weight * (xdd - bias))
+            forces.SetZero()
+            tau = plant.CalcInverseDynamics(context, vdot, forces)[cols]
+            if payload > 0.0:
+                Jv = J[3:] if six else J  # (the translational rows: weight 1)
+                tau = tau + Jv.T @ (payload * (xdd[-3:] - gravity))
+            speeds[k], torques[k] = v[cols], tau
+    return out
 
 
 def _set_positions(plant: MultibodyPlant, context, instance, q: np.ndarray) -> None:

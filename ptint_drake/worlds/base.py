@@ -220,6 +220,16 @@ class World:
         return (f"scenario: {name} belongs to the {self.name} world, which ptint tune does not "
                 f"search (World.tune_refusal)")
 
+    def compare_scenario(self, scenario: Scenario, controller: str) -> Scenario:
+        """``ptint compare``'s scenario for ``controller`` (``controller.type`` already set): as
+        it is, unless this world adapts it to a controller."""
+        return scenario
+
+    def compare_row(self, metrics: dict, series: dict) -> Optional[dict]:
+        """``ptint compare``'s row of a finished run of this world, or None: the segments' own
+        (``studies.compare.compare_run``)."""
+        return None
+
     def robust_sample(self, scenario: Scenario, name: str, seed: int, u) -> tuple:
         """(scenario, params) of a ``robust`` sample drawn with ``u(key, size=None)`` (``u.rng``:
         the sample's generator): by default the arm's own deviations, which every world has —

@@ -5,12 +5,15 @@ too fast is refused, at every revision, and the arm never moves (``not reachable
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
 from ptint_drake.simulation.scenario import LoadedScenario
 from ptint_drake.worlds.catch import oracle
-from ptint_drake.worlds.catch.outcome import HAND_BODIES
+from ptint_drake.worlds.catch.outcome import HAND_BODIES, OUTCOMES
+from ptint_drake.worlds.catch.planner import predict
 from ptint_drake.worlds.catch.run import CatchRun, settled
 from ptint_drake.worlds.runner import simulate
 
@@ -51,3 +54,42 @@ def test_a_throw_the_oracle_calls_too_fast_is_named_not_reachable_before_moving(
     assert oracle.reachable(96) is False
     q = run.series["plant_state"][:, :7]
     assert np.abs(q - q[0]).max() < np.radians(0.5)  # the arm held its pose throughout
+
+
+def test_compare_puts_the_ct_quintic_baseline_with_the_same_planner_beside_ptsmc(tmp_path, ptint_here):
+    """``ptint compare`` on the catch world (``CatchWorld.compare_scenario``/``compare_row``): both
+    controllers aim at the same planner's moving catch target (ct_quintic with the position task,
+    the only one it has), each row the catch's named outcome, the hand's error, the peak force."""
+    out = ptint_here("compare", "catch_toss_iiwa14", "--controllers", "ptsmc,ct_quintic", "--variants",
+                     "nominal", "--workers", "2", "--out", str(tmp_path), "--quiet")
+    assert out.returncode == 0, out.stderr
+    rows = {r["controller"]: r for r in json.loads((tmp_path / "compare.json").read_text())["rows"]}
+    assert set(rows) == {"ptsmc", "ct_quintic"}
+    for row in rows.values():
+        name = row["world"]["outcome"]
+        assert row["world"]["throw"] == 0 and (name in OUTCOMES or name.startswith("collision with "))
+        assert row["ok"] == (name == "caught")
+    assert rows["ptsmc"]["world"]["outcome"] == "caught" and rows["ptsmc"]["world"]["hand error (mm)"] < 10.0
+    assert rows["ct_quintic"]["world"]["plans"] >= 1  # the planner's target drove it too
+    table = (tmp_path / "compare.md").read_text()
+    assert "| controller | variant | throw | outcome | plans | hand error (mm) | peak force (N) |" in table
+
+
+def test_the_catch_point_is_revised_as_the_estimate_improves_and_the_target_follows(caught):
+    """The plan's catch point is the estimate's at t_plan; the target re-predicts it from every
+    newer estimate (``target``: the law tracks it as the frames come in).  Measured: the planner
+    replaced no plan in 100 formula-camera and 200 RGB-D throws (``Planner.holds`` fails only when
+    the re-predicted point leaves the IK's reach), so this revision is the one that happens."""
+    c = caught.metrics["catch"]
+    t, x, estimate, target = (np.asarray(caught.series[k])
+                              for k in ("t", "plant_state", "estimate", "target"))
+    t_catch = c["t_catch"]
+    true = x[np.searchsorted(t, t_catch), 13:16]
+    first = np.asarray(c["plans"][0]["point"])
+    late = np.searchsorted(t, t_catch - 0.05)
+    revised = predict(estimate[late], t_catch - t[late])[0]
+    assert np.linalg.norm(first - revised) > 0.005  # revised by more than the hand's error budget
+    assert np.linalg.norm(revised - true) < np.linalg.norm(first - true)  # towards the true ball
+    aimed = target[np.searchsorted(t, t_catch), 0:3]  # where the law took the hand at t_catch
+    assert np.linalg.norm(aimed - revised) < np.linalg.norm(aimed - first)
+    assert c["outcome"] == "caught"

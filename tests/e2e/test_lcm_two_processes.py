@@ -31,6 +31,10 @@ PATIENT = ("--startup-timeout", "60")
 # periods (the kill test checks the reaction is exactly that); the default 5 is measured by
 # scripts/link_faults.py and tests/unit/test_lcm_checks.py
 SLACK = ("--silent-periods", "100")
+# lockstep: the hardware's pace is the machine's, and a rendered tick of the camera's station
+# took over the drive's default status timeout (0.5 s) once at load 12 (t = 0.09 s): not what
+# the accuracy test checks
+LOCKSTEP_DRIVE = ("--status-timeout", "30")
 
 
 def ptint(*args: str) -> list[str]:
@@ -137,8 +141,8 @@ def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
         [
             {"name": "hw", "argv": ptint("hardware", RGBD_PICK, *PATIENT, "--lockstep", "--quiet",
                                          "--out", str(tmp_path / "hw")), "timeout": 400.0},
-            {"name": "drive", "argv": ptint("drive", RGBD_PICK, *PATIENT, "--out", str(tmp_path / "dr")),
-             "timeout": 400.0},
+            {"name": "drive", "argv": ptint("drive", RGBD_PICK, *PATIENT, *LOCKSTEP_DRIVE, "--out",
+                                            str(tmp_path / "dr")), "timeout": 400.0},
         ],
         tmp_path,
         timeout=450.0,
@@ -199,9 +203,11 @@ def test_drive_killed_holds_the_arm(tmp_path):
     assert "command timeout at t" in one_line(out["hw"]["stderr"])
     link = json.loads((tmp_path / "hw" / "metrics.json").read_text())["hardware"]
     assert link["fault_kind"] == "command timeout" and 0.8 < link["fault_time"] < 2.5
-    assert "no command for 100 periods" in link["fault"]
-    # from the last command taken to the hold: 100 ticks (the last command's own tick is not silent)
-    assert abs(link["fault_time"] - link["last_command_t"] - 100 * PERIOD) < 1e-9, link
+    assert "no command for 100 statuses in a row" in link["fault"] and link["silent_run_max"] == 100
+    # from the tick the last command came in to the hold: 100 statuses (the last command's own tick
+    # is not silent), one a period, and any tick the hardware skipped after a stall of its own
+    silent = (link["fault_time"] - link["last_heard_t"]) / PERIOD
+    assert 100 - 1e-6 < silent < 100 + link["ticks_skipped"] + 1e-6, link
     assert link["hold"]["settled_s_after_fault"] <= 0.2 and link["hold"]["speed_at_end"] < 0.05
 
 
@@ -363,7 +369,8 @@ def test_realtime_lost_gripper_status_does_not_end_the_run(tmp_path):
     assert out["drive"]["rc"] == 0, out
     metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
     link = metrics["hardware"]
-    assert link["companions_dropped"] == 1 and link["fault"] is None and link["ticks"] == 5000, link
+    assert link["companions_dropped"] == 1 and link["fault"] is None, link
+    assert link["ticks"] + link["ticks_skipped"] == 5000, link  # (skipped: the hardware's own stalls)
     assert link["ticks_late"] >= 1  # the tick whose gripper status was lost went unanswered
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
     assert drive["fault"] is None and drive["companions_lost"] == 1 and drive["last_t"] >= 4.998, drive
@@ -419,19 +426,23 @@ def test_realtime_run_completes(tmp_path):
     assert out["drive"]["rc"] == 0, out
     metrics = json.loads((tmp_path / "hw" / "metrics.json").read_text())
     link = metrics["hardware"]
-    assert link["mode"] == "realtime" and link["ticks"] == 3000 and link["fault"] is None, link
+    assert link["mode"] == "realtime" and link["fault"] is None, link
+    # every tick published its status, but those the hardware skipped after a stall of its own
+    assert link["ticks"] + link["ticks_skipped"] == 3000, link
     # the run completes; its verdict is ok unless the machine was loaded enough that late commands
-    # (each tick keeps the previous torque) cost the accuracy: then exit 1 with the late ticks
+    # or skipped ticks (each keeps the previous torque) cost the accuracy: then exit 1 with them
     # counted (measured once in CI beside a Monte Carlo: 759 of 3000 ticks late, "segment 0: late", exit 1)
     if out["hw"]["rc"] != 0:
-        assert out["hw"]["rc"] == 1 and metrics["status"] != "ok" and link["ticks_late"] > 0, out
+        kept = link["ticks_late"] + link["ticks_skipped"]
+        assert out["hw"]["rc"] == 1 and metrics["status"] != "ok" and kept > 0, out
     # paced at the 1 ms period (a free-running lockstep takes a fraction of it); the band is wide
     # because a loaded machine falls behind and catches up (measured 0.88 ms with CI beside it)
     assert link["lateness_ms"] is not None and 0.5 < link["achieved_period_ms"]["median"] < 2.0
     assert np.isfinite(link["round_trip_ms"]["p99"])
     # both loops ran under SCHED_FIFO where the machine permits it (root: CI), else said why
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
-    if os.geteuid() == 0:
+    if os.geteuid() == 0:  # (LCM's receive threads too: every message passes through them)
         assert link["scheduler"] == drive["scheduler"] == "SCHED_FIFO 10", (link, drive)
+        assert link["receive_thread_scheduler"] == drive["receive_thread_scheduler"] == ["SCHED_FIFO 10"]
     else:
         assert "real-time scheduling (SCHED_FIFO 10) refused" in out["drive"]["stderr"]

@@ -58,8 +58,8 @@ def test_harsh_ranges_reach_a_named_failure_and_mild_passes():
     assert not failed["ok"] and failed["reasons"] == ["pick 0: late grasp"], failed
     assert passed["ok"] and not passed["reasons"], passed
     summary = robust_summary(rows)
-    assert summary == {"pick_success_rate": 0.5, "failures_by_reason": {"late grasp": 1},
-                       "collisions_by_body": {}}
+    assert summary == {"pick_success_rate": 0.5, "cannot_be_held": 0, "pick_success_rate_holdable": 0.5,
+                       "failures_by_reason": {"late grasp": 1}, "collisions_by_body": {}}
 
 
 def test_failures_are_counted_by_reason_without_the_pick_index():
@@ -95,7 +95,8 @@ def test_a_sample_that_raises_ends_with_a_verdict(monkeypatch):
     row = robust.robust_sample(text, name, 3)
     assert row["ok"] is False and row["status"] == "error"
     assert row["error"] == "ZeroDivisionError: in the middle of a run"
-    assert robust_summary([row]) == {"pick_success_rate": 0.0, "failures_by_reason": {
+    assert robust_summary([row]) == {"pick_success_rate": 0.0, "cannot_be_held": 0,
+                                     "pick_success_rate_holdable": 0.0, "failures_by_reason": {
         "error: ZeroDivisionError: in the middle of a run": 1}, "collisions_by_body": {}}
 
 
@@ -166,3 +167,17 @@ def test_cli_ranges_preset(tmp_path, capsys):
     assert result["ranges_preset"] == "mild" and result["ranges"]["part_mass"] == [0.05, 0.3]
     assert result["pick_success_rate"] == 1.0 and result["failures_by_reason"] == {}
     assert "pick success rate 100.0 %" in capsys.readouterr().out
+
+
+def test_a_part_below_the_friction_bound_is_not_carried():
+    """hold_limit's bound is necessary: conveyor_pick_place's part made heavy and slippery enough
+    that 2 μ F < m (g + a_lift) is judged unholdable and, run on the real plant, is not placed."""
+    from ptint_drake.simulation import simulate  # noqa: PLC0415
+    from ptint_drake.worlds.pick.hold_limit import holdable  # noqa: PLC0415
+
+    name, text = CONVEYOR
+    scenario = parse_with_overrides(text, ("pick.parts[0].mass=1.0", "pick.parts[0].friction=0.1"), name)
+    assert not holdable(scenario.pick, scenario.pick.parts[0].name)
+    metrics = simulate(scenario).metrics
+    assert not metrics["picks"][0]["placed"], metrics["picks"][0]
+    assert metrics["status"] != "ok" and metrics["reasons"]

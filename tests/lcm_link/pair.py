@@ -6,8 +6,8 @@ started once that process's stderr shows the text, after the steps without one),
 ([other name, text]:
 a signal once that process's stderr shows the text, e.g. a progress line), "signal" (its name,
 default "SIGKILL"), "timeout" (s)}.
-Result: {name: {"rc", "stdout", "stderr", "started", "ended", "killed"}}, wall times in s from
-the plan's start.
+Result: {name: {"rc", "stdout", "stderr", "started", "ended", "killed", "origin"}}, wall times in s
+from the plan's start (``origin``: that start on ``time.monotonic``'s clock).
 """
 
 from __future__ import annotations
@@ -53,8 +53,8 @@ def main() -> None:
             if proc.poll() is None:
                 when = step.get("kill_when")
                 if when and p["killed"] is None and when[1] in (folder / f"{when[0]}.err").read_text():
+                    p["killed"] = time.monotonic() - t0  # (the signal's own time, not the loop's)
                     proc.send_signal(getattr(signal, step.get("signal", "SIGKILL")))
-                    p["killed"] = now
                 elif now - p["started"] >= step.get("timeout", 120.0):
                     proc.kill()
                 continue
@@ -67,6 +67,7 @@ def main() -> None:
                 "started": p["started"],
                 "ended": now,
                 "killed": p["killed"],
+                "origin": t0,  # time.monotonic() of the plan's start (CLOCK_MONOTONIC: perf_counter's)
             }
         time.sleep(0.005)
     print(json.dumps(result))

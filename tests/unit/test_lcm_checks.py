@@ -10,25 +10,46 @@ from pydrake.lcm import DrakeLcm
 
 from ptint_drake.hardware.link import (COMMAND_CHANNEL, STATUS_CHANNEL, Endpoint, pack_command, pack_status,
                                        unpack_command, unpack_status, url_warning, utime_of)
+from ptint_drake.hardware.realtime import Silence, TickPacer
 from ptint_drake.hardware.session import HardwareSession, LinkSettings
 
 N = 3
 LIMITS = np.array([5.0, 12.0, 12.0])
 
 
+class Wall:
+    """A real-time pacer's wall clock (s) set by the test (``tick``): the test thread's own
+    stalls on a loaded machine are then no stalls of the hardware."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+    def sleep(self, s: float) -> None:
+        self.now += s
+
+
 def pair(**settings):
-    """(hardware session, drive endpoint) on one memq:// LCM."""
+    """(hardware session, drive endpoint) on one memq:// LCM; in real time the session's pacer
+    reads ``session.wall`` (``Wall``)."""
     lcm = DrakeLcm("memq://")
     hardware = Endpoint(None, listen=COMMAND_CHANNEL, publish=STATUS_CHANNEL, lcm=lcm)
     drive = Endpoint(None, listen=STATUS_CHANNEL, publish=COMMAND_CHANNEL, lcm=lcm)
     s = LinkSettings(period=1e-3, duration=1.0, command_timeout=0.05, **settings)
-    return HardwareSession(hardware, N, LIMITS, s), drive
+    session = HardwareSession(hardware, N, LIMITS, s)
+    session.wall = Wall()
+    session.pacer = TickPacer(s.period, s.realtime_rate, clock=session.wall, sleep=session.wall.sleep)
+    return session, drive
 
 
-def tick(session, t, commands=()):
-    """Publish ``commands`` (utime, τ bytes), then the tick at ``t``."""
+def tick(session, t, commands=(), wall=None):
+    """Publish ``commands`` (utime, τ bytes), then the tick at ``t``, found by the pacer at wall
+    time ``wall`` (default: ``t``, on time)."""
     for data in commands:
         session.endpoint.lcm.Publish(COMMAND_CHANNEL, data)
+    session.wall.now = t if wall is None else wall
     return session.exchange(t, np.zeros(N), np.zeros(N), np.zeros(N))
 
 
@@ -114,7 +135,7 @@ def test_realtime_late_ticks_then_timeout():
         if session.record.fault:
             break
     assert session.record.late == k == 5 and session.record.fault_kind == "command timeout"
-    assert session.record.late_run_max == 5 and "5 periods" in session.record.fault
+    assert session.record.late_run_max == 5 and "no command for 5 statuses in a row" in session.record.fault
 
 
 def test_realtime_a_late_tick_between_answers_is_no_fault():
@@ -129,6 +150,98 @@ def test_realtime_a_late_tick_between_answers_is_no_fault():
         t += 1e-3
         assert np.array_equal(tick(session, t, [pack_command(utime_of(t), np.ones(N))]), np.ones(N))
     assert session.record.fault is None and session.record.late == 12 and session.record.late_run_max == 4
+
+
+def test_silence_is_counted_in_statuses_and_a_sign_of_life_resets_it():
+    """``Silence``: a status without any command counts one; a command (its own answer, or a late
+    answer to an older status) sets the count back; the 5th status in a row without one is the
+    hold, not the 4th."""
+    silence = Silence(5)
+    for heard in (False, False, False, False, True, False, False, False, False):
+        silence.start_tick()
+        if heard:
+            silence.heard()
+        assert not silence.end_tick(answered=False)
+    assert silence.count == 4 and silence.count_max == 4
+    silence.start_tick()
+    assert silence.end_tick(answered=False) and silence.count == 5
+
+
+def test_pacer_skips_the_ticks_of_its_own_stall_then_paces_again():
+    """``TickPacer``: on time, each tick sleeps until it is due; after a stall of the hardware's
+    own process (8.5 periods), the ticks it passed go without a status until it is within a
+    period again (a plant step takes 0.1 period here) — no burst of catch-up statuses — and the
+    next ones are due one period apart again."""
+    wall = Wall()
+    pacer = TickPacer(1e-3, 1.0, clock=wall, sleep=wall.sleep)
+    for k in range(10):
+        wall.now = max(wall.now, k * 1e-3 - 0.3e-3)  # each tick found a little early: it sleeps
+        assert pacer.admit(k * 1e-3) and abs(wall.now - k * 1e-3) < 1e-12
+    wall.now = 18.5e-3  # the tick of 10 ms found 8.5 ms late
+    admitted = []
+    for k in range(10, 30):
+        admitted.append(pacer.admit(k * 1e-3))
+        wall.now = max(wall.now, k * 1e-3) + 0.1e-3
+    assert admitted == [False] * 9 + [True] * 11, admitted
+    assert pacer.skipped == pacer.skipped_run_max == 9 and pacer.rebased == 0 and pacer.late_max < 1e-3
+
+
+def test_pacer_goes_on_when_the_simulation_is_slower_than_real_time():
+    """A plant step that takes 1.5 periods: a skipped tick does not shrink the lag, so the clock
+    is set back and the tick goes out — the link never stops publishing."""
+    wall = Wall()
+    pacer = TickPacer(1e-3, 1.0, clock=wall, sleep=wall.sleep)
+    admitted = []
+    for k in range(40):
+        admitted.append(pacer.admit(k * 1e-3))
+        wall.now += 1.5e-3
+    assert pacer.rebased > 0 and pacer.skipped_run_max <= 2 and sum(admitted) > 40 // 3
+
+
+def test_a_stall_of_the_hardware_is_not_the_controller_silent():
+    """Real time: the hardware's own process stalls for 30 periods while the controller answers
+    every status it gets: the ticks it passed publish nothing, nothing counts as silence, the
+    run goes on (the old wall-clock rule: 5 late ticks, a hold) — and a controller that then
+    goes silent is held at its 5th unanswered status, 5 periods after it was last heard."""
+    session, drive = pair(lockstep=False, budget=50.0)  # a tick waits 50 ms: this thread may stall
+    alive, lcm = [True], session.endpoint.lcm
+
+    def respond(data):  # the controller: each status answered as soon as it is handled
+        utime = unpack_status(bytes(data), N)[0]
+        if alive[0]:
+            lcm.Publish(COMMAND_CHANNEL, pack_command(utime, np.full(N, utime / 1e5)))  # τ: tick (ms) / 100
+
+    lcm.Subscribe(STATUS_CHANNEL, respond)
+    for k in range(1, 11):
+        assert np.array_equal(tick(session, k * 1e-3), np.full(N, k / 100))
+    tick(session, 11e-3, wall=11e-3 + 30e-3)  # the hardware comes back 30 ms late at the tick of 11 ms
+    for k in range(12, 60):
+        tick(session, k * 1e-3, wall=session.wall.now + 0.2e-3)  # a plant step (0.2 ms) per tick
+    statuses = [unpack_status(data, N)[0] for _, data in drive.poll(0.0)]
+    skipped = session.pacer.skipped
+    assert session.record.fault is None and session.silence.count_max == 0 and skipped >= 30, skipped
+    assert session.record.late == 0 and len(statuses) == 59 - skipped  # a skipped tick sends no status
+    assert not set(range(11000, 11000 + 1000 * skipped, 1000)) & set(statuses)
+    alive[0], t = False, 60e-3  # the controller goes silent
+    while session.record.fault is None:
+        tick(session, t, wall=session.wall.now + 0.2e-3)
+        t += 1e-3
+    assert session.record.fault_kind == "command timeout" and "5 statuses in a row" in session.record.fault
+    assert abs(session.record.fault_time - session.record.last_heard_t - 5e-3) < 1e-12
+
+
+def test_a_late_answer_is_taken_and_is_a_sign_of_life():
+    """Real time: a controller one status behind (each tick's wait brings the answer to the
+    previous status) is alive: never held, and its newest torque steers the arm, one period
+    late, instead of the first torque staying for good."""
+    session, _ = pair(lockstep=False)
+    assert tick(session, 1e-3) is None  # the first status's answer comes during the second's wait
+    for k in range(2, 30):
+        late = pack_command(utime_of((k - 1) * 1e-3), np.full(N, (k - 1) / 10))
+        assert np.array_equal(tick(session, k * 1e-3, [late]), np.full(N, (k - 1) / 10))
+    record = session.record
+    assert record.fault is None and record.late == 29 and record.late_run_max == 29
+    assert session.silence.count_max == 1 and record.late_commands == 28 and record.last_heard_t == 29e-3
 
 
 @pytest.mark.parametrize("lockstep", [True, False])

@@ -77,3 +77,17 @@ def test_a_bad_argument_is_one_line_naming_it():
     out = subprocess.run([sys.executable, str(SCRIPT), "--base", "no-such-rev"], capture_output=True,
                          text=True, timeout=60)
     assert out.returncode == 2 and out.stderr.count("\n") == 1 and "argument --base" in out.stderr
+
+
+def test_values_identical_allows_additions_only():
+    """A new key, warning lines added around the base's (in their order) and a grown count of them
+    are additions; a changed value, a base line dropped or reordered, a key the head lacks are not."""
+    base = {"e": 1.0, "warnings": ["a", "b"], "warnings_before_run": 1}
+    head = {"e": 1.0, "warnings": ["new", "a", "b", "later"], "warnings_before_run": 2, "added": 3}
+    assert identity.additions_only(identity.compare(base, head), base, head)
+    for change in ({"e": 1.0000000000000002},
+                   {"warnings": ["b", "a"]}, {"warnings": ["a"]}, {"warnings_before_run": 0}):
+        other = head | change
+        assert not identity.additions_only(identity.compare(base, other), base, other), change
+    lacking = {"warnings": ["a", "b"]}  # e and the count gone from the head
+    assert not identity.additions_only(identity.compare(base, lacking), base, lacking)

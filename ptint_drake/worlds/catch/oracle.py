@@ -37,18 +37,22 @@ def row(seed: int, params: dict, metrics: dict) -> dict:
             "reachable": reachable(params.get("throw", seed)),
             "error_at_catch_mm": None if err is None else 1e3 * err,
             "peak_contact_force_n": c.get("peak_contact_force_n"),
+            "joint_speed_ratio_max": c.get("joint_speed_ratio_max"),
+            "plans": len(c.get("plans", [])),
             "realtime_factor": metrics["sim"]["realtime_factor"], "warnings": metrics.get("warnings", [])}
 
 
 def summary(rows: list) -> dict:
     """Catch rate, the oracle's reachable rate, the rate over the reachable throws, failures by
-    reason (the outcome's name; an error run as ``error``), and the median error and force."""
+    reason (the outcome's name; an error run as ``error``), the median error and force, and the
+    largest joint speed of any run over its limit."""
     n = len(rows)
     caught = [r for r in rows if r.get("outcome") == "caught"]
     known = [r for r in rows if r.get("reachable") is not None]
     reach = [r for r in known if r["reachable"]]
     errors = sorted(r["error_at_catch_mm"] for r in rows if r.get("error_at_catch_mm") is not None)
     forces = sorted(r["peak_contact_force_n"] for r in caught if r.get("peak_contact_force_n") is not None)
+    speeds = [r["joint_speed_ratio_max"] for r in rows if r.get("joint_speed_ratio_max") is not None]
     return {"catch": {
         "throws": n, "caught": len(caught), "catch_rate": len(caught) / n if n else None,
         "reachable_rate": len(reach) / len(known) if known else None,
@@ -57,4 +61,5 @@ def summary(rows: list) -> dict:
         "failures_by_reason": dict(Counter(
             r.get("outcome", "error") for r in rows if r.get("outcome") != "caught").most_common()),
         "error_at_catch_mm_median": errors[len(errors) // 2] if errors else None,
-        "peak_force_caught_n_median": forces[len(forces) // 2] if forces else None}}
+        "peak_force_caught_n_median": forces[len(forces) // 2] if forces else None,
+        "joint_speed_ratio_max": max(speeds) if speeds else None}}

@@ -37,6 +37,8 @@ HAND_BODIES = ("gripper_base", "left_finger", "right_finger")
 HELD_RADIUS = 0.02  # m
 GRIP_TOLERANCE = 0.01  # m
 LATE_RADIUS = 0.025  # m
+# the named outcomes (``run``'s docstring), besides "collision with <body>"
+OUTCOMES = ("caught", "not reachable", "slipped out", "late", "closed on nothing", "bounced off")
 
 
 def _held(d: float, opening: float) -> bool:

@@ -198,8 +198,17 @@ class CatchRun(WorldRun):
                              "catch_posture_deg": np.degrees(plan.q[:7]).tolist() if plan else None,
                              "error_at_catch_m": at_catch[0] if at_catch else None,
                              "peak_contact_force_n": max(self.touched.values(), default=0.0),
+                             **self._joint_speeds(x),
                              "touched": dict(sorted(self.touched.items()))}}
         return metrics, {"t": t, "plant_state": x, "estimate": estimate, "target": target}, []
+
+    def _joint_speeds(self, x: np.ndarray) -> dict:
+        """The arm's largest joint speed over the run as a fraction of its limit, and that joint
+        (1–7): the simulated plant does not enforce the limits, so this is what shows them kept."""
+        nq = self.station.plant.num_positions()
+        ratio = np.abs(x[:, nq:nq + 7]) / self.planner.v_max
+        j = int(np.argmax(np.max(ratio, axis=0)))
+        return {"joint_speed_ratio_max": float(ratio[:, j].max()), "joint_speed_ratio_joint": j + 1}
 
     def _logs(self) -> tuple:
         return self.logger, self.estimate_log, self.target_log

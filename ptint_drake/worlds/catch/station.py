@@ -1,8 +1,10 @@
 """The catch station (issue 46): the KUKA iiwa 14, the full-size WSG 50-110 welded at its tip
 frame, the foam ball with the truth side's air drag, on one discrete plant (1 ms, point contact,
-SAP), the gripper's driver, and the formula camera (60 Hz) on the ball feeding the ball's
-estimator: the fit of its dragged flight (``flight_estimator``; ``catch.predictor: fit``, the
-default) or the scenario's camera estimator (``catch.predictor: auto``, the IMM).
+SAP), the gripper's driver, and the formula camera (60 Hz) on the ball (with
+``measurement.sensor: rgbd``: the rendered RGB-D camera and ``ball_camera``'s sphere fit in each
+depth frame) feeding the ball's estimator: the fit of its dragged flight (``flight_estimator``;
+``catch.predictor: fit``, the default) or the scenario's camera estimator
+(``catch.predictor: auto``, the IMM).
 
 ``AddCatchStation`` adds it to a builder and returns the handles: the arm's ``state`` and
 ``actuation`` ports (the controller's only wiring to the plant), the gripper's ``command`` input,
@@ -21,6 +23,7 @@ controller's and the planner's kinematics.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +39,9 @@ from ptint_drake.robot.plant import resolve_model
 from ptint_drake.systems.estimation.imm import AdaptiveTargetEstimator
 from ptint_drake.systems.hand.gripper import GripperDriver
 from ptint_drake.systems.perception.camera import Camera
-from ptint_drake.worlds.catch.ball import AddAirDrag, AddBall
+from ptint_drake.systems.perception.rgbd_camera import AddRgbdCamera
+from ptint_drake.worlds.catch.ball import BALL_DIAMETER, AddAirDrag, AddBall
+from ptint_drake.worlds.catch.ball_camera import FIT_STD, BallCamera
 from ptint_drake.worlds.catch.flight_estimator import FlightEstimator
 
 FINGERS = ("left_finger_joint", "right_finger_joint")
@@ -44,7 +49,9 @@ HAND_RELAXATION_TIME = 0.001  # s (module docstring)
 TIP = "schunk_wsg_50_110_full_tip"
 
 
-def _add_arm_and_hand(plant: MultibodyPlant, gripper):
+def add_arm_and_hand(plant: MultibodyPlant, gripper):
+    """The iiwa 14 and ``gripper``'s hand model welded at its tip frame, in ``plant`` (not
+    finalized): (arm, hand) model instances."""
     (arm,) = Parser(plant, "arm").AddModels(str(resolve_model("iiwa14")))
     path = resolve_model("iiwa14").parent / f"{gripper.model}.sdf"
     (hand,) = Parser(plant, "gripper").AddModels(str(path))
@@ -64,6 +71,16 @@ def _relax_hand(plant: MultibodyPlant, scene_graph, hand) -> None:
             else:
                 props.AddProperty("material", "relaxation_time", HAND_RELAXATION_TIME)
             scene_graph.AssignRole(plant.get_source_id(), gid, props, RoleAssign.kReplace)
+
+
+def _add_ball_camera(builder: DiagramBuilder, scene_graph, m) -> tuple:
+    """The rendered RGB-D camera on the station's scene graph and the ``BallCamera`` reading its
+    depth; the measurement settings the estimator is given (``noise_std``: ``FIT_STD`` unless set)."""
+    rgbd = AddRgbdCamera(builder, scene_graph, m.camera, rate_hz=m.rate_hz, seed=m.seed)
+    camera = builder.AddNamedSystem("camera_0", BallCamera(config=m, info=rgbd.info, X_WC=rgbd.X_WC,
+                                                           radius=BALL_DIAMETER / 2))
+    builder.Connect(rgbd.depth_image, camera.get_depth_image_input_port())
+    return camera, (m if m.noise_std else dataclasses.replace(m, noise_std=FIT_STD))
 
 
 def arm_plant() -> MultibodyPlant:
@@ -97,7 +114,7 @@ def AddCatchStation(builder: DiagramBuilder, scenario) -> CatchStation:
     step = scenario.catch.time_step
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(
         time_step=step, contact_model="point", discrete_contact_approximation="sap"), builder)
-    arm, hand = _add_arm_and_hand(plant, g)
+    arm, hand = add_arm_and_hand(plant, g)
     _relax_hand(plant, scene_graph, hand)
     ball = AddBall(plant)
     stroke = 0.0
@@ -126,10 +143,14 @@ def AddCatchStation(builder: DiagramBuilder, scenario) -> CatchStation:
     builder.Connect(plant.get_state_output_port(hand), driver.GetInputPort("finger_state"))
     split = builder.AddNamedSystem("ball_state", Demultiplexer([4, 3, 6]))
     builder.Connect(plant.get_state_output_port(ball.model_instance()), split.get_input_port())
-    camera = builder.AddNamedSystem("camera_0", Camera(config=scenario.measurement, seed_offset=0))
-    builder.Connect(split.get_output_port(1), camera.get_x_true_input_port())
+    m = scenario.measurement
+    if m.sensor == "rgbd":
+        camera, m = _add_ball_camera(builder, scene_graph, m)
+    else:
+        camera = builder.AddNamedSystem("camera_0", Camera(config=m, seed_offset=0))
+        builder.Connect(split.get_output_port(1), camera.get_x_true_input_port())
     chosen = (FlightEstimator if scenario.catch.predictor == "fit" else AdaptiveTargetEstimator)
-    estimator = builder.AddNamedSystem("ball_estimator", chosen(config=scenario.measurement))
+    estimator = builder.AddNamedSystem("ball_estimator", chosen(config=m))
     builder.Connect(camera.get_measurement_output_port(), estimator.get_measurement_input_port())
     return CatchStation(plant, arm, hand, ball, driver, camera, estimator, plant.get_state_output_port(arm),
                         plant.get_actuation_input_port(arm), driver.GetInputPort("command"),

@@ -9,6 +9,12 @@ rate over the reachable throws and the failures by reason (``oracle.summary``)."
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from pydrake.common.yaml import yaml_load_typed
+
+from ptint_drake.config.schema import Scenario
+from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.verdict.metrics import Reason
 from ptint_drake.worlds.base import World
@@ -33,6 +39,41 @@ class CatchWorld(World):
     def reasons(self, metrics: dict, criteria) -> list:
         name = metrics.get("catch", {}).get("outcome")
         return [] if name == "caught" else [Reason(None, "catch", f"not caught: {name}")]
+
+    def view_tasks(self, scenario, series: dict, metrics: dict, stage: Path, figures: bool,
+                   replay: bool, svg: bool) -> list[tuple]:
+        """The replay (``views``), when asked for."""
+        if not replay:
+            return []
+        return [("catch_replay", series, metrics, stage, scenario.name, (dump_yaml(scenario),))]
+
+    def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:
+        from ptint_drake.worlds.catch.views import write_catch_replay  # noqa: PLC0415
+
+        scenario = yaml_load_typed(schema=Scenario, data=args[0])
+        write_catch_replay(scenario, series, metrics, stage / "replay.html", title=title)
+        return name
+
+    def compare_scenario(self, scenario, controller: str):
+        """``ptint compare``: a controller that has only the position task (``ct_quintic``) aims
+        the hand's fingertip centre at the same planner's moving catch target, the hand's
+        orientation left to it (the catch posture's is ptsmc's pose task)."""
+        if controller != "ptsmc" and scenario.controller.task != "position":
+            scenario.controller.task = "position"
+        return scenario
+
+    def compare_row(self, metrics: dict, series: dict) -> dict:
+        """The catch's row: its outcome, the hand's error, the peak force and the largest joint
+        speed over its limit (``world``: what ``studies.compare`` tables beside the controller)."""
+        c = metrics["catch"]
+        err = c["error_at_catch_m"]
+        return {"ok": metrics["status"] == "ok", "status": metrics["status"], "reasons": metrics["reasons"],
+                "reason_codes": metrics["reason_codes"], "torque_peak_max": None, "segments": [],
+                "realtime_factor": metrics["sim"]["realtime_factor"],
+                "world": {"throw": c["throw"], "outcome": c["outcome"], "plans": len(c["plans"]),
+                          "hand error (mm)": None if err is None else round(1e3 * err, 1),
+                          "peak force (N)": round(c["peak_contact_force_n"], 1),
+                          "joint speed / limit": round(c["joint_speed_ratio_max"], 2)}}
 
     def own_plant_step(self, scenario) -> float:
         return scenario.catch.time_step

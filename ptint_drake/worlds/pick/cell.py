@@ -8,11 +8,13 @@ takes its sample times there too, so that its integration splits where the run's
 
 from __future__ import annotations
 
+import numpy as np
+
 from ptint_drake.config.schema import Scenario
 from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
 from ptint_drake.worlds.pick.placement import placed_parts
-from ptint_drake.worlds.pick.scene import slot_pose
-from ptint_drake.worlds.pick.tasks import PickPlan
+from ptint_drake.worlds.pick.scene import bin_drop, slot_pose
+from ptint_drake.worlds.pick.tasks import PLACES, PickPlan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
 REPLAY_PERIOD = 1.0 / 30.0  # s, between logged whole-plant states (the replay's frames)
@@ -25,7 +27,8 @@ def world_config(scenario: Scenario) -> PickWorldConfig:
     seed = scenario.measurement.seed if scenario.measurement is not None else 0
     config = PickWorldConfig(model=scenario.robot.model, end_effector=scenario.robot.end_effector,
                              initial_q_deg=list(scenario.robot.initial_q_deg), gripper=p.gripper,
-                             belts=p.belts, parts=placed_parts(p.parts, seed), tray=p.tray)
+                             belts=p.belts, parts=placed_parts(p.parts, seed), tray=p.tray,
+                             bins=p.bins)
     if mb is not None:
         config.time_step = mb.time_step
         config.contact_approximation = mb.discrete_contact_approximation or DEFAULT_APPROXIMATION
@@ -33,17 +36,26 @@ def world_config(scenario: Scenario) -> PickWorldConfig:
     return config
 
 
+def place_point(config, kind: str, index: int, part) -> np.ndarray:
+    """The place pose of ``part`` (its centre, world, m) at slot ``index`` (``kind`` "slot": resting
+    on the tray, ``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at) or over
+    bin ``index`` ("bin": ``scene.bin_drop``); ``config``: a ``PickWorldConfig`` or a ``pick`` block."""
+    if kind == "bin":
+        return bin_drop(config.bins[index], part)
+    height = part.size[2] if part.shape == "box" else part.size[1]
+    return slot_pose(config.tray, index).translation() + [0.0, 0.0, height / 2]
+
+
 def place_positions(config: PickWorldConfig, plan: PickPlan) -> list:
     """Per segment: the world position of its slot's place pose (the part's centre resting on the
-    tray), None for the segments that aim at a part — from the declared tray and slots alone
-    (``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at), so the controller
-    side needs no station to find them."""
+    tray; a bin's drop point, ``scene.bin_drop``), None for the segments that aim at a part — from
+    the declared tray, slots and bins alone (``place_point``), so the controller side needs no
+    station to find them."""
     out = []
     for seg in plan.segments:
-        if seg.kind != "slot":
+        if seg.kind not in PLACES:
             out.append(None)
             continue
         part = config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
-        height = part.size[2] if part.shape == "box" else part.size[1]
-        out.append(slot_pose(config.tray, seg.index).translation() + [0.0, 0.0, height / 2])
+        out.append(place_point(config, seg.kind, seg.index, part))
     return out

@@ -15,6 +15,7 @@ import numpy as np
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.pick import (  # noqa: F401
     BeltConfig,
+    BinConfig,
     GripperConfig,
     PartConfig,
     PickWorldConfig,
@@ -112,3 +113,23 @@ def check_pick_parts(config) -> None:
         _check_part(k, part, belts)
     if len(config.tray.center) != 3 or len(config.tray.size) != 3:
         raise ScenarioError("pick.tray: center and size need 3 values")
+    for k, box in enumerate(config.bins):
+        _check_bin(k, box)
+    taken = {b.name for b in config.belts} | {p.name for p in config.parts} | {"tray", "floor"}
+    for k, box in enumerate(config.bins):
+        if box.name in taken:
+            raise ScenarioError(f"pick.bins[{k}].name: {box.name!r} is taken (by a belt, a part, the tray, "
+                                f"the floor or another bin)")
+        taken.add(box.name)
+
+
+def _check_bin(k: int, box: BinConfig) -> None:
+    where = f"pick.bins[{k}]"
+    for name in ("center", "size"):
+        if len(getattr(box, name)) != 3:
+            raise ScenarioError(f"{where}.{name}: needs 3 values (m)")
+    if min(box.size) <= 0.0:
+        raise ScenarioError(f"{where}.size: [x, y, depth] must be positive, got {box.size}")
+    for name in ("wall", "friction"):
+        if not getattr(box, name) > 0.0:
+            raise ScenarioError(f"{where}.{name}: must be positive, got {getattr(box, name)}")

@@ -3,17 +3,6 @@ in messages (``ptint drive``, ``hardware.drive``): what the controller aims at, 
 commands and the grasp state, with no plant.
 
 ``AddPickControllerSide`` adds to a builder: ``PickTargets`` (what each segment aims at) fed from
-port (export)   size        meaning
-==============  ==========  ================================================================
-``parts``       24 a part   input: per part (scenario order) [x, ẋ, ẍ] (9) and [R, ω, ω̇] (15),
-                            ``pick.part_pose``'s ports (without an rgbd camera)
-``depth_image`` image       input (an rgbd camera): the station's depth frame; the perception,
-                            the estimators and ``EstimatedParts`` run here (``camera``)
-``gripper``     6           input: [q_left, q_right, v_left, v_right] (m, m/s) and each finger
-                            drive's force (N, − squeezes): ``GraspObserver``'s inputs
-``grasp_state`` 1           output: the observer's state (``systems.hand.gripper.GRASP_STATES``)
-==============  ==========  ================================================================
-=======
 the part tracker's reports or the camera's frames as received, ``GripperSequence`` (the plan's
 gripper commands) and ``GraspObserver`` (``systems.hand.gripper``: the grasp state) fed from an input
 of the gripper's reported fingers and drive forces.  The slots' places come from the scenario's

@@ -24,17 +24,86 @@ pick 1's approach cut to 0.3 s: docs/pick_place.md ("Checks before and during th
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Optional
+
 import numpy as np
 
 from ptint_drake.robot.plant import effort_limits
 from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.systems.task.tbg import tbg_profile
-from ptint_drake.verdict.run_warnings import Profile, feasibility_warning, joint_demand, profile_times
+from ptint_drake.verdict.run_warnings import (SPEED_SAMPLES, Profile, feasibility_warning, joint_demand,
+                                               profile_times)
 from ptint_drake.worlds.pick.route import tool_yaws
 from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT
 
 HELD = ("lift", "carry", "place")  # phases that carry the part (a via before a carry too)
+
+
+@dataclass(frozen=True)
+class Way:
+    """One segment's way as the feasibility model follows it: its ``target`` at the segment's start
+    (m) riding at ``ride`` (m/s; 0 for a fixed target), the start error ``e0`` = where the tool
+    starts less that target (m), the tool's yaw at the start and at the target (rad, ``yaws``),
+    and the ``payload`` (kg) held at the tool."""
+
+    target: np.ndarray
+    ride: np.ndarray
+    e0: np.ndarray
+    yaws: tuple = (0.0, 0.0)
+    payload: float = 0.0
+
+
+def top_down(yaw: float) -> np.ndarray:
+    """Rz(yaw)·Rx(π): the top-down tool turned to ``yaw`` (rad)."""
+    c, n = np.cos(yaw), np.sin(yaw)
+    return np.array([[c, n, 0.0], [n, -c, 0.0], [0.0, 0.0, -1.0]])
+
+
+def way_postures(arm, frame, way: Way, tf: float, beta: float, q: np.ndarray,
+                 samples: int = SPEED_SAMPLES) -> Optional[np.ndarray]:
+    """The postures (samples × nq) along ``way`` taken in ``tf`` s with TBG shape ``beta`` at the
+    feasibility model's ``samples`` (``run_warnings.profile_times``), each by Drake's
+    ``InverseKinematics`` from the previous one's (the first from ``q``); None where a sample has
+    no top-down posture."""
+    tau = profile_times(tf, samples)
+    xi = tbg_profile(tau, tf, beta)[0]
+    yaw0, yaw1 = way.yaws
+    postures = []
+    for k, t in enumerate(tau):
+        x = way.target + way.ride * t + xi[k] * way.e0
+        q = inverse_kinematics(arm, frame, x, q, R=top_down(yaw1 + xi[k] * (yaw0 - yaw1)))
+        if q is None:
+            return None
+        postures.append(q)
+    return np.array(postures)
+
+
+def way_motion(way: Way, tf: float, beta: float,
+               samples: int = SPEED_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
+    """(velocity, acceleration) of the tool along ``way`` in ``tf`` s, [ω; v] and [α; a] per sample
+    (``profile_times``): ẋ = ẋ_target + ξ̇ e0 and ẍ = ξ̈ e0, the yaw turning on the same ξ (β < 1/2
+    taken as 1/2 for ξ̈, where it is unbounded)."""
+    tau = profile_times(tf, samples)
+    xi_d = tbg_profile(tau, tf, beta)[1]
+    xi_dd = tbg_profile(tau, tf, max(beta, 0.5))[2]
+    turn = way.yaws[0] - way.yaws[1]
+    z = np.array([0.0, 0.0, 1.0])
+    velocity = np.hstack([np.outer(xi_d * turn, z), way.ride + np.outer(xi_d, way.e0)])
+    acceleration = np.hstack([np.outer(xi_dd * turn, z), np.outer(xi_dd, way.e0)])
+    return velocity, acceleration
+
+
+def way_profile(arm, frame, way: Way, tf: float, beta: float, q: np.ndarray,
+                start: float = 0.0) -> Optional[Profile]:
+    """The ``run_warnings.Profile`` of ``way`` taken in ``tf`` s from time ``start`` (module
+    docstring): the one evaluation the warnings before a run and ``phase_time.min_tf`` share."""
+    postures = way_postures(arm, frame, way, tf, beta, q)
+    if postures is None:
+        return None
+    velocity, acceleration = way_motion(way, tf, beta)
+    return Profile(start + profile_times(tf), postures, velocity, acceleration, way.payload)
 
 
 def _profiles(scenario, built) -> list:
@@ -48,34 +117,16 @@ def _profiles(scenario, built) -> list:
     yaws = tool_yaws(world, plan)
     q, out = world.q0, []
     for i, (seg, s) in enumerate(zip(plan.segments, plan.schedule.segments)):
-        tau = profile_times(s.tf)
-        target = segment_target(world, plan, i, s.start + tau)
-        ride = world.parts[seg.index][1] if seg.kind in ("part",) else np.zeros(3)
-        xi, xi_d = tbg_profile(tau, s.tf, s.beta)[0:2]
-        xi_dd = tbg_profile(tau, s.tf, max(s.beta, 0.5))[2]
-        e0 = start_error(world, plan, i)
-        yaw0, yaw1 = yaws[i]
-        turn = yaw0 - yaw1
-        postures = []
-        for k in range(len(tau)):
-            yaw = yaw1 + xi[k] * turn
-            c, n = np.cos(yaw), np.sin(yaw)
-            R = np.array([[c, n, 0.0], [n, -c, 0.0], [0.0, 0.0, -1.0]])  # Rz(yaw)·Rx(π): top-down
-            solution = inverse_kinematics(arm, frame, target[k] + xi[k] * e0, q, R=R)
-            if solution is None:
-                break
-            postures.append(solution)
-            q = solution
-        if len(postures) < len(tau):
-            out.append(None)
-            continue
-        z = np.array([0.0, 0.0, 1.0])
-        velocity = np.hstack([np.outer(xi_d * turn, z), ride + np.outer(xi_d, e0)])
-        acceleration = np.hstack([np.outer(xi_dd * turn, z), np.outer(xi_dd, e0)])
+        ride = world.parts[seg.index][1] if seg.kind == "part" else np.zeros(3)
         task = scenario.pick.tasks[seg.task]
         held = seg.phase in HELD or seg.kind == VIA_SLOT
         payload = masses[names.index(task.part)] if held else 0.0
-        out.append(Profile(s.start + tau, np.array(postures), velocity, acceleration, payload))
+        way = Way(segment_target(world, plan, i, s.start)[0], ride, start_error(world, plan, i), yaws[i],
+                  payload)
+        profile = way_profile(arm, frame, way, s.tf, s.beta, q, s.start)
+        if profile is not None:
+            q = profile.q[-1]
+        out.append(profile)
     return out
 
 

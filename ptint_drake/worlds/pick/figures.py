@@ -38,9 +38,12 @@ def pick_outcome(row: int, pick: dict) -> str:
              f"grasped at {pick['t_grasp']:.3f} s (prescribed {pick['t_grasp_prescribed']:.3f} s)")
     place = (f"placed {pick['place_error_mm']:.2f} mm, {pick['place_error_deg']:.2f}° from its slot"
              if pick["placed"] else "NOT placed")
+    into = f"slot {pick['slot']}"
+    if "bin" in pick:  # a bin: in it or not, no mm criterion
+        place, into = ("in the bin" if pick["placed"] else "NOT in the bin"), f"bin {pick['bin']}"
     attempts = len(pick.get("attempt_details") or [pick])
     retried = f" after {attempts} attempts" if attempts > 1 else ""
-    return f"pick {row} ({pick['part']} → slot {pick['slot']}): {grasp}{retried}, {place}"
+    return f"pick {row} ({pick['part']} → {into}): {grasp}{retried}, {place}"
 
 
 def _mark_attempts(ax, pick: dict) -> None:

@@ -28,7 +28,9 @@ observer's log (``systems.hand.gripper.GraspObserver``: what the gripper sensed)
   its place pose (centre; the angle of the rotation between them, a box's half-turn about its
   vertical axis counted as the same pose, a cylinder's turn about its axis ignored);
 - ``placed``: grasped, held at the place, and within ``criteria.place_mm`` and
-  ``criteria.place_deg``;
+  ``criteria.place_deg``; for a task into a bin (``bin``: its name, ``slot`` None) instead
+  ``in_bin``: the part's final centre inside the bin's inner box, below its walls' top
+  (``scene.in_bin``), with no mm criterion (its ``place_error_mm`` is from the drop point);
 - ``collision``: a contact of the arm or the gripper with any part or belt during an approach or
   a descend before its close command, or any in ``collision_with``;
 - ``collision_with``: the obstacles (belts, ``tray``, ``floor``, other parts; the own part touched
@@ -50,7 +52,7 @@ saturated`` and ``pick k: joint speed beyond limit`` (``runaway``); ``pick k: co
 ``pick k: missed after retry`` (retries spent, or the retry out of reach); otherwise ``pick k:
 late grasp`` (t_grasp more than ``LATE_GRASP`` after the prescribed grasp time, or never),
 ``pick k: early grasp`` (more than ``EARLY_GRASP`` before it), ``pick k: dropped`` (grasped, not
-in the hand at the place) or ``pick k: not placed``.
+in the hand at the place) or ``pick k: not placed`` (a bin's: ``pick k: not in the bin``).
 """
 
 from __future__ import annotations
@@ -64,6 +66,7 @@ from ptint_drake.worlds.pick.collisions import pick_collisions, touched_before_c
 from ptint_drake.worlds.pick.part_tracks import track_metrics
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.worlds.pick.runaway import runaway_reasons
+from ptint_drake.worlds.pick.scene import in_bin
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time
 EARLY_GRASP = 0.05  # s before it
@@ -79,9 +82,10 @@ def _aim(built, i: int, aims: dict, at_start: bool):
     """(position, rotation 15) that segment i aims at, from the values at a stop."""
     seg = built.plan.segments[i]
     offset = np.asarray(seg.offset)
-    if seg.kind == "slot":
+    if seg.kind in ("slot", "bin"):  # a bin's: the rotation latched at the lift (targets.PickTargets)
         rot = np.zeros(15)
-        rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
+        rot[0:9] = (RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind == "slot"
+                    else aims["latched"][7:16])
         return built.targets.places[i] + offset, rot
     if seg.kind == "via_slot":  # a via (pick.route): a fixed point turned to a yaw (via_part: as its part)
         rot = np.zeros(15)
@@ -146,6 +150,19 @@ def _at(t: np.ndarray, when: float) -> int:
     return min(max(int(np.searchsorted(t, when + 1e-9, side="right")) - 1, 0), len(t) - 1)
 
 
+def _destination(built, k: int, part, end: np.ndarray) -> tuple:
+    """Task k's place as metrics: ({"slot": its slot} or {"slot": None, "bin", "in_bin"},
+    {"place_error_mm", "place_error_deg"}) from the part's probe row at the end, ``end``."""
+    plan = built.plan
+    i = plan.segment_index(k, "place")
+    into = plan.segments[i]
+    box = built.station.config.bins[into.index] if into.kind == "bin" else None
+    where = ({"slot": into.index} if box is None
+             else {"slot": None, "bin": box.name, "in_bin": in_bin(box, end[0:3])})
+    return where, {"place_error_mm": float(1e3 * np.linalg.norm(end[0:3] - built.targets.places[i])),
+                   "place_error_deg": _place_angle(rotation_of(end[3:7]), into.yaw, part.shape, part.size)}
+
+
 def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
     from ptint_drake.systems.hand.gripper import GRASP_STATES, HOLDING  # noqa: PLC0415
 
@@ -190,10 +207,8 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
         details.append({"t_close_command": a.close, "t_grasp_prescribed": a.grasp, "t_check": t_check,
                         "state": checks[j]["state"] if j < len(checks) else None,
                         "peak_grip_force_N": float(np.max(grip[span])) if np.any(span) else 0.0})
-    i_place_seg = plan.segment_index(k, "place")
-    place, place_yaw = built.targets.places[i_place_seg], plan.segments[i_place_seg].yaw
-    R_end = rotation_of(block[-1, 3:7])
-    return {"part": part.name, "part_index": part_index, "slot": plan.segments[i_place_seg].index,
+    where, error = _destination(built, k, part, block[-1])
+    return {"part": part.name, "part_index": part_index, **where,
             "grasped": grasped, "t_grasp": t_grasp, "t_grasp_prescribed": last.grasp,
             "t_close_command": last.close, "attempts": len(attempts), "attempt_details": details,
             "grasp_confirmed": confirmed,
@@ -203,9 +218,7 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
             "grip_force_N": float(grip[i_lift]),
             "slip_mm": None if slip is None else 1e3 * slip,
             "peak_grip_force_N": float(np.max(grip[in_carry])) if np.any(in_carry) else 0.0,
-            "place_error_mm": float(1e3 * np.linalg.norm(block[-1, 0:3] - place)),
-            "place_error_deg": _place_angle(R_end, place_yaw, part.shape, part.size),
-            "collision": collision, "collision_before_close": early}
+            **error, "collision": collision, "collision_before_close": early}
 
 
 def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> dict:
@@ -218,9 +231,10 @@ def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> 
         # arm/gripper vs belts, tray, floor, parts; and whatever the open fingers touched before the close
         pick["collision_with"] = [name for name in built.station.obstacles if name in touched]
         pick["collision"] = bool(pick["collision"] or pick["collision_with"])
-        pick["placed"] = bool(pick["grasped"] and pick["held_at_place"]
-                              and pick["place_error_mm"] <= scenario.criteria.place_mm
-                              and pick["place_error_deg"] <= scenario.criteria.place_deg)
+        within = (pick["in_bin"] if "bin" in pick  # a bin: in it, no mm criterion
+                  else pick["place_error_mm"] <= scenario.criteria.place_mm
+                  and pick["place_error_deg"] <= scenario.criteria.place_deg)
+        pick["placed"] = bool(pick["grasped"] and pick["held_at_place"] and within)
         picks.append(pick)
     out = {"scenario": scenario.name, "duration": outcome["end"], "segments": segments, "picks": picks}
     if "tracks" in logs:  # with a camera: the identity switches against the truth (part_tracks)
@@ -251,5 +265,5 @@ def pick_reasons(picks: list) -> list:
         if p["grasped"] and not p["held_at_place"]:
             out.append((k, "dropped"))
         elif not p["placed"]:
-            out.append((k, "not placed"))
+            out.append((k, "not in the bin" if "bin" in p else "not placed"))
     return out

@@ -37,8 +37,8 @@ from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.placement import nominal_parts
-from ptint_drake.worlds.pick.scene import (FINGER_JOINTS, belt_frame, finger_extent, gripper_path, part_shape,
-                                           tray_pose)
+from ptint_drake.worlds.pick.scene import (FINGER_JOINTS, belt_frame, bin_boxes, finger_extent, gripper_path,
+                                           part_shape, tray_pose)
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, segment_way
 
@@ -109,6 +109,10 @@ class PlanningScene:
         X_T = tray_pose(pick.tray).multiply(RigidTransform([0.0, 0.0, -pick.tray.size[2] / 2]))
         plant.RegisterCollisionGeometry(plant.world_body(), X_T, Box(*pick.tray.size), "tray",
                                         ProximityProperties())
+        for box in pick.bins:  # a bin's floor and walls, named by the bin
+            for name, X, size in bin_boxes(box):
+                plant.RegisterCollisionGeometry(plant.world_body(), X, Box(*size), f"{box.name} {name}",
+                                                ProximityProperties())
         plant.Finalize()
         self.plant, self.scene_graph = plant, scene_graph
         self.diagram = builder.Build()

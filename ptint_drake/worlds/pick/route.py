@@ -48,7 +48,7 @@ import numpy as np
 
 from ptint_drake.worlds.pick.obstacles import obstacle_vias
 from ptint_drake.robot.reachability import inverse_kinematics
-from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
+from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, nominal, nominal_paths
 
 INNER_MARGIN = 0.04  # m: a way closer than this to the inner edge of the top-down workspace is too near
@@ -138,6 +138,11 @@ def _via_for(world: Nominal, pick, replans: tuple, vias: tuple, k: int, phase: s
     return None
 
 
+def nearest_branch(yaw: float, target: float) -> float:
+    """The top-down branch of ``target`` (rad, modulo π) nearest ``yaw``: where the task turns the tool."""
+    return float(target + np.pi * np.rint((yaw - target) / np.pi))
+
+
 def tool_yaws(world: Nominal, plan: PickPlan) -> list:
     """Per segment: the tool's yaw (rad, unwrapped) at its start and at its end, as the top-down
     task turns it: to the branch (modulo π) of the target's yaw nearest the tool's yaw
@@ -147,8 +152,8 @@ def tool_yaws(world: Nominal, plan: PickPlan) -> list:
     R = world.frame.CalcPoseInWorld(context).rotation().matrix()
     yaw, out = float(np.arctan2(R[1, 0], R[0, 0])), []
     for seg in plan.segments:
-        target = seg.yaw if seg.kind in ("slot", VIA_SLOT) else world.part_yaws[seg.index]
-        end = target + np.pi * np.rint((yaw - target) / np.pi)
+        target = seg.yaw if seg.kind in (*PLACES, VIA_SLOT) else world.part_yaws[seg.index]
+        end = nearest_branch(yaw, target)
         out.append((yaw, end))
         yaw = end
     return out

@@ -216,7 +216,8 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
     time), its lift point and its slot (and the carry above it), solved from one to the next, then
     every slot no task uses (``_check_slots``) must be reachable from above (Drake's
     InverseKinematics, the model's joint limits); a ScenarioError naming the field: a slot out of
-    reach is ``pick.tray.slots[j]`` (the tray's centre and the slot's offset put it there)."""
+    reach is ``pick.tray.slots[j]`` (the tray's centre and the slot's offset put it there), a bin's
+    drop point out of reach ``pick.bins[j]``."""
     arm = built.arm
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     plan, config = built.plan, built.station.config
@@ -232,7 +233,7 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
         place = built.targets.places[plan.segment_index(k, "place")]
         for where, x in ((f"pick.tasks[{k}].part", grasp), (f"pick.tasks[{k}].lift_height",
                                                            grasp + [0, 0, task.lift_height]),
-                         (_slot_field(task.slot), place), (f"pick.tasks[{k}].lift_height",
+                         (_place_field(scenario, task), place), (f"pick.tasks[{k}].lift_height",
                                                            place + [0, 0, task.lift_height])):
             solution = inverse_kinematics(arm, frame, np.asarray(x), guess, down=True)
             if solution is None:
@@ -241,6 +242,14 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
             guess = solution
         guesses.append(guess)
     _check_slots(scenario, built, frame, guesses, context)
+
+
+def _place_field(scenario: Scenario, task) -> str:
+    """The field that puts a task's place where it is: its slot's, or its bin's."""
+    if task.bin:
+        j = [b.name for b in scenario.pick.bins].index(task.bin)
+        return f"pick.bins[{j}] (its center and depth)"
+    return _slot_field(task.slot)
 
 
 def _slot_field(j: int) -> str:

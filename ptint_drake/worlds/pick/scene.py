@@ -13,6 +13,8 @@ tray, added to a not yet finalized MultibodyPlant (``world.MakePickStation`` cal
   whose default pose rests it on its belt.
 - **Tray** (``AddTray``): a welded plate; each slot is a frame ``slot_k`` on its top surface with
   a thin marker visual (the place pose of a part's centre is ``slot_k`` raised by half its height).
+- **Bin** (``AddBin``): an open box welded to the world, its floor and four walls boxes
+  (``bin_boxes``); a part is let go over it (``bin_drop``) and counts when it rests inside (``in_bin``).
 - **Floor** (``AddFloor``): a 4 × 4 × 0.1 m slab welded to the world, its top surface at z = FLOOR_Z = 0,
   the plane the arm's pedestal stands on (models/README.md): a part that leaves the hand or falls
   off a belt comes to rest there, so its place error stays finite.
@@ -42,7 +44,7 @@ from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelI
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.robot.rvm1 import model_path
-from ptint_drake.worlds.pick.config import BeltConfig, GripperConfig, PartConfig, TrayConfig
+from ptint_drake.worlds.pick.config import BeltConfig, BinConfig, GripperConfig, PartConfig, TrayConfig
 
 BELT_KD = 1e5  # N·s/m: the belt's velocity servo (implicit, so any stiffness is stable)
 BELT_FORCE = 1e4  # N: the belt drive's force limit
@@ -258,6 +260,47 @@ def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
         plant.RegisterVisualGeometry(body, X_TS.multiply(RigidTransform([0.0, 0.0, 0.0005])),
                                      Box(0.03, 0.004, 0.001), f"slot_{k}", [0.1, 0.7, 0.2, 1.0])
     return slots
+
+
+BIN_DROP_CLEARANCE = 0.01  # m: a part's bottom above a bin's walls where the fingers let it go (assumption)
+BIN_RGBA = [0.35, 0.5, 0.35, 1.0]
+
+
+def bin_boxes(box: BinConfig) -> list:
+    """The bin's floor and four walls, each (name, pose in the world, size [x, y, z] m): an open box
+    aligned with the world's axes, its inner floor's centre at ``center``, ``size`` inside,
+    ``wall`` thick (the one description the station and the planning model both build)."""
+    c, (ix, iy, depth), w = np.asarray(box.center, dtype=float), box.size, box.wall
+    up = depth / 2
+    return [("floor", RigidTransform(c + [0.0, 0.0, -w / 2]), [ix + 2 * w, iy + 2 * w, w]),
+            ("wall_x-", RigidTransform(c + [-(ix + w) / 2, 0.0, up]), [w, iy + 2 * w, depth]),
+            ("wall_x+", RigidTransform(c + [(ix + w) / 2, 0.0, up]), [w, iy + 2 * w, depth]),
+            ("wall_y-", RigidTransform(c + [0.0, -(iy + w) / 2, up]), [ix, w, depth]),
+            ("wall_y+", RigidTransform(c + [0.0, (iy + w) / 2, up]), [ix, w, depth])]
+
+
+def bin_drop(box: BinConfig, part: PartConfig) -> np.ndarray:
+    """Where the place phase takes a part's centre over ``box``: above its centre, the part's
+    bottom ``BIN_DROP_CLEARANCE`` above the walls' top (the fingers open there, the part drops)."""
+    _, height = part_shape(part)
+    return np.asarray(box.center, dtype=float) + [0.0, 0.0, box.size[2] + BIN_DROP_CLEARANCE + height / 2]
+
+
+def in_bin(box: BinConfig, p: np.ndarray) -> bool:
+    """The point ``p`` (a part's centre, world) is inside the bin's inner box, below its walls' top."""
+    d = np.asarray(p, dtype=float) - box.center
+    return bool(abs(d[0]) <= box.size[0] / 2 and abs(d[1]) <= box.size[1] / 2 and 0.0 <= d[2] <= box.size[2])
+
+
+def AddBin(plant: MultibodyPlant, box: BinConfig):
+    """The bin as a body welded to the world (its floor and walls, ``bin_boxes``); returns the body."""
+    instance = plant.AddModelInstance(box.name)
+    body = plant.AddRigidBody(box.name, instance, SpatialInertia.SolidBoxWithMass(1.0, *box.size))
+    plant.WeldFrames(plant.world_frame(), body.body_frame(), RigidTransform())
+    for name, X, size in bin_boxes(box):
+        plant.RegisterCollisionGeometry(body, X, Box(*size), name, _surface_properties(box.friction))
+        plant.RegisterVisualGeometry(body, X, Box(*size), name, BIN_RGBA)
+    return body
 
 
 def AddFloor(plant: MultibodyPlant):

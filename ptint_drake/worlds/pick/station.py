@@ -68,7 +68,8 @@ from ptint_drake.worlds.pick.config import PickWorldConfig, check_pick_world, gr
 from ptint_drake.worlds.pick.contact_pairs import ContactPairs
 from ptint_drake.worlds.pick.part_pose import PartPoses
 from ptint_drake.worlds.pick.tracker import TRACKER_PORT, PartTracker
-from ptint_drake.worlds.pick.scene import AddBelt, AddFloor, AddGripper, AddPart, AddTray, gripper_stroke
+from ptint_drake.worlds.pick.scene import (AddBelt, AddBin, AddFloor, AddGripper, AddPart, AddTray,
+                                          gripper_stroke)
 
 
 @dataclass
@@ -122,7 +123,7 @@ def _parse_arm(plant: MultibodyPlant, config: PickWorldConfig) -> ModelInstanceI
 
 
 def _add_world(plant: MultibodyPlant, scene_graph: SceneGraph, config: PickWorldConfig):
-    """Arm, gripper, belts, parts and tray in ``plant`` (not finalized); the handles."""
+    """Arm, gripper, belts, parts, tray and bins in ``plant`` (not finalized); the handles."""
     arm = _parse_arm(plant, config)
     nubs = config.contact_model == "point"
     gripper = AddGripper(plant, plant.GetFrameByName(config.end_effector, arm), config.gripper, nubs)
@@ -136,9 +137,11 @@ def _add_world(plant: MultibodyPlant, scene_graph: SceneGraph, config: PickWorld
                                 f"fit the gripper's {stroke} m stroke")
         parts.append(AddPart(plant, part, by_name[part.belt], nubs))
     slots = AddTray(plant, config.tray)
+    bins = [AddBin(plant, box) for box in config.bins]
     floor = AddFloor(plant)
     fixed = GeometrySet([g for j in belts for g in plant.GetCollisionGeometriesForBody(j.child_body())]
-                        + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("tray"))) + [floor])
+                        + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("tray"))) + [floor]
+                        + [g for body in bins for g in plant.GetCollisionGeometriesForBody(body)])
     # the arm and its gripper do not collide with themselves (no self-collision avoidance is
     # planned; Drake already filters bodies joined by a joint, this also covers e.g. hand–finger)
     robot = GeometrySet([g for m in (arm, gripper) for b in plant.GetBodyIndices(m)
@@ -211,11 +214,12 @@ def MakePickStation(config: PickWorldConfig, measurement=None) -> PickStation:
 
 
 def _collision_probe(plant, config, arm, gripper, belts, parts) -> tuple:
-    """The obstacles' names (belts, "tray", "floor", parts) and their ``CollisionProbe``."""
-    names = [b.name for b in config.belts] + ["tray", "floor"] + [p.name for p in config.parts]
+    """The obstacles' names (belts, "tray", "floor", parts, bins) and their ``CollisionProbe``."""
+    names = ([b.name for b in config.belts] + ["tray", "floor"] + [p.name for p in config.parts]
+             + [b.name for b in config.bins])
     bodies = ([[j.child_body().index()] for j in belts] + [[plant.GetBodyByName("tray").index()],
                                                            [plant.world_body().index()]]
-              + [[b.index()] for b in parts])
+              + [[b.index()] for b in parts] + [[plant.GetBodyByName(b.name).index()] for b in config.bins])
     robot = [b for m in (arm, gripper) for b in plant.GetBodyIndices(m)]
     fingers = [plant.GetBodyByName(n, gripper).index() for n in ("left_finger", "right_finger")]
     return names, CollisionProbe(bodies, fingers, robot)

@@ -19,6 +19,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from ptint_drake.config.pick import PHASES
 from ptint_drake.robot.mass_scaling import scale_in_context
 from ptint_drake.worlds.base import advance_over_stops, new_simulator
+from ptint_drake.worlds.pick.hold_limit import holdable
 from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.run import pick_simulator
@@ -89,7 +90,8 @@ def robust_sample(scenario, name: str, seed: int, u):
               "part_friction": [p.friction for p in pick.parts],
               "belt_speed": [b.speed for b in pick.belts],
               "close_delay": [t.close_delay for t in pick.tasks],
-              "part_lateral": [p.lateral for p in pick.parts]}
+              "part_lateral": [p.lateral for p in pick.parts],
+              "holdable": [holdable(pick, t.part) for t in pick.tasks]}
     return scenario, params | camera
 
 
@@ -118,12 +120,32 @@ def failure_reason(text: str) -> str:
     return _NUMBER.sub("#", text)[:160]
 
 
+def _pick_oks(row: dict) -> list[bool]:
+    """Per pick of a sample: placed, with no collision and no reason of the verdict naming it."""
+    named = {int(m.group(1)) for text in row.get("reasons") or [] if (m := re.match(r"pick (\d+):", text))}
+    return [bool(p.get("placed")) and not p.get("collision") and k not in named
+            for k, p in enumerate(row.get("picks", []))]
+
+
 def picks_ok(row: dict) -> int:
     """How many of a sample's picks succeeded: placed, with no collision and no reason of the
     verdict naming the pick (``pick k: late grasp`` fails pick k even if it was placed)."""
-    named = {int(m.group(1)) for text in row.get("reasons") or [] if (m := re.match(r"pick (\d+):", text))}
-    return sum(bool(p.get("placed")) and not p.get("collision") and k not in named
-               for k, p in enumerate(row.get("picks", [])))
+    return sum(_pick_oks(row))
+
+
+def holdable_counts(rows: list) -> dict:
+    """``cannot_be_held`` (picks whose part no grasp could lift: ``hold_limit``, judged from the
+    drawn truth) and ``pick_success_rate_holdable`` (picks that succeeded among the others);
+    {} for rows without the judgement (studies written before it)."""
+    if not rows or any("holdable" not in r.get("params", {}) for r in rows):
+        return {}
+    can = cannot = ok = 0
+    for r in rows:
+        flags = r["params"]["holdable"]
+        oks = _pick_oks(r) or [False] * len(flags)  # a sample that could not run placed none
+        can, cannot = can + sum(flags), cannot + len(flags) - sum(flags)
+        ok += sum(o for o, h in zip(oks, flags) if h)
+    return {"cannot_be_held": cannot, "pick_success_rate_holdable": ok / can if can else 0.0}
 
 
 def robust_summary(rows: list) -> dict:
@@ -146,7 +168,7 @@ def robust_summary(rows: list) -> dict:
                 bodies.update(b.strip() for b in touched.split(",") if b.strip())
                 code = COLLISION
             reasons[code] += 1
-    return {"pick_success_rate": ok / parts if parts else 0.0,
+    return {"pick_success_rate": ok / parts if parts else 0.0, **holdable_counts(rows),
             "failures_by_reason": _most_first(reasons), "collisions_by_body": _most_first(bodies)}
 
 
@@ -188,10 +210,12 @@ def report(scenario, metrics: dict, out) -> int:
     for k, p in enumerate(metrics["picks"]):
         grasp = "never" if p["t_grasp"] is None else \
             f"{p['t_grasp']:.3f} s (prescribed {p['t_grasp_prescribed']:.3f} s)"
-        print(f"{scenario.name} pick {k} ({p['part']} → slot {p['slot']}): grasped at {grasp}, "
-              f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
-              f"{p['place_error_deg']:.2f}°"
-              f" from its slot, slip {p['slip_mm'] or 0.0:.2f} mm, "
+        into = f"bin {p['bin']}" if "bin" in p else f"slot {p['slot']}"
+        place = (f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
+                 f"{p['place_error_deg']:.2f}° from its slot" if "bin" not in p
+                 else ("in the bin" if p["placed"] else "NOT in the bin"))
+        print(f"{scenario.name} pick {k} ({p['part']} → {into}): grasped at {grasp}, {place}, "
+              f"slip {p['slip_mm'] or 0.0:.2f} mm, "
               f"contact grip {p['peak_grip_force_N']:.1f} N peak, {p.get('grip_force_N') or 0.0:.1f} N at "
               f"the lift; {p.get('attempts', 1)} "
               f"attempt{'s' if p.get('attempts', 1) != 1 else ''}, {p.get('state_at_place')} at the place"

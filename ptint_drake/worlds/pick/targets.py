@@ -20,7 +20,9 @@ a target read off a part in the hand would follow the hand and hold nothing.  A 
 aims at where the part was at the segment's start + offset, at rest.  Discrete state ``latched``
 = [p, v, t₀, R] (m, m/s, s, row-major), updated at each "latched" segment's start and at each
 grasp time.  A "slot"
-segment aims at the fixed place pose, turned to the slot's yaw about the vertical.  A via segment
+segment aims at the fixed place pose, turned to the slot's yaw about the vertical; a "bin" segment
+at the bin's drop point, turned as the part was at the lift's start (the latched rotation: the tool
+keeps the yaw it grasped at).  A via segment
 (``pick.route``: the way around the arm's base) aims at its fixed point, at rest, turned as the
 segment after it will be: as its part (``via_part``, before an approach), or to a yaw
 (``via_slot``, before a carry: the slot's, or halfway to it the other way round).
@@ -45,7 +47,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from ptint_drake.controllers import TargetView
 from ptint_drake.systems.task.cache import DeclareVectorCache
 from ptint_drake.systems.task.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
-from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan
+from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan
 
 PART, LATCHED, SLOT, VIA = 0, 1, 2, 3  # a segment's kind ("part", "latched", "slot", "via_*") in ``_aims``
 
@@ -80,9 +82,9 @@ class PickTargets(LeafSystem):
         prescribed grasp time of a descend (None otherwise))."""
         seg = self._plan.segments[i]
         offset = np.asarray(seg.offset)
-        if seg.kind == "slot":
-            return (SLOT, None, offset, np.asarray(self.places[i]) + offset,
-                    RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
+        if seg.kind in PLACES:  # a bin's: no yaw of its own (None), the tool keeps the latched one
+            R = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind == "slot" else None
+            return (SLOT, None, offset, np.asarray(self.places[i]) + offset, R, None)
         if seg.kind in (VIA_PART, VIA_SLOT):  # a fixed point; turned as its part, or to a yaw
             return (VIA, seg.index if seg.kind == VIA_PART else None, offset, offset,
                     RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
@@ -127,7 +129,9 @@ class PickTargets(LeafSystem):
         kind, part, offset, place, R_slot, grasp = self._aims[i]
         value = np.zeros(24)
         if kind == SLOT:
-            value[0:3], value[9:18] = place, R_slot
+            value[0:3] = place
+            value[9:18] = (R_slot if R_slot is not None
+                           else context.get_discrete_state(self._latched).get_value()[7:16])
             return value
         if kind == VIA:
             value[0:3] = place

@@ -19,6 +19,11 @@ other, each a prescribed-time interception (SPEC 2.1) of its own target:
    open at this segment's tf + ``dwell``;
 6. ``retreat`` — ``clearance`` above the slot, starting ``dwell`` after the fingers opened.
 
+A task with a ``bin`` instead of a ``slot`` (``pick.bins``: an open box) carries the part to
+``lift_height`` above the bin's drop point (``scene.bin_drop``: over its centre, the part's bottom
+``scene.BIN_DROP_CLEARANCE`` above its walls), lowers it there, opens the fingers and retreats
+up; the tool keeps the yaw it grasped at (``place_target``).
+
 A *via* (``Via``: ``worlds.pick.route`` decides where one is needed) splits a task's first approach or
 its carry in two: first a segment of its own (phase ``via``) to a fixed point, then the approach or
 carry itself, the two together taking the segment's tf (so every later prescribed time stays
@@ -45,8 +50,9 @@ from ptint_drake.worlds.pick.config import grasp_width
 @dataclass(frozen=True)
 class PlanSegment:
     """What one segment aims at: ``kind`` "part" (part ``index``'s simulated centre + ``offset``),
-    "latched" (where part ``index`` was at the segment's start + ``offset``) or "slot" (slot
-    ``index``'s place pose + ``offset``, yaw ``yaw`` rad); ``task``, ``phase`` and ``attempt``
+    "latched" (where part ``index`` was at the segment's start + ``offset``), "slot" (slot
+    ``index``'s place pose + ``offset``, yaw ``yaw`` rad) or "bin" (bin ``index``'s drop point +
+    ``offset``; ``yaw``: the part's declared yaw, for planning); ``task``, ``phase`` and ``attempt``
     (0: the first approach and descend, 1…: a retry's backoff, approach, descend) name it."""
 
     task: int
@@ -59,6 +65,7 @@ class PlanSegment:
 
 
 VIA_PART, VIA_SLOT = "via_part", "via_slot"  # the kinds of a via segment (``Via``)
+PLACES = ("slot", "bin")  # the kinds of a fixed place target: a tray slot, or a bin (``place_target``)
 
 
 @dataclass(frozen=True)
@@ -128,11 +135,12 @@ def _up(h: float) -> tuple:
     return (0.0, 0.0, h)
 
 
-def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, start: float, replan: Replan,
+def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start: float, replan: Replan,
                    hold: float = 0.0, vias: tuple = ()):
     """The segments of task k, their plan entries, the attempts' (start, grasp) and the end;
-    ``hold``: how long the first attempt waits at its pre-grasp pose before its descend (s);
-    ``vias``: the task's ``Via`` (at most one per phase)."""
+    ``place``: (kind, index, yaw) of its place target (``place_target``); ``hold``: how long the
+    first attempt waits at its pre-grasp pose before its descend (s); ``vias``: the task's ``Via``
+    (at most one per phase)."""
     segments, plans, attempts = [], [], []
     routes = {v.phase: v for v in vias if v.task == k}
 
@@ -170,9 +178,10 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, slot_yaw: float, sta
         t = add("backoff", "latched", part, _up(task.clearance), 0.0, replan.abort, len(retries))
         t -= task.dwell  # the lift right after it
     t = add("lift", "latched", part, _up(task.lift_height), 0.0, t + task.dwell + replan.lift_delay)
-    t = add("carry", "slot", task.slot, _up(task.lift_height), slot_yaw, t)
-    t = add("place", "slot", task.slot, _up(0.0), slot_yaw, t)
-    t = add("retreat", "slot", task.slot, _up(task.clearance), slot_yaw, t + task.dwell)
+    kind, index, yaw = place
+    t = add("carry", kind, index, _up(task.lift_height), yaw, t)
+    t = add("place", kind, index, _up(0.0), yaw, t)
+    t = add("retreat", kind, index, _up(task.clearance), yaw, t + task.dwell)
     return segments, plans, attempts, t
 
 
@@ -187,12 +196,12 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
     for k, task in enumerate(pick.tasks):
         replan = replans[k] if k < len(replans) else Replan()
         part = names.index(task.part)
-        slot_yaw = np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg)
         start = max(task.start, t) if task.start > 0.0 else t
         width = grasp_width(pick.parts[part])
         opening = width + task.margin
         first_close, hold = _closed_on_nothing(pick, task, start)
-        segs, plan, tries, t = _task_segments(k, task, part, float(slot_yaw), start, replan, hold, vias)
+        segs, plan, tries, t = _task_segments(k, task, part, place_target(pick, task), start, replan, hold,
+                                              vias)
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):
@@ -216,6 +225,17 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
         attempts.append(tuple(task_attempts))
     return PickPlan(Schedule(segments), tuple(plans), tuple(commands), tuple(closes), tuple(grasps), t,
                     tuple(widths), tuple(attempts))
+
+
+def place_target(pick: PickConfig, task: PickTaskConfig) -> tuple:
+    """(kind, index, yaw) of a task's place target: ("slot", the slot, its yaw on the tray), or
+    ("bin", the bin, the part's declared yaw: the tool keeps the yaw it grasped at, and the targets
+    read it off the part at the lift, ``targets.PickTargets``) (rad)."""
+    if task.bin:
+        yaw = next(p.yaw_deg for p in pick.parts if p.name == task.part)
+        index = [b.name for b in pick.bins].index(task.bin)
+        return "bin", index, float(np.radians(yaw)) if isinstance(yaw, (int, float)) else 0.0
+    return "slot", task.slot, float(np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg))
 
 
 def _planned_close(grasp: float, task: PickTaskConfig, speed: float) -> float:
@@ -253,6 +273,19 @@ def _closed_on_nothing(pick: PickConfig, task: PickTaskConfig, start: float) -> 
     return close, max(0.0, closed - SETTLE_BEFORE_DESCEND - approach_end)
 
 
+def _check_place(pick: PickConfig, task: PickTaskConfig, where: str) -> None:
+    """ScenarioError unless the task names exactly one place: a slot of the tray or a bin."""
+    if (task.slot is None) == (not task.bin):
+        raise ScenarioError(f"{where}.slot: give exactly one of slot (a tray slot) and bin (a bin's name)"
+                            + (f", got slot {task.slot} and bin {task.bin!r}" if task.bin else ""))
+    if task.bin and task.bin not in [b.name for b in pick.bins]:
+        raise ScenarioError(f"{where}.bin: no bin named {task.bin!r} (bins: "
+                            f"{', '.join(b.name for b in pick.bins) or 'none'})")
+    if task.slot is not None and not (isinstance(task.slot, int) and 0 <= task.slot < len(pick.tray.slots)):
+        raise ScenarioError(f"{where}.slot: {task.slot} is not a slot of the tray "
+                            f"({len(pick.tray.slots)} slots)")
+
+
 def check_tasks(pick: PickConfig) -> None:
     """ScenarioError naming the first bad field of the tasks."""
     names = [p.name for p in pick.parts]
@@ -273,9 +306,7 @@ def check_tasks(pick: PickConfig) -> None:
         where = f"pick.tasks[{k}]"
         if task.part not in names:
             raise ScenarioError(f"{where}.part: no part named {task.part!r} (parts: {', '.join(names)})")
-        if not 0 <= task.slot < len(pick.tray.slots):
-            raise ScenarioError(f"{where}.slot: {task.slot} is not a slot of the tray "
-                                f"({len(pick.tray.slots)} slots)")
+        _check_place(pick, task, where)
         for phase in (*PHASES, "backoff"):
             move = getattr(task, phase)
             if not (move.tf > 0.0 and np.isfinite(move.tf)):

@@ -23,8 +23,8 @@ from scipy.special import betaincinv
 from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.worlds.pick.camera import nominal_paths as nominal_motions
 from ptint_drake.worlds.pick.placement import nominal_parts
-from ptint_drake.worlds.pick.scene import part_shape, tray_pose
-from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan
+from ptint_drake.worlds.pick.cell import place_point
+from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan, place_target
 
 SAMPLES = 41  # samples of each segment's way
 
@@ -65,13 +65,11 @@ def nominal(scenario, arm) -> Nominal:
     pick = scenario.pick
     parts = nominal_motions(pick)
     yaws = [float(np.radians(part.yaw_deg)) for part in nominal_parts(pick.parts)]
-    X_WT = tray_pose(pick.tray)
     names = [p.name for p in pick.parts]
     places = []
     for task in pick.tasks:
-        slot = pick.tray.slots[task.slot]
-        _, height = part_shape(pick.parts[names.index(task.part)])
-        places.append(X_WT.multiply(np.array([slot.offset[0], slot.offset[1], 0.0])) + [0.0, 0.0, height / 2])
+        kind, index, _ = place_target(pick, task)
+        places.append(place_point(pick, kind, index, pick.parts[names.index(task.part)]))
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     context = arm.CreateDefaultContext()
     q0 = np.radians(scenario.robot.initial_q_deg)
@@ -87,7 +85,7 @@ def segment_target(world: Nominal, plan: PickPlan, i: int, t) -> np.ndarray:
     offset = np.asarray(seg.offset, float)
     if seg.kind in (VIA_PART, VIA_SLOT):
         return np.tile(offset, (len(t), 1))
-    if seg.kind == "slot":
+    if seg.kind in PLACES:
         return np.tile(world.places[seg.task] + offset, (len(t), 1))
     p0, v = world.parts[seg.index]
     if seg.kind == "latched":
