@@ -44,6 +44,7 @@ from pydrake.solvers import Solve
 
 from ptint_drake.systems.task.tbg import tbg_profile
 from ptint_drake.worlds.catch.flight import from_estimate, propagate
+from ptint_drake.worlds.catch.speeds import peak_ratio
 
 APPROACH_CONE_DEG = 25.0
 FLOOR_Z = 0.2
@@ -54,6 +55,7 @@ MIN_TF = 0.1  # s
 REACH = 0.5  # m: candidates farther than this from the hand's tip are not tried
 ROT_SCALE = 0.1  # m/rad: the controller's weighing of the rotation (the catch scenario's)
 SPEED_SHARE = 0.8  # of a joint's speed limit the matched velocity may take
+MATCH_STEPS = 3  # tries at a smaller m when the whole motion exceeds SPEED_SHARE
 
 
 @dataclass(frozen=True)
@@ -67,6 +69,7 @@ class Plan:
     q: np.ndarray
     tf_min: float
     match: float = 0.0
+    speed_ratio: float = 0.0
 
 
 def predict(estimate: np.ndarray, dt) -> np.ndarray:
@@ -84,8 +87,9 @@ def flight_states(estimate: np.ndarray, dt) -> np.ndarray:
 class Planner:
     """Catch plans for one arm with its hand (module docstring)."""
 
-    def __init__(self, plant, tip: str, beta: float, match: float = 0.0):
+    def __init__(self, plant, tip: str, beta: float, match: float = 0.0, match_time: float = 0.2):
         self.plant, self.frame, self.match = plant, plant.GetFrameByName(tip), float(match)
+        self.beta, self.match_time = float(beta), float(match_time)
         self.context = plant.CreateDefaultContext()
         self.v_max = plant.GetVelocityUpperLimits()[:7]
         f = np.linspace(0.0, 1.0, 401)
@@ -133,9 +137,32 @@ class Planner:
                 continue
             self._left = True
             tf = self.tf_needed(q_now, q)
-            if t_c - t_plan >= max(tf, MIN_TF):
-                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, self.matchable(q, v))
+            if t_c - t_plan < max(tf, MIN_TF):
+                continue
+            R = self.tip(q)[1]
+            fit = self.within_limits(q_now, t_plan, float(t_c), p, v, R, self.matchable(q, v))
+            if fit is not None:
+                return Plan(t_plan, float(t_c), p, R, q, tf, *fit)
         return None
+
+    def within_limits(self, q_now, t_plan: float, t_c: float, p, v, R, m: float) -> Optional[tuple]:
+        """(m', peak) for a catch at (t_c, p, v, R) from ``q_now``: the largest matched fraction
+        m' ≤ ``m`` whose whole modelled motion (``speeds.peak_ratio``) keeps every joint within
+        ``SPEED_SHARE`` of its limit, and that motion's peak; None when not even m' = 0 does."""
+        def peak(fraction: float) -> float:
+            return peak_ratio(self, q_now, t_plan, t_c, p, v, R, fraction, self.match_time, self.beta)
+        top = peak(m)
+        if top <= SPEED_SHARE:
+            return m, top
+        low = peak(0.0) if m > 0.0 else top
+        if low > SPEED_SHARE:
+            return None
+        for _ in range(MATCH_STEPS):  # the peak grows about linearly with m at the catch
+            m *= max(min((SPEED_SHARE - low) / max(top - low, 1e-9), 0.95), 0.0)
+            top = peak(m)
+            if top <= SPEED_SHARE:
+                return m, top
+        return 0.0, low
 
     def matchable(self, q, v) -> float:
         """The fraction of the ball's velocity ``v`` the hand may match at posture ``q``: the
