@@ -130,20 +130,31 @@ class Planner:
         ``q_arm``, or None (refused now); ``near``: the catch time of a plan it replaces (the
         candidates nearest it first, not the nearest points)."""
         q_now = np.asarray(q_arm, float)
-        self._left = False
-        for t_c, p, v in self.candidates(estimate, t_plan, self.tip(q_now)[0], near):
+        self._left, kept = False, []
+        for k, (t_c, p, v) in enumerate(self.candidates(estimate, t_plan, self.tip(q_now)[0], near)):
             q = self.ik(p, -v / np.linalg.norm(v), q_now)
             if q is None:
                 continue
             self._left = True
             tf = self.tf_needed(q_now, q)
-            if t_c - t_plan < max(tf, MIN_TF):
-                continue
+            if t_c - t_plan >= max(tf, MIN_TF):
+                kept.append((self.matchable(q, v) * float(np.linalg.norm(v)), k, float(t_c), p, v, q, tf))
+        return self._fastest_match(kept, q_now, t_plan)
+
+    def _fastest_match(self, kept: list, q_now: np.ndarray, t_plan: float) -> Optional[Plan]:
+        """Of the candidates ``kept`` (bound on the matched speed, order, t_c, point, velocity,
+        posture, tf), the one whose matched speed m'|v| within the limits (``within_limits``) is
+        the largest, the first in order among equals (without matching: the first that fits)."""
+        best, best_speed = None, -1.0
+        for bound, _, t_c, p, v, q, tf in sorted(kept, key=lambda c: (-c[0], c[1])):
+            if bound <= best_speed:
+                break  # m' ≤ the matched velocity's own cap: no later one can be faster
+            speed = float(np.linalg.norm(v))
             R = self.tip(q)[1]
-            fit = self.within_limits(q_now, t_plan, float(t_c), p, v, R, self.matchable(q, v))
-            if fit is not None:
-                return Plan(t_plan, float(t_c), p, R, q, tf, *fit)
-        return None
+            fit = self.within_limits(q_now, t_plan, t_c, p, v, R, bound / speed)
+            if fit is not None and fit[0] * speed > best_speed:
+                best, best_speed = Plan(t_plan, t_c, p, R, q, tf, *fit), fit[0] * speed
+        return best
 
     def within_limits(self, q_now, t_plan: float, t_c: float, p, v, R, m: float) -> Optional[tuple]:
         """(m', peak) for a catch at (t_c, p, v, R) from ``q_now``: the largest matched fraction

@@ -34,6 +34,7 @@ from ptint_drake.worlds.catch.target import _ramp
 
 STEP = 0.005  # s
 FEEDBACK = 20.0  # 1/s: the differential kinematics' pull back onto the modelled path
+REVISION = 0.04  # m: the catch point's revision the approach must leave room for (module docstring)
 
 
 def _rotvec(R: np.ndarray) -> np.ndarray:
@@ -84,6 +85,7 @@ def peak_ratio(planner, q_now: np.ndarray, t_plan: float, t_catch: float, p_c: n
                                               world)[:, :7]
         twist = np.concatenate([xi_d[k] * r0, xd_r[k] + e0 * xi_d[k]])
         J_plus = np.linalg.pinv(J)
-        worst = max(worst, float(np.max(np.abs(J_plus @ twist) / planner.v_max)))
+        revision = abs(xi_d[k]) * REVISION * np.linalg.norm(J_plus[:, 3:6], axis=1)
+        worst = max(worst, float(np.max((np.abs(J_plus @ twist) + revision) / planner.v_max)))
         q[:7] += (J_plus @ (twist + FEEDBACK * err)) * dt
     return worst
