@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ptint_drake.worlds.catch import thrower
-from ptint_drake.worlds.catch.planner import SPEED_SHARE, Planner, flight_states
+from ptint_drake.worlds.catch.planner import MATCH_MARGIN, SPEED_SHARE, Planner, flight_states
 from ptint_drake.worlds.catch.speeds import peak_ratio
 from ptint_drake.worlds.catch.station import TIP, arm_plant
 
@@ -42,5 +42,6 @@ def test_every_plan_keeps_its_modelled_joint_speeds_within_the_share():
         plan = planner.plan(truth, 0.15, Q0)
         assert plan is not None and plan.speed_ratio <= SPEED_SHARE
         v = flight_states(truth, [plan.t_catch - 0.15])[0, 3:6]
-        again = peak_ratio(planner, Q0, 0.15, plan.t_catch, plan.point, v, plan.R, plan.match, 0.2, 0.5)
+        again = peak_ratio(planner, Q0, 0.15, plan.t_catch, plan.point, v, plan.R, MATCH_MARGIN * plan.match,
+                           0.2, 0.5, plan.q)
         assert abs(again - plan.speed_ratio) < 0.05
