@@ -38,6 +38,8 @@ def row(seed: int, params: dict, metrics: dict) -> dict:
             "error_at_catch_mm": None if err is None else 1e3 * err,
             "peak_contact_force_n": c.get("peak_contact_force_n"),
             "impact_force_n": c.get("impact_force_n"), "impact_speed_m_s": c.get("impact_speed_m_s"),
+            "ball_speed_at_impact_m_s": c.get("ball_speed_at_impact_m_s"),
+            "match_bound": c.get("match_bound"),
             "joint_speed_ratio_max": c.get("joint_speed_ratio_max"),
             "plans": len(c.get("plans", [])),
             "realtime_factor": metrics["sim"]["realtime_factor"], "warnings": metrics.get("warnings", [])}
@@ -47,7 +49,8 @@ def summary(rows: list) -> dict:
     """Catch rate, the oracle's reachable rate, the rate over the reachable throws, failures by
     reason (the outcome's name; an error run as ``error``), the median error, the medians over the
     caught throws of the largest force on the ball, of the impact force and of the ball's speed
-    relative to the hand at the impact (``outcome.BallContacts``, ``run.CatchRun``), and the
+    relative to the hand at the impact (``outcome.BallContacts``, ``run.CatchRun``) and of the
+    matched fraction the joints' limits allow there (``Planner.match_bound``), and the
     largest joint speed of any run over its limit."""
     n = len(rows)
     caught = [r for r in rows if r.get("outcome") == "caught"]
@@ -57,6 +60,7 @@ def summary(rows: list) -> dict:
     forces = sorted(r["peak_contact_force_n"] for r in caught if r.get("peak_contact_force_n") is not None)
     impacts = sorted(r["impact_force_n"] for r in caught if r.get("impact_force_n") is not None)
     speeds_in = sorted(r["impact_speed_m_s"] for r in caught if r.get("impact_speed_m_s") is not None)
+    bounds = sorted(r["match_bound"] for r in caught if r.get("match_bound") is not None)
     speeds = [r["joint_speed_ratio_max"] for r in rows if r.get("joint_speed_ratio_max") is not None]
     return {"catch": {
         "throws": n, "caught": len(caught), "catch_rate": len(caught) / n if n else None,
@@ -69,4 +73,5 @@ def summary(rows: list) -> dict:
         "peak_force_caught_n_median": forces[len(forces) // 2] if forces else None,
         "impact_force_caught_n_median": impacts[len(impacts) // 2] if impacts else None,
         "impact_speed_caught_m_s_median": speeds_in[len(speeds_in) // 2] if speeds_in else None,
+        "match_bound_caught_median": bounds[len(bounds) // 2] if bounds else None,
         "joint_speed_ratio_max": max(speeds) if speeds else None}}

@@ -207,17 +207,22 @@ class CatchRun(WorldRun):
     def _impact(self, t: np.ndarray, x: np.ndarray) -> dict:
         """The impact (``BallContacts``): its force along the palm's normal, and the ball's speed
         and its speed relative to the fingertip centre at the last logged sample before the palm
-        first touched it (what the velocity matching lowers).  None when the palm was not touched."""
+        first touched it (what the velocity matching lowers), and the largest fraction of the
+        ball's velocity the hand could have had there at the full joint speed limits
+        (``Planner.match_bound``).  None when the palm was not touched."""
         if "axis" not in self.impact:
-            return {"impact_force_n": None, "impact_speed_m_s": None, "ball_speed_at_impact_m_s": None}
+            return {"impact_force_n": None, "impact_speed_m_s": None, "ball_speed_at_impact_m_s": None,
+                    "match_bound": None}
         plant = self.station.plant
         context = plant.CreateDefaultContext()
-        plant.SetPositionsAndVelocities(context, x[max(int(np.searchsorted(t, self.impact["time"])) - 1, 0)])
+        i = max(int(np.searchsorted(t, self.impact["time"])) - 1, 0)
+        plant.SetPositionsAndVelocities(context, x[i])
         tip = plant.GetFrameByName(TIP).CalcSpatialVelocity(context, plant.world_frame(), plant.world_frame())
         ball = self.station.ball.EvalSpatialVelocityInWorld(context).translational()
         return {"impact_force_n": self.impact["peak"],
                 "impact_speed_m_s": float(np.linalg.norm(ball - tip.translational())),
-                "ball_speed_at_impact_m_s": float(np.linalg.norm(ball))}
+                "ball_speed_at_impact_m_s": float(np.linalg.norm(ball)),
+                "match_bound": self.planner.match_bound(x[i, :7], ball)}
 
     def _joint_speeds(self, x: np.ndarray) -> dict:
         """The arm's largest joint speed over the run as a fraction of its limit, and that joint
