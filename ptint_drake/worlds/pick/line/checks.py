@@ -26,7 +26,7 @@ from ptint_drake.worlds.pick.line.driver import cycle_time
 from ptint_drake.worlds.pick.line.plan import line_plan
 
 __all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
-from ptint_drake.worlds.pick.scene import AddGripper, gripper_stroke, slot_pose
+from ptint_drake.worlds.pick.scene import BIN_DROP_CLEARANCE, AddGripper, gripper_stroke, slot_pose
 
 
 def stroke_of(gripper) -> float:
@@ -50,8 +50,16 @@ def check_line_scenario(scenario) -> None:
     arm = nominal_plant(scenario)
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     guess = np.radians(scenario.robot.initial_q_deg)
+    bins = {b.name: (j, b) for j, b in enumerate(pick.bins)}
     for kind in pick.line.catalog:
         height = kind.size[2] if kind.shape == "box" else kind.size[1]
+        if kind.bin:
+            j, box = bins[kind.bin]
+            x = np.asarray(box.center, dtype=float) + [0.0, 0.0, box.size[2] + BIN_DROP_CLEARANCE
+                                                       + height / 2]
+            if inverse_kinematics(arm, frame, x, guess, down=True) is None:
+                raise ScenarioError(f"pick.bins[{j}] (its center and depth): {np.round(x, 3).tolist()} m is "
+                                    f"outside what the arm reaches from above")
         for j in kind.slots:
             x = slot_pose(pick.tray, j).translation() + [0.0, 0.0, height / 2]
             for where in (x, x + [0.0, 0.0, task.lift_height]):

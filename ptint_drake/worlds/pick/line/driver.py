@@ -215,7 +215,8 @@ class LineDriver:
         keep = [k for k in range(len(tasks)) if k != replacing]
         assigned = {self.committed[k][0] for k in keep}
         used = {tasks[k].slot for k in keep}
-        free = {c.name: [j for j in c.slots if j not in used] for c in self.line.catalog}
+        free = {c.name: [c.bin] if c.bin else [j for j in c.slots if j not in used]
+                for c in self.line.catalog}
         decision = decide(t, tracks, windows, assigned, free, self.timing)
         if decision.track is not None:
             station = self.built.station
@@ -242,7 +243,7 @@ class LineDriver:
         name = self.built.station.config.parts[decision.track].name
         if replacing is None:
             start = max(t, decision.grasp - self.timing.lead)
-            task = PickTaskConfig(part=name, slot=decision.slot, start=start)
+            task = PickTaskConfig(part=name, start=start, **_destination(decision.slot))
             tasks.append(task)
             run.replans.append(Replan())
             run.checks.append([])
@@ -250,8 +251,13 @@ class LineDriver:
             k = len(tasks) - 1
         else:
             tf = decision.grasp - default.descend.tf - t
-            task = PickTaskConfig(part=name, slot=decision.slot, start=t,
+            task = PickTaskConfig(part=name, start=t, **_destination(decision.slot),
                                   approach=MoveConfig(tf, default.approach.beta))
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
         self.committed[k] = [decision.track, decision.grasp, decision.point]
+
+
+def _destination(where) -> dict:
+    """A decision's destination as a task's fields: a tray slot (an index) or a bin (its name)."""
+    return {"bin": where} if isinstance(where, str) else {"slot": where}
