@@ -30,7 +30,9 @@ With the rgbd camera (``seen``) the parts are counted by what the camera could s
   the nearest simulated part, from the probe's log): ``idsw`` (must be 0), the tracks of each
   part, the parts of each track; the scheduler's skips of a part are those of its tracks;
 - per part ``seen``: the stamp of the first frame a track took a fit of it (the pose sensor's
-  line: its release, the sensor reports it from then on; never: None).
+  line: its release, the sensor reports it from then on; never: None);
+- ``classes``: the catalog's kinds in order (name, height): what a track's class (the tracks log's
+  column, ``track_system``) is, for the replay's markers.
 """
 
 from __future__ import annotations
@@ -151,6 +153,8 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
             "passed": len(truth.passed), "parts": parts, "decisions": driver.decisions,
             "replaced": jumps, "largest_torque_step_elsewhere_Nm": usual,
             "not_seen": sum(p["reason"] == "not seen" for p in parts),
+            "classes": [{"name": c.name, "height": float(part_shape(c)[1])}
+                        for c in scenario.pick.line.catalog],
             "idsw": tracking["idsw"] if camera else None,
             "tracking": tracking or "pose sensor: identities are the sensor's (no association, no IDSW)"}
 
