@@ -2,8 +2,9 @@
 (``worlds.pick.line.seen.LineSeenParts``, its tracker state input fixed): a task's slot reads the
 track it is aimed at, moved along its belt at the filter's speed along it, at the class's height,
 turned by the mean of its fitted yaws (unwrapped by the class's symmetry); an unaimed slot reads
-nothing; a track that ended keeps its last row, extrapolated; and the plan's model holds tracked
-parts at their tasks' slots or at free ones (``view.LineView.slots_of``)."""
+nothing; a track that ended keeps its last row, extrapolated; the plan's model holds tracked
+parts at their tasks' slots or at free ones (``view.LineView.slots_of``); and the timeline marks
+a line part seen when the line saw it."""
 
 import math
 
@@ -16,6 +17,7 @@ from ptint_drake.systems.perception.tracks import Detection, Tracker
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
 from ptint_drake.worlds.pick.line.seen import LineSeenParts, line_perception
 from ptint_drake.worlds.pick.line.view import LineView
+from ptint_drake.worlds.pick.timeline import part_timelines
 
 PERIOD = 1.0 / 30.0
 CUBE, DISC = 0, 1  # line_two_belts' catalog
@@ -95,3 +97,11 @@ def test_the_plan_holds_aimed_tracks_at_their_tasks_slots_and_others_at_free_one
     assert sorted([slots[3], slots[9]]) == [n - 2, n - 1]  # free slots, from the last one down
     pose = LineView(load_scenario("line_two_belts"))  # the pose sensor: its ids are the slots
     assert pose.slots_of([4, 1]) == {4: 4, 1: 1}
+
+
+def test_a_line_part_is_on_the_timeline_when_the_line_saw_it():
+    # the line's own ``seen`` (the camera's first fit; the pose line's release), not 0 for every part
+    metrics = {"picks": [], "segments": [], "line": {"parts": [{"seen": 9.87}, {"seen": None}]}}
+    for camera in (True, False):
+        lines = part_timelines(["cube_0", "disc_1"], {}, metrics, camera)
+        assert [line.seen for line in lines] == [9.87, None]
