@@ -105,3 +105,18 @@ def test_a_line_part_is_on_the_timeline_when_the_line_saw_it():
     for camera in (True, False):
         lines = part_timelines(["cube_0", "disc_1"], {}, metrics, camera)
         assert [line.seen for line in lines] == [9.87, None]
+
+
+def test_a_slot_aimed_between_frames_reads_its_track_at_once():
+    config, system = _system()
+    tracker = Tracker(config.tracking)
+    states = _frames(tracker, 5, [0.3])
+    (track,) = tracker.tracks
+    system.aim({1: track.id})
+    context = system.CreateDefaultContext()  # no frame copied yet: the rows are empty
+    system.get_input_port().FixValue(context, states[-1])
+    context.SetTime(4 * PERIOD)
+    pose = system.GetOutputPort("part_1_pose").Eval(context)
+    assert pose[0:3] == pytest.approx([0.30, -0.40 + 0.1 * 4 * PERIOD, 0.15], abs=1e-3)
+    R = system.GetOutputPort("part_1_rotation").Eval(context)[0:9].reshape(3, 3)
+    assert math.atan2(R[1, 0], R[0, 0]) == pytest.approx(0.3, abs=1e-6)

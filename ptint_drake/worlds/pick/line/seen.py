@@ -20,8 +20,9 @@ diagram it rebuilds is run): the filter's centre moved along its belt at the fil
 along it (the conveyor's constraint: the height is the belt's top plus half the class's height,
 no vertical motion), turned by the mean yaw.  The rows are copied at every frame's time from the
 tracker as of the previous frame (one period behind: the frame's processing), so a track that
-ends (it left the view, or coasted too long) keeps its last row, extrapolated.  A slot no track
-is aimed at reads zeros.
+ends (it left the view, or coasted too long) keeps its last row, extrapolated; a slot aimed since
+the last frame (a task decided between frames) reads its track from the tracker directly until
+then.  A slot no track is aimed at reads zeros.
 """
 
 from __future__ import annotations
@@ -84,11 +85,12 @@ class LineSeenParts(LeafSystem):
         self._yaws = self.DeclareDiscreteState(np.zeros(MAX_TRACKS * YAWS))
         self._rows = self.DeclareDiscreteState(np.zeros(slots * SLOT))
         self.DeclarePeriodicUnrestrictedUpdateEvent(1.0 / config.rate_hz, 0.0, self._update)
+        reads = {self.xd_ticket(), self.all_input_ports_ticket()}
         for k in range(slots):
             self.DeclareVectorOutputPort(f"part_{k}_pose", 9, self._pose_calc(k),
-                                         prerequisites_of_calc={self.time_ticket(), self.xd_ticket()})
+                                         prerequisites_of_calc=reads | {self.time_ticket()})
             self.DeclareVectorOutputPort(f"part_{k}_rotation", 15, self._rotation_calc(k),
-                                         prerequisites_of_calc={self.xd_ticket()})
+                                         prerequisites_of_calc=reads)
 
     def aim(self, aims: dict) -> None:
         """{slot: track id}: what each task's slot reads (set before a context of this system is made)."""
@@ -133,8 +135,15 @@ class LineSeenParts(LeafSystem):
         state.get_mutable_discrete_state(self._rows).SetFromVector(rows.ravel())
 
     def _row(self, context, k: int):
+        """Slot k's row: as copied at the last frame, or — aimed since (a new task, before the next
+        frame) — the aimed track as the tracker has it now; None: nothing aimed, or its track gone."""
         row = context.get_discrete_state(self._rows).value()[k * SLOT:(k + 1) * SLOT]
-        return row if row[0] > 0 and row[0] == self._aims[k] else None
+        if self._aims[k] == 0 or (row[0] > 0 and row[0] == self._aims[k]):
+            return row if self._aims[k] else None
+        tr = next((tr for tr in self.tracker(context).tracks if tr.id == self._aims[k]), None)
+        if tr is None:
+            return None
+        return np.array([tr.id, tr.t, *tr.x, tr.belt, self.mean_yaws(context).get(tr.id, tr.yaw), tr.kind])
 
     def _pose_calc(self, k: int):
         def calc(context, output):
