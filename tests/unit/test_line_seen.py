@@ -4,7 +4,7 @@ track it is aimed at, moved along its belt at the filter's speed along it, at th
 turned by the mean of its fitted yaws (unwrapped by the class's symmetry); an unaimed slot reads
 nothing; a track that ended keeps its last row, extrapolated; the plan's model holds tracked
 parts at their tasks' slots or at free ones (``view.LineView.slots_of``); and the timeline marks
-a line part seen when the line saw it."""
+a line part seen when the line saw it; an identity switch is in the verdict."""
 
 import math
 
@@ -15,6 +15,7 @@ from pydrake.systems.analysis import Simulator
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.systems.perception.tracks import Detection, Tracker
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.metrics import line_reasons
 from ptint_drake.worlds.pick.line.seen import LineSeenParts, line_perception
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.timeline import part_timelines
@@ -120,3 +121,10 @@ def test_a_slot_aimed_between_frames_reads_its_track_at_once():
     assert pose[0:3] == pytest.approx([0.30, -0.40 + 0.1 * 4 * PERIOD, 0.15], abs=1e-3)
     R = system.GetOutputPort("part_1_rotation").Eval(context)[0:9].reshape(3, 3)
     assert math.atan2(R[1, 0], R[0, 0]) == pytest.approx(0.3, abs=1e-6)
+
+
+def test_an_identity_switch_is_in_the_verdict():
+    part = {"part": "cube_0", "entered": True, "placed": True, "reason": None}
+    assert line_reasons({"parts": [part], "idsw": 0}) == []
+    (reason,) = line_reasons({"parts": [part], "idsw": 2})
+    assert reason.code == "identity switch" and "2 identity switches" in reason.message

@@ -161,6 +161,9 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
 
 def line_reasons(line: dict) -> list[Reason]:
     """The verdict's reasons: every part that entered and was not placed, and every part not seen,
-    with its reason."""
-    return [Reason(None, p["reason"], f"{p['part']}: {p['reason']}") for p in line["parts"]
-            if (p["entered"] or p["reason"] == "not seen") and not p["placed"]]
+    with its reason; with the camera, identity switches (``idsw`` > 0)."""
+    reasons = [Reason(None, p["reason"], f"{p['part']}: {p['reason']}") for p in line["parts"]
+               if (p["entered"] or p["reason"] == "not seen") and not p["placed"]]
+    if line.get("idsw"):  # the camera's tracks: a part's fits went to another track (must be 0)
+        reasons.append(Reason(None, "identity switch", f"tracking: {line['idsw']} identity switches"))
+    return reasons
