@@ -4,14 +4,18 @@ track it is aimed at, moved along its belt at the filter's speed along it, at th
 turned by the mean of its fitted yaws (unwrapped by the class's symmetry); an unaimed slot reads
 nothing; a track that ended keeps its last row, extrapolated; the plan's model holds tracked
 parts at their tasks' slots or at free ones (``view.LineView.slots_of``); and the timeline marks
-a line part seen when the line saw it; an identity switch is in the verdict."""
+a line part seen when the line saw it; an identity switch is in the verdict; the line's camera
+tells a cube from a disc of the same width."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
+from static_scene import StaticScene
 
+from ptint_drake.config.measurement import BeltRegionConfig
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.systems.perception.tracks import Detection, Tracker
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
@@ -128,3 +132,20 @@ def test_an_identity_switch_is_in_the_verdict():
     assert line_reasons({"parts": [part], "idsw": 0}) == []
     (reason,) = line_reasons({"parts": [part], "idsw": 2})
     assert reason.code == "identity switch" and "2 identity switches" in reason.message
+
+
+@pytest.mark.parametrize("kind", [CUBE, DISC])
+def test_the_line_camera_tells_a_cube_from_a_disc_of_one_width(kind):
+    # rendered by line_two_belts_rgbd's camera: a 30 mm cube at yaw 0 (its square top and a disc's
+    # round one have the same smallest rectangle; by the size alone 5 of 16 frames called it a disc)
+    camera = load_scenario("line_two_belts_rgbd").measurement.camera
+    config = line_perception(load_scenario("line_two_belts_rgbd"))
+    shape, size = config.catalog[kind]
+    belts = [BeltRegionConfig(center=list(b.center), direction=list(b.direction), length=float(b.length),
+                              width=float(b.width)) for b in config.belts]
+    camera = replace(camera, part_shape=shape, part_size=size, belts=belts)
+    for y in (-0.25, -0.1, 0.05):
+        scene = StaticScene(camera, [([0.30, y, 0.15], 0.0)], check_above=True)
+        scene.estimator._c.catalog = config.catalog  # the line's catalog: cube, disc
+        kinds = [[f.kind for f in scene.fits(k / 30.0)[0] if f.ok] for k in range(6)]
+        assert kinds == [[kind]] * 6, (y, kinds)

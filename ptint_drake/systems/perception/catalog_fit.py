@@ -27,11 +27,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
-from ptint_drake.systems.perception.part_fit import (MIN_POINTS, BeltRegion, PartFit, _split, _top_face,
-                                                     clusters, fit_part, in_band, min_area_rectangle,
-                                                     nearest_belt, part_height)
+from ptint_drake.systems.perception.part_fit import (MIN_POINTS, BeltRegion, PartFit, _hull, _split,
+                                                     _top_face, clusters, fit_part, in_band,
+                                                     min_area_rectangle, nearest_belt, part_height)
 
 HEIGHT_TOLERANCE = 0.004  # m, measured (top face over its belt) vs the class's height
 FILL = {"box": 1.0, "cylinder": math.pi / 4.0}  # a top face's area over its smallest rectangle's
@@ -47,12 +46,16 @@ def catalog_points(points: np.ndarray, belts: list[BeltRegion], catalog: list) -
 
 
 def fill_ratio(points: np.ndarray) -> float:
-    """The top face's convex hull area over its smallest rectangle's (module docstring; nan: none)."""
+    """The top face's convex hull area over its smallest rectangle's (module docstring; nan: none).
+    One hull of the face's points; the area (shoelace) and the rectangle from its vertices."""
     xy = _top_face(points)[:, 0:2]
-    rect = min_area_rectangle(xy) if len(xy) >= 3 else None
+    hull = _hull(xy) if len(xy) >= 3 else None
+    rect = min_area_rectangle(hull) if hull is not None and len(hull) >= 3 else None
     if rect is None or rect[2] * rect[3] <= 0.0:
         return math.nan
-    return float(ConvexHull(xy).volume / (rect[2] * rect[3]))
+    x, y = hull[:, 0], hull[:, 1]
+    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    return area / (rect[2] * rect[3])
 
 
 def classified_fit(points: np.ndarray, belts: list[BeltRegion], catalog: list, **fit) -> PartFit:
