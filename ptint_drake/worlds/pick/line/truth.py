@@ -131,9 +131,9 @@ class LineTruth:
     def part_under(self, context, position) -> int:
         """The released part (not taken off) whose centre is nearest ``position`` (m, world): the
         pool part a camera track's task picks, by the truth — the metrics' name for the task (its
-        targets read the track, never this)."""
+        targets read the track, never this); none on the line (a track of nothing): of all."""
         pc = self.station.plant.GetMyContextFromRoot(context)
-        live = [k for k in self.released if k not in self.passed]
+        live = [k for k in self.released if k not in self.passed] or list(range(len(self.station.parts)))
         far = [np.linalg.norm(self.station.plant.EvalBodyPoseInWorld(pc, self.station.parts[k]).translation()
                               - np.asarray(position)) for k in live]
         return live[int(np.argmin(far))]
