@@ -70,8 +70,9 @@ def line_perception(scenario) -> PerceptionConfig:
 
 class LineSeenParts(LeafSystem):
     """Input ``tracker_state`` (``tracks.Tracker.state_vector``); outputs ``part_k_pose`` (9) and
-    ``part_k_rotation`` (15) per pool slot k (module docstring).  ``heights``: per class the
-    centre's height over the belt; ``belts``: per perceived belt (top height, unit direction)."""
+    ``part_k_rotation`` (15) per pool slot k (module docstring); ``config``: the line's perception
+    (its classes give the centres' heights over the belt, its belts their tops and directions),
+    ``slots``: the pool's size."""
 
     def __init__(self, config: PerceptionConfig, slots: int):
         super().__init__()
