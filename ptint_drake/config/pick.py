@@ -12,6 +12,8 @@ task becomes six prescribed-time segments (``worlds.pick.tasks`` has the plan).
 from dataclasses import dataclass, field
 from typing import List, Optional, Union
 
+from ptint_drake.config.line import LineConfig
+
 
 @dataclass
 class GripperConfig:
@@ -172,5 +174,7 @@ class PickConfig:
     # "closed on nothing" is reproducible (e.g. 0.3: the arm holds its pre-grasp pose until the
     # fingers have closed above the part, ``pick.tasks._closed_on_nothing``; negative: later, a late grasp)
     test_close_advance_s: float = 0.0
+    # a line that runs itself (issue 44, ``config.line``): parts arrive, the arm decides; None: the tasks
+    line: Optional[LineConfig] = None
 
 

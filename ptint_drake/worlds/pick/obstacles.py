@@ -177,7 +177,8 @@ def way_hit(scene: PlanningScene, world: Nominal, plan: PickPlan, i: int) -> Hit
     length = float(np.sum(np.linalg.norm(np.diff(coarse, axis=0), axis=1)))
     tau = np.linspace(0.0, s.tf, max(11, int(np.ceil(2.0 * length / STEP)) + 1))
     way = segment_way(world, plan, i, tau)
-    held = seg.index if seg.phase == "carry" else None
+    # the part a carry holds: its task's (a carry segment's own index is its slot)
+    held = plan.segments[plan.segment_index(seg.task, "approach")].index if seg.phase == "carry" else None
     key = (seg.task, "carry" if seg.phase == "carry" or seg.kind == VIA_SLOT else "approach")
     worst = None
     target = seg.index if seg.phase == "approach" else None  # the part the fingers come down around

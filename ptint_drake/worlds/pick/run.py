@@ -32,6 +32,7 @@ from ptint_drake.systems.hand.gripper import GraspObserver
 from ptint_drake.systems.task.kinematics import FrameKinematics
 from ptint_drake.worlds.pick.camera import AddPartEstimates, PartEstimates
 from ptint_drake.worlds.pick.cell import PROBE_PERIOD, REPLAY_PERIOD, place_positions, world_config
+from ptint_drake.worlds.pick.line.plan import line_plan
 from ptint_drake.worlds.pick.probe import PickProbe
 from ptint_drake.worlds.pick.route import routed_plan
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
@@ -65,13 +66,16 @@ class PickBuilt:
         return self.diagram.GetSubsystemByName("tracked_parts")
 
 
-def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = ()) -> PickBuilt:
-    """The pick scenario's diagram (module docstring), its plan with the ``replans`` a run decided."""
+def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = (), planning=None) -> PickBuilt:
+    """The pick scenario's diagram (module docstring), its plan with the ``replans`` a run decided;
+    ``planning``: a line's plan is made from it, the scenario as the controller side believes it
+    (``line.driver.LineDriver.planning``: the tracked parts where they are seen)."""
     builder = DiagramBuilder()
     station = MakePickStation(world_config(scenario), scenario.measurement)
     st = builder.AddNamedSystem("pick_station", station.diagram)
     arm = nominal_plant(scenario)
-    plan = routed_plan(scenario, replans, arm)  # the way around the base where one is needed (route)
+    # the way around the base where one is needed (route); a line's begins with its idle segment
+    plan = (line_plan if scenario.pick.line is not None else routed_plan)(planning or scenario, replans, arm)
     n = len(station.parts)
     places = place_positions(station.config, plan)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, places))

@@ -21,6 +21,9 @@ diagram (the controller's schedule is built into it): ``replan`` builds it and `
 carries the numeric state (time, plant, controller, drive, observer, targets) into its
 context; the runner goes on from there.  If the retries push
 the plan's end later, the run is lengthened by as much (metrics ``duration``).
+
+A line (``pick.line``, issue 44): ``line.driver`` makes its pool of parts, acts for the truth side
+and decides its tasks at the stops (``NoLine``, without a line: the same hooks, doing nothing).
 """
 
 from __future__ import annotations
@@ -47,6 +50,9 @@ from ptint_drake.worlds.pick.config import (DEFAULT_APPROXIMATION, SCENARIO_PLAN
                                             check_plant_settings)
 from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.grasp_gate import grasp_refusal
+from ptint_drake.worlds.pick.line.checks import check_line_scenario, line_plan, line_warnings
+from ptint_drake.worlds.pick.line.driver import LineDriver, NoLine, view_scenario
+from ptint_drake.worlds.pick.line.metrics import line_reasons
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.route import routed_plan
@@ -67,8 +73,11 @@ class PickRun(WorldRun):
 
     def __init__(self, scenario: Scenario):
         check_pick_plant(scenario)
-        self.scenario = scenario
+        # a line (issue 44): its pool of parts and the decisions it makes (``line.driver``)
+        self.line = LineDriver(scenario) if scenario.pick.line is not None else NoLine(scenario)
+        self.scenario = scenario = self.line.scenario
         self.built = build_pick(scenario)
+        self.line.bind(self.built)
         self.diagram, self.controller = self.built.diagram, self.built.controller
         self.simulator_config = pick_simulator(scenario)
         self.plant_time_step = self.built.station.config.time_step
@@ -80,11 +89,13 @@ class PickRun(WorldRun):
         self.refused: list = [None] * n  # why a retry was not planned (out of reach / of retries)
         self.estimates: dict = {}  # with a camera, per task: the estimate at the grasp and the truth
         self.end = scenario.duration
-        self._tail = scenario.duration - self.built.plan.end  # kept after a lengthened plan
+        self._tail = 0.0 if self.line.active else scenario.duration - self.built.plan.end  # (a line's end)
         self._pieces: list = []  # the logs of the diagrams a replan replaced
         self._rebuilt = False
 
     def pre_run_warnings(self) -> list[str]:
+        if self.line.active:
+            return sampled_control_warnings(self.scenario) + line_warnings(self.scenario)
         check_pick_reachable(self.scenario, self.built)
         check_pick_clearance(self.scenario, self.built)  # the fingers clear of the belts
         return (sampled_control_warnings(self.scenario) + arm_warnings(self.scenario, self.built)
@@ -95,6 +106,7 @@ class PickRun(WorldRun):
         plant_context = station.plant.GetMyMutableContextFromRoot(context)
         scale_in_context(station.plant, plant_context, station.arm, self.scenario.plant.mass_scale)
         station.start_running(plant_context)
+        self.line.start(context)
 
     def _sense_times(self, k: int) -> list[float]:
         """The reads of task k's grasp state between its last close command and its check (on the
@@ -113,6 +125,7 @@ class PickRun(WorldRun):
             stops.update(self._sense_times(k))
         for seg in plan.schedule.segments:
             stops.update({seg.start, seg.end})
+        stops.update(self.line.stops(duration))
         return sorted(t for t in stops if 0.0 <= t <= duration)
 
     def at_stop(self, context, t: float) -> None:
@@ -130,6 +143,7 @@ class PickRun(WorldRun):
                 state = self._grasp_state(context)
                 if not plan_stands(state, "sense"):  # nothing between the fingers: no need to wait
                     self._check(context, k, t, state)
+        self._rebuilt |= self.line.at_stop(self, context, t)  # a line's decision: a new task
 
     def _unseen(self, context, k: int, t: float) -> bool:
         """With a camera, at task k's descend start: if the part was never seen — or fitted fewer
@@ -221,8 +235,9 @@ class PickRun(WorldRun):
             return False
         self._rebuilt = False
         self._pieces.append(pick_logs(self.built, context))  # the old diagram's loggers, up to now
-        self.built = build_pick(self.scenario, tuple(self.replans))
+        self.built = build_pick(self.scenario, tuple(self.replans), self.line.planning())
         self.diagram, self.controller = self.built.diagram, self.built.controller
+        self.line.bind(self.built)
         self.end = max(self.scenario.duration, self.built.plan.end + self._tail)
         return True
 
@@ -245,6 +260,7 @@ class PickRun(WorldRun):
             value = targets.latch_value(tc)
             if value is not None:  # the backoff's latch, before the controller captures its start
                 tc.SetDiscreteState(0, value)
+        self.line.restore(new_context)  # a line's parked parts' locks and belt drives (parameters)
 
     def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
         built = self.built
@@ -262,6 +278,7 @@ class PickRun(WorldRun):
         metrics |= drive_metrics(built.plan.schedule, series["t"], series["tau"], series["tau_applied"],
                                  series["v"], built.limits)
         runaway_metrics(built, metrics, series)  # per pick: saturated, joint speed beyond limit
+        self.line.add_metrics(metrics, series)  # a line's ``line`` (``line.metrics``)
         return metrics, series, joint_limit_warnings(built.arm, series)
 
     def sim_info(self, integrator) -> dict:
@@ -287,6 +304,9 @@ class PickWorld(World):
         if s.measurement is not None and s.measurement.sensor != "rgbd":
             raise ScenarioError("measurement.sensor: a pick scenario sees its parts through an rgbd camera "
                                 "(sensor: rgbd) or aims at their simulated poses (leave measurement out)")
+        if s.pick.line is not None:  # a line: its own checks (no parts, no tasks: it makes them)
+            check_line_scenario(s)
+            return
         check_placement(s.pick, s.measurement)  # random placement needs the camera
         if s.controller.task != "top_down":
             raise ScenarioError(f"controller.task: a pick grasps from above: top_down, "
@@ -306,12 +326,15 @@ class PickWorld(World):
             raise ScenarioError(f"duration: {s.duration:g} s ends before the pick tasks do ({end:.3g} s)")
 
     def schedule(self, scenario: Scenario):
-        return routed_plan(scenario).schedule  # with its vias (route), as the run's
+        # with its vias (route), as the run's; a line's: its idle segment (the run decides the rest)
+        return (line_plan if scenario.pick.line is not None else routed_plan)(scenario).schedule
 
     def prepare(self, scenario: Scenario, log: bool = True) -> PickRun:
         return PickRun(scenario)
 
     def reasons(self, metrics: dict, criteria) -> list[Reason]:
+        if "line" in metrics:  # a line: per part that entered and was not placed (``line.metrics``)
+            return line_reasons(metrics["line"])
         return [Reason(None, code, f"pick {k}: {code}") for k, code in pick_reasons(metrics["picks"])]
 
     def figure_files(self, scenario: Scenario) -> list[str]:
@@ -322,7 +345,7 @@ class PickWorld(World):
         camera = figures and _has_camera(scenario)  # the estimates' figure and the camera's frames
         names = [n for n, on in (("pick_replay", replay), ("picks", figures), ("timeline", figures),
                                  ("estimates", camera), ("camera_frames", camera)) if on]
-        text = dump_yaml(scenario)  # picklable, for a worker process
+        text = dump_yaml(view_scenario(scenario))  # picklable, for a worker process (a line's: its pool)
         return [(n, series, metrics, stage, scenario.name, (text,)) for n in names]
 
     def draw_view(self, name: str, series: dict, metrics: dict, stage: Path, title: str, args: tuple) -> str:

@@ -1,0 +1,99 @@
+"""The arrival process of a line (``config.line.ArrivalConfig``) and the pool of parts it makes.
+
+Drake adds no body to a finalized plant, so the arrivals are drawn before the station is built:
+per arrival block ``k`` a generator seeded by (``line.seed``, k) draws the release times over
+[``start``, duration − ``until``) and, per release, the kind (by the ``mix`` weights), the lateral
+offset and the yaw (uniform in their [min, max]).  Each release becomes an ordinary
+``PartConfig`` (named ``<kind>_<n>``, n in release order over the whole line), so the station,
+the tracker, the metrics and the views take the pool as any list of parts; its ``offset`` is the
+release point on its belt.  The truth side parks every part until its release (``truth``).
+
+The process (a choice the issue leaves open): ``poisson`` is a Poisson process with a dead time
+— gaps ``min_gap`` + Exp(1/rate − ``min_gap``), so the mean gap stays 1/rate while no two parts
+are put on the belt closer than ``min_gap`` × speed (a real feeder's singulation); ``jittered``
+is a period of 1/rate, each gap × (1 ± ``jitter``) uniformly, at least ``min_gap``.  Rates are per
+second, not spacings: a faster belt spreads the same parts farther apart.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+import numpy as np
+
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.line import ArrivalConfig, LineConfig
+from ptint_drake.config.pick import PartConfig
+
+
+@dataclass(frozen=True)
+class Release:
+    """Pool part ``part`` (index in the expanded ``pick.parts``) is put on ``belt`` at ``t`` (s)."""
+
+    part: int
+    t: float
+    belt: str
+    kind: str
+
+
+def release_times(arrival: ArrivalConfig, end: float, rng: np.random.Generator) -> list[float]:
+    """The release times of one arrival block in [start, end) (module docstring)."""
+    mean = 1.0 / arrival.rate
+    if arrival.process == "poisson" and mean <= arrival.min_gap:
+        raise ScenarioError(f"pick.line.arrivals: rate {arrival.rate}/s leaves no time beyond min_gap "
+                            f"{arrival.min_gap} s between parts")
+    times, t = [], arrival.start
+    if arrival.process == "poisson":
+        t += rng.exponential(mean - arrival.min_gap)
+    while t < end:
+        times.append(float(t))
+        if arrival.process == "poisson":
+            gap = arrival.min_gap + rng.exponential(mean - arrival.min_gap)
+        else:
+            gap = max(arrival.min_gap, mean * (1.0 + rng.uniform(-arrival.jitter, arrival.jitter)))
+        t += gap
+    return times
+
+
+def _kinds(line: LineConfig, arrival: ArrivalConfig) -> tuple[list, np.ndarray]:
+    names = [c.name for c in line.catalog]
+    weights = np.array([arrival.mix.get(n, 0.0) if arrival.mix else 1.0 for n in names], dtype=float)
+    if not weights.sum() > 0.0:
+        raise ScenarioError("pick.line.arrivals: mix: the weights sum to 0")
+    return names, weights / weights.sum()
+
+
+def line_pool(line: LineConfig, duration: float) -> tuple[list[PartConfig], list[Release]]:
+    """The pool of parts (release order) and their releases of ``line`` over ``duration``."""
+    drawn = []
+    catalog = {c.name: c for c in line.catalog}
+    for k, arrival in enumerate(line.arrivals):
+        rng = np.random.default_rng([line.seed, k])
+        names, weights = _kinds(line, arrival)
+        for t in release_times(arrival, duration - arrival.until, rng):
+            kind = names[int(rng.choice(len(names), p=weights))]
+            lateral = float(rng.uniform(*arrival.lateral))
+            yaw = float(rng.uniform(*arrival.yaw_deg))
+            drawn.append((t, k, kind, lateral, yaw))
+    drawn.sort()
+    parts, releases = [], []
+    for n, (t, k, kind, lateral, yaw) in enumerate(drawn):
+        c, arrival = catalog[kind], line.arrivals[k]
+        parts.append(PartConfig(name=f"{kind}_{n}", belt=arrival.belt, shape=c.shape, size=list(c.size),
+                                offset=arrival.release, lateral=lateral, yaw_deg=yaw, mass=c.mass,
+                                friction=c.friction))
+        releases.append(Release(n, t, arrival.belt, kind))
+    return parts, releases
+
+
+def line_scenario(scenario):
+    """A copy of the line ``scenario`` whose ``pick.parts`` is the pool (``line_pool``) and whose
+    ``pick.tasks`` is empty (the run appends what it decides); and the releases."""
+    out = copy.deepcopy(scenario)
+    parts, releases = line_pool(scenario.pick.line, scenario.duration)
+    if not parts:
+        raise ScenarioError("pick.line.arrivals: no part arrives before the scenario's end (rate, "
+                            "start, until, duration)")
+    out.pick.parts, out.pick.tasks = parts, []
+    return out, releases

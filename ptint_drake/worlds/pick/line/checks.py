@@ -1,0 +1,71 @@
+"""A line scenario's checks before its run (one line naming the field, exit 2) and its warnings.
+
+``check_line_scenario``: the pose sensor only (the rgbd line is not built yet: ``measurement``
+refused), the cell (``config.check_pick_parts``), the ``pick.line`` block (``config.line.check_line``
+with the gripper's stroke read from its model), the pool on its belts, and every slot of the
+catalog reachable from above (Drake's IK from the start posture) at half its kind's height and
+``lift_height`` above — a slot out of reach is named ``pick.tray.slots[j]``.
+
+``line_warnings``: the arrival rate against the planned capacity (60 / one pick's cycle with the
+tasks' defaults, per minute): above it, a warning with both numbers, and the run goes on.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+
+from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.line import check_line
+from ptint_drake.config.pick import PickTaskConfig
+from ptint_drake.robot.plant import nominal_plant
+from ptint_drake.robot.reachability import inverse_kinematics
+from ptint_drake.worlds.pick.config import check_pick_parts
+from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.driver import cycle_time
+from ptint_drake.worlds.pick.line.plan import line_plan
+
+__all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
+from ptint_drake.worlds.pick.scene import AddGripper, gripper_stroke, slot_pose
+
+
+def stroke_of(gripper) -> float:
+    """m: the largest opening of the gripper ``gripper`` (a ``GripperConfig``), from its model."""
+    plant = MultibodyPlant(0.001)
+    instance = AddGripper(plant, plant.world_frame(), gripper)
+    return gripper_stroke(plant, instance)
+
+
+def check_line_scenario(scenario) -> None:
+    """ScenarioError naming the first bad field of a line scenario (module docstring)."""
+    if scenario.measurement is not None:
+        raise ScenarioError("measurement: a line aims by the pose sensor (leave measurement out); the line "
+                            "seen by the rgbd camera is not built yet")
+    pick = scenario.pick
+    check_pick_parts(pick)
+    task = PickTaskConfig()
+    check_line(pick, scenario.duration, stroke_of(pick.gripper), task.margin)
+    expanded, _ = line_scenario(scenario)
+    check_pick_parts(expanded.pick)
+    arm = nominal_plant(scenario)
+    frame = arm.GetFrameByName(scenario.robot.end_effector)
+    guess = np.radians(scenario.robot.initial_q_deg)
+    for kind in pick.line.catalog:
+        height = kind.size[2] if kind.shape == "box" else kind.size[1]
+        for j in kind.slots:
+            x = slot_pose(pick.tray, j).translation() + [0.0, 0.0, height / 2]
+            for where in (x, x + [0.0, 0.0, task.lift_height]):
+                if inverse_kinematics(arm, frame, where, guess, down=True) is None:
+                    raise ScenarioError(f"pick.tray.slots[{j}] (pick.tray.center and the slot's offset): "
+                                        f"{np.round(where, 3).tolist()} m is outside what the arm reaches "
+                                        f"from above")
+
+
+def line_warnings(scenario) -> list[str]:
+    """The arrival rate above the planned capacity (module docstring)."""
+    rate = 60.0 * sum(a.rate for a in scenario.pick.line.arrivals)
+    capacity = 60.0 / cycle_time(PickTaskConfig())
+    if rate <= capacity:
+        return []
+    return [f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's planned capacity "
+            f"{capacity:.1f} picks/min (60 / one pick's {cycle_time(PickTaskConfig()):.2f} s cycle)"]

@@ -1,0 +1,109 @@
+"""What a line achieved (metrics.json ``line``), from the truth (the probe's log of every part)
+and the run's records — the parts, not the tasks, are counted:
+
+- ``entered``: pool parts that came into the arm's reach (the pose sensor's line: its part's
+  centre, resting on its belt, at or past the start of its reach window, ``view.window`` — the
+  same Drake IK the scheduler uses); ``placed``: those a task placed (``picks[*].placed``: held
+  at the place and within ``criteria.place_mm`` / ``place_deg`` at the end);
+- per part (``parts``): its kind, release time, whether it entered and was placed, its task and,
+  entered but not placed, a ``reason``: its task's failure (the pick verdict's codes, e.g.
+  ``collision with <body>``, ``dropped``, ``missed after retry``, ``not placed``), or for a part
+  no task took, the scheduler's last word on it (``not reachable in time``, ``blocked``, ``tray
+  full``), ``passed unpicked`` (taken off past the belt's end, never looked at: the arm busy
+  throughout) or ``on the belt at the end``;
+- ``placed_fraction`` (placed / entered), ``picks_per_minute`` (placed / duration),
+  ``cycle_s`` (per task: its approach's start to its retreat's end) and their mean;
+- ``decisions``: the decision log (``scheduler.Decision.record``, and the re-decisions);
+- ``replaced``: the tasks replaced in their approach, each with the commanded torque's jump at
+  the switch (N·m, the largest joint's change between the logged samples around it) beside the
+  run's largest sample-to-sample change outside any switch;
+- ``tracking``: the pose sensor's identities are the sensor's (no association, no IDSW to count).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ptint_drake.verdict.metrics import Reason
+from ptint_drake.worlds.pick.metrics import pick_reasons
+from ptint_drake.worlds.pick.probe import PART_WIDTH
+from ptint_drake.worlds.pick.scene import belt_frame, part_shape
+
+
+def _entered(scenario, view, probe: np.ndarray, k: int) -> bool:
+    part = scenario.pick.parts[k]
+    belt = {b.name: b for b in scenario.pick.belts}[part.belt]
+    X_BW = belt_frame(belt).inverse()
+    local = np.array([X_BW.multiply(p) for p in probe[:, PART_WIDTH * k: PART_WIDTH * k + 3]])
+    on = (np.abs(local[:, 1]) <= belt.width / 2) & (np.abs(local[:, 2] - part_shape(part)[1] / 2) < 0.01)
+    if not np.any(on):
+        return False
+    s_in, _ = view.window_at(belt.name, float(np.median(local[on, 1])), float(np.median(local[on, 2])))
+    return bool(np.any(local[on, 0] >= s_in))
+
+
+def _unpicked_reason(k: int, decisions: list, passed: bool) -> str:
+    last = None
+    for d in decisions:
+        for skip in d.get("skipped", []):
+            if skip["track"] == k:
+                last = skip["reason"]
+    if last is None or last == "later deadline":
+        return "passed unpicked" if passed else "on the belt at the end"
+    return "blocked" if last.startswith("blocked") else last
+
+
+def _torque_jumps(series: dict, replaced: list) -> tuple[list, float]:
+    t, tau = series["t"], np.asarray(series["tau"])
+    steps = np.max(np.abs(np.diff(tau, axis=0)), axis=1)
+    near = np.zeros(len(steps), dtype=bool)
+    rows = []
+    for r in replaced:
+        i = int(np.searchsorted(t, r["t"]))
+        lo, hi = max(i - 1, 0), min(i + 1, len(t) - 1)
+        near[max(lo - 1, 0):hi + 1] = True
+        rows.append({"t": r["t"], "task": r["task"], "drift_mm": round(r["drift_mm"], 2),
+                     "torque_jump_Nm": float(np.max(np.abs(tau[hi] - tau[lo])))})
+    usual = float(np.max(steps[~near])) if np.any(~near) else 0.0
+    return rows, usual
+
+
+def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
+    """metrics.json ``line`` (module docstring); ``scenario``: the run's expanded copy."""
+    probe = series["probe"]
+    by_part = {p["part_index"]: (k, p) for k, p in enumerate(metrics["picks"])}
+    codes = {}
+    for k, code in pick_reasons(metrics["picks"]):
+        codes.setdefault(k, code)
+    truth, parts = driver.truth, []
+    for r in driver.releases:
+        k = r.part
+        row = {"part": scenario.pick.parts[k].name, "kind": r.kind, "belt": r.belt, "released": r.t,
+               "entered": k in truth.released and _entered(scenario, driver.view, probe, k),
+               "task": by_part[k][0] if k in by_part else None, "placed": False, "reason": None}
+        if row["task"] is not None:
+            row["placed"] = bool(by_part[k][1]["placed"])
+        if row["entered"] and not row["placed"]:
+            row["reason"] = (codes.get(row["task"], "not placed") if row["task"] is not None
+                             else _unpicked_reason(k, driver.decisions, k in truth.passed))
+        parts.append(row)
+    entered = sum(p["entered"] for p in parts)
+    placed = sum(p["placed"] for p in parts)
+    plan = driver.built.plan
+    cycles = [plan.schedule.segments[plan.segment_index(k, "retreat")].end
+              - plan.schedule.segments[plan.segment_index(k, "approach", 0)].start
+              for k in range(len(scenario.pick.tasks))]
+    jumps, usual = _torque_jumps(series, driver.replaced)
+    return {"released": len(truth.released), "entered": entered, "placed": placed,
+            "placed_fraction": placed / entered if entered else None,
+            "picks_per_minute": 60.0 * placed / scenario.duration, "cycle_s": cycles,
+            "mean_cycle_s": float(np.mean(cycles)) if cycles else None,
+            "passed": len(truth.passed), "parts": parts, "decisions": driver.decisions,
+            "replaced": jumps, "largest_torque_step_elsewhere_Nm": usual,
+            "tracking": "pose sensor: identities are the sensor's (no association, no IDSW)"}
+
+
+def line_reasons(line: dict) -> list[Reason]:
+    """The verdict's reasons: every part that entered and was not placed, with its reason."""
+    return [Reason(None, p["reason"], f"{p['part']}: {p['reason']}") for p in line["parts"]
+            if p["entered"] and not p["placed"]]

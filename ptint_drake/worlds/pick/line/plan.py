@@ -1,0 +1,44 @@
+"""A line's plan: an idle segment, then the tasks the run decided (``route.routed_plan``).
+
+A line starts with no task, and Drake's schedule needs a segment (``Schedule``).  The line's plan
+begins with one ``IDLE_TF`` segment (phase ``idle``, task -1, a fixed point: kind ``via_slot``)
+aiming at the tool's start position and yaw, so the arm holds where it stands until the first
+task; every later task is an ordinary pick task (``tasks.pick_plan``) after it.  The scheduler
+decides nothing before the idle segment's end.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ptint_drake.systems.task.orientation import tool_yaw
+from ptint_drake.systems.task.schedule import Schedule, Segment
+from ptint_drake.worlds.pick.route import routed_plan
+from ptint_drake.worlds.pick.tasks import VIA_SLOT, PickPlan, PlanSegment
+
+IDLE_TF = 0.5  # s
+IDLE_BETA = 0.75
+
+
+def home_pose(scenario, arm) -> tuple:
+    """(position, yaw) of the end-effector frame at the scenario's start posture."""
+    context = arm.CreateDefaultContext()
+    arm.SetPositions(context, np.radians(scenario.robot.initial_q_deg))
+    X = arm.GetFrameByName(scenario.robot.end_effector).CalcPoseInWorld(context)
+    return tuple(float(c) for c in X.translation()), float(tool_yaw(X.rotation().matrix()))
+
+
+def line_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
+    """The idle segment, then the plan of ``scenario.pick.tasks`` (module docstring)."""
+    if arm is None:
+        from ptint_drake.robot.plant import nominal_plant  # noqa: PLC0415
+
+        arm = nominal_plant(scenario)
+    home, yaw = home_pose(scenario, arm)
+    idle = (Segment(0.0, IDLE_TF, IDLE_BETA), PlanSegment(-1, "idle", VIA_SLOT, -1, home, yaw))
+    if not scenario.pick.tasks:
+        return PickPlan(Schedule([idle[0]]), (idle[1],), ((0.0, scenario.pick.gripper.initial_opening),),
+                        (), (), IDLE_TF)
+    plan = routed_plan(scenario, replans, arm)
+    return PickPlan(Schedule([idle[0], *plan.schedule.segments]), (idle[1], *plan.segments), plan.commands,
+                    plan.close_times, plan.grasp_times, plan.end, plan.widths, plan.attempts)

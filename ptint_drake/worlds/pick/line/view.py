@@ -1,0 +1,124 @@
+"""What the controller side of a line reads at a stop (``driver``): the tracks in the part
+tracker's report, each belt's known speed, each track's reach window — never the pool's truth.
+
+- **the view**: a report is a track when it lies on a belt (within its width, resting on it) from
+  ``VIEW_BEFORE`` upstream of the release point on; parked parts (under the floor), parts in the
+  hand and in the tray are none.  Its kind is the catalog kind of the reported part's declared
+  shape and size (the pose sensor's object model, from the cell both sides build from; a camera
+  would classify by the measured size);
+- **the known speed** of a belt: its encoder's reading (the drive joint's rate) where the line
+  declares ``encoder: true``, else the declared ``speed`` — a speed step is unknown then, until
+  a track's drift shows it: the speed the sensor reports for that track is learned for the belt
+  (``learned``, set by ``driver``);
+- **the reach window** of a track (``window``): along its belt, at its lateral offset and height,
+  the longest stretch where a top-down grasp and the lift above it are reachable (Drake's IK,
+  ``robot.reachability.inverse_kinematics(down=True)``, every ``WINDOW_STEP``), cached per
+  (belt, lateral, height).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ptint_drake.config.pick import PickTaskConfig
+from ptint_drake.robot.reachability import inverse_kinematics
+from ptint_drake.systems.perception.part_fit import reach
+from ptint_drake.worlds.pick.line.scheduler import Track
+from ptint_drake.worlds.pick.scene import belt_frame
+
+VIEW_BEFORE = 0.05  # m, upstream of the release point: where the view begins
+WINDOW_STEP = 0.01  # m, of the reach window's scan
+KEY_STEP = 0.005  # m: windows are scanned at the lateral offset and height rounded to this
+
+
+class LineView:
+    """The controller side's reading of a line (module docstring); ``bind`` a built diagram first."""
+
+    def __init__(self, scenario):
+        self.scenario, self.line = scenario, scenario.pick.line
+        self._windows: dict = {}
+        self.built = None
+        # belt → the speed learned from its tracks after a drift (no encoder: ``driver``)
+        self.learned: dict = {}
+
+    def bind(self, built) -> None:
+        self.built = built
+        self._arm = built.arm
+        self._frame = built.arm.GetFrameByName(self.scenario.robot.end_effector)
+
+    def _known_speed(self, context, belt) -> float:
+        encoder = {b.name: b.encoder for b in self.line.belts}.get(belt.name, False)
+        if not encoder:
+            return self.learned.get(belt.name, belt.speed)
+        station = self.built.station
+        joint = station.belts[[b.name for b in station.config.belts].index(belt.name)]
+        return float(joint.get_translation_rate(station.plant.GetMyContextFromRoot(context)))
+
+    def _kind(self, part) -> str:
+        for c in self.line.catalog:
+            if c.shape == part.shape and np.allclose(c.size, part.size):
+                return c.name
+        return ""
+
+    def tracks(self, context, t: float) -> list[Track]:
+        """The tracks (module docstring: the view) in the tracker's report now."""
+        config, source = self.built.station.config, self.built.part_system()
+        sc = source.GetMyContextFromRoot(context)
+        belts = {b.name: b for b in config.belts}
+        view = {a.belt: a.release - VIEW_BEFORE for a in self.line.arrivals}
+        out = []
+        for k, part in enumerate(config.parts):
+            pose = source.GetOutputPort(f"part_{k}_pose").Eval(sc)
+            R = source.GetOutputPort(f"part_{k}_rotation").Eval(sc)[0:9].reshape(3, 3)
+            belt = belts[part.belt]
+            local = belt_frame(belt).inverse().multiply(pose[0:3])
+            height = part.size[2] if part.shape == "box" else part.size[1]
+            if not (abs(local[1]) <= belt.width / 2 and abs(local[2] - height / 2) < 0.01
+                    and view[belt.name] <= local[0] <= belt.length / 2):
+                continue
+            out.append(Track(k, self._kind(part), belt.name, tuple(pose[0:3]), float(local[0]),
+                             tuple(belt.direction), self._known_speed(context, belt), tuple(R[:, 0]),
+                             float(part.size[0]), reach(part.shape, part.size),
+                             float(np.dot(pose[3:6], belt.direction))))
+        return out
+
+    def window(self, track: Track) -> tuple:
+        """The reach window [s_in, s_out] (m along the belt) of ``track`` (module docstring)."""
+        belt = {b.name: b for b in self.built.station.config.belts}[track.belt]
+        local = belt_frame(belt).inverse().multiply(np.asarray(track.position))
+        return self.window_at(track.belt, float(local[1]), float(local[2]))
+
+    def _scan(self, X, belt, local) -> tuple:
+        guess = np.radians(self.scenario.robot.initial_q_deg)
+        best, run = (math.inf, -math.inf), []
+        for s in np.arange(-belt.length / 2, belt.length / 2 + 1e-9, WINDOW_STEP):
+            ok = self.reachable(X.multiply(np.array([s, local[1], local[2]])), guess)
+            if ok is not None:
+                guess = ok
+                run.append(s)
+            if run and (ok is None or s + WINDOW_STEP > belt.length / 2):
+                if run[-1] - run[0] > best[1] - best[0]:
+                    best = (float(run[0]), float(run[-1]))
+                run = []
+        return best
+
+    def reachable(self, x, guess):
+        """IK from above at ``x`` and ``lift_height`` above it: the posture at ``x`` or None."""
+        q = inverse_kinematics(self._arm, self._frame, np.asarray(x), guess, down=True)
+        lift = PickTaskConfig().lift_height
+        if q is None or inverse_kinematics(self._arm, self._frame, np.asarray(x) + [0, 0, lift], q,
+                                           down=True) is None:
+            return None
+        return q
+
+    def window_at(self, belt_name: str, lateral: float, height: float) -> tuple:
+        """The reach window [s_in, s_out] along belt ``belt_name`` at ``lateral`` and ``height``
+        (m, in the belt's frame; ``window``'s cache)."""
+        belt = {b.name: b for b in self.built.station.config.belts}[belt_name]
+        key = (belt_name, round(lateral / KEY_STEP), round(height / KEY_STEP))
+        if key not in self._windows:
+            self._windows[key] = self._scan(belt_frame(belt), belt, np.array([0.0, KEY_STEP * key[1],
+                                                                              KEY_STEP * key[2]]))
+        return self._windows[key]

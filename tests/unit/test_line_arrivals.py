@@ -1,0 +1,46 @@
+"""Issue 44: the line's arrival process (``worlds.pick.line.arrivals``) — seeded, at its rate in
+parts per second whatever the belt's speed, never two releases closer than ``min_gap``."""
+
+import copy
+
+import numpy as np
+import pytest
+
+from ptint_drake.config.line import ArrivalConfig
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.worlds.pick.line.arrivals import line_pool, line_scenario, release_times
+
+
+def test_the_pool_is_seeded():
+    line = load_scenario("line_short").pick.line
+    a, b = line_pool(line, 60.0), line_pool(line, 60.0)
+    draws = [[(r.t, p.lateral, p.yaw_deg) for p, r in zip(*pool)] for pool in (a, b)]
+    assert draws[0] == draws[1]
+    other = copy.deepcopy(line)
+    other.seed = 1
+    assert [r.t for r in line_pool(other, 60.0)[1]] != [r.t for r in a[1]]
+
+
+@pytest.mark.parametrize("process", ["poisson", "jittered"])
+def test_rate_in_parts_per_second_and_the_least_gap(process):
+    arrival = ArrivalConfig(belt="b", rate=0.2, process=process, min_gap=0.6, until=0.0)
+    times = np.array(release_times(arrival, 5000.0, np.random.default_rng(3)))
+    rate = len(times) / 5000.0
+    assert abs(rate - 0.2) < 0.2 * 0.05  # 1000 expected: within 5 % (Poisson: 3.2 σ)
+    assert np.min(np.diff(times)) >= 0.6 - 1e-12
+
+
+def test_a_faster_belt_brings_no_more_parts():
+    scenario = load_scenario("line_short")
+    fast = copy.deepcopy(scenario)
+    fast.pick.belts[0].speed *= 2.0
+    slow_pool, fast_pool = line_scenario(scenario)[1], line_scenario(fast)[1]
+    assert [r.t for r in slow_pool] == [r.t for r in fast_pool]
+
+
+def test_the_pool_is_ordinary_parts_named_by_kind_in_release_order():
+    scenario, releases = line_scenario(load_scenario("line_short"))
+    assert [p.name for p in scenario.pick.parts] == [f"cube_{n}" for n in range(len(releases))]
+    assert [r.t for r in releases] == sorted(r.t for r in releases)
+    assert all(r.t < 60.0 - 12.0 for r in releases) and scenario.pick.tasks == []
+    assert all(-0.015 <= p.lateral <= 0.015 and p.offset == -0.7 for p in scenario.pick.parts)
