@@ -25,13 +25,17 @@ nothing new are not repeated in it.
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
 import numpy as np
 
-from ptint_drake.config.pick import MoveConfig, PickTaskConfig
+from ptint_drake.config.pick import PickTaskConfig
+from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.cycle import LineCycles
+from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.plan import IDLE_TF
 from ptint_drake.worlds.pick.line.scheduler import Timing, decide, drifted
@@ -107,6 +111,8 @@ class LineDriver:
         self._last_look = None
         self._beliefs: dict = {}  # part → (offset, lateral, yaw_deg) as tracked at the last decision
         self._speeds: dict = {}  # belt → its known speed then
+        self.cycles = None  # the min-tf model (``line.cycle``), built at the first bind
+        self.planning_s: list = []  # wall s of each decision that chose (the scheduler and the model)
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -115,6 +121,7 @@ class LineDriver:
             task = PickTaskConfig()
             self.timing = Timing(lead=task.approach.tf + task.descend.tf, margin=task.margin,
                                  finger=finger_extent(built.station))
+            self.cycles = LineCycles(self.scenario)
         self.truth.rebind(built.station)
         self.view.bind(built)
         self.built = built
@@ -206,23 +213,34 @@ class LineDriver:
         return any(b.name == belt and b.encoder for b in self.line.belts)
 
     def _choose(self, run, context, t: float, replacing=None) -> bool:
-        """A decision from now; a task appended (or task ``replacing`` replaced): True."""
+        """A decision from now, each track's lead from the min-tf model (``line.cycle``); a task
+        appended (or task ``replacing`` replaced): True."""
+        clock = time.perf_counter()
         tasks = self.scenario.pick.tasks
-        if t + cycle_time(PickTaskConfig()) > self.scenario.duration:
-            return False  # no cycle fits before the end
         tracks = self.view.tracks(context, t)
         windows = {tr.id: self.view.window(tr) for tr in tracks}
         keep = [k for k in range(len(tasks)) if k != replacing]
         assigned = {self.committed[k][0] for k in keep}
         used = {tasks[k].slot for k in keep}
         free = {c.name: [j for j in c.slots if j not in used] for c in self.line.catalog}
-        decision = decide(t, tracks, windows, assigned, free, self.timing)
+        station = self.built.station
+        q = station.diagram.GetOutputPort("state").Eval(station.diagram.GetMyContextFromRoot(context))
+        q = q[:self.built.arm.num_positions()]
+        start, yaw = self._tool_now(q)  # the arm's present point and yaw
+        decision = decide(t, tracks, windows, assigned, free, self.timing,
+                          lambda tr, w: self.cycles.lead(tr, w, t, start, yaw))
+        cycle = None
         if decision.track is not None:
-            station = self.built.station
-            q = station.diagram.GetOutputPort("state").Eval(station.diagram.GetMyContextFromRoot(context))
-            if self.view.reachable(np.asarray(decision.point), q[:self.built.arm.num_positions()]) is None:
+            if self.view.reachable(np.asarray(decision.point), q) is None:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
+            else:
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw)
+                if cycle is None:
+                    return False
+                if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
+                        > self.scenario.duration:
+                    return False  # its cycle would end after the line's
         record = decision.record()
         if decision.track is None:
             look = [(s["track"], s["reason"]) for s in record["skipped"]]
@@ -232,26 +250,43 @@ class LineDriver:
             return False
         self._last_look = None
         self._believe(tracks, t)
-        self._commit(run, t, decision, replacing)
-        self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1})
+        self._commit(run, t, decision, replacing, cycle)
+        self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1,
+                                        "tf": {p: round(v, 3) for p, v in cycle.phases.items()}})
+        self.planning_s.append(time.perf_counter() - clock)
         return True
 
-    def _commit(self, run, t: float, decision, replacing) -> None:
-        """The decision's task into the run's tasks (and its per-task records)."""
-        tasks, default = self.scenario.pick.tasks, PickTaskConfig()
+    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float):
+        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``); None where no tf
+        fits a phase (logged)."""
+        track = next(tr for tr in tracks if tr.id == decision.track)
+        try:
+            return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
+        except NoTfFits as error:
+            self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
+            return None
+
+    def _tool_now(self, q) -> tuple:
+        """(point, yaw) of the tool at the arm's posture ``q``."""
+        arm = self.built.arm
+        context = arm.CreateDefaultContext()
+        arm.SetPositions(context, q)
+        X = arm.GetFrameByName(self.scenario.robot.end_effector).CalcPoseInWorld(context)
+        return X.translation(), float(tool_yaw(X.rotation().matrix()))
+
+    def _commit(self, run, t: float, decision, replacing, cycle) -> None:
+        """The decision's task, its tfs from ``cycle`` (the min-tf model), into the run's tasks
+        (and its per-task records)."""
+        tasks = self.scenario.pick.tasks
         name = self.built.station.config.parts[decision.track].name
+        task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle)
         if replacing is None:
-            start = max(t, decision.grasp - self.timing.lead)
-            task = PickTaskConfig(part=name, slot=decision.slot, start=start)
             tasks.append(task)
             run.replans.append(Replan())
             run.checks.append([])
             run.refused.append(None)
             k = len(tasks) - 1
         else:
-            tf = decision.grasp - default.descend.tf - t
-            task = PickTaskConfig(part=name, slot=decision.slot, start=t,
-                                  approach=MoveConfig(tf, default.approach.beta))
-            tasks[replacing], k = task, replacing
+            tasks[replacing], k = replace(task, start=t), replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
         self.committed[k] = [decision.track, decision.grasp, decision.point]

@@ -10,8 +10,9 @@ finds its grasp time on a grid of ``Timing.step`` from the decision:
 2. its reach window (``windows[id]`` = [s_in, s_out]: where along its belt a top-down grasp and
    the lift above it are reachable, found by Drake's IK, ``robot.reachability``) — the predicted
    coordinate s(t) = s + speed · (t − now) inside it at the grasp time;
-3. the earliest grasp time at least ``Timing.lead`` from now (the default approach and descend
-   tfs: phases the arm is known to make — the tasks' defaults) and ``lead`` after the part enters
+3. the earliest grasp time at least the track's lead from now (``leads``: the approach and
+   descend min tfs of the phase time model from the arm's present point, ``line.cycle``; without
+   it ``Timing.lead``, the tasks' default tfs) and that lead after the part enters
    its window (a prescribed-time approach aims at the moving part all along: the part in reach
    from the approach's start on, else the reference drags the arm towards a place it cannot be —
    measured: a grasp at the window's entry ran the RV-M1 through its base into its joint
@@ -104,19 +105,21 @@ class Decision:
                             for i, r in self.skipped]}
 
 
-def grasp_time(track: Track, window: tuple, now: float, timing: Timing):
+def grasp_time(track: Track, window: tuple, now: float, timing: Timing, lead: Optional[float] = None):
     """(grasp time, deadline) of ``track`` in its reach ``window`` (module docstring, step 3), or
-    (None, reason)."""
+    (None, reason); ``lead``: this track's (s, the model's approach and descend), else
+    ``timing.lead``."""
     s_in, s_out = window
+    lead = timing.lead if lead is None else lead
     if track.speed <= 1e-9:
         inside = s_in <= track.s <= s_out
-        return (now + timing.lead, math.inf) if inside else (None, "not in reach (belt stopped)")
+        return (now + lead, math.inf) if inside else (None, "not in reach (belt stopped)")
     leave = now + (s_out - track.s) / track.speed  # the part's centre leaves the window
     enter = now + (s_in - track.s) / track.speed
     deadline = leave - timing.slack
     if enter - now > timing.horizon:
         return None, "not in reach yet"
-    earliest = max(now, enter) + timing.lead  # in reach from the approach's start on
+    earliest = max(now, enter) + lead  # in reach from the approach's start on
     t = now + timing.step * math.ceil((earliest - now) / timing.step - 1e-9)
     if t > deadline:
         return None, "not reachable in time"
@@ -138,9 +141,11 @@ def blocker(track: Track, tracks: list, grasp: float, now: float, timing: Timing
 
 
 def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: dict,
-           timing: Timing) -> Decision:
+           timing: Timing, leads=None) -> Decision:
     """The next pick among ``tracks`` not in ``assigned`` (module docstring); ``free_slots``: kind
-    → the slots still free for it, in filling order."""
+    → the slots still free for it, in filling order; ``leads``: a callable (track, window) → the
+    track's lead (s, ``line.cycle.LineCycles.lead``: the min-tf model) or a str naming why no tf
+    fits — None: ``timing.lead`` for every track."""
     decision = Decision(now)
     feasible = []
     for track in tracks:
@@ -149,7 +154,12 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
         if not free_slots.get(track.kind):
             decision.skipped.append((track.id, "tray full"))
             continue
-        grasp, deadline = grasp_time(track, windows[track.id], now, timing)
+        never = grasp_time(track, windows[track.id], now, timing, 0.0)  # no lead fits: no model asked
+        lead = never[1] if never[0] is None else None if leads is None else leads(track, windows[track.id])
+        if isinstance(lead, str):
+            decision.skipped.append((track.id, lead))
+            continue
+        grasp, deadline = grasp_time(track, windows[track.id], now, timing, lead)
         if grasp is None:
             decision.skipped.append((track.id, deadline))
             continue

@@ -1,0 +1,148 @@
+"""The line's phase times from the minimum phase time model (``phase_time.PhaseTimes``, issue 44).
+
+The scheduler asks, per track, how long the arm needs from where it stands to a grasp of that
+part (``LineCycles.lead``: the approach's min tf from the tool's present point and yaw to
+``clearance`` above the part riding its belt, plus the descend's — at least the fingers' close):
+a grasp time at least that far ahead (and that far after the part enters its reach window) is one
+the arm makes within its joint speed and torque limits (× ``phase_time.MARGIN``).  The part is
+taken where it will be when the approach can start: now, or its window's entry if it is still
+upstream — or up to ``WAITS`` later, where the straight way from the tool to it has no top-down
+posture all along (the lead then counts the wait).  A lead is cached per track and ``LEAD_STEP``
+of its belt coordinate (a free arm looks
+every ``decide_period``; the tool holds still meanwhile).
+
+The chosen task's tfs (``LineCycles.phases``) are one ``phase_time.cycle_time`` from the tool's
+point and yaw, the part at the approach's start riding its belt (approach, descend), the payload
+held (lift, carry, place), to its slot and back up (retreat).
+
+``estimate`` — the line's capacity by the model: per kind of the catalog, one cycle from
+``clearance`` above its first slot to a part at the middle of its reach window on its belt (no
+lateral offset, yaw 0) and back to that slot; 60 / the mean cycle, picks per minute (the arrival
+warning's number, and the surplus line's estimate, ``scripts/line_capacity.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Optional
+
+import numpy as np
+
+from ptint_drake.config.pick import MoveConfig, PartConfig, PickTaskConfig
+from ptint_drake.worlds.pick.cell import place_point
+from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time
+from ptint_drake.worlds.pick.route import nearest_branch
+from ptint_drake.worlds.pick.scene import belt_frame
+from ptint_drake.worlds.pick.tasks import place_target
+
+LEAD_STEP = 0.01  # m along the belt: a lead's cache key
+WAITS = (0.0, 0.25, 0.5, 1.0, 1.5, 2.0)  # s: an approach's start put off, when its way leaves the reach
+PHASE_NAMES = ("approach", "descend", "lift", "carry", "place", "retreat")
+
+
+class LineCycles:
+    """The min-tf model of a line's station and the leads it gave (module docstring)."""
+
+    def __init__(self, scenario, model: Optional[PhaseTimes] = None):
+        self.scenario = scenario
+        self.model = model or PhaseTimes.of(scenario)
+        self.task = PickTaskConfig()
+        self._leads: dict = {}
+
+    def lead(self, track, window: tuple, now: float, start, yaw: float):
+        """s from an approach's start to the grasp of ``track`` (approach + descend min tfs), the
+        tool at ``start`` turned to ``yaw``; a str naming why no tf fits."""
+        ahead, key = _key(track, window, start, yaw)
+        if key not in self._leads:
+            self._leads[key] = self._lead(track, ahead, start, yaw)
+        found = self._leads[key]
+        return found if isinstance(found, str) else float(sum(found))
+
+    def _lead(self, track, ahead: float, start, yaw: float):
+        """(approach, descend, wait) or a str: the approach starting ``ahead`` + wait s from now,
+        the first of ``WAITS`` whose way has a top-down posture all along (at its window's entry
+        the part may be in reach while the way above it is not yet)."""
+        ride = track.speed * np.asarray(track.direction)
+        up = np.array([0.0, 0.0, self.task.clearance])
+        grip = nearest_branch(yaw, _yaw(track))
+        why = ""
+        for wait in WAITS:
+            part = np.asarray(track.at(0.0, -(ahead + wait)))  # where it is at the approach's start
+            try:
+                approach = self.model.min_tf(start, part + up, ride, 0.0, self.task.approach.beta,
+                                             (yaw, grip))
+                at = part + ride * approach
+                descend = max(self.model.min_tf(at + up, at, ride, 0.0, self.task.descend.beta, (grip, grip)),
+                              self.task.margin / self.model.gripper_speed)
+            except NoTfFits as error:
+                why = f"no tf fits: {error}"
+                continue
+            return approach, descend, wait
+        return why
+
+    def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot: int) -> Cycle:
+        """The cycle of a grasp of ``track`` (reach ``window``) at ``grasp`` (module docstring), its
+        approach starting ``lead`` before it."""
+        pick = self.scenario.pick
+        kind = _kind_part(pick, track.kind)
+        lead = self.lead(track, window, now, start, yaw)
+        found = self._leads.get(_key(track, window, start, yaw)[1])
+        wait = found[2] if isinstance(found, tuple) else 0.0
+        begin = max(now, grasp - lead + wait) if isinstance(lead, float) else now
+        task = replace(self.task, slot=slot)
+        place = place_point(pick, "slot", slot, kind)
+        return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
+                          place, place_target(pick, task)[2], _yaw(track), kind.mass, task, start, yaw)
+
+    def task_of(self, part: str, slot: int, grasp: float, now: float, cycle: Cycle) -> PickTaskConfig:
+        """The ``PickTaskConfig`` of ``cycle`` for a grasp at ``grasp``: its approach stretched (or
+        started now) so that the descend ends at the grasp."""
+        tf = cycle.phases
+        begin = max(now, grasp - tf["approach"] - tf["descend"])
+        moves = {p: MoveConfig(tf[p], getattr(self.task, p).beta) for p in PHASE_NAMES}
+        moves["approach"] = MoveConfig(grasp - tf["descend"] - begin, self.task.approach.beta)
+        return replace(self.task, part=part, slot=slot, start=begin, **moves)
+
+
+def estimate(scenario, view, model: Optional[PhaseTimes] = None) -> tuple:
+    """(picks per minute, mean cycle s) of the line by the model (module docstring); ``view``
+    gives the reach windows (``LineView.window_at``)."""
+    model = model or PhaseTimes.of(scenario)
+    pick, task = scenario.pick, PickTaskConfig()
+    belts = {b.name: b for b in pick.belts}
+    totals = []
+    for kind in pick.line.catalog:
+        part = _kind_part(pick, kind.name)
+        for arrival in pick.line.arrivals:
+            if arrival.mix and not arrival.mix.get(kind.name):
+                continue
+            belt = belts[arrival.belt]
+            height = part.size[2] if part.shape == "box" else part.size[1]
+            s_in, s_out = view(arrival.belt, 0.0, height / 2)
+            x = belt_frame(belt).multiply(np.array([0.5 * (s_in + s_out), 0.0, height / 2]))
+            place = place_point(pick, "slot", kind.slots[0], part)
+            place_yaw = place_target(pick, replace(task, slot=kind.slots[0]))[2]
+            ride = belt.speed * np.asarray(belt.direction) / np.linalg.norm(belt.direction)
+            cycle = cycle_time(model, x, ride, place, place_yaw, 0.0, kind.mass, task)
+            totals.append(cycle.total)
+    mean = float(np.mean(totals))
+    return 60.0 / mean, mean
+
+
+def _key(track, window: tuple, start, yaw: float) -> tuple:
+    """(s until the part enters ``window``, ≥ 0; a lead's cache key)."""
+    ahead = max(0.0, (window[0] - track.s) / track.speed) if track.speed > 1e-9 else 0.0
+    return ahead, (track.id, round((track.s + track.speed * ahead) / LEAD_STEP),
+                   tuple(np.round(np.asarray(start), 3)), round(yaw, 2))
+
+
+def _yaw(track) -> float:
+    """rad: the yaw of a track's closing axis (world)."""
+    return float(math.atan2(track.axis[1], track.axis[0]))
+
+
+def _kind_part(pick, kind: str) -> PartConfig:
+    """A ``PartConfig`` of the catalog kind ``kind`` (its shape, size, mass and friction)."""
+    k = next(c for c in pick.line.catalog if c.name == kind)
+    return PartConfig(name=k.name, shape=k.shape, size=list(k.size), mass=k.mass, friction=k.friction)
