@@ -34,7 +34,7 @@ from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
-from ptint_drake.worlds.pick.line.cycle import LineCycles
+from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.plan import IDLE_TF
@@ -159,8 +159,11 @@ class LineDriver:
             self._speeds[tr.belt] = tr.speed
 
     def add_metrics(self, metrics: dict, series: dict) -> None:
-        """metrics.json ``line`` (``metrics.line_metrics``)."""
+        """metrics.json ``line`` (``metrics.line_metrics``) and the min-tf model's capacity estimate
+        (``line.cycle.estimate``: ``capacity_estimate``, picks per minute and the cycle, s)."""
         metrics["line"] = line_metrics(self.scenario, self, metrics, series)
+        ppm, cycle = estimate(self.scenario, self.view.window_at, self.cycles.model)
+        metrics["line"]["capacity_estimate"] = {"picks_per_minute": ppm, "cycle_s": cycle}
 
     def stops(self, duration: float) -> list[float]:
         """The truth's stops and the scheduler's looks (every ``decide_period``)."""

@@ -24,7 +24,7 @@ finds its grasp time on a grid of ``Timing.step`` from the decision:
    ``finger_clearance`` < ``FINGER_MARGIN``: ``blocked``).
 
 Of the candidates left, the one whose window closes first (earliest deadline first), ties by the
-earlier grasp.  ``Decision.skipped`` holds every other track with its reason (the chosen one's
+lower id.  ``Decision.skipped`` holds every other track with its reason (the chosen one's
 rivals that were feasible read ``later deadline``, their deadlines in ``rivals``).
 
 ``drifted``: the known prediction of a committed grasp point against the one the decision made:
@@ -145,32 +145,35 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
     """The next pick among ``tracks`` not in ``assigned`` (module docstring); ``free_slots``: kind
     → the slots still free for it, in filling order; ``leads``: a callable (track, window) → the
     track's lead (s, ``line.cycle.LineCycles.lead``: the min-tf model) or a str naming why no tf
-    fits — None: ``timing.lead`` for every track."""
+    fits — None: ``timing.lead`` for every track.  A deadline does not depend on the lead, so the
+    tracks are looked at in deadline order, and with ``leads`` the model is asked no further than
+    the first feasible one (the rest read ``later deadline``)."""
     decision = Decision(now)
-    feasible = []
+    order = []
     for track in tracks:
         if track.id in assigned:
             continue
         if not free_slots.get(track.kind):
             decision.skipped.append((track.id, "tray full"))
             continue
-        never = grasp_time(track, windows[track.id], now, timing, 0.0)  # no lead fits: no model asked
-        lead = never[1] if never[0] is None else None if leads is None else leads(track, windows[track.id])
-        if isinstance(lead, str):
-            decision.skipped.append((track.id, lead))
-            continue
-        grasp, deadline = grasp_time(track, windows[track.id], now, timing, lead)
+        grasp, deadline = grasp_time(track, windows[track.id], now, timing, 0.0)  # no lead: none fits
         if grasp is None:
             decision.skipped.append((track.id, deadline))
             continue
-        hit = blocker(track, tracks, grasp, now, timing)
-        if hit is not None:
-            decision.skipped.append((track.id, f"blocked (track {hit})"))
+        order.append((deadline, track.id, track))
+    order.sort(key=lambda f: f[:2])
+    feasible = []
+    for deadline, _, track in order:
+        if feasible and leads is not None:
+            feasible.append((deadline, None, track))
             continue
-        feasible.append((deadline, grasp, track))
+        reason, grasp = _feasible(track, tracks, windows[track.id], now, timing, leads)
+        if reason:
+            decision.skipped.append((track.id, reason))
+        else:
+            feasible.append((deadline, grasp, track))
     if not feasible:
         return decision
-    feasible.sort(key=lambda f: (f[0], f[1], f[2].id))
     deadline, grasp, chosen = feasible[0]
     decision.skipped += [(f[2].id, "later deadline") for f in feasible[1:]]
     decision.rivals = {f[2].id: f[0] for f in feasible[1:]}
@@ -178,6 +181,19 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
     decision.slot = free_slots[chosen.kind][0]
     decision.point = tuple(float(c) for c in chosen.at(grasp, now))
     return decision
+
+
+def _feasible(track: Track, tracks: list, window: tuple, now: float, timing: Timing, leads) -> tuple:
+    """("", grasp time) of a track the arm can take (its lead, its grasp time in its window, the
+    fingers clear of the others), else (the reason, None)."""
+    lead = None if leads is None else leads(track, window)
+    if isinstance(lead, str):
+        return lead, None
+    grasp, deadline = grasp_time(track, window, now, timing, lead)
+    if grasp is None:
+        return deadline, None
+    hit = blocker(track, tracks, grasp, now, timing)
+    return (f"blocked (track {hit})", None) if hit is not None else ("", grasp)
 
 
 def drifted(track: Track, grasp: float, point: tuple, now: float, tolerance: float) -> float:
