@@ -14,8 +14,9 @@ belt speeds, the reach windows; the arm's state; its own tasks):
 - **while a task approaches** (before its descend), the grasp point predicted now is compared with
   the committed one; beyond ``line.redecide_mm`` (a belt without an encoder running faster or
   slower than declared: its speed is then learned from the track, ``view.LineView.learned``) the
-  window is checked at the committed time with that speed: still
-  in it, the task goes on (the targets follow the track: ``kept``); out of it, the scheduler
+  window is checked at the committed time with that speed, and the min-tf model's lead from the
+  tool's present point to the part (``line.cycle``) against the time left to the grasp: still
+  in it and time enough, the task goes on (the targets follow the track: ``kept``); out of it, the scheduler
   decides again from now and the task is replaced (``replaced``: its approach restarts from the
   present state, its tf stretched to the new grasp time; nothing feasible: the task goes on).
 
@@ -200,7 +201,9 @@ class LineDriver:
         s = track.s + track.speed * (grasp - t)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
                  "speed": round(track.speed, 4)}
-        if s_in <= s <= s_out - track.speed * self.timing.slack:
+        lead = self.cycles.lead(track, (s_in, s_out), t, *self._tool_now(self._arm_q(context)))
+        if s_in <= s <= s_out - track.speed * self.timing.slack and isinstance(lead, float) \
+                and t + lead <= grasp + 1e-9:  # in reach then, and the model's approach still fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False
@@ -226,9 +229,7 @@ class LineDriver:
         assigned = {self.committed[k][0] for k in keep}
         used = {tasks[k].slot for k in keep}
         free = {c.name: [j for j in c.slots if j not in used] for c in self.line.catalog}
-        station = self.built.station
-        q = station.diagram.GetOutputPort("state").Eval(station.diagram.GetMyContextFromRoot(context))
-        q = q[:self.built.arm.num_positions()]
+        q = self._arm_q(context)
         start, yaw = self._tool_now(q)  # the arm's present point and yaw
         decision = decide(t, tracks, windows, assigned, free, self.timing,
                           lambda tr, w: self.cycles.lead(tr, w, t, start, yaw))
@@ -268,6 +269,12 @@ class LineDriver:
         except NoTfFits as error:
             self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
             return None
+
+    def _arm_q(self, context) -> np.ndarray:
+        """The arm's present joint positions (the station's state output)."""
+        station = self.built.station
+        q = station.diagram.GetOutputPort("state").Eval(station.diagram.GetMyContextFromRoot(context))
+        return q[:self.built.arm.num_positions()]
 
     def _tool_now(self, q) -> tuple:
         """(point, yaw) of the tool at the arm's posture ``q``."""
