@@ -34,10 +34,10 @@ class CatchConfig:
     sensing: float = 0.15
     replan_every: float = 0.02
     commit: float = 0.15
-    beta: float = 0.75
+    beta: float = 0.5
     held_for: float = 0.5
     time_step: float = 0.001
     match: float = 0.3
     match_time: float = 0.2
-    freeze: float = 0.02
+    freeze: float = 0.06
     final: float = 0.0

@@ -24,9 +24,9 @@ from typing import Dict, List
 import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.part_shape import check_part_shape
 
 PROCESSES = ("poisson", "jittered")
-SHAPE_SIZES = {"box": 3, "cylinder": 2}
 
 
 @dataclass
@@ -107,13 +107,7 @@ def _pair(values: list, where: str) -> None:
 
 def _check_kind(k: int, kind: KindConfig, slots: int) -> None:
     where = f"pick.line.catalog[{k}]"
-    if kind.shape not in SHAPE_SIZES:
-        raise ScenarioError(f"{where}.shape: {kind.shape!r} is not one of box, cylinder")
-    if len(kind.size) != SHAPE_SIZES[kind.shape] or min(kind.size) <= 0.0:
-        raise ScenarioError(f"{where}.size: a {kind.shape} needs {SHAPE_SIZES[kind.shape]} positive "
-                            f"sizes (m)")
-    if not kind.mass > 0.0 or not kind.friction > 0.0:
-        raise ScenarioError(f"{where}.{'mass' if not kind.mass > 0.0 else 'friction'}: must be positive")
+    check_part_shape(where, kind.shape, kind.size, kind.mass, kind.friction)
     if not kind.slots or any(not 0 <= j < slots for j in kind.slots):
         raise ScenarioError(f"{where}.slots: tray slots 0 … {slots - 1} for this kind, got {kind.slots}")
 

@@ -265,17 +265,27 @@ def _record(meshcat, viz, plant, context, series: dict, objs: np.ndarray, ends, 
                 meshcat.SetTransform(f"triads/{name}", pose, time_in_recording=tf_)
 
 
-def _replay_diagram(model_file: str, meshcat: Meshcat):
+def replay_visualizer(builder: DiagramBuilder, scene_graph) -> tuple:
+    """The shared Meshcat cleared (its scene and its recording) and an illustration visualizer of
+    ``scene_graph`` added to ``builder``, which is then built: (visualizer, meshcat, the diagram's
+    default context) for a world's replay to record into."""
+    meshcat = shared_meshcat()
+    meshcat.Delete()
+    meshcat.DeleteRecording()
+    viz = MeshcatVisualizer.AddToBuilder(
+        builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration))
+    return viz, meshcat, builder.Build().CreateDefaultContext()
+
+
+def _replay_diagram(model_file: str):
     """The model in a plant + SceneGraph + MeshcatVisualizer diagram (no dynamics: the logged
-    q is replayed into it); returns (plant, scene_graph, visualizer, root context)."""
+    q is replayed into it); returns (plant, scene_graph, visualizer, meshcat, root context)."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     Parser(plant).AddModels(str(model_file))
     plant.Finalize()
-    viz = MeshcatVisualizer.AddToBuilder(
-        builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration))
-    diagram = builder.Build()
-    return plant, scene_graph, viz, diagram.CreateDefaultContext()
+    viz, meshcat, context = replay_visualizer(builder, scene_graph)
+    return plant, scene_graph, viz, meshcat, context
 
 
 def _draw_scene(meshcat: Meshcat, series: dict, raw: np.ndarray, ends, radius: float, belts) -> None:
@@ -312,10 +322,7 @@ def write_replay(series: dict, metrics: dict, model_file: str, path, fps: float 
     each object's true R_r (row-major) at ``series["t"]`` — to draw the frame triads on
     ``end_effector`` and the active object.  ``title``: the overlay's first line (``finish_page``).
     """
-    meshcat = shared_meshcat()
-    meshcat.Delete()
-    meshcat.DeleteRecording()
-    plant, scene_graph, viz, context = _replay_diagram(model_file, meshcat)
+    plant, scene_graph, viz, meshcat, context = _replay_diagram(model_file)
     starts = [s["start"] for s in metrics["segments"]]
     ends = [s["start"] + s["tf"] for s in metrics["segments"]]
     objs = object_positions(series, starts, ends)

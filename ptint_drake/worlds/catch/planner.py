@@ -11,8 +11,13 @@ with the catch's β) × ``TORQUE_MARGIN``, and at least ``MIN_TF``.  The margin 
 term of the oracle's feasibility model is not binding on the arm's tf at these speeds, and a
 margin of 1.25 (as first set) refused throws 58, 67 and 147, which the oracle calls reachable
 (the straight joint-space bound is already above the oracle's tf on them) and which are caught
-without it.  Of those,
-the one nearest the hand's present tip (least motion) is chosen.  None: the plan is refused now;
+without it.  Each such candidate's whole motion is then modelled (``speeds.peak_ratio``: the
+approach along the law's task-space line, the moving catch target, the matching, with room for
+a revision of the catch point) and kept only when every joint stays within ``SPEED_SHARE`` of
+its speed limit, with the largest matched fraction m' ≤ the configured one that does
+(``within_limits``; not even m' = 0: refused).  Of those, the one with the largest matched
+speed m'|v_c| is chosen (``_fastest_match``), the nearest the hand's present tip among equals
+(without matching: the nearest that fits).  None: the plan is refused now;
 ``Planner.hopeless`` tells whether any candidate is left at all (a point in reach with the hand
 turned to it, whatever the time: the ball may still come), i.e. whether to try again later.
 
@@ -24,10 +29,14 @@ then met, and each replacement, nearest the hand, was an earlier, shorter catch)
 replaces one takes the candidate times nearest the old catch time first.
 
 The velocity the hand matches at the catch (``target``) is the plan's ``match``: ``catch.match``,
-capped by ``matchable`` so that the matched velocity alone takes at most ``SPEED_SHARE`` of any
-joint's speed limit (uncapped, 0.3 of a 4 m/s ball asked the iiwa's elbow for 1.8–2.3 times its
-limit at the catch postures: measured on throws 0, 1, 58, 147; the simulated plant does not
-enforce speed limits, so nothing else would show it).
+capped first by ``matchable`` (the matched velocity alone within ``SPEED_SHARE`` of every joint's
+limit: uncapped, 0.3 of a 4 m/s ball asked the iiwa's elbow for 1.8–2.3 times its limit) and
+then by the whole motion's model above.  Capping the matched velocity alone was not enough: the
+realized joint speeds exceeded a limit on 70 of throws 0–99 (the elbow of throw 58 at 1.37), from
+the approach along a straight task-space line (which a joint-space bound does not see), the
+law's lag and catch-up on it, and the revisions of the catch point corrected late at the
+prescribed-time gain (docs/catch.md).  The simulated plant does not enforce speed limits, so
+nothing else would show it.
 
 What the controller and the hand are then given is ``target``'s.
 """
@@ -44,6 +53,7 @@ from pydrake.solvers import Solve
 
 from ptint_drake.systems.task.tbg import tbg_profile
 from ptint_drake.worlds.catch.flight import from_estimate, propagate
+from ptint_drake.worlds.catch.speeds import peak_ratio
 
 APPROACH_CONE_DEG = 25.0
 FLOOR_Z = 0.2
@@ -54,6 +64,8 @@ MIN_TF = 0.1  # s
 REACH = 0.5  # m: candidates farther than this from the hand's tip are not tried
 ROT_SCALE = 0.1  # m/rad: the controller's weighing of the rotation (the catch scenario's)
 SPEED_SHARE = 0.8  # of a joint's speed limit the matched velocity may take
+MATCH_MARGIN = 1.15  # the matched velocity as modelled: the hand overshoots it near the catch
+MATCH_STEPS = 5  # bisection steps for a smaller m when the whole motion exceeds SPEED_SHARE
 
 
 @dataclass(frozen=True)
@@ -67,6 +79,7 @@ class Plan:
     q: np.ndarray
     tf_min: float
     match: float = 0.0
+    speed_ratio: float = 0.0
 
 
 def predict(estimate: np.ndarray, dt) -> np.ndarray:
@@ -84,8 +97,9 @@ def flight_states(estimate: np.ndarray, dt) -> np.ndarray:
 class Planner:
     """Catch plans for one arm with its hand (module docstring)."""
 
-    def __init__(self, plant, tip: str, beta: float, match: float = 0.0):
+    def __init__(self, plant, tip: str, beta: float, match: float = 0.0, match_time: float = 0.2):
         self.plant, self.frame, self.match = plant, plant.GetFrameByName(tip), float(match)
+        self.beta, self.match_time = float(beta), float(match_time)
         self.context = plant.CreateDefaultContext()
         self.v_max = plant.GetVelocityUpperLimits()[:7]
         f = np.linspace(0.0, 1.0, 401)
@@ -126,16 +140,54 @@ class Planner:
         ``q_arm``, or None (refused now); ``near``: the catch time of a plan it replaces (the
         candidates nearest it first, not the nearest points)."""
         q_now = np.asarray(q_arm, float)
-        self._left = False
-        for t_c, p, v in self.candidates(estimate, t_plan, self.tip(q_now)[0], near):
+        self._left, kept = False, []
+        for k, (t_c, p, v) in enumerate(self.candidates(estimate, t_plan, self.tip(q_now)[0], near)):
             q = self.ik(p, -v / np.linalg.norm(v), q_now)
             if q is None:
                 continue
             self._left = True
             tf = self.tf_needed(q_now, q)
             if t_c - t_plan >= max(tf, MIN_TF):
-                return Plan(t_plan, float(t_c), p, self.tip(q)[1], q, tf, self.matchable(q, v))
-        return None
+                kept.append((self.matchable(q, v) * float(np.linalg.norm(v)), k, float(t_c), p, v, q, tf))
+        return self._fastest_match(kept, q_now, t_plan)
+
+    def _fastest_match(self, kept: list, q_now: np.ndarray, t_plan: float) -> Optional[Plan]:
+        """Of the candidates ``kept`` (bound on the matched speed, order, t_c, point, velocity,
+        posture, tf), the one whose matched speed m'|v| within the limits (``within_limits``) is
+        the largest, the first in order among equals (without matching: the first that fits)."""
+        best, best_speed = None, -1.0
+        for bound, _, t_c, p, v, q, tf in sorted(kept, key=lambda c: (-c[0], c[1])):
+            if bound <= best_speed:
+                break  # m' ≤ the matched velocity's own cap: no later one can be faster
+            speed = float(np.linalg.norm(v))
+            R = self.tip(q)[1]
+            fit = self.within_limits(q_now, t_plan, t_c, p, v, R, q, bound / speed)
+            if fit is not None and fit[0] * speed > best_speed:
+                best, best_speed = Plan(t_plan, t_c, p, R, q, tf, *fit), fit[0] * speed
+        return best
+
+    def within_limits(self, q_now, t_plan: float, t_c: float, p, v, R, q, m: float) -> Optional[tuple]:
+        """(m', peak) for a catch at (t_c, p, v, R; posture q) from ``q_now``: the largest matched fraction
+        m' ≤ ``m`` whose whole modelled motion (``speeds.peak_ratio``) keeps every joint within
+        ``SPEED_SHARE`` of its limit, and that motion's peak; None when not even m' = 0 does."""
+        def peak(fraction: float) -> float:
+            return peak_ratio(self, q_now, t_plan, t_c, p, v, R, MATCH_MARGIN * fraction, self.match_time,
+                              self.beta, q)
+        top = peak(m)
+        if top <= SPEED_SHARE:
+            return m, top
+        low = peak(0.0) if m > 0.0 else top
+        if low > SPEED_SHARE:
+            return None
+        fit, lo, hi = (0.0, low), 0.0, m
+        for _ in range(MATCH_STEPS):  # bisection: the largest m' that fits, within m / 2^steps
+            mid = 0.5 * (lo + hi)
+            top = peak(mid)
+            if top <= SPEED_SHARE:
+                fit, lo = (mid, top), mid
+            else:
+                hi = mid
+        return fit
 
     def matchable(self, q, v) -> float:
         """The fraction of the ball's velocity ``v`` the hand may match at posture ``q``: the

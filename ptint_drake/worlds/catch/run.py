@@ -63,7 +63,7 @@ class CatchRun(WorldRun):
     def __init__(self, scenario, log: bool = True, settling: bool = False):
         self.scenario, c, self.settling = scenario, scenario.catch, settling
         self.arm = arm_plant()
-        self.planner = Planner(self.arm, TIP, c.beta, c.match)
+        self.planner = Planner(self.arm, TIP, c.beta, c.match, c.match_time)
         self.q0 = np.radians(scenario.robot.initial_q_deg)
         self.x0, self.R0 = self.planner.tip(self.q0)
         self.throw = throw(c.throw, self.x0)
@@ -225,4 +225,5 @@ def _span(a: float, b: float) -> float:
 def _plan_row(plan) -> dict:
     """A plan as the metrics list the revisions: when it was made, its catch time and point."""
     return {"t_plan": round(plan.t_plan, 6), "t_catch": round(plan.t_catch, 6), "match": round(plan.match, 3),
-            "point": np.round(plan.point, 5).tolist(), "tf_min": round(plan.tf_min, 4)}
+            "point": np.round(plan.point, 5).tolist(), "tf_min": round(plan.tf_min, 4),
+            "speed_ratio": round(plan.speed_ratio, 3)}

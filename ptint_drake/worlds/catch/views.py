@@ -41,11 +41,10 @@ def replay_frames(times: np.ndarray) -> np.ndarray:
 def _replay_plant(scenario):
     """The station's arm, hand and ball in a plant with a MeshcatVisualizer on the shared Meshcat
     (cleared): (plant, visualizer, meshcat, root context)."""
-    from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role  # noqa: PLC0415
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph  # noqa: PLC0415
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
-    from ptint_drake.views.replay import shared_meshcat  # noqa: PLC0415
+    from ptint_drake.views.replay import replay_visualizer  # noqa: PLC0415
     from ptint_drake.worlds.catch.ball import AddBall  # noqa: PLC0415
     from ptint_drake.worlds.catch.station import add_arm_and_hand  # noqa: PLC0415
 
@@ -54,12 +53,8 @@ def _replay_plant(scenario):
     add_arm_and_hand(plant, scenario.catch.gripper)
     AddBall(plant)
     plant.Finalize()
-    meshcat = shared_meshcat()
-    meshcat.Delete()
-    meshcat.DeleteRecording()
-    viz = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat,
-                                         MeshcatVisualizerParams(role=Role.kIllustration))
-    return plant, viz, meshcat, builder.Build().CreateDefaultContext()
+    viz, meshcat, context = replay_visualizer(builder, scene_graph)
+    return plant, viz, meshcat, context
 
 
 def _line(meshcat, path: str, points: np.ndarray, rgba: tuple, width: float = 2.0) -> None:

@@ -13,6 +13,7 @@ the plant's settings (Drake's ``MultibodyPlantConfig`` fields that matter here).
 import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.part_shape import check_part_shape
 from ptint_drake.config.pick import (  # noqa: F401
     BeltConfig,
     BinConfig,
@@ -26,7 +27,6 @@ from ptint_drake.systems.hand.datasheets import check_gripper
 
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
 DEFAULT_APPROXIMATION = "sap"  # measured by scripts/contact_bench.py: the most accurate, and fast
-SHAPE_SIZES = {"box": 3, "cylinder": 2}
 
 
 def contact_approximations() -> list:
@@ -43,13 +43,7 @@ def grasp_width(part: PartConfig) -> float:
 
 def _check_part(k: int, part: PartConfig, belts: dict) -> None:
     where = f"pick.parts[{k}]"
-    if part.shape not in SHAPE_SIZES:
-        raise ScenarioError(f"{where}.shape: {part.shape!r} is not one of box, cylinder")
-    if len(part.size) != SHAPE_SIZES[part.shape] or min(part.size) <= 0.0:
-        raise ScenarioError(f"{where}.size: a {part.shape} needs {SHAPE_SIZES[part.shape]} positive sizes "
-                            f"(m)")
-    if not part.mass > 0.0 or not part.friction > 0.0:
-        raise ScenarioError(f"{where}.{'mass' if not part.mass > 0.0 else 'friction'}: must be positive")
+    check_part_shape(where, part.shape, part.size, part.mass, part.friction)
     if part.belt not in belts:
         raise ScenarioError(f"{where}.belt: no belt named {part.belt!r}")
     if abs(part.offset) + abs(part.offset_jitter) > belts[part.belt].length / 2:

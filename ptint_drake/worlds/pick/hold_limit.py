@@ -19,7 +19,7 @@ from functools import lru_cache
 import numpy as np
 from pydrake.geometry import Role, SceneGraph
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.plant import CalcContactFrictionFromSurfaceProperties, CoulombFriction, MultibodyPlant
 
 from ptint_drake.config.pick import GripperConfig, MoveConfig, PickTaskConfig
 from ptint_drake.systems.task.tbg import tbg_profile
@@ -48,8 +48,9 @@ def pad_friction(model: str) -> float:
 
 
 def pair_friction(mu_a: float, mu_b: float) -> float:
-    """Drake's combination of two surfaces' friction coefficients."""
-    return 0.0 if mu_a + mu_b <= 0.0 else 2.0 * mu_a * mu_b / (mu_a + mu_b)
+    """Drake's combination of two surfaces' (static) friction coefficients, as the plant applies it."""
+    pair = CalcContactFrictionFromSurfaceProperties(CoulombFriction(mu_a, mu_a), CoulombFriction(mu_b, mu_b))
+    return float(pair.static_friction())
 
 
 def lift_acceleration(height: float, lift: MoveConfig) -> float:

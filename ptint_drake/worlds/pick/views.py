@@ -35,11 +35,10 @@ def replay_world(scenario):
     """The scenario's whole pick world (arm, gripper, belts, parts, tray) in a plant with a
     MeshcatVisualizer on the shared Meshcat, cleared: (plant, visualizer, Meshcat, root context) —
     no dynamics, a logged plant state is set into it."""
-    from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role  # noqa: PLC0415
     from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig  # noqa: PLC0415
     from pydrake.systems.framework import DiagramBuilder  # noqa: PLC0415
 
-    from ptint_drake.views.replay import shared_meshcat  # noqa: PLC0415
+    from ptint_drake.views.replay import replay_visualizer  # noqa: PLC0415
     from ptint_drake.worlds.pick.cell import world_config  # noqa: PLC0415
     from ptint_drake.worlds.pick.station import _add_world  # noqa: PLC0415
 
@@ -48,12 +47,8 @@ def replay_world(scenario):
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(time_step=config.time_step), builder)
     _add_world(plant, scene_graph, config)
     plant.Finalize()
-    meshcat = shared_meshcat()
-    meshcat.Delete()
-    meshcat.DeleteRecording()
-    viz = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat,
-                                         MeshcatVisualizerParams(role=Role.kIllustration))
-    return plant, viz, meshcat, builder.Build().CreateDefaultContext()
+    viz, meshcat, context = replay_visualizer(builder, scene_graph)
+    return plant, viz, meshcat, context
 
 
 CLOUD_HOLD = 0.25  # s, the least a frame's cloud stays shown after its frame (one replay frame is 33 ms)
