@@ -7,9 +7,10 @@ catalog reachable from above (Drake's IK from the start posture) at half its kin
 ``lift_height`` above — a slot out of reach is named ``pick.tray.slots[j]``.
 
 ``line_warnings``: the arrival rate against the arm's capacity — the min-tf model's estimate
-(``line.cycle.estimate``, picks per minute) beside the saturated throughput measured on the
-bundled surplus line (``MEASURED_SURPLUS``, ``scripts/line_capacity.py``): above it, a warning with
-the numbers, and the run goes on.
+(``line.cycle.estimate``, picks per minute): above it, a warning with the numbers, and the run goes
+on.  The estimate, not a measurement: a measured throughput belongs to one cell and one commit
+(the surplus line's is measured by ``scripts/line_capacity.py``, docs/pick_place.md "The line's
+capacity").
 """
 
 from __future__ import annotations
@@ -31,9 +32,6 @@ from ptint_drake.worlds.pick.line.plan import line_plan
 from ptint_drake.worlds.pick.scene import AddGripper, gripper_stroke, slot_pose
 
 __all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
-# the saturated throughput measured on the bundled surplus line (a record of a measurement, not a
-# model: ``scripts/line_capacity.py``, docs/pick_place.md "The line's capacity")
-MEASURED_SURPLUS = "20.7 picks/min over 3 seeds (20.1, 21.3, 20.5; commit 4cdfe81)"
 
 
 def stroke_of(gripper) -> float:
@@ -75,7 +73,7 @@ def line_warnings(scenario, driver=None) -> list[str]:
     if driver is not None and getattr(driver, "cycles", None) is not None:
         capacity, cycle = estimate(driver.scenario, driver.view.window_at, driver.cycles.model)
         how = (f"the feasibility model's estimate: 60 / a {cycle:.2f} s cycle at the min tfs, "
-               f"line.cycle.estimate; measured on line_surplus: {MEASURED_SURPLUS}")
+               f"line.cycle.estimate")
     else:
         cycle = cycle_time(PickTaskConfig())
         capacity, how = 60.0 / cycle, f"60 / one pick's {cycle:.2f} s cycle with the tasks' default tfs"

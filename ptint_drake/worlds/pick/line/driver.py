@@ -14,11 +14,19 @@ belt speeds, the reach windows; the arm's state; its own tasks):
 - **while a task approaches** (before its descend), the grasp point predicted now is compared with
   the committed one; beyond ``line.redecide_mm`` (a belt without an encoder running faster or
   slower than declared: its speed is then learned from the track, ``view.LineView.learned``) the
-  window is checked at the committed time with that speed, and the min-tf model's lead from the
-  tool's present point to the part (``line.cycle``) against the time left to the grasp: still
-  in it and time enough, the task goes on (the targets follow the track: ``kept``); out of it, the scheduler
-  decides again from now and the task is replaced (``replaced``: its approach restarts from the
-  present state, its tf stretched to the new grasp time; nothing feasible: the task goes on).
+  scheduler's rule is checked again with that speed: the part in its window from the approach's
+  start (or now, the approach under way) to the committed grasp and the lift, and the min-tf
+  model's lead from the tool's present point (``line.cycle``) fitting between that start and the
+  grasp — measured without the first condition (the belt slowed to 0.3×, tests/e2e): the
+  approach kept aimed at a part still upstream of reach and the arm ran away.  Still in it and
+  time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
+  decides again from now and the task is replaced (``replaced``: an approach under way restarts
+  from the present state, its tf stretched to the new grasp time; one not started yet starts at
+  the model's lead before it; nothing feasible: the task goes on).
+
+Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
+a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
+the approach is stretched, and the task is not started where that grasp leaves reach.
 
 Every decision goes to the log (``decisions``: metrics.json ``line.decisions``); looks that find
 nothing new are not repeated in it.
@@ -31,21 +39,22 @@ from dataclasses import replace
 
 import numpy as np
 
-from ptint_drake.config.pick import PickTaskConfig
+from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
 from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.metrics import line_metrics
-from ptint_drake.worlds.pick.line.plan import IDLE_TF
-from ptint_drake.worlds.pick.line.scheduler import Timing, decide, drifted
+from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
+from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
 
 FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
+DETOUR_PASSES = 3  # plans made to fit a task's vias (``LineDriver._fit``)
 
 
 def cycle_time(task: PickTaskConfig) -> float:
@@ -114,6 +123,7 @@ class LineDriver:
         self._speeds: dict = {}  # belt → its known speed then
         self.cycles = None  # the min-tf model (``line.cycle``), built at the first bind
         self.planning_s: list = []  # wall s of each decision that chose (the scheduler and the model)
+        self._vias: dict = {}
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -202,8 +212,10 @@ class LineDriver:
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
                  "speed": round(track.speed, 4)}
         lead = self.cycles.lead(track, (s_in, s_out), t, *self._tool_now(self._arm_q(context)))
-        if s_in <= s <= s_out - track.speed * self.timing.slack and isinstance(lead, float) \
-                and t + lead <= grasp + 1e-9:  # in reach then, and the model's approach still fits
+        begin = max(t, self.scenario.pick.tasks[k].start)  # the approach's start (or now: under way)
+        if s_in <= track.s + track.speed * (begin - t) and s <= s_out - track.speed * self.timing.slack \
+                and isinstance(lead, float) and begin + lead <= grasp + 1e-9:
+            # in reach from the approach's start to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False
@@ -254,7 +266,11 @@ class LineDriver:
             return False
         self._last_look = None
         self._believe(tracks, t)
-        self._commit(run, t, decision, replacing, cycle)
+        task = self._fit(run, t, decision, replacing, cycle, tracks)
+        if task is None:
+            return False
+        self._commit(run, t, decision, replacing, task)
+        record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
         self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1,
                                         "tf": {p: round(v, 3) for p, v in cycle.phases.items()}})
         self.planning_s.append(time.perf_counter() - clock)
@@ -284,12 +300,55 @@ class LineDriver:
         X = arm.GetFrameByName(self.scenario.robot.end_effector).CalcPoseInWorld(context)
         return X.translation(), float(tool_yaw(X.rotation().matrix()))
 
-    def _commit(self, run, t: float, decision, replacing, cycle) -> None:
-        """The decision's task, its tfs from ``cycle`` (the min-tf model), into the run's tasks
-        (and its per-task records)."""
+    def _fit(self, run, t: float, decision, replacing, cycle, tracks):
+        """The decision's task (``LineCycles.task_of``: its approach from the model's start, or —
+        a replaced task whose approach is under way — from now), each phase the plan splits by a
+        via stretched to what the via's legs need (``LineCycles.detours``, on the plan the run
+        will follow: ``DETOUR_PASSES`` at most, the part's way moving with the approach); None,
+        logged, where the grasp then leaves reach (the track's lead grows by it: ``extra``)."""
         tasks = self.scenario.pick.tasks
         name = self.built.station.config.parts[decision.track].name
-        task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle)
+        track = next(tr for tr in tracks if tr.id == decision.track)
+        k = len(tasks) if replacing is None else replacing
+        tf = cycle.phases
+        begin = max(t, decision.grasp - tf["approach"] - tf["descend"] - self.cycles.extra.get(track.id, 0.0))
+        if replacing is not None and t >= tasks[replacing].start - 1e-9:
+            begin = t  # its approach under way: restarted from the present state
+        task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
+        mass = next(c.mass for c in self.line.catalog if c.name == track.kind)
+        self._vias = {}  # phase → the tf its via's legs need (the decision log's ``via_tf``)
+        why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
+        for _ in range(DETOUR_PASSES):
+            scenario = self.planning()
+            trial = [*tasks[:k], task, *tasks[k + 1:]]
+            scenario = replace(scenario, pick=replace(scenario.pick, tasks=trial))
+            replans = (*run.replans[:k], Replan(), *run.replans[k + 1:])
+            try:
+                needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
+            except NoTfFits as error:
+                why = f"no tf fits a via's leg: {error}"
+                break
+            short = {p: v for p, v in needs.items() if v > getattr(task, p).tf + 1e-3}
+            self._vias = {p: round(v, 3) for p, v in needs.items()}
+            if not short:
+                return task
+            task = replace(task, **{p: MoveConfig(v, getattr(task, p).beta) for p, v in short.items()})
+            grasp = task.start + task.approach.tf + task.descend.tf
+            if "approach" in short:
+                self.cycles.extra[track.id] = self.cycles.extra.get(track.id, 0.0) + grasp - decision.grasp
+            hit = blocker(track, tracks, grasp, t, self.timing)
+            if grasp > decision.deadline + 1e-9 or hit is not None:
+                why = (f"the approach's via needs {task.approach.tf:.3f} s: grasp at {grasp:.2f} s "
+                       + (f"blocked (track {hit})" if hit is not None else
+                          f"after the deadline {decision.deadline:.2f} s"))
+                break
+            decision.grasp, decision.point = grasp, tuple(float(c) for c in track.at(grasp, t))
+        self.decisions.append(decision.record() | {"not started": why})
+        return None
+
+    def _commit(self, run, t: float, decision, replacing, task) -> None:
+        """The decision's ``task`` (``_fit``) into the run's tasks (and its per-task records)."""
+        tasks = self.scenario.pick.tasks
         if replacing is None:
             tasks.append(task)
             run.replans.append(Replan())
@@ -297,6 +356,6 @@ class LineDriver:
             run.refused.append(None)
             k = len(tasks) - 1
         else:
-            tasks[replacing], k = replace(task, start=t), replacing
+            tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
         self.committed[k] = [decision.track, decision.grasp, decision.point]
