@@ -3,13 +3,18 @@
 The scheduler asks, per track, how long the arm needs from where it stands to a grasp of that
 part (``LineCycles.lead``: the approach's min tf from the tool's present point and yaw to
 ``clearance`` above the part riding its belt, plus the descend's — at least the fingers' close):
-a grasp time at least that far ahead (and that far after the part enters its reach window) is one
-the arm makes within its joint speed and torque limits (× ``phase_time.MARGIN``).  The part is
-taken where it will be when the approach can start: now, or its window's entry if it is still
-upstream — or up to ``WAITS`` later, where the straight way from the tool to it has no top-down
-posture all along (the lead then counts the wait).  A lead is cached per track and ``LEAD_STEP``
-of its belt coordinate (a free arm looks
-every ``decide_period``; the tool holds still meanwhile).
+a grasp time at least that far ahead is one the arm makes within its joint speed and torque
+limits (× ``phase_time.MARGIN``).  A lead counts from now, or from the part's entry into its
+reach window when it is still upstream; there the approach starts before the entry, so that it
+ends as the part enters (the approach's min tf found again for the part where it is at that
+earlier start: a fixed point, ``EARLY_PASSES``; the grasp then one descend after the entry).
+Every sample of both ways has a top-down posture by Drake's IK (``phase_time``), and the part is
+in reach over the whole descend, the grasp and the lift: the scheduler's old rule — the part in
+reach from the approach's start on, the approach from the tray to the window's entry passing the
+waist axis in 1.5–2.5 s after the part entered (line_short seed 0: 2.45 s) — is kept for the
+approach's end only.  Where a way has no top-down posture all along, the approach starts up to
+``WAITS`` later (the lead counts the wait).  A lead is cached per track and ``LEAD_STEP`` of its
+belt coordinate (a free arm looks every ``decide_period``; the tool holds still meanwhile).
 
 The chosen task's tfs (``LineCycles.phases``) are one ``phase_time.cycle_time`` from the tool's
 point and yaw, the part at the approach's start riding its belt (approach, descend), the payload
@@ -49,6 +54,7 @@ from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
 
 LEAD_STEP = 0.01  # m along the belt: a lead's cache key
 WAITS = (0.0, 0.25, 0.5, 1.0, 1.5, 2.0)  # s: an approach's start put off, when its way leaves the reach
+EARLY_PASSES = 3  # fixed-point passes of an approach that ends as its part enters reach
 PHASE_NAMES = ("approach", "descend", "lift", "carry", "place", "retreat")
 
 
@@ -63,45 +69,107 @@ class LineCycles:
         self.extra: dict = {}  # track → s its approach's via needs beyond the straight way (``detours``)
 
     def lead(self, track, window: tuple, now: float, start, yaw: float):
-        """s from an approach's start to the grasp of ``track`` (approach + descend min tfs), the
-        tool at ``start`` turned to ``yaw``; a str naming why no tf fits."""
+        """s from now, or from the part's entry into its ``window`` if later, to the earliest grasp
+        of ``track`` (module docstring), the tool at ``start`` turned to ``yaw``; a str naming why
+        no tf fits."""
+        found = self.found(track, window, start, yaw)
+        if isinstance(found, str):
+            return found
+        return float(_lead_of(found)) + self.extra.get(track.id, 0.0)
+
+    def found(self, track, window: tuple, start, yaw: float):
+        """(approach, descend, wait, early) of ``_lead``, cached, or a str."""
         ahead, key = _key(track, window, start, yaw)
         if key not in self._leads:
             self._leads[key] = self._lead(track, ahead, start, yaw)
-        found = self._leads[key]
-        return found if isinstance(found, str) else float(sum(found)) + self.extra.get(track.id, 0.0)
+        return self._leads[key]
 
     def _lead(self, track, ahead: float, start, yaw: float):
-        """(approach, descend, wait) or a str: the approach starting ``ahead`` + wait s from now,
-        the first of ``WAITS`` whose way has a top-down posture all along (at its window's entry
-        the part may be in reach while the way above it is not yet)."""
+        """(approach, descend, wait, early) or a str naming why no tf fits (module docstring): the
+        approach starting at the entry (or now) + wait, the first of ``WAITS`` whose ways have a
+        top-down posture all along; then, for a part upstream, one that starts ``early`` s before
+        and ends at the entry + a wait (the first of ``WAITS`` that fits, ``_early``), where its
+        lead is the shorter."""
         ride = track.speed * np.asarray(track.direction)
         up = np.array([0.0, 0.0, self.task.clearance])
         grip = nearest_branch(yaw, _yaw(track))
-        why = ""
+
+        def approach_from(t: float, guess: Optional[float] = None) -> float:
+            """The approach's min tf, the part where it is at t (the fixed point from ``guess``: a
+            riding way too short to reach the window has no top-down posture all along)."""
+            self.model.last = guess or self.model.last
+            return self.model.min_tf(start, np.asarray(track.at(t, 0.0)) + up, ride, 0.0,
+                                     self.task.approach.beta, (yaw, grip))
+
+        def descend_at(t: float) -> float:  # the descend's, the part where it is at t
+            at = np.asarray(track.at(t, 0.0))
+            return max(self.model.min_tf(at + up, at, ride, 0.0, self.task.descend.beta, (grip, grip)),
+                       self.task.margin / self.model.gripper_speed)
+
+        best, why = None, ""
         for wait in WAITS:
-            part = np.asarray(track.at(0.0, -(ahead + wait)))  # where it is at the approach's start
             try:
-                approach = self.model.min_tf(start, part + up, ride, 0.0, self.task.approach.beta,
-                                             (yaw, grip))
-                at = part + ride * approach
-                descend = max(self.model.min_tf(at + up, at, ride, 0.0, self.task.descend.beta, (grip, grip)),
-                              self.task.margin / self.model.gripper_speed)
+                approach = approach_from(ahead + wait)
+                best = (approach, descend_at(ahead + wait + approach), wait, 0.0)
+                break
             except NoTfFits as error:
                 why = f"no tf fits: {error}"
+        if best is None:
+            return why
+        for wait in WAITS if ahead > 0.0 else ():
+            if wait + best[1] >= _lead_of(best):
+                break  # no shorter lead left
+            found = self._early(approach_from, ahead, wait)
+            try:
+                if found is not None:
+                    early = (found[0], descend_at(ahead + wait - found[1] + found[0]), wait, found[1])
+                    return early if _lead_of(early) < _lead_of(best) else best
+            except NoTfFits:
                 continue
-            return approach, descend, wait
-        return why
+        return best
+
+    @staticmethod
+    def _early(approach_from, ahead: float, wait: float):
+        """(approach, early): an approach's min tf that ends with the part in its window, and how
+        long before the entry + ``wait`` it starts (not before now) — a fixed point,
+        ``EARLY_PASSES`` at most; None where none ends so or a way has no top-down posture."""
+        trial = ahead + wait
+        for _ in range(EARLY_PASSES):
+            try:
+                tf = approach_from(ahead + wait - trial, trial)
+            except NoTfFits:
+                return None
+            if tf + wait >= trial - 1e-9:  # it ends with the part in its window
+                return tf, trial
+            trial = tf  # it would end before the part enters: start it later
+        return None
+
+    def fits(self, track, begin: float, grasp: float, now: float, start, yaw: float) -> bool:
+        """Whether an approach from the tool at ``start`` (turned to ``yaw``) starting at ``begin``
+        and the descend make the grasp of ``track`` at ``grasp``: their min tfs, the part where it
+        is at ``begin`` (a kept task, ``driver``); False where no tf fits."""
+        ride = track.speed * np.asarray(track.direction)
+        up = np.array([0.0, 0.0, self.task.clearance])
+        grip = nearest_branch(yaw, _yaw(track))
+        try:
+            part = np.asarray(track.at(begin, now))
+            approach = self.model.min_tf(start, part + up, ride, 0.0, self.task.approach.beta, (yaw, grip))
+            at = part + ride * approach
+            descend = max(self.model.min_tf(at + up, at, ride, 0.0, self.task.descend.beta, (grip, grip)),
+                          self.task.margin / self.model.gripper_speed)
+        except NoTfFits:
+            return False
+        return begin + approach + descend + self.extra.get(track.id, 0.0) <= grasp + 1e-9
 
     def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot: int) -> Cycle:
         """The cycle of a grasp of ``track`` (reach ``window``) at ``grasp`` (module docstring), its
-        approach starting ``lead`` before it."""
+        approach starting its min tf and the descend's before it (or now)."""
         pick = self.scenario.pick
         kind = _kind_part(pick, track.kind)
-        lead = self.lead(track, window, now, start, yaw)
-        found = self._leads.get(_key(track, window, start, yaw)[1])
-        wait = found[2] if isinstance(found, tuple) else 0.0
-        begin = max(now, grasp - lead + wait) if isinstance(lead, float) else now
+        found = self.found(track, window, start, yaw)
+        begin = now
+        if not isinstance(found, str):
+            begin = max(now, grasp - found[0] - found[1] - self.extra.get(track.id, 0.0))
         task = replace(self.task, slot=slot)
         place = place_point(pick, "slot", slot, kind)
         return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
@@ -166,6 +234,12 @@ def estimate(scenario, view, model: Optional[PhaseTimes] = None) -> tuple:
             totals.append(cycle.total)
     mean = float(np.mean(totals))
     return 60.0 / mean, mean
+
+
+def _lead_of(found: tuple) -> float:
+    """s from the entry (or now) to the grasp of a ``_lead`` (approach, descend, wait, early)."""
+    approach, descend, wait, early = found
+    return approach + descend + wait - early
 
 
 def _key(track, window: tuple, start, yaw: float) -> tuple:

@@ -15,10 +15,10 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   the committed one; beyond ``line.redecide_mm`` (a belt without an encoder running faster or
   slower than declared: its speed is then learned from the track, ``view.LineView.learned``) the
   scheduler's rule is checked again with that speed: the part in its window from the approach's
-  start (or now, the approach under way) to the committed grasp and the lift, and the min-tf
-  model's lead from the tool's present point (``line.cycle``) fitting between that start and the
-  grasp — measured without the first condition (the belt slowed to 0.3×, tests/e2e): the
-  approach kept aimed at a part still upstream of reach and the arm ran away.  Still in it and
+  end to the committed grasp and the lift, and the min-tf model's approach and descend from the
+  tool's present point (``line.cycle.LineCycles.fits``) fitting between the approach's start (or
+  now, under way) and the grasp — measured without the first condition (the belt slowed to 0.3×,
+  tests/e2e): the approach kept aimed at a part still upstream of reach and the arm ran away.  Still in it and
   time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
   decides again from now and the task is replaced (``replaced``: an approach under way restarts
   from the present state, its tf stretched to the new grasp time; one not started yet starts at
@@ -211,11 +211,11 @@ class LineDriver:
         s = track.s + track.speed * (grasp - t)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
                  "speed": round(track.speed, 4)}
-        lead = self.cycles.lead(track, (s_in, s_out), t, *self._tool_now(self._arm_q(context)))
-        begin = max(t, self.scenario.pick.tasks[k].start)  # the approach's start (or now: under way)
-        if s_in <= track.s + track.speed * (begin - t) and s <= s_out - track.speed * self.timing.slack \
-                and isinstance(lead, float) and begin + lead <= grasp + 1e-9:
-            # in reach from the approach's start to the lift (``scheduler``), the model's approach fits
+        task = self.scenario.pick.tasks[k]
+        begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
+        if s_in <= track.s + track.speed * (end - t) and s <= s_out - track.speed * self.timing.slack \
+                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
+            # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False

@@ -10,13 +10,12 @@ finds its grasp time on a grid of ``Timing.step`` from the decision:
 2. its reach window (``windows[id]`` = [s_in, s_out]: where along its belt a top-down grasp and
    the lift above it are reachable, found by Drake's IK, ``robot.reachability``) — the predicted
    coordinate s(t) = s + speed · (t − now) inside it at the grasp time;
-3. the earliest grasp time at least the track's lead from now (``leads``: the approach and
-   descend min tfs of the phase time model from the arm's present point, ``line.cycle``; without
-   it ``Timing.lead``, the tasks' default tfs) and that lead after the part enters
-   its window (a prescribed-time approach aims at the moving part all along: the part in reach
-   from the approach's start on, else the reference drags the arm towards a place it cannot be —
-   measured: a grasp at the window's entry ran the RV-M1 through its base into its joint
-   limits), and at least
+3. the earliest grasp time at least the track's lead after now or, if later, after the part
+   enters its window (``leads``: the phase time model's, ``line.cycle``: its approach from the
+   arm's present point ends as the part enters, every sample of its way checked by IK, then the
+   descend; without it ``Timing.lead``, the tasks' default tfs, the whole approach with the part
+   in reach — a prescribed-time approach aims at the moving part all along, and unchecked, a
+   grasp at the window's entry ran the RV-M1 through its base into its joint limits), and at least
    ``Timing.slack`` before the part leaves it (so that the lift too is done in reach): else
    ``not reachable in time`` when the window closes too soon, or ``not in reach yet`` when the
    part is still upstream beyond the look-ahead ``Timing.horizon`` (not a failure: looked at again);
