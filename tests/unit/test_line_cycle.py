@@ -82,6 +82,10 @@ def test_an_upstream_parts_approach_ends_as_the_part_enters_its_reach(cycles):
     lead = cycles.lead(part, window, 5.0, start, 0.0)
     assert lead == pytest.approx(approach + descend + wait - early)
     assert lead < approach + descend  # the old rule: the whole approach after the entry
+    cycles.drop_early(part.id)  # (its cycle found no early approach): the whole approach after the entry
+    assert cycles.found(part, window, start, 0.0)[3] == 0.0
+    assert cycles.lead(part, window, 5.0, start, 0.0) > lead
+    cycles.plain.clear()
 
 
 def test_a_kept_task_fits_only_with_the_models_approach_before_its_grasp(cycles):

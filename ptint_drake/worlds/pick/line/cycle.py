@@ -67,6 +67,7 @@ class LineCycles:
         self.task = PickTaskConfig()
         self._leads: dict = {}
         self.extra: dict = {}  # track → s its approach's via needs beyond the straight way (``detours``)
+        self.plain: set = set()  # tracks whose approach starts after the entry (``drop_early``)
 
     def lead(self, track, window: tuple, now: float, start, yaw: float):
         """s from now, or from the part's entry into its ``window`` if later, to the earliest grasp
@@ -116,7 +117,7 @@ class LineCycles:
                 why = f"no tf fits: {error}"
         if best is None:
             return why
-        for wait in WAITS if ahead > 0.0 else ():
+        for wait in WAITS if ahead > 0.0 and track.id not in self.plain else ():
             if wait + best[1] >= _lead_of(best):
                 break  # no shorter lead left
             found = self._early(approach_from, ahead, wait)
@@ -127,6 +128,11 @@ class LineCycles:
             except NoTfFits:
                 continue
         return best
+
+    def drop_early(self, track_id: int) -> None:
+        """The track's leads from now on without an early approach (its cycle found none: ``driver``)."""
+        self.plain.add(track_id)
+        self._leads = {k: v for k, v in self._leads.items() if k[0] != track_id}
 
     @staticmethod
     def _early(approach_from, ahead: float, wait: float):
@@ -170,6 +176,7 @@ class LineCycles:
         begin = now
         if not isinstance(found, str):
             begin = max(now, grasp - found[0] - found[1] - self.extra.get(track.id, 0.0))
+            self.model.last = found[0]  # the riding approach's fixed point from the lead's (``_early``)
         task = replace(self.task, slot=slot)
         place = place_point(pick, "slot", slot, kind)
         return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),

@@ -284,6 +284,7 @@ class LineDriver:
             return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
         except NoTfFits as error:
             self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
+            self.cycles.drop_early(track.id)  # the next look: the approach after the entry
             return None
 
     def _arm_q(self, context) -> np.ndarray:
