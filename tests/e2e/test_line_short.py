@@ -30,15 +30,16 @@ def test_short_line_places_what_it_decides_and_logs_every_decision(tmp_path, pti
     redecided = [d for d in line["decisions"] if d.get("redecide") == "replaced"]
     assert len(redecided) == 1 and redecided[0]["task"] == again["task"]
     default = PickTaskConfig()
-    chosen = [d for d in line["decisions"]
-              if d["track"] is not None and d.get("redecide", "replaced") == "replaced"]
+    chosen = [d for d in line["decisions"]  # (a choice whose task was not started names why instead)
+              if d["track"] is not None and "not started" not in d
+              and d.get("redecide", "replaced") == "replaced"]
     assert len(chosen) >= 2
     for d in line["decisions"]:
         if "redecide" in d and d["redecide"] != "replaced":  # a drift checked and kept: no choice
             continue
         assert all(s["reason"] in REASONS or s["reason"].startswith(("blocked", "no tf fits"))
                    for s in d["skipped"]), d
-        if d["track"] is not None:  # a grasp far enough ahead for the arm, before the deadline
+        if d in chosen:  # a grasp far enough ahead for the arm, before the deadline
             tf = d["tf"]  # each phase's tf from the min-tf model (line.cycle), not the tasks' defaults
             assert d["t"] + tf["descend"] - 1e-6 <= d["grasp"] <= d["deadline"] + 1e-9, d
             assert tf["carry"] != default.carry.tf and tf["approach"] != default.approach.tf, d

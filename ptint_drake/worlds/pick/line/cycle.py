@@ -30,6 +30,13 @@ two legs are asked of the model on their own — from the previous segment's tar
 way starts — and the phase takes the longest of tf₁ / share and tf₂ / (1 − share), the plan's own
 split kept (``driver`` stretches the task, or gives it up where its grasp then leaves reach).
 
+The start state: the model starts each phase at rest on its way, from the tool's present point
+(the arm's posture read at the decision).  Measured over 110 segment starts of two runs
+(line_surplus seed 2 and the slowed-belt case of tests/e2e, with the fixes here) the largest
+joint speed at a segment's start was 0.31 of its limit (a lift, leaving the belt's speed; median
+0.02): no margin is added for it.  The two runaways blamed on chaining were a via (above) and a
+drift kept with its part out of reach at the approach's end (``driver``), not a carried velocity.
+
 ``estimate`` — the line's capacity by the model: per kind of the catalog, one cycle from
 ``clearance`` above its first slot to a part at the middle of its reach window on its belt (no
 lateral offset, yaw 0) and back to that slot; 60 / the mean cycle, picks per minute (the arrival
