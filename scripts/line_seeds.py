@@ -7,7 +7,10 @@ Each seed is one ``ptint run SCENARIO --set pick.line.seed=K`` in a child proces
 other (the CPU seconds are the child's, from ``resource.getrusage(RUSAGE_CHILDREN)``).
 
     PYTHONPATH=$PWD python scripts/line_seeds.py [--scenario line_short] [--seeds 10] [--first 0]
-                                                 [--set KEY=VALUE ...]
+                                                 [--set KEY=VALUE ...] [--keep DIR]
+
+``--keep DIR``: each seed's metrics.json kept as DIR/seed_K.json (the decision log, per part its
+reason), to study the failures.
 """
 
 from __future__ import annotations
@@ -16,14 +19,16 @@ import argparse
 import collections
 import json
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 
-def run_seed(scenario: str, seed: int, overrides: list) -> dict:
-    """One seed's run: its ``line`` numbers and the child's CPU seconds."""
+def run_seed(scenario: str, seed: int, overrides: list, keep=None) -> dict:
+    """One seed's run: its ``line`` numbers and the child's CPU seconds (its metrics.json copied
+    into the folder ``keep``, if given)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out"
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -37,6 +42,9 @@ def run_seed(scenario: str, seed: int, overrides: list) -> dict:
         if not (out / "metrics.json").is_file():
             return {"seed": seed, "error": done.stderr.strip()[-300:], "cpu_s": cpu}
         metrics = json.loads((out / "metrics.json").read_text())
+        if keep is not None:
+            Path(keep).mkdir(parents=True, exist_ok=True)
+            shutil.copy(out / "metrics.json", Path(keep) / f"seed_{seed}.json")
     line = metrics["line"]
     reasons = collections.Counter(p["reason"] for p in line["parts"] if p["entered"] and not p["placed"])
     return {"seed": seed, "released": line["released"], "entered": line["entered"], "placed": line["placed"],
@@ -52,10 +60,11 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=10)
     parser.add_argument("--first", type=int, default=0)
     parser.add_argument("--set", action="append", default=[], dest="overrides")
+    parser.add_argument("--keep", default=None, help="a folder for each seed's metrics.json")
     args = parser.parse_args()
     rows = []
     for seed in range(args.first, args.first + args.seeds):
-        rows.append(run_seed(args.scenario, seed, args.overrides))
+        rows.append(run_seed(args.scenario, seed, args.overrides, args.keep))
         print(json.dumps(rows[-1]), file=sys.stderr, flush=True)
     ok = [r for r in rows if "error" not in r]
     entered, placed = sum(r["entered"] for r in ok), sum(r["placed"] for r in ok)

@@ -76,3 +76,24 @@ def test_decide_again_when_the_estimate_moves():
 def test_grasp_time_on_a_stopped_belt():
     assert grasp_time(track(0, 0.0, speed=0.0), WINDOW, 1.0, TIMING)[0] == 1.0 + TIMING.lead
     assert grasp_time(track(0, -1.0, speed=0.0), WINDOW, 1.0, TIMING) == (None, "not in reach (belt stopped)")
+
+
+def test_each_track_lead_comes_from_the_leads_model_and_a_lead_that_fits_nothing_is_named():
+    """With ``leads`` (the min-tf model's approach + descend per track) the grasp time is that lead
+    from now, not ``Timing.lead``; a str from the model skips the track with it."""
+    near, far = track(0, 0.0), track(1, -0.1)
+    asked = []
+
+    def leads(tr, window):
+        asked.append(tr.id)
+        return 0.83 if tr.id == 0 else 2.4
+
+    d = decide(10.0, [near, far], {0: WINDOW, 1: WINDOW}, set(), {"cube": [0]}, TIMING, leads)
+    assert d.track == 0 and abs(d.grasp - 10.9) < 1e-9  # 0.83 s rounded up to the 0.1 s grid
+    assert asked == [0]  # the later deadline is not asked for once a feasible part is found
+    d = decide(10.0, [near, far], {0: WINDOW, 1: WINDOW}, set(), {"cube": [0]}, TIMING,
+               lambda tr, w: "no tf fits: x" if tr.id == 0 else 2.4)
+    assert d.track == 1 and dict(d.skipped)[0] == "no tf fits: x" and abs(d.grasp - 12.4) < 1e-9
+    # a lead longer than the window leaves: not reachable in time (2.5 s left before the slack)
+    d = decide(10.0, [near], {0: WINDOW}, set(), {"cube": [0]}, TIMING, lambda tr, w: 2.6)
+    assert d.track is None and d.skipped == [(0, "not reachable in time")]

@@ -95,7 +95,7 @@ class PickRun(WorldRun):
 
     def pre_run_warnings(self) -> list[str]:
         if self.line.active:
-            return sampled_control_warnings(self.scenario) + line_warnings(self.scenario)
+            return sampled_control_warnings(self.scenario) + line_warnings(self.scenario, self.line)
         check_pick_reachable(self.scenario, self.built)
         check_pick_clearance(self.scenario, self.built)  # the fingers clear of the belts
         return (sampled_control_warnings(self.scenario) + arm_warnings(self.scenario, self.built)

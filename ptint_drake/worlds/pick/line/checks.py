@@ -8,10 +8,12 @@ gripper's stroke read from its model), the pool on its belts, and every slot of 
 reachable from above (Drake's IK from the start posture) at half its kind's height and
 ``lift_height`` above — a slot out of reach is named ``pick.tray.slots[j]``.
 
-``line_warnings``: the arrival rate against the planned capacity (60 / one pick's cycle with the
-tasks' defaults, per minute): above it, a warning with both numbers, and the run goes on; a
-camera that sees no point of the line's belts' centre lines (every ``VIEW_STEP``): a warning
-(every part will be ``not seen``), and the run goes on.
+``line_warnings``: the arrival rate against the arm's capacity — the min-tf model's estimate
+(``line.cycle.estimate``, picks per minute): above it, a warning with the numbers, and the run goes
+on.  The estimate, not a measurement: a measured throughput belongs to one cell and one commit
+(the surplus line's is measured by ``scripts/line_capacity.py``, docs/pick_place.md "The line's
+capacity").  A camera that sees no point of the line's belts' centre lines (every
+``VIEW_STEP``): a warning (every part will be ``not seen``), and the run goes on.
 """
 
 from __future__ import annotations
@@ -27,14 +29,15 @@ from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, describe_pose, in_view
 from ptint_drake.worlds.pick.config import check_pick_parts
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.cycle import estimate
 from ptint_drake.worlds.pick.line.driver import cycle_time
 from ptint_drake.worlds.pick.line.plan import line_plan
-
-__all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
 from ptint_drake.worlds.pick.scene import (BIN_DROP_CLEARANCE, AddGripper, belt_frame, gripper_stroke,
                                           slot_pose)
 
 VIEW_STEP = 0.01  # m, along a belt's centre line: the points a camera must see one of
+
+__all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
 
 
 def stroke_of(gripper) -> float:
@@ -95,12 +98,19 @@ def _blind(scenario) -> list[str]:
             f"every part will be not seen"]
 
 
-def line_warnings(scenario) -> list[str]:
-    """The arrival rate above the planned capacity, a blind camera (module docstring)."""
+def line_warnings(scenario, driver=None) -> list[str]:
+    """The arrival rate above the capacity, a blind camera (module docstring): the capacity is the
+    min-tf model's estimate when the run's ``driver`` (a bound ``LineDriver``) is given, else the
+    tasks' default tfs."""
     rate = 60.0 * sum(a.rate for a in scenario.pick.line.arrivals)
-    capacity = 60.0 / cycle_time(PickTaskConfig())
+    if driver is not None and getattr(driver, "cycles", None) is not None:
+        capacity, cycle = estimate(driver.scenario, driver.view.window_at, driver.cycles.model)
+        how = (f"the feasibility model's estimate: 60 / a {cycle:.2f} s cycle at the min tfs, "
+               f"line.cycle.estimate")
+    else:
+        cycle = cycle_time(PickTaskConfig())
+        capacity, how = 60.0 / cycle, f"60 / one pick's {cycle:.2f} s cycle with the tasks' default tfs"
     if rate <= capacity:
         return _blind(scenario)
-    return _blind(scenario) + [
-        f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's planned capacity "
-        f"{capacity:.1f} picks/min (60 / one pick's {cycle_time(PickTaskConfig()):.2f} s cycle)"]
+    return _blind(scenario) + [f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's capacity "
+                               f"{capacity:.1f} picks/min ({how}); the run goes on"]

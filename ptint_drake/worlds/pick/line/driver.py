@@ -14,10 +14,19 @@ belt speeds, the reach windows; the arm's state; its own tasks):
 - **while a task approaches** (before its descend), the grasp point predicted now is compared with
   the committed one; beyond ``line.redecide_mm`` (a belt without an encoder running faster or
   slower than declared: its speed is then learned from the track, ``view.LineView.learned``) the
-  window is checked at the committed time with that speed: still
-  in it, the task goes on (the targets follow the track: ``kept``); out of it, the scheduler
-  decides again from now and the task is replaced (``replaced``: its approach restarts from the
-  present state, its tf stretched to the new grasp time; nothing feasible: the task goes on).
+  scheduler's rule is checked again with that speed: the part in its window from the approach's
+  end to the committed grasp and the lift, and the min-tf model's approach and descend from the
+  tool's present point (``line.cycle.LineCycles.fits``) fitting between the approach's start (or
+  now, under way) and the grasp — measured without the first condition (the belt slowed to 0.3×,
+  tests/e2e): the approach kept aimed at a part still upstream of reach and the arm ran away.  Still in it and
+  time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
+  decides again from now and the task is replaced (``replaced``: an approach under way restarts
+  from the present state, its tf stretched to the new grasp time; one not started yet starts at
+  the model's lead before it; nothing feasible: the task goes on).
+
+Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
+a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
+the approach is stretched, and the task is not started where that grasp leaves reach.
 
 Every decision goes to the log (``decisions``: metrics.json ``line.decisions``); looks that find
 nothing new are not repeated in it.
@@ -25,22 +34,27 @@ nothing new are not repeated in it.
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
 import numpy as np
 
 from ptint_drake.config.pick import MoveConfig, PickTaskConfig
+from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate
+from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.metrics import line_metrics
-from ptint_drake.worlds.pick.line.plan import IDLE_TF
-from ptint_drake.worlds.pick.line.scheduler import Timing, decide, drifted
+from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
+from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
 
 FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
+DETOUR_PASSES = 3  # plans made to fit a task's vias (``LineDriver._fit``)
 
 
 def cycle_time(task: PickTaskConfig) -> float:
@@ -107,6 +121,9 @@ class LineDriver:
         self._last_look = None
         self._beliefs: dict = {}  # part → (offset, lateral, yaw_deg) as tracked at the last decision
         self._speeds: dict = {}  # belt → its known speed then
+        self.cycles = None  # the min-tf model (``line.cycle``), built at the first bind
+        self.planning_s: list = []  # wall s of each decision that chose (the scheduler and the model)
+        self._vias: dict = {}
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -115,6 +132,7 @@ class LineDriver:
             task = PickTaskConfig()
             self.timing = Timing(lead=task.approach.tf + task.descend.tf, margin=task.margin,
                                  finger=finger_extent(built.station))
+            self.cycles = LineCycles(self.scenario)
         self.truth.rebind(built.station)
         self.view.bind(built)
         self.built = built
@@ -155,8 +173,11 @@ class LineDriver:
             self._speeds[tr.belt] = tr.speed
 
     def add_metrics(self, metrics: dict, series: dict) -> None:
-        """metrics.json ``line`` (``metrics.line_metrics``)."""
+        """metrics.json ``line`` (``metrics.line_metrics``) and the min-tf model's capacity estimate
+        (``line.cycle.estimate``: ``capacity_estimate``, picks per minute and the cycle, s)."""
         metrics["line"] = line_metrics(self.scenario, self, metrics, series)
+        ppm, cycle = estimate(self.scenario, self.view.window_at, self.cycles.model)
+        metrics["line"]["capacity_estimate"] = {"picks_per_minute": ppm, "cycle_s": cycle}
 
     def stops(self, duration: float) -> list[float]:
         """The truth's stops and the scheduler's looks (every ``decide_period``)."""
@@ -193,7 +214,11 @@ class LineDriver:
         s = track.s + track.speed * (grasp - t)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
                  "speed": round(track.speed, 4)}
-        if s_in <= s <= s_out - track.speed * self.timing.slack:
+        task = self.scenario.pick.tasks[k]
+        begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
+        if s_in <= track.s + track.speed * (end - t) and s <= s_out - track.speed * self.timing.slack \
+                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
+            # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False
@@ -209,10 +234,10 @@ class LineDriver:
         return any(b.name == belt and b.encoder for b in self.line.belts)
 
     def _choose(self, run, context, t: float, replacing=None) -> bool:
-        """A decision from now; a task appended (or task ``replacing`` replaced): True."""
+        """A decision from now, each track's lead from the min-tf model (``line.cycle``); a task
+        appended (or task ``replacing`` replaced): True."""
+        clock = time.perf_counter()
         tasks = self.scenario.pick.tasks
-        if t + cycle_time(PickTaskConfig()) > self.scenario.duration:
-            return False  # no cycle fits before the end
         tracks = self.view.tracks(context, t)
         windows = {tr.id: self.view.window(tr) for tr in tracks}
         keep = [k for k in range(len(tasks)) if k != replacing]
@@ -220,13 +245,22 @@ class LineDriver:
         used = {tasks[k].slot for k in keep}
         free = {c.name: [c.bin] if c.bin else [j for j in c.slots if j not in used]
                 for c in self.line.catalog}
-        decision = decide(t, tracks, windows, assigned, free, self.timing)
+        q = self._arm_q(context)
+        start, yaw = self._tool_now(q)  # the arm's present point and yaw
+        decision = decide(t, tracks, windows, assigned, free, self.timing,
+                          lambda tr, w: self.cycles.lead(tr, w, t, start, yaw))
+        cycle = None
         if decision.track is not None:
-            station = self.built.station
-            q = station.diagram.GetOutputPort("state").Eval(station.diagram.GetMyContextFromRoot(context))
-            if self.view.reachable(np.asarray(decision.point), q[:self.built.arm.num_positions()]) is None:
+            if self.view.reachable(np.asarray(decision.point), q) is None:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
+            else:
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw)
+                if cycle is None:
+                    return False
+                if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
+                        > self.scenario.duration:
+                    return False  # its cycle would end after the line's
         record = decision.record()
         if decision.track is None:
             look = [(s["track"], s["reason"]) for s in record["skipped"]]
@@ -237,8 +271,14 @@ class LineDriver:
         self._last_look = None
         part = self._part_of(context, decision.track, tracks)
         self._believe(tracks, t)
-        self._commit(run, t, decision, replacing, part)
-        self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1})
+        task = self._fit(run, t, decision, replacing, cycle, tracks, part)
+        if task is None:
+            return False
+        self._commit(run, t, decision, replacing, task)
+        record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
+        self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1,
+                                        "tf": {p: round(v, 3) for p, v in cycle.phases.items()}})
+        self.planning_s.append(time.perf_counter() - clock)
         return True
 
     def _part_of(self, context, track: int, tracks: list) -> int:
@@ -251,27 +291,88 @@ class LineDriver:
         self.view.aim(part, track)
         return part
 
-    def _commit(self, run, t: float, decision, replacing, part: int) -> None:
-        """The decision's task into the run's tasks (and its per-task records)."""
-        tasks, default = self.scenario.pick.tasks, PickTaskConfig()
+    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float):
+        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``); None where no tf
+        fits a phase (logged)."""
+        track = next(tr for tr in tracks if tr.id == decision.track)
+        try:
+            return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
+        except NoTfFits as error:
+            self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
+            self.cycles.drop_early(track.id)  # the next look: the approach after the entry
+            return None
+
+    def _arm_q(self, context) -> np.ndarray:
+        """The arm's present joint positions (the station's state output)."""
+        station = self.built.station
+        q = station.diagram.GetOutputPort("state").Eval(station.diagram.GetMyContextFromRoot(context))
+        return q[:self.built.arm.num_positions()]
+
+    def _tool_now(self, q) -> tuple:
+        """(point, yaw) of the tool at the arm's posture ``q``."""
+        arm = self.built.arm
+        context = arm.CreateDefaultContext()
+        arm.SetPositions(context, q)
+        X = arm.GetFrameByName(self.scenario.robot.end_effector).CalcPoseInWorld(context)
+        return X.translation(), float(tool_yaw(X.rotation().matrix()))
+
+    def _fit(self, run, t: float, decision, replacing, cycle, tracks, part: int):
+        """The decision's task (``LineCycles.task_of``: its approach from the model's start, or —
+        a replaced task whose approach is under way — from now), each phase the plan splits by a
+        via stretched to what the via's legs need (``LineCycles.detours``, on the plan the run
+        will follow: ``DETOUR_PASSES`` at most, the part's way moving with the approach); None,
+        logged, where the grasp then leaves reach (the track's lead grows by it: ``extra``)."""
+        tasks = self.scenario.pick.tasks
         name = self.built.station.config.parts[part].name
+        track = next(tr for tr in tracks if tr.id == decision.track)
+        k = len(tasks) if replacing is None else replacing
+        tf = cycle.phases
+        begin = max(t, decision.grasp - tf["approach"] - tf["descend"] - self.cycles.extra.get(track.id, 0.0))
+        if replacing is not None and t >= tasks[replacing].start - 1e-9:
+            begin = t  # its approach under way: restarted from the present state
+        task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
+        mass = next(c.mass for c in self.line.catalog if c.name == track.kind)
+        self._vias = {}  # phase → the tf its via's legs need (the decision log's ``via_tf``)
+        why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
+        for _ in range(DETOUR_PASSES):
+            scenario = self.planning()
+            trial = [*tasks[:k], task, *tasks[k + 1:]]
+            scenario = replace(scenario, pick=replace(scenario.pick, tasks=trial))
+            replans = (*run.replans[:k], Replan(), *run.replans[k + 1:])
+            try:
+                needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
+            except NoTfFits as error:
+                why = f"no tf fits a via's leg: {error}"
+                break
+            short = {p: v for p, v in needs.items() if v > getattr(task, p).tf + 1e-3}
+            self._vias = {p: round(v, 3) for p, v in needs.items()}
+            if not short:
+                return task
+            task = replace(task, **{p: MoveConfig(v, getattr(task, p).beta) for p, v in short.items()})
+            grasp = task.start + task.approach.tf + task.descend.tf
+            if "approach" in short:
+                self.cycles.extra[track.id] = self.cycles.extra.get(track.id, 0.0) + grasp - decision.grasp
+            hit = blocker(track, tracks, grasp, t, self.timing)
+            if grasp > decision.deadline + 1e-9 or hit is not None:
+                why = (f"the approach's via needs {task.approach.tf:.3f} s: grasp at {grasp:.2f} s "
+                       + (f"blocked (track {hit})" if hit is not None else
+                          f"after the deadline {decision.deadline:.2f} s"))
+                break
+            decision.grasp, decision.point = grasp, tuple(float(c) for c in track.at(grasp, t))
+        self.decisions.append(decision.record() | {"not started": why})
+        return None
+
+    def _commit(self, run, t: float, decision, replacing, task) -> None:
+        """The decision's ``task`` (``_fit``) into the run's tasks (and its per-task records)."""
+        tasks = self.scenario.pick.tasks
         if replacing is None:
-            start = max(t, decision.grasp - self.timing.lead)
-            task = PickTaskConfig(part=name, start=start, **_destination(decision.slot))
             tasks.append(task)
             run.replans.append(Replan())
             run.checks.append([])
             run.refused.append(None)
             k = len(tasks) - 1
         else:
-            tf = decision.grasp - default.descend.tf - t
-            task = PickTaskConfig(part=name, start=t, **_destination(decision.slot),
-                                  approach=MoveConfig(tf, default.approach.beta))
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
         self.committed[k] = [decision.track, decision.grasp, decision.point]
 
-
-def _destination(where) -> dict:
-    """A decision's destination as a task's fields: a tray slot (an index) or a bin (its name)."""
-    return {"bin": where} if isinstance(where, str) else {"slot": where}

@@ -13,6 +13,10 @@ and the run's records — the parts, not the tasks, are counted:
   throughout) or ``on the belt at the end``;
 - ``placed_fraction`` (placed / entered), ``picks_per_minute`` (placed / duration),
   ``cycle_s`` (per task: its approach's start to its retreat's end) and their mean;
+  ``tasks_span_s`` (the first approach's start to the last retreat's end) and
+  ``tasks_per_minute_busy`` (the tasks over it: on a surplus line, the arm's saturated
+  throughput); ``planning_ms``: the wall time of the decisions that chose (the scheduler, the
+  reach windows, the min-tf model of ``line.cycle``), median and max;
 - ``decisions``: the decision log (``scheduler.Decision.record``, and the re-decisions);
 - ``replaced``: the tasks replaced in their approach, each with the commanded torque's jump at
   the switch (N·m, the largest joint's change between the logged samples around it) beside the
@@ -145,11 +149,19 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
     cycles = [plan.schedule.segments[plan.segment_index(k, "retreat")].end
               - plan.schedule.segments[plan.segment_index(k, "approach", 0)].start
               for k in range(len(scenario.pick.tasks))]
+    segments = plan.schedule.segments
+    span = (segments[plan.segment_index(len(cycles) - 1, "retreat")].end
+            - segments[plan.segment_index(0, "approach", 0)].start) if cycles else None
     jumps, usual = _torque_jumps(series, driver.replaced)
+    times = 1e3 * np.asarray(driver.planning_s)
     return {"released": len(truth.released), "entered": entered, "placed": placed,
             "placed_fraction": placed / entered if entered else None,
             "picks_per_minute": 60.0 * placed / scenario.duration, "cycle_s": cycles,
             "mean_cycle_s": float(np.mean(cycles)) if cycles else None,
+            "tasks_span_s": span, "tasks_per_minute_busy": 60.0 * len(cycles) / span if span else None,
+            "planning_ms": {"decisions": len(times),
+                            "median": float(np.median(times)) if len(times) else None,
+                            "max": float(np.max(times)) if len(times) else None},
             "passed": len(truth.passed), "parts": parts, "decisions": driver.decisions,
             "replaced": jumps, "largest_torque_step_elsewhere_Nm": usual,
             "not_seen": sum(p["reason"] == "not seen" for p in parts),

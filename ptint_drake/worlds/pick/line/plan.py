@@ -28,8 +28,22 @@ def home_pose(scenario, arm) -> tuple:
     return tuple(float(c) for c in X.translation()), float(tool_yaw(X.rotation().matrix()))
 
 
+_LAST: dict = {}  # the last plan made, by what it was made from (``line_plan``)
+
+
 def line_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
-    """The idle segment, then the plan of ``scenario.pick.tasks`` (module docstring)."""
+    """The idle segment, then the plan of ``scenario.pick.tasks`` (module docstring).  The last
+    plan is kept by the robot, the pick block and the replans it was made from (``repr``: the driver
+    makes the plan of a task it fits, then the run's rebuild asks for the same)."""
+    key = repr((scenario.robot, scenario.pick, replans))
+    if key not in _LAST:
+        _LAST.clear()
+        _LAST[key] = _line_plan(scenario, replans, arm)
+    return _LAST[key]
+
+
+def _line_plan(scenario, replans: tuple, arm) -> PickPlan:
+    """``line_plan``, made."""
     if arm is None:
         from ptint_drake.robot.plant import nominal_plant  # noqa: PLC0415
 

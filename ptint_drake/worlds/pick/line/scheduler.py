@@ -10,12 +10,12 @@ finds its grasp time on a grid of ``Timing.step`` from the decision:
 2. its reach window (``windows[id]`` = [s_in, s_out]: where along its belt a top-down grasp and
    the lift above it are reachable, found by Drake's IK, ``robot.reachability``) — the predicted
    coordinate s(t) = s + speed · (t − now) inside it at the grasp time;
-3. the earliest grasp time at least ``Timing.lead`` from now (the default approach and descend
-   tfs: phases the arm is known to make — the tasks' defaults) and ``lead`` after the part enters
-   its window (a prescribed-time approach aims at the moving part all along: the part in reach
-   from the approach's start on, else the reference drags the arm towards a place it cannot be —
-   measured: a grasp at the window's entry ran the RV-M1 through its base into its joint
-   limits), and at least
+3. the earliest grasp time at least the track's lead after now or, if later, after the part
+   enters its window (``leads``: the phase time model's, ``line.cycle``: its approach from the
+   arm's present point ends as the part enters, every sample of its way checked by IK, then the
+   descend; without it ``Timing.lead``, the tasks' default tfs, the whole approach with the part
+   in reach — a prescribed-time approach aims at the moving part all along, and unchecked, a
+   grasp at the window's entry ran the RV-M1 through its base into its joint limits), and at least
    ``Timing.slack`` before the part leaves it (so that the lift too is done in reach): else
    ``not reachable in time`` when the window closes too soon, or ``not in reach yet`` when the
    part is still upstream beyond the look-ahead ``Timing.horizon`` (not a failure: looked at again);
@@ -23,7 +23,7 @@ finds its grasp time on a grid of ``Timing.step`` from the decision:
    ``finger_clearance`` < ``FINGER_MARGIN``: ``blocked``).
 
 Of the candidates left, the one whose window closes first (earliest deadline first), ties by the
-earlier grasp.  ``Decision.skipped`` holds every other track with its reason (the chosen one's
+lower id.  ``Decision.skipped`` holds every other track with its reason (the chosen one's
 rivals that were feasible read ``later deadline``, their deadlines in ``rivals``).
 
 ``drifted``: the known prediction of a committed grasp point against the one the decision made:
@@ -104,19 +104,21 @@ class Decision:
                             for i, r in self.skipped]}
 
 
-def grasp_time(track: Track, window: tuple, now: float, timing: Timing):
+def grasp_time(track: Track, window: tuple, now: float, timing: Timing, lead: Optional[float] = None):
     """(grasp time, deadline) of ``track`` in its reach ``window`` (module docstring, step 3), or
-    (None, reason)."""
+    (None, reason); ``lead``: this track's (s, the model's approach and descend), else
+    ``timing.lead``."""
     s_in, s_out = window
+    lead = timing.lead if lead is None else lead
     if track.speed <= 1e-9:
         inside = s_in <= track.s <= s_out
-        return (now + timing.lead, math.inf) if inside else (None, "not in reach (belt stopped)")
+        return (now + lead, math.inf) if inside else (None, "not in reach (belt stopped)")
     leave = now + (s_out - track.s) / track.speed  # the part's centre leaves the window
     enter = now + (s_in - track.s) / track.speed
     deadline = leave - timing.slack
     if enter - now > timing.horizon:
         return None, "not in reach yet"
-    earliest = max(now, enter) + timing.lead  # in reach from the approach's start on
+    earliest = max(now, enter) + lead  # in reach from the approach's start on
     t = now + timing.step * math.ceil((earliest - now) / timing.step - 1e-9)
     if t > deadline:
         return None, "not reachable in time"
@@ -138,29 +140,39 @@ def blocker(track: Track, tracks: list, grasp: float, now: float, timing: Timing
 
 
 def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: dict,
-           timing: Timing) -> Decision:
+           timing: Timing, leads=None) -> Decision:
     """The next pick among ``tracks`` not in ``assigned`` (module docstring); ``free_slots``: kind
-    → the slots still free for it, in filling order (a bin kind: [its bin's name])."""
+    → the slots still free for it, in filling order (a bin kind: [its bin's name]); ``leads``: a
+    callable (track, window) → the track's lead (s, ``line.cycle.LineCycles.lead``: the min-tf
+    model) or a str naming why no tf fits — None: ``timing.lead`` for every track.  A deadline does
+    not depend on the lead, so the tracks are looked at in deadline order, and with ``leads`` the
+    model is asked no further than the first feasible one (the rest read ``later deadline``)."""
     decision = Decision(now)
-    feasible = []
+    order = []
     for track in tracks:
         if track.id in assigned:
             continue
         if not free_slots.get(track.kind):
             decision.skipped.append((track.id, "tray full"))
             continue
-        grasp, deadline = grasp_time(track, windows[track.id], now, timing)
+        grasp, deadline = grasp_time(track, windows[track.id], now, timing, 0.0)  # no lead: none fits
         if grasp is None:
             decision.skipped.append((track.id, deadline))
             continue
-        hit = blocker(track, tracks, grasp, now, timing)
-        if hit is not None:
-            decision.skipped.append((track.id, f"blocked (track {hit})"))
+        order.append((deadline, track.id, track))
+    order.sort(key=lambda f: f[:2])
+    feasible = []
+    for deadline, _, track in order:
+        if feasible and leads is not None:
+            feasible.append((deadline, None, track))
             continue
-        feasible.append((deadline, grasp, track))
+        reason, grasp = _feasible(track, tracks, windows[track.id], now, timing, leads)
+        if reason:
+            decision.skipped.append((track.id, reason))
+        else:
+            feasible.append((deadline, grasp, track))
     if not feasible:
         return decision
-    feasible.sort(key=lambda f: (f[0], f[1], f[2].id))
     deadline, grasp, chosen = feasible[0]
     decision.skipped += [(f[2].id, "later deadline") for f in feasible[1:]]
     decision.rivals = {f[2].id: f[0] for f in feasible[1:]}
@@ -168,6 +180,19 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
     decision.slot = free_slots[chosen.kind][0]
     decision.point = tuple(float(c) for c in chosen.at(grasp, now))
     return decision
+
+
+def _feasible(track: Track, tracks: list, window: tuple, now: float, timing: Timing, leads) -> tuple:
+    """("", grasp time) of a track the arm can take (its lead, its grasp time in its window, the
+    fingers clear of the others), else (the reason, None)."""
+    lead = None if leads is None else leads(track, window)
+    if isinstance(lead, str):
+        return lead, None
+    grasp, deadline = grasp_time(track, window, now, timing, lead)
+    if grasp is None:
+        return deadline, None
+    hit = blocker(track, tracks, grasp, now, timing)
+    return (f"blocked (track {hit})", None) if hit is not None else ("", grasp)
 
 
 def drifted(track: Track, grasp: float, point: tuple, now: float, tolerance: float) -> float:

@@ -1,0 +1,287 @@
+"""The line's phase times from the minimum phase time model (``phase_time.PhaseTimes``, issue 44).
+
+The scheduler asks, per track, how long the arm needs from where it stands to a grasp of that
+part (``LineCycles.lead``: the approach's min tf from the tool's present point and yaw to
+``clearance`` above the part riding its belt, plus the descend's — at least the fingers' close):
+a grasp time at least that far ahead is one the arm makes within its joint speed and torque
+limits (× ``phase_time.MARGIN``).  A lead counts from now, or from the part's entry into its
+reach window when it is still upstream; there the approach starts before the entry, so that it
+ends as the part enters (the approach's min tf found again for the part where it is at that
+earlier start: a fixed point, ``EARLY_PASSES``; the grasp then one descend after the entry).
+Every sample of both ways has a top-down posture by Drake's IK (``phase_time``), and the part is
+in reach over the whole descend, the grasp and the lift: the scheduler's old rule — the part in
+reach from the approach's start on, the approach from the tray to the window's entry passing the
+waist axis in 1.5–2.5 s after the part entered (line_short seed 0: 2.45 s) — is kept for the
+approach's end only.  Where a way has no top-down posture all along, the approach starts up to
+``WAITS`` later (the lead counts the wait).  A lead is cached per track and ``LEAD_STEP`` of its
+belt coordinate (a free arm looks every ``decide_period``; the tool holds still meanwhile).
+
+The chosen task's tfs (``LineCycles.phases``) are one ``phase_time.cycle_time`` from the tool's
+point and yaw, the part at the approach's start riding its belt (approach, descend), the payload
+held (lift, carry, place), to its slot and back up (retreat).
+
+``detours`` — what the plan makes of a task: a phase the plan splits by a via (``route``: around
+the waist axis; ``obstacles``: above a part in the way) shares the phase's tf between its two legs
+by their lengths, and the via's leg turns the tool's whole yaw; the min-tf model above takes the
+straight way.  Measured (line_surplus seed 2 at 22.19 s): a 0.264 s approach got a via 45 mm above
+the slot, its leg 0.1 s with a 90° turn, and the wrist ran at 9 rad/s, 766 N·m commanded, into the
+conveyor.  So the task's plan is made (``plan.line_plan``, what the run will follow) and each via's
+two legs are asked of the model on their own — from the previous segment's target, as the plan's
+way starts — and the phase takes the longest of tf₁ / share and tf₂ / (1 − share), the plan's own
+split kept (``driver`` stretches the task, or gives it up where its grasp then leaves reach).
+
+The start state: the model starts each phase at rest on its way, from the tool's present point
+(the arm's posture read at the decision).  Measured over 110 segment starts of two runs
+(line_surplus seed 2 and the slowed-belt case of tests/e2e, with the fixes here) the largest
+joint speed at a segment's start was 0.31 of its limit (a lift, leaving the belt's speed; median
+0.02): no margin is added for it.  The two runaways blamed on chaining were a via (above) and a
+drift kept with its part out of reach at the approach's end (``driver``), not a carried velocity.
+
+``estimate`` — the line's capacity by the model: per kind of the catalog, one cycle from
+``clearance`` above its first slot to a part at the middle of its reach window on its belt (no
+lateral offset, yaw 0) and back to that slot; 60 / the mean cycle, picks per minute (the arrival
+warning's number, and the surplus line's estimate, ``scripts/line_capacity.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Optional
+
+import numpy as np
+
+from ptint_drake.config.pick import MoveConfig, PartConfig, PickTaskConfig
+from ptint_drake.worlds.pick.cell import place_point
+from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time
+from ptint_drake.worlds.pick.route import nearest_branch, tool_yaws
+from ptint_drake.worlds.pick.scene import belt_frame
+from ptint_drake.worlds.pick.tasks import place_target
+from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
+
+LEAD_STEP = 0.01  # m along the belt: a lead's cache key
+WAITS = (0.0, 0.25, 0.5, 1.0, 1.5, 2.0)  # s: an approach's start put off, when its way leaves the reach
+EARLY_PASSES = 3  # fixed-point passes of an approach that ends as its part enters reach
+PHASE_NAMES = ("approach", "descend", "lift", "carry", "place", "retreat")
+
+
+class LineCycles:
+    """The min-tf model of a line's station and the leads it gave (module docstring)."""
+
+    def __init__(self, scenario, model: Optional[PhaseTimes] = None):
+        self.scenario = scenario
+        self.model = model or PhaseTimes.of(scenario)
+        self.task = PickTaskConfig()
+        self._leads: dict = {}
+        self.extra: dict = {}  # track → s its approach's via needs beyond the straight way (``detours``)
+        self.plain: set = set()  # tracks whose approach starts after the entry (``drop_early``)
+
+    def lead(self, track, window: tuple, now: float, start, yaw: float):
+        """s from now, or from the part's entry into its ``window`` if later, to the earliest grasp
+        of ``track`` (module docstring), the tool at ``start`` turned to ``yaw``; a str naming why
+        no tf fits."""
+        found = self.found(track, window, start, yaw)
+        if isinstance(found, str):
+            return found
+        return float(_lead_of(found)) + self.extra.get(track.id, 0.0)
+
+    def found(self, track, window: tuple, start, yaw: float):
+        """(approach, descend, wait, early) of ``_lead``, cached, or a str."""
+        ahead, key = _key(track, window, start, yaw)
+        if key not in self._leads:
+            self._leads[key] = self._lead(track, ahead, start, yaw)
+        return self._leads[key]
+
+    def _lead(self, track, ahead: float, start, yaw: float):
+        """(approach, descend, wait, early) or a str naming why no tf fits (module docstring): the
+        approach starting at the entry (or now) + wait, the first of ``WAITS`` whose ways have a
+        top-down posture all along; then, for a part upstream, one that starts ``early`` s before
+        and ends at the entry + a wait (the first of ``WAITS`` that fits, ``_early``), where its
+        lead is the shorter."""
+        ride = track.speed * np.asarray(track.direction)
+        up = np.array([0.0, 0.0, self.task.clearance])
+        grip = nearest_branch(yaw, _yaw(track))
+
+        def approach_from(t: float, guess: Optional[float] = None) -> float:
+            """The approach's min tf, the part where it is at t (the fixed point from ``guess``: a
+            riding way too short to reach the window has no top-down posture all along)."""
+            self.model.last = guess or self.model.last
+            return self.model.min_tf(start, np.asarray(track.at(t, 0.0)) + up, ride, 0.0,
+                                     self.task.approach.beta, (yaw, grip))
+
+        def descend_at(t: float) -> float:  # the descend's, the part where it is at t
+            at = np.asarray(track.at(t, 0.0))
+            return max(self.model.min_tf(at + up, at, ride, 0.0, self.task.descend.beta, (grip, grip)),
+                       self.task.margin / self.model.gripper_speed)
+
+        best, why = None, ""
+        for wait in WAITS:
+            try:
+                approach = approach_from(ahead + wait)
+                best = (approach, descend_at(ahead + wait + approach), wait, 0.0)
+                break
+            except NoTfFits as error:
+                why = f"no tf fits: {error}"
+        if best is None:
+            return why
+        for wait in WAITS if ahead > 0.0 and track.id not in self.plain else ():
+            if wait + best[1] >= _lead_of(best):
+                break  # no shorter lead left
+            found = self._early(approach_from, ahead, wait)
+            try:
+                if found is not None:
+                    early = (found[0], descend_at(ahead + wait - found[1] + found[0]), wait, found[1])
+                    return early if _lead_of(early) < _lead_of(best) else best
+            except NoTfFits:
+                continue
+        return best
+
+    def drop_early(self, track_id: int) -> None:
+        """The track's leads from now on without an early approach (its cycle found none: ``driver``)."""
+        self.plain.add(track_id)
+        self._leads = {k: v for k, v in self._leads.items() if k[0] != track_id}
+
+    @staticmethod
+    def _early(approach_from, ahead: float, wait: float):
+        """(approach, early): an approach's min tf that ends with the part in its window, and how
+        long before the entry + ``wait`` it starts (not before now) — a fixed point,
+        ``EARLY_PASSES`` at most; None where none ends so or a way has no top-down posture."""
+        trial = ahead + wait
+        for _ in range(EARLY_PASSES):
+            try:
+                tf = approach_from(ahead + wait - trial, trial)
+            except NoTfFits:
+                return None
+            if tf + wait >= trial - 1e-9:  # it ends with the part in its window
+                return tf, trial
+            trial = tf  # it would end before the part enters: start it later
+        return None
+
+    def fits(self, track, begin: float, grasp: float, now: float, start, yaw: float) -> bool:
+        """Whether an approach from the tool at ``start`` (turned to ``yaw``) starting at ``begin``
+        and the descend make the grasp of ``track`` at ``grasp``: their min tfs, the part where it
+        is at ``begin`` (a kept task, ``driver``); False where no tf fits."""
+        ride = track.speed * np.asarray(track.direction)
+        up = np.array([0.0, 0.0, self.task.clearance])
+        grip = nearest_branch(yaw, _yaw(track))
+        try:
+            part = np.asarray(track.at(begin, now))
+            approach = self.model.min_tf(start, part + up, ride, 0.0, self.task.approach.beta, (yaw, grip))
+            at = part + ride * approach
+            descend = max(self.model.min_tf(at + up, at, ride, 0.0, self.task.descend.beta, (grip, grip)),
+                          self.task.margin / self.model.gripper_speed)
+        except NoTfFits:
+            return False
+        return begin + approach + descend + self.extra.get(track.id, 0.0) <= grasp + 1e-9
+
+    def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot) -> Cycle:
+        """The cycle of a grasp of ``track`` (reach ``window``) at ``grasp`` (module docstring), its
+        approach starting its min tf and the descend's before it (or now)."""
+        pick = self.scenario.pick
+        kind = _kind_part(pick, track.kind)
+        found = self.found(track, window, start, yaw)
+        begin = now
+        if not isinstance(found, str):
+            begin = max(now, grasp - found[0] - found[1] - self.extra.get(track.id, 0.0))
+            self.model.last = found[0]  # the riding approach's fixed point from the lead's (``_early``)
+        task = replace(self.task, **destination(slot))
+        place = _place(pick, slot, kind)
+        return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
+                          place, place_target(pick, task)[2], _yaw(track), kind.mass, task, start, yaw)
+
+    def task_of(self, part: str, slot, grasp: float, now: float, cycle: Cycle,
+                begin: Optional[float] = None) -> PickTaskConfig:
+        """The ``PickTaskConfig`` of ``cycle`` for a grasp at ``grasp``: its approach starting at
+        ``begin`` (default: its min tf before the descend, or now) and stretched so that the
+        descend ends at the grasp."""
+        tf = cycle.phases
+        if begin is None:
+            begin = max(now, grasp - tf["approach"] - tf["descend"])
+        moves = {p: MoveConfig(tf[p], getattr(self.task, p).beta) for p in PHASE_NAMES}
+        moves["approach"] = MoveConfig(grasp - tf["descend"] - begin, self.task.approach.beta)
+        return replace(self.task, part=part, start=begin, **destination(slot), **moves)
+
+
+    def detours(self, scenario, plan, k: int, mass: float) -> dict:
+        """phase → the tf (s) that task ``k``'s phase split by a via needs in ``plan`` (the plan
+        of ``scenario``; module docstring), ``mass`` (kg) held on a carry; only phases with a via.
+        ``NoTfFits`` where a leg has none."""
+        world = nominal(scenario, self.model.arm)
+        yaws = tool_yaws(world, plan)
+        segments, times = plan.segments, plan.schedule.segments
+        needs = {}
+        for i, seg in enumerate(segments[:-1]):
+            if seg.task != k or seg.phase != "via":
+                continue
+            nxt, s0, s1 = segments[i + 1], times[i], times[i + 1]
+            payload = mass if nxt.phase == "carry" else 0.0
+            via = segment_target(world, plan, i, s0.start)[0]
+            ride = world.parts[nxt.index][1] if nxt.kind == "part" else None
+            first = self.model.min_tf(via + start_error(world, plan, i), via, None, payload, s0.beta, yaws[i])
+            second = self.model.min_tf(via, segment_target(world, plan, i + 1, s1.start)[0], ride, payload,
+                                       s1.beta, yaws[i + 1])
+            share = s0.tf / (s0.tf + s1.tf)
+            needs[nxt.phase] = max(first / share, second / (1.0 - share))
+        return needs
+
+
+def estimate(scenario, view, model: Optional[PhaseTimes] = None) -> tuple:
+    """(picks per minute, mean cycle s) of the line by the model (module docstring); ``view``
+    gives the reach windows (``LineView.window_at``)."""
+    model = model or PhaseTimes.of(scenario)
+    pick, task = scenario.pick, PickTaskConfig()
+    belts = {b.name: b for b in pick.belts}
+    totals = []
+    for kind in pick.line.catalog:
+        part = _kind_part(pick, kind.name)
+        for arrival in pick.line.arrivals:
+            if arrival.mix and not arrival.mix.get(kind.name):
+                continue
+            belt = belts[arrival.belt]
+            height = part.size[2] if part.shape == "box" else part.size[1]
+            s_in, s_out = view(arrival.belt, 0.0, height / 2)
+            x = belt_frame(belt).multiply(np.array([0.5 * (s_in + s_out), 0.0, height / 2]))
+            where = kind.bin or kind.slots[0]
+            place = _place(pick, where, part)
+            place_yaw = place_target(pick, replace(task, **destination(where)))[2]
+            ride = belt.speed * np.asarray(belt.direction) / np.linalg.norm(belt.direction)
+            cycle = cycle_time(model, x, ride, place, place_yaw, 0.0, kind.mass, task)
+            totals.append(cycle.total)
+    mean = float(np.mean(totals))
+    return 60.0 / mean, mean
+
+
+def destination(where) -> dict:
+    """A decision's destination as a task's fields: a tray slot (an index) or a bin (its name)."""
+    return {"bin": where, "slot": None} if isinstance(where, str) else {"slot": where, "bin": ""}
+
+
+def _place(pick, where, part) -> np.ndarray:
+    """The place point of ``part`` at a tray slot (an index) or over a bin (its name)."""
+    if isinstance(where, str):
+        return place_point(pick, "bin", [b.name for b in pick.bins].index(where), part)
+    return place_point(pick, "slot", where, part)
+
+
+def _lead_of(found: tuple) -> float:
+    """s from the entry (or now) to the grasp of a ``_lead`` (approach, descend, wait, early)."""
+    approach, descend, wait, early = found
+    return approach + descend + wait - early
+
+
+def _key(track, window: tuple, start, yaw: float) -> tuple:
+    """(s until the part enters ``window``, ≥ 0; a lead's cache key)."""
+    ahead = max(0.0, (window[0] - track.s) / track.speed) if track.speed > 1e-9 else 0.0
+    return ahead, (track.id, round((track.s + track.speed * ahead) / LEAD_STEP),
+                   tuple(np.round(np.asarray(start), 3)), round(yaw, 2))
+
+
+def _yaw(track) -> float:
+    """rad: the yaw of a track's closing axis (world)."""
+    return float(math.atan2(track.axis[1], track.axis[0]))
+
+
+def _kind_part(pick, kind: str) -> PartConfig:
+    """A ``PartConfig`` of the catalog kind ``kind`` (its shape, size, mass and friction)."""
+    k = next(c for c in pick.line.catalog if c.name == kind)
+    return PartConfig(name=k.name, shape=k.shape, size=list(k.size), mass=k.mass, friction=k.friction)

@@ -1,0 +1,130 @@
+"""Issue 44: the line's phase times come from the minimum phase time model
+(``worlds.pick.line.cycle`` over ``phase_time.PhaseTimes``) — a track's lead is the approach's and
+the descend's min tf from the tool's point, the chosen task's tfs are ``cycle_time``'s, and the
+capacity estimate is 60 / the model's cycle; an upstream part's approach ends as it enters reach;
+a phase the plan splits by a via gets what both legs need."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.cycle import LineCycles
+from ptint_drake.worlds.pick.line.scheduler import Track
+from ptint_drake.worlds.pick.phase_time import PhaseTimes, cycle_time
+from ptint_drake.worlds.pick.route import routed_plan, tool_yaws
+from ptint_drake.worlds.pick.tasks import VIA_SLOT
+from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
+
+MIRRORED = str(Path(__file__).resolve().parents[1] / "two_belt_pick_mirrored.yaml")
+
+
+@pytest.fixture(scope="module")
+def cycles():
+    """The min-tf model of line_short's station (the expanded scenario, as the run builds it)."""
+    scenario, _ = line_scenario(load_scenario("line_short"))
+    return LineCycles(scenario)
+
+
+def cube(s: float) -> Track:
+    """A cube on line_short's belt (x = 0.25 m, +y at 0.1 m/s, top at 0.135 m), ``s`` m along it."""
+    return Track(0, "cube", "conveyor", (0.25, s, 0.15), s, (0.0, 1.0, 0.0), 0.1, (1.0, 0.0, 0.0),
+                 0.03, 0.0212)
+
+
+def test_a_lead_is_the_models_approach_and_descend_from_the_tool(cycles):
+    start, part = np.array([0.13, 0.2, 0.15]), cube(-0.1)
+    lead = cycles.lead(part, (-0.3, 0.3), 5.0, start, 0.0)
+    model, up, ride = cycles.model, np.array([0.0, 0.0, 0.04]), np.array([0.0, 0.1, 0.0])
+    approach = model.min_tf(start, np.asarray(part.position) + up, ride, 0.0, 0.75, (0.0, 0.0))
+    at = np.asarray(part.position) + ride * approach
+    descend = max(model.min_tf(at + up, at, ride, 0.0, 0.75, (0.0, 0.0)), 0.012 / model.gripper_speed)
+    assert lead == pytest.approx(approach + descend, rel=1e-6)
+    # from farther away the lead is longer; from the same point it is the cached one
+    assert cycles.lead(part, (-0.3, 0.3), 5.0, start + [0.0, 0.1, 0.0], 0.0) > lead
+    assert cycles.lead(part, (-0.3, 0.3), 5.0, start, 0.0) == lead
+
+
+def test_the_tasks_tfs_are_the_models_cycle_and_the_descend_ends_at_the_grasp(cycles):
+    start, part = np.array([0.13, 0.2, 0.15]), cube(-0.1)
+    lead = cycles.lead(part, (-0.3, 0.3), 5.0, start, 0.0)
+    grasp = 5.0 + np.ceil(lead / 0.1) * 0.1
+    cycle = cycles.phases(part, (-0.3, 0.3), grasp, 5.0, start, 0.0, 3)
+    task = cycles.task_of("cube_0", 3, grasp, 5.0, cycle)
+    assert task.start + task.approach.tf + task.descend.tf == pytest.approx(grasp)
+    assert task.approach.tf >= cycle.phases["approach"] - 1e-9  # stretched to the grid, never shorter
+    for phase in ("descend", "lift", "carry", "place", "retreat"):
+        assert getattr(task, phase).tf == cycle.phases[phase]
+    # the carry is the model's for the payload held: a heavier part gets a carry no shorter
+    heavy = cycle_time(cycles.model, part.at(task.start, 5.0), np.array([0.0, 0.1, 0.0]),
+                       np.array([0.13, 0.2, 0.125]), mass=2.0, start=start, yaw=0.0)
+    light = cycle_time(cycles.model, part.at(task.start, 5.0), np.array([0.0, 0.1, 0.0]),
+                       np.array([0.13, 0.2, 0.125]), mass=0.1, start=start, yaw=0.0)
+    assert heavy.phases["carry"] >= light.phases["carry"]
+    assert isinstance(cycles.model, PhaseTimes)
+
+
+def test_an_upstream_parts_approach_ends_as_the_part_enters_its_reach(cycles):
+    """The approach starts before the part enters its window, so that it ends as the part enters:
+    the lead counts from the entry (the descend and what is left), not the whole approach."""
+    start, part, window = np.array([0.13, 0.2, 0.15]), cube(-0.5), (-0.3, 0.3)
+    approach, descend, wait, early = cycles.found(part, window, start, 0.0)
+    ahead = 2.0  # s until the part's centre is at -0.3 m at 0.1 m/s
+    assert early > 0.0
+    assert ahead + wait - early >= 0.0  # not before now
+    assert ahead + wait - early + approach >= ahead - 1e-9  # it ends with the part in reach
+    up, ride = np.array([0.0, 0.0, 0.04]), np.array([0.0, 0.1, 0.0])
+    at_start = part.at(ahead + wait - early, 0.0)
+    cycles.model.last = early  # the fixed point's first guess, as the lead's (a shorter way leaves reach)
+    assert approach == pytest.approx(cycles.model.min_tf(start, at_start + up, ride, 0.0, 0.75, (0.0, 0.0)))
+    lead = cycles.lead(part, window, 5.0, start, 0.0)
+    assert lead == pytest.approx(approach + descend + wait - early)
+    assert lead < approach + descend  # the old rule: the whole approach after the entry
+    cycles.drop_early(part.id)  # (its cycle found no early approach): the whole approach after the entry
+    assert cycles.found(part, window, start, 0.0)[3] == 0.0
+    assert cycles.lead(part, window, 5.0, start, 0.0) > lead
+    cycles.plain.clear()
+
+
+def test_a_kept_task_fits_only_with_the_models_approach_before_its_grasp(cycles):
+    start, part = np.array([0.13, 0.2, 0.15]), cube(-0.1)
+    lead = cycles.lead(part, (-0.3, 0.3), 5.0, start, 0.0)
+    assert cycles.fits(part, 5.0, 5.0 + lead + 0.05, 5.0, start, 0.0)
+    assert not cycles.fits(part, 5.0, 5.0 + 0.5 * lead, 5.0, start, 0.0)
+
+
+def _legs(world, plan, k: int, mass: float) -> list:
+    """(start, target, tf, ride, payload, beta, yaws) of each via, approach and carry segment of
+    task ``k`` in ``plan``, each from the previous segment's target (the plan's way)."""
+    yaws, out = tool_yaws(world, plan), []
+    for i, seg in enumerate(plan.segments):
+        if seg.task != k or seg.phase not in ("via", "approach", "carry"):
+            continue
+        s = plan.schedule[i]
+        target = segment_target(world, plan, i, s.start)[0]
+        ride = world.parts[seg.index][1] if seg.kind == "part" else None
+        payload = mass if seg.phase == "carry" or seg.kind == VIA_SLOT else 0.0
+        out.append((target + start_error(world, plan, i), target, s.tf, ride, payload, s.beta, yaws[i]))
+    return out
+
+
+def test_a_phase_split_by_a_via_gets_what_both_legs_need():
+    """two_belt_pick_mirrored on rvm1_5dof: pick 1's approach and carry each go through a via, the
+    phase's tf shared by the legs by their lengths, the via's leg turning the tool.  At the
+    scenario's 1.2 s a leg asks a joint for more than its limit (the model's check, ``demand``);
+    with each phase at the tf ``detours`` gives, its share kept, both legs are within the limits."""
+    scenario = load_scenario(MIRRORED)
+    cycles = LineCycles(scenario)
+    model, mass = cycles.model, scenario.pick.parts[1].mass
+    plan = routed_plan(scenario, arm=model.arm)
+    needs = cycles.detours(scenario, plan, 1, mass)
+    assert set(needs) == {"approach", "carry"} and cycles.detours(scenario, plan, 0, mass) == {}
+    legs = _legs(nominal(scenario, model.arm), plan, 1, mass)
+    assert [leg[2] for leg in legs[:2]] == pytest.approx([plan.schedule[6].tf, plan.schedule[7].tf])
+    assert max(model.demand(a, b, tf, v, m, beta, y) for a, b, tf, v, m, beta, y in legs) > 1.0
+    phases = ["approach", "approach", "carry", "carry"]  # via, approach, via, carry
+    scale = [needs[p] / getattr(scenario.pick.tasks[1], p).tf for p in phases]
+    after = [model.demand(a, b, tf * f, v, m, beta, y) for (a, b, tf, v, m, beta, y), f in zip(legs, scale)]
+    assert max(after) <= 1.0, after
