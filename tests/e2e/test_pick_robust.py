@@ -59,7 +59,8 @@ def test_harsh_ranges_reach_a_named_failure_and_mild_passes():
     assert passed["ok"] and not passed["reasons"], passed
     summary = robust_summary(rows)
     assert summary == {"pick_success_rate": 0.5, "cannot_be_held": 0, "pick_success_rate_holdable": 0.5,
-                       "failures_by_reason": {"late grasp": 1}, "collisions_by_body": {}}
+                       "failures_by_reason": {"late grasp": 1}, "collisions_by_body": {},
+                       "placed_with_collision": 0}
 
 
 def test_failures_are_counted_by_reason_without_the_pick_index():

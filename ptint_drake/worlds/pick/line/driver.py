@@ -31,7 +31,7 @@ import numpy as np
 
 from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
-from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.plan import IDLE_TF
 from ptint_drake.worlds.pick.line.scheduler import Timing, decide, drifted
@@ -254,4 +254,5 @@ class LineDriver:
                                   approach=MoveConfig(tf, default.approach.beta))
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
+        task.close_delay = close_delay(self.line.truth, decision.track)  # the truth's jitter (robust)
         self.committed[k] = [decision.track, decision.grasp, decision.point]
