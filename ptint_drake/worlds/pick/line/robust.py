@@ -38,14 +38,15 @@ NOT_ENTERED = "not entered by the end"
 def _belt_speeds(scenario, u) -> list:
     """Step 3 (module docstring): every line belt's drawn truth speed (m/s)."""
     line, declared = scenario.pick.line, {b.name: b.speed for b in scenario.pick.belts}
-    speeds = []
+    speeds, starts = [], []
     for belt in line.belts:
         factor = float(u("belt_speed"))
         for step in line.speed_steps:
             if step.belt == belt.name:
                 step.factor *= factor
-        line.speed_steps.insert(0, SpeedStepConfig(belt=belt.name, t=0.0, factor=factor))
+        starts.append(SpeedStepConfig(belt=belt.name, t=0.0, factor=factor))
         speeds.append(factor * declared[belt.name])
+    line.speed_steps = starts + line.speed_steps
     return speeds
 
 
@@ -86,6 +87,8 @@ def line_row(seed: int, params: dict, m: dict) -> dict:
         row = {"part": p["part"], "entered": p["entered"], "placed": p["placed"], "task": p["task"],
                "collision": bool(pick.get("collision")), "place_error_mm": pick.get("place_error_mm"),
                "place_error_deg": pick.get("place_error_deg"), "t_grasp": pick.get("t_grasp"),
+               "t_grasp_prescribed": pick.get("t_grasp_prescribed"),
+               "t_close_command": pick.get("t_close_command"),
                "reason": None if p["placed"] else reason}
         if pick.get("collision") and p["placed"]:  # placed, but its task touched something
             reasons.append("collision with " + ", ".join(pick.get("collision_with") or ["?"]))
