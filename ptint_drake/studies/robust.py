@@ -42,7 +42,11 @@ A pick scenario (``pick``) draws ``mass`` and the five pick ranges only (its pla
 other deviation; the part in the hand is the payload) and is judged by its picks: robust.json
 adds ``pick_success_rate`` (parts placed with no collision / all parts) and ``failures_by_reason``
 (each failed pick's verdict reason without its index, each sample's error: their counts; every
-collision under ``collision``) and ``collisions_by_body`` (the bodies those collisions touched).  Every
+collision under ``collision``), ``collisions_by_body`` (the bodies those collisions touched) and
+``placed_with_collision``.  A line (``pick.line``, issue 44) draws the same per part of its pool, on
+the truth side only (its belts' speeds as speed steps at t = 0: the declared speeds unchanged), and
+is judged per part (``worlds/pick/line/robust.py``).  Every sample records ``cpu_s`` (its CPU time in
+its worker) and robust.json ``cpu_s_per_sample``.  Every
 sample ends with a verdict: a sample that is rejected before its run or raises is an error row,
 counted by its reason.
 

@@ -98,7 +98,9 @@ def test_a_sample_that_raises_ends_with_a_verdict(monkeypatch):
     assert row["error"] == "ZeroDivisionError: in the middle of a run"
     assert robust_summary([row]) == {"pick_success_rate": 0.0, "cannot_be_held": 0,
                                      "pick_success_rate_holdable": 0.0, "failures_by_reason": {
-        "error: ZeroDivisionError: in the middle of a run": 1}, "collisions_by_body": {}}
+        "error: ZeroDivisionError: in the middle of a run": 1}, "collisions_by_body": {},
+        "placed_with_collision": 0}
+    assert row["cpu_s"] > 0.0  # the sample's CPU seconds, an error row's too
 
 
 def test_lateral_offset_moves_the_part_and_is_checked():
