@@ -1,8 +1,11 @@
 """The catch table and figure of docs/catch.md (issue 46) from ``ptint robust`` folders of a catch
 scenario: the catch rate, the oracle's reachable rate, the rate over the reachable throws, the
-failures by reason, the hand's error, the peak contact force and the arm's largest joint speed over
+failures by reason, the hand's error, the peak contact force (the grip's, mostly), the impact
+force along the palm's normal and the ball's speed relative to the hand at the impact over its own
+(``worlds/catch/outcome.py``), and the arm's largest joint speed over
 its limit (the realized one: the simulated plant does not enforce it); ``--compare`` adds rows of other
-runs on the same seeds (without velocity matching, at half the time step); ``--figure`` writes the
+runs on the same seeds (without velocity matching, at half the time step) and the impact on the
+throws caught by both, paired; ``--figure`` writes the
 catch rate against the throw's launch speed (the frozen thrower's, bins of 0.25 m/s).
 
     ptint robust catch_toss_iiwa14 --samples 200 --workers 2 --out out/catch200
@@ -46,7 +49,32 @@ def line(name: str, rows: list) -> str:
     return (f"| {name} | {len(rows)} | {len(caught)} ({100 * len(caught) / len(rows):.1f} %) | "
             f"{len(reach)} | {of_reach} ({100 * of_reach / max(len(reach), 1):.1f} %) | "
             f"{_median(r['error_at_catch_mm'] for r in rows)} | "
-            f"{_median(r['peak_contact_force_n'] for r in caught)} | {_speeds(rows)} |")
+            f"{_median(r['peak_contact_force_n'] for r in caught)} | "
+            f"{_median(r.get('impact_force_n') for r in caught)} | {_relative(caught)} | {_speeds(rows)} |")
+
+
+def _relative(rows: list) -> str:
+    """The ball's speed relative to the hand at the impact over its own speed: the median."""
+    values = [r["impact_speed_m_s"] / r["ball_speed_at_impact_m_s"] for r in rows
+              if r.get("impact_speed_m_s") is not None and r.get("ball_speed_at_impact_m_s")]
+    return f"{np.median(values):.3f}" if values else "–"
+
+
+def paired(name: str, rows: list, other: list) -> str:
+    """The impact force and the relative speed on the throws caught in both runs (with the
+    matching: ``rows``; ``other``: the run named ``name``): medians and the per-throw change."""
+    a = {r["seed"]: r for r in rows if r["outcome"] == "caught" and r.get("impact_force_n") is not None}
+    b = {r["seed"]: r for r in other if r["outcome"] == "caught" and r.get("impact_force_n") is not None}
+    both = sorted(set(a) & set(b))
+    if not both:
+        return f"{name}: no throw caught by both with an impact measured"
+    fa, fb = (np.array([x[k]["impact_force_n"] for k in both]) for x in (a, b))
+    va, vb = (np.array([x[k]["impact_speed_m_s"] for k in both]) for x in (a, b))
+    lower_f, lower_v = 100 * (1 - np.median(fa) / np.median(fb)), 100 * (1 - np.median(va) / np.median(vb))
+    return (f"impact on the {len(both)} throws caught by both (default vs {name}): median "
+            f"{np.median(fa):.1f} N vs {np.median(fb):.1f} N ({lower_f:.1f} % lower; per throw "
+            f"{100 * np.median(1 - fa / fb):.1f} % median); relative speed {np.median(va):.2f} vs "
+            f"{np.median(vb):.2f} m/s ({lower_v:.1f} % lower)")
 
 
 def _speeds(rows: list) -> str:
@@ -118,13 +146,16 @@ def main(argv=None) -> int:
         print(exc, file=sys.stderr)
         return 2
     print("| run | throws | caught | reachable (oracle) | caught of reachable | hand error median (mm) "
-          "| peak force median, caught (N) | joint speed / limit, median (max; runs > 1) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| peak force median, caught (N) | impact median, caught (N) "
+          "| relative / ball speed at the impact, median | joint speed / limit, median (max; runs > 1) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     print(line("default", rows))
     for name, other in others:
         seeds = {r["seed"] for r in other}
         print(line(f"default, the same {len(seeds)} throws", [r for r in rows if r["seed"] in seeds]))
         print(line(name, other))
+    for name, other in others:
+        print("\n" + paired(name, rows, other))
     print("\n| failure | throws | which (* the oracle: not reachable) |\n|---|---|---|")
     print(failures(rows))
     if args.figure:

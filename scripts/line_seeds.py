@@ -1,6 +1,7 @@
 """Measures a line scenario over seeds (issue 44) and prints JSON: per seed the parts released,
-entered and placed, picks per minute, the failures' reasons and the CPU seconds of the run; then
-the pooled numbers (placed / entered over every seed).
+entered and placed, picks per minute, the failures' reasons, with the camera its IDSW and the
+parts not seen, the CPU seconds of the run and the realtime factor in CPU (simulated / CPU
+seconds); then the pooled numbers (placed / entered over every seed).
 
 Each seed is one ``ptint run SCENARIO --set pick.line.seed=K`` in a child process, one after the
 other (the CPU seconds are the child's, from ``resource.getrusage(RUSAGE_CHILDREN)``).
@@ -41,7 +42,8 @@ def run_seed(scenario: str, seed: int, overrides: list) -> dict:
     return {"seed": seed, "released": line["released"], "entered": line["entered"], "placed": line["placed"],
             "picks_per_minute": line["picks_per_minute"], "mean_cycle_s": line["mean_cycle_s"],
             "replaced": len(line["replaced"]), "reasons": dict(reasons), "status": metrics["status"],
-            "cpu_s": round(cpu, 1)}
+            "idsw": line.get("idsw"), "not_seen": line.get("not_seen", 0),  # (the camera's line)
+            "cpu_s": round(cpu, 1), "realtime_cpu": round(metrics["duration"] / cpu, 3)}
 
 
 def main() -> None:
@@ -64,7 +66,7 @@ def main() -> None:
                       "failed_runs": len(rows) - len(ok), "entered": entered, "placed": placed,
                       "placed_fraction": placed / entered if entered else None,
                       "picks_per_minute_mean": sum(r["picks_per_minute"] for r in ok) / max(len(ok), 1),
-                      "reasons": dict(reasons),
+                      "reasons": dict(reasons), "idsw": sum(r.get("idsw") or 0 for r in ok),
                       "cpu_s_per_run": sum(r["cpu_s"] for r in rows) / max(len(rows), 1), "runs": rows},
                      indent=1))
 

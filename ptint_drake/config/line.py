@@ -7,7 +7,8 @@ scenario, no ``pick.parts`` and no ``pick.tasks`` (the run makes them), and this
 - ``belts``: the belts the line uses, by name, each with or without an ``encoder`` (with one the
   controller side reads the belt's measured speed; without, only its declared ``speed``);
 - ``catalog``: the kinds of part (shape, size, mass, friction) and where each goes: the tray
-  ``slots`` it fills, in order (a hook is left for a bin or an outgoing belt: ``KindConfig``);
+  ``slots`` it fills, in order, or a ``bin`` of ``pick.bins`` it is dropped into (which never
+  fills: "in the bin", no mm criterion; an outgoing belt is not built);
 - ``arrivals``: per belt, parts per second (a rate, not a spacing: a faster belt does not bring
   more parts), the process (``poisson`` or ``jittered``), the distributions of the lateral offset
   and the yaw, the kinds' mix;
@@ -42,8 +43,8 @@ class LineBeltConfig:
 
 @dataclass
 class KindConfig:
-    """A kind of part of the catalog and where it goes (its tray ``slots``, filled in order).
-    (Another destination — a bin, an outgoing belt — would be a field beside ``slots``.)"""
+    """A kind of part of the catalog and where it goes: its tray ``slots``, filled in order, or a
+    ``bin`` (the name of one of ``pick.bins``) — exactly one of the two."""
 
     name: str = "cube"
     shape: str = "box"  # "box" or "cylinder" (axis vertical)
@@ -51,6 +52,7 @@ class KindConfig:
     mass: float = 0.1  # kg
     friction: float = 0.8  # 1, Coulomb friction of its surface
     slots: List[int] = field(default_factory=list)  # indices into pick.tray.slots
+    bin: str = ""  # or the name of a bin (pick.bins[*].name): every part of the kind dropped into it
 
 
 @dataclass
@@ -123,9 +125,15 @@ def _pair(values: list, where: str) -> None:
         raise ScenarioError(f"{where}: [min, max] with min <= max, got {values}")
 
 
-def _check_kind(k: int, kind: KindConfig, slots: int) -> None:
+def _check_kind(k: int, kind: KindConfig, slots: int, bins: list) -> None:
     where = f"pick.line.catalog[{k}]"
     check_part_shape(where, kind.shape, kind.size, kind.mass, kind.friction)
+    if kind.bin:
+        if kind.slots:
+            raise ScenarioError(f"{where}.bin: a kind goes to its slots or to a bin, not both")
+        if kind.bin not in bins:
+            raise ScenarioError(f"{where}.bin: no bin named {kind.bin!r} in pick.bins")
+        return
     if not kind.slots or any(not 0 <= j < slots for j in kind.slots):
         raise ScenarioError(f"{where}.slots: tray slots 0 … {slots - 1} for this kind, got {kind.slots}")
 
@@ -172,7 +180,7 @@ def check_line(pick, duration: float, stroke: float, margin: float) -> None:
     if not line.catalog:
         raise ScenarioError("pick.line.catalog: at least one kind of part is needed")
     for k, kind in enumerate(line.catalog):
-        _check_kind(k, kind, len(pick.tray.slots))
+        _check_kind(k, kind, len(pick.tray.slots), [b.name for b in pick.bins])
         if kind.size[0] + margin > stroke:
             raise ScenarioError(f"pick.line.catalog[{k}].size: {kind.size[0]} m across the fingers + the "
                                 f"{margin} m margin exceeds the gripper's {stroke} m stroke")

@@ -2,7 +2,9 @@
 into the open WSG 50-110's palm at 3 m/s hits it with a peak force that is converged in the time
 step once the hand's geometries carry the station's relaxation time (halving the step moves it
 by less than 15 %), and that is not with the model's unset one (SAP's default then stops the ball
-within one step: the force doubles with the step halved)."""
+within one step: the force doubles with the step halved).  The impact ``outcome.BallContacts``
+reports is the force along the palm's normal that stops the ball: it scales with the ball's speed,
+and the jaws' squeeze, however strong, is not in it."""
 
 from __future__ import annotations
 
@@ -16,12 +18,17 @@ from pydrake.systems.framework import DiagramBuilder
 from ptint_drake.robot.plant import resolve_model
 from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.catch.ball import BALL_DIAMETER, AddBall
+from ptint_drake.worlds.catch.outcome import BallContacts
 from ptint_drake.worlds.catch.station import FINGERS, _relax_hand
 
 PALM_TOP = 0.0725  # m above the gripper's flange (models/schunk_wsg_50_110_full.sdf)
 
 
-def _peak_force(step: float, relaxed: bool) -> float:
+def _peak_force(step: float, relaxed: bool, speed: float = 3.0, squeeze: float = 0.0,
+                opening: float = 0.081, probe: list | None = None) -> float:
+    """The largest contact force on the ball shot down at ``speed`` into the open palm (or set on
+    it at rest and squeezed by the jaws' actuators with ``squeeze`` N each), over 20 ms; ``probe``
+    gets the ``BallContacts`` of the run."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(
         time_step=step, contact_model="point", discrete_contact_approximation="sap"), builder)
@@ -32,13 +39,18 @@ def _peak_force(step: float, relaxed: bool) -> float:
         _relax_hand(plant, scene_graph, hand)
     ball = AddBall(plant)
     plant.Finalize()
+    contacts = builder.AddSystem(BallContacts(plant, plant.get_body(ball.index()), {}))
+    builder.Connect(plant.get_contact_results_output_port(), contacts.get_input_port())
+    if probe is not None:
+        probe.append(contacts)
     simulator = new_simulator(builder.Build())
     context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
-    plant.get_actuation_input_port().FixValue(context, np.zeros(plant.num_actuated_dofs()))
+    plant.get_actuation_input_port().FixValue(context, np.full(plant.num_actuated_dofs(), -squeeze))
     for name in FINGERS:  # open at the catch's pre-shape, 81 mm
-        plant.GetJointByName(name, hand).set_translation(context, 0.0405)
-    plant.SetFreeBodyPose(context, ball, RigidTransform([0.0, 0.0, PALM_TOP + BALL_DIAMETER / 2 + 0.006]))
-    plant.SetFreeBodySpatialVelocity(context, ball, SpatialVelocity(np.zeros(3), [0.0, 0.0, -3.0]))
+        plant.GetJointByName(name, hand).set_translation(context, opening / 2)
+    gap = 0.006 if speed > 0.0 else 0.0
+    plant.SetFreeBodyPose(context, ball, RigidTransform([0.0, 0.0, PALM_TOP + BALL_DIAMETER / 2 + gap]))
+    plant.SetFreeBodySpatialVelocity(context, ball, SpatialVelocity(np.zeros(3), [0.0, 0.0, -speed]))
     peak, t = 0.0, 0.0
     while t < 0.02:
         t += step
@@ -58,3 +70,21 @@ def test_the_balls_impact_on_the_hand_is_converged_in_the_time_step():
 def test_without_the_relaxation_time_the_impact_is_one_step_long():
     at_1ms, at_half = _peak_force(0.001, False), _peak_force(0.0005, False)
     assert at_half > 1.5 * at_1ms
+
+
+def test_the_impact_is_the_palms_force_along_its_normal_and_scales_with_the_speed():
+    fast, slow = [], []
+    peak_fast = _peak_force(0.001, True, 3.0, probe=fast)
+    _peak_force(0.001, True, 2.0, probe=slow)
+    (fast,), (slow,) = fast, slow
+    assert np.allclose(fast.impact["axis"], [0.0, 0.0, 1.0], atol=1e-6)  # out of the palm, up
+    assert abs(fast.impact["peak"] - peak_fast) <= 1e-6 * peak_fast  # only the palm touched
+    assert slow.impact["peak"] < 0.8 * fast.impact["peak"]  # a third slower: ≥ 20 % less force
+
+
+def test_the_jaws_squeeze_is_not_in_the_impact():
+    probe = []
+    _peak_force(0.001, True, 0.0, squeeze=40.0, opening=0.066, probe=probe)
+    (contacts,) = probe
+    assert min(contacts.touched["left_finger"], contacts.touched["right_finger"]) > 20.0
+    assert "axis" in contacts.impact and contacts.impact["peak"] < 5.0

@@ -45,3 +45,18 @@ def test_every_plan_keeps_its_modelled_joint_speeds_within_the_share():
         again = peak_ratio(planner, Q0, 0.15, plan.t_catch, plan.point, v, plan.R, MATCH_MARGIN * plan.match,
                            0.2, 0.5, plan.q)
         assert abs(again - plan.speed_ratio) < 0.05
+
+
+def test_the_match_bound_is_the_limits_own_and_above_what_the_planner_allows():
+    """``Planner.match_bound``: the hand velocity it finds is the ball's direction at the full
+    speed limits (a joint at its limit, none beyond), and no less than the planner's own cap on
+    the matched velocity scaled from its share of the limits to all of them."""
+    planner = Planner(arm_plant(), TIP, 0.5, 10.0, 0.2)  # match uncapped: matchable is the share's
+    p, v, _ = _catch(planner)
+    q = planner.ik(p, -v / np.linalg.norm(v), Q0)
+    bound = planner.match_bound(q, v)
+    assert 0.0 < bound < 1.0
+    assert bound >= planner.matchable(q, v) / SPEED_SHARE - 1e-9
+    slower = Planner(arm_plant(), TIP, 0.5, 10.0, 0.2)
+    slower.v_max = 0.5 * planner.v_max
+    assert abs(slower.match_bound(q, v) - 0.5 * bound) < 1e-6  # linear in the limits

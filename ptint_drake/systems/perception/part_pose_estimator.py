@@ -314,6 +314,7 @@ def MakeRgbdPerception(config: PerceptionConfig, estimator_type=None) -> tuple[D
     builder.ExportOutput(estimator.GetOutputPort("fits"), "fits")
     if estimator.HasOutputPort("tracks"):
         builder.ExportOutput(estimator.GetOutputPort("tracks"), "tracks")
+        builder.ExportOutput(estimator.GetOutputPort("tracker_state"), "tracker_state")
     diagram = builder.Build()
     diagram.set_name("rgbd_perception")
     return diagram, estimator

@@ -9,7 +9,9 @@ its bound track took this frame (none: a dropout, as before).  The tracker's sta
 state (the pick world's re-plans carry it).  Output ``tracks`` (1 + ``MAX_TRACKS`` × 7): [the
 frame's stamp, then per track slot: id (0: free), bound part (−1: none), 1 when it took a fit
 this frame, that fit's centre (3; else the track's predicted one) and its class] — what the
-metrics match against the truth for the identity switches (``worlds.pick.track_metrics``).
+metrics match against the truth for the identity switches (``worlds.pick.track_metrics``) — and
+``tracker_state``: the whole tracker (``tracks.Tracker.state_vector``: every track's filter), what
+a line's controller side reads (``worlds.pick.line.seen``).
 """
 
 from __future__ import annotations
@@ -34,6 +36,8 @@ class TrackingPartPoseEstimator(PartPoseEstimator):
         self._frame = self.DeclareDiscreteState(np.zeros(1 + MAX_TRACKS * ROW))
         self.DeclareVectorOutputPort("tracks", 1 + MAX_TRACKS * ROW, self._tracks_calc,
                                      prerequisites_of_calc={self.xd_ticket()})
+        self.DeclareVectorOutputPort("tracker_state", len(initial), self._tracker_state_calc,
+                                     prerequisites_of_calc={self.xd_ticket()})
 
     def tracker(self, context) -> Tracker:
         """The tracker as of ``context`` (its tracks: ``Tracker.tracks``)."""
@@ -45,6 +49,9 @@ class TrackingPartPoseEstimator(PartPoseEstimator):
 
     def _tracks_calc(self, context, output) -> None:
         output.SetFromVector(context.get_discrete_state(self._frame).value())
+
+    def _tracker_state_calc(self, context, output) -> None:
+        output.SetFromVector(context.get_discrete_state(self._track_state).value())
 
     def _choose(self, context, state, t: float, fits: list, memory: np.ndarray) -> list:
         """The tracker's step at the frame's time ``t`` (a fit made elsewhere is written later:

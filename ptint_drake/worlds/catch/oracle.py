@@ -37,6 +37,9 @@ def row(seed: int, params: dict, metrics: dict) -> dict:
             "reachable": reachable(params.get("throw", seed)),
             "error_at_catch_mm": None if err is None else 1e3 * err,
             "peak_contact_force_n": c.get("peak_contact_force_n"),
+            "impact_force_n": c.get("impact_force_n"), "impact_speed_m_s": c.get("impact_speed_m_s"),
+            "ball_speed_at_impact_m_s": c.get("ball_speed_at_impact_m_s"),
+            "match_bound": c.get("match_bound"),
             "joint_speed_ratio_max": c.get("joint_speed_ratio_max"),
             "plans": len(c.get("plans", [])),
             "realtime_factor": metrics["sim"]["realtime_factor"], "warnings": metrics.get("warnings", [])}
@@ -44,7 +47,10 @@ def row(seed: int, params: dict, metrics: dict) -> dict:
 
 def summary(rows: list) -> dict:
     """Catch rate, the oracle's reachable rate, the rate over the reachable throws, failures by
-    reason (the outcome's name; an error run as ``error``), the median error and force, and the
+    reason (the outcome's name; an error run as ``error``), the median error, the medians over the
+    caught throws of the largest force on the ball, of the impact force and of the ball's speed
+    relative to the hand at the impact (``outcome.BallContacts``, ``run.CatchRun``) and of the
+    matched fraction the joints' limits allow there (``Planner.match_bound``), and the
     largest joint speed of any run over its limit."""
     n = len(rows)
     caught = [r for r in rows if r.get("outcome") == "caught"]
@@ -52,6 +58,9 @@ def summary(rows: list) -> dict:
     reach = [r for r in known if r["reachable"]]
     errors = sorted(r["error_at_catch_mm"] for r in rows if r.get("error_at_catch_mm") is not None)
     forces = sorted(r["peak_contact_force_n"] for r in caught if r.get("peak_contact_force_n") is not None)
+    impacts = sorted(r["impact_force_n"] for r in caught if r.get("impact_force_n") is not None)
+    speeds_in = sorted(r["impact_speed_m_s"] for r in caught if r.get("impact_speed_m_s") is not None)
+    bounds = sorted(r["match_bound"] for r in caught if r.get("match_bound") is not None)
     speeds = [r["joint_speed_ratio_max"] for r in rows if r.get("joint_speed_ratio_max") is not None]
     return {"catch": {
         "throws": n, "caught": len(caught), "catch_rate": len(caught) / n if n else None,
@@ -62,4 +71,7 @@ def summary(rows: list) -> dict:
             r.get("outcome", "error") for r in rows if r.get("outcome") != "caught").most_common()),
         "error_at_catch_mm_median": errors[len(errors) // 2] if errors else None,
         "peak_force_caught_n_median": forces[len(forces) // 2] if forces else None,
+        "impact_force_caught_n_median": impacts[len(impacts) // 2] if impacts else None,
+        "impact_speed_caught_m_s_median": speeds_in[len(speeds_in) // 2] if speeds_in else None,
+        "match_bound_caught_median": bounds[len(bounds) // 2] if bounds else None,
         "joint_speed_ratio_max": max(speeds) if speeds else None}}

@@ -11,29 +11,48 @@ from pydrake.systems.framework import LeafSystem
 from ptint_drake.worlds.catch.ball import BALL_DIAMETER
 
 
+PALM = "gripper_base"
+HAND_BODIES = (PALM, "left_finger", "right_finger")
+
+
 class BallContacts(LeafSystem):
     """At every step of the plant, the bodies touching the ball and the peak normal force on it by body
-    (``touched``: name → N, a dict shared across the run's diagrams)."""
+    (``touched``: name → N, a dict shared across the run's diagrams), and the impact (``impact``,
+    shared the same way): ``time``, when the palm first touched the ball; ``axis``, the direction of
+    that first palm force (the palm's normal, out of the palm); ``peak``, the largest component along
+    it of the net contact force on the ball — the force that stops the ball's approach.  The jaws'
+    squeeze acts along the closing axis, across the palm's normal, and the two jaws' forces cancel
+    in the net, so the grip (up to the driver's force limit, held for the whole catch) is not in
+    ``peak`` while it is in ``touched``'s finger entries."""
 
-    def __init__(self, plant, ball, touched: dict):
+    def __init__(self, plant, ball, touched: dict, impact: dict | None = None):
         super().__init__()
         self._plant, self._ball, self.touched = plant, ball.index(), touched
+        self.impact = {} if impact is None else impact
         self.DeclareAbstractInputPort("contact_results", AbstractValue.Make(ContactResults()))
         self.DeclarePeriodicPublishEvent(plant.time_step(), 0.0, self._record)
 
     def _record(self, context) -> None:
         results = self.get_input_port().Eval(context)
+        net, palm = np.zeros(3), None
         for i in range(results.num_point_pair_contacts()):
             info = results.point_pair_contact_info(i)
             a, b = info.bodyA_index(), info.bodyB_index()
             if self._ball not in (a, b):
                 continue
             other = self._plant.get_body(b if a == self._ball else a).name()
-            force = float(np.linalg.norm(info.contact_force()))
+            on_ball = np.asarray(info.contact_force()) * (1.0 if b == self._ball else -1.0)
+            net += on_ball
+            if other == PALM:
+                palm = on_ball if palm is None else palm + on_ball
+            force = float(np.linalg.norm(on_ball))
             self.touched[other] = max(self.touched.get(other, 0.0), force)
+        if palm is not None and "axis" not in self.impact and np.linalg.norm(palm) > 0.0:
+            self.impact.update(time=context.get_time(), axis=palm / np.linalg.norm(palm), peak=0.0)
+        if "axis" in self.impact:
+            self.impact["peak"] = max(self.impact["peak"], float(net @ self.impact["axis"]))
 
 
-HAND_BODIES = ("gripper_base", "left_finger", "right_finger")
 HELD_RADIUS = 0.02  # m
 GRIP_TOLERANCE = 0.01  # m
 LATE_RADIUS = 0.025  # m

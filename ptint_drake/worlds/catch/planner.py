@@ -50,6 +50,7 @@ import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.solvers import Solve
+from scipy.optimize import linprog
 
 from ptint_drake.systems.task.tbg import tbg_profile
 from ptint_drake.worlds.catch.flight import from_estimate, propagate
@@ -203,6 +204,22 @@ class Planner:
         J = np.vstack([ROT_SCALE * J[:3], J[3:]])
         qd = np.linalg.lstsq(J, np.concatenate([np.zeros(3), v]), rcond=None)[0]
         return float(min(self.match, SPEED_SHARE / np.max(np.abs(qd) / self.v_max)))
+
+    def match_bound(self, q, v) -> float:
+        """The largest fraction of the ball's velocity ``v`` the hand can have at posture ``q``
+        with its orientation held and every joint at most at its speed limit (a linear program over
+        q̇: J_ω q̇ = 0, J_v q̇ = u v/|v|, |q̇_j| ≤ q̇_max,j, u the largest): no matching at this
+        posture takes more off the ball's speed relative to the hand, whatever the margins."""
+        self.plant.SetPositions(self.context, q)
+        world = self.plant.world_frame()
+        J = self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
+                                                   np.zeros(3), world, world)[:, :7]
+        speed = float(np.linalg.norm(v))
+        direction = np.concatenate([np.zeros(3), np.asarray(v) / speed])
+        # unknowns [q̇ (7), u]: maximise u
+        result = linprog(np.r_[np.zeros(7), -1.0], A_eq=np.hstack([J, -direction[:, None]]), b_eq=np.zeros(6),
+                         bounds=[(-vm, vm) for vm in self.v_max] + [(0.0, None)], method="highs")
+        return float(result.x[-1]) / speed if result.status == 0 else 0.0
 
     def hopeless(self) -> bool:
         """After a refused ``plan``: no candidate was in reach at all (no point to try again)."""

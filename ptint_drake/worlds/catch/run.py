@@ -69,7 +69,7 @@ class CatchRun(WorldRun):
         self.throw = throw(c.throw, self.x0)
         self.parked = RigidTransform([self.throw.launch[0], self.throw.launch[1], -10.0])
         self.plan, self.plans, self.gave_up, self._replan = None, [], None, False
-        self._pieces, self.touched, self._at = [], {}, {}
+        self._pieces, self.touched, self.impact, self._at = [], {}, {}, {}
         self.simulator_config = SimulatorConfig(integration_scheme="explicit_euler", use_error_control=False,
                                                 max_step_size=0.001)
         self.plant_time_step = c.time_step
@@ -106,7 +106,8 @@ class CatchRun(WorldRun):
         self.logger = LogVectorOutput(st.plant.get_state_output_port(), builder, publish_period=0.001)
         self.estimate_log = LogVectorOutput(st.estimate, builder, publish_period=0.001)
         self.target_log = LogVectorOutput(target.GetOutputPort("target"), builder, publish_period=0.001)
-        probe = builder.AddNamedSystem("ball_contacts", BallContacts(st.plant, st.ball, self.touched))
+        probe = builder.AddNamedSystem("ball_contacts", BallContacts(st.plant, st.ball, self.touched,
+                                                                              self.impact))
         builder.Connect(st.plant.get_contact_results_output_port(), probe.get_input_port())
         self.diagram = builder.Build()
 
@@ -198,9 +199,30 @@ class CatchRun(WorldRun):
                              "catch_posture_deg": np.degrees(plan.q[:7]).tolist() if plan else None,
                              "error_at_catch_m": at_catch[0] if at_catch else None,
                              "peak_contact_force_n": max(self.touched.values(), default=0.0),
+                             **self._impact(t, x),
                              **self._joint_speeds(x),
                              "touched": dict(sorted(self.touched.items()))}}
         return metrics, {"t": t, "plant_state": x, "estimate": estimate, "target": target}, []
+
+    def _impact(self, t: np.ndarray, x: np.ndarray) -> dict:
+        """The impact (``BallContacts``): its force along the palm's normal, and the ball's speed
+        and its speed relative to the fingertip centre at the last logged sample before the palm
+        first touched it (what the velocity matching lowers), and the largest fraction of the
+        ball's velocity the hand could have had there at the full joint speed limits
+        (``Planner.match_bound``).  None when the palm was not touched."""
+        if "axis" not in self.impact:
+            return {"impact_force_n": None, "impact_speed_m_s": None, "ball_speed_at_impact_m_s": None,
+                    "match_bound": None}
+        plant = self.station.plant
+        context = plant.CreateDefaultContext()
+        i = max(int(np.searchsorted(t, self.impact["time"])) - 1, 0)
+        plant.SetPositionsAndVelocities(context, x[i])
+        tip = plant.GetFrameByName(TIP).CalcSpatialVelocity(context, plant.world_frame(), plant.world_frame())
+        ball = self.station.ball.EvalSpatialVelocityInWorld(context).translational()
+        return {"impact_force_n": self.impact["peak"],
+                "impact_speed_m_s": float(np.linalg.norm(ball - tip.translational())),
+                "ball_speed_at_impact_m_s": float(np.linalg.norm(ball)),
+                "match_bound": self.planner.match_bound(x[i, :7], ball)}
 
     def _joint_speeds(self, x: np.ndarray) -> dict:
         """The arm's largest joint speed over the run as a fraction of its limit, and that joint

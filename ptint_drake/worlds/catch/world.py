@@ -66,13 +66,14 @@ class CatchWorld(World):
         """The catch's row: its outcome, the hand's error, the peak force and the largest joint
         speed over its limit (``world``: what ``studies.compare`` tables beside the controller)."""
         c = metrics["catch"]
-        err = c["error_at_catch_m"]
+        err, impact = c["error_at_catch_m"], c.get("impact_force_n")
         return {"ok": metrics["status"] == "ok", "status": metrics["status"], "reasons": metrics["reasons"],
                 "reason_codes": metrics["reason_codes"], "torque_peak_max": None, "segments": [],
                 "realtime_factor": metrics["sim"]["realtime_factor"],
                 "world": {"throw": c["throw"], "outcome": c["outcome"], "plans": len(c["plans"]),
                           "hand error (mm)": None if err is None else round(1e3 * err, 1),
                           "peak force (N)": round(c["peak_contact_force_n"], 1),
+                          "impact (N)": None if impact is None else round(impact, 1),
                           "joint speed / limit": round(c["joint_speed_ratio_max"], 2)}}
 
     def own_plant_step(self, scenario) -> float:

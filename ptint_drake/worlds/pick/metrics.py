@@ -237,7 +237,7 @@ def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> 
         pick["placed"] = bool(pick["grasped"] and pick["held_at_place"] and within)
         picks.append(pick)
     out = {"scenario": scenario.name, "duration": outcome["end"], "segments": segments, "picks": picks}
-    if "tracks" in logs:  # with a camera: the identity switches against the truth (part_tracks)
+    if "tracks" in logs and scenario.pick.line is None:  # a camera: the IDSW (part_tracks; a line: its own)
         out["tracking"] = track_metrics(logs["tracks"], [logs[f"part_true_{k}"] for k in range(len(
             scenario.pick.parts))], [p.name for p in scenario.pick.parts])
     return out

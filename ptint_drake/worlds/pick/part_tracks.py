@@ -72,17 +72,29 @@ def tracker_settings(pick: PickConfig, regions: list, part_belts: list[int], pat
                            visible=CameraView(X_WC, info))
 
 
-def frame_matches(tracks_log: tuple, truth: list[tuple]) -> tuple[list, int]:
-    """Per frame of the ``tracks`` log (times, rows), [(part, track id)] of the fits taken, each
-    matched to the nearest simulated part (``truth``: per part (times, poses) whose columns 0:3
-    are its centre); and the count of fits no part is near."""
+def _frames(tracks_log: tuple):
+    """(stamp, row) of each frame of the ``tracks`` log once (its first sample at or after the stamp)."""
     t, rows = tracks_log
-    frames, false_fits, last = [], 0, None
+    last = None
     for time, row in zip(t, rows):
         stamp = row[0]
         if stamp == last or time < stamp - 1e-9:
             continue
         last = stamp
+        yield stamp, row
+
+
+def frame_stamps(tracks_log: tuple) -> list[float]:
+    """The stamps of ``frame_matches``' frames, in its order."""
+    return [float(stamp) for stamp, _ in _frames(tracks_log)]
+
+
+def frame_matches(tracks_log: tuple, truth: list[tuple]) -> tuple[list, int]:
+    """Per frame of the ``tracks`` log (times, rows), [(part, track id)] of the fits taken, each
+    matched to the nearest simulated part (``truth``: per part (times, poses) whose columns 0:3
+    are its centre); and the count of fits no part is near."""
+    frames, false_fits = [], 0
+    for stamp, row in _frames(tracks_log):
         frame = []
         for slot in row[1:].reshape(MAX_TRACKS, ROW):
             if slot[0] == 0 or slot[2] < 0.5:

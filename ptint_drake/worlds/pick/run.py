@@ -33,6 +33,7 @@ from ptint_drake.systems.task.kinematics import FrameKinematics
 from ptint_drake.worlds.pick.camera import AddPartEstimates, PartEstimates
 from ptint_drake.worlds.pick.cell import PROBE_PERIOD, REPLAY_PERIOD, place_positions, world_config
 from ptint_drake.worlds.pick.line.plan import line_plan
+from ptint_drake.worlds.pick.line.seen import AddLineCamera, LineCamera
 from ptint_drake.worlds.pick.probe import PickProbe
 from ptint_drake.worlds.pick.route import routed_plan
 from ptint_drake.worlds.pick.station import MakePickStation, PickStation
@@ -57,10 +58,14 @@ class PickBuilt:
     estimates: PartEstimates = None  # with an rgbd camera: what the pick aims at (pick.camera)
     # with an rgbd camera: the same plan's targets read off the simulated parts (the metrics' truth)
     true_targets: PickTargets = None
+    line_camera: LineCamera = None  # a line seen by an rgbd camera: its tracks (line.seen)
 
     def part_system(self):
         """The system whose ``part_k_pose`` / ``part_k_rotation`` the targets read: the camera's
-        estimates, or the part tracker's reports (``tracker.TrackedParts``)."""
+        estimates (a line's: its tracks, ``line.seen.LineSeenParts``), or the part tracker's
+        reports (``tracker.TrackedParts``)."""
+        if self.line_camera is not None:
+            return self.line_camera.parts
         if self.estimates is not None:
             return self.estimates.parts
         return self.diagram.GetSubsystemByName("tracked_parts")
@@ -79,16 +84,7 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = (), planning=No
     n = len(station.parts)
     places = place_positions(station.config, plan)
     targets = builder.AddNamedSystem("pick_targets", PickTargets(plan, n, places))
-    estimates, true_targets = None, None
-    if scenario.measurement is not None and scenario.measurement.sensor == "rgbd":
-        estimates = AddPartEstimates(builder, st.GetOutputPort("depth_image"), scenario)
-        parts = estimates.parts
-        true_targets = builder.AddNamedSystem("pick_targets_true",
-                                              PickTargets(plan, n, places))
-        _connect_parts(builder, st, true_targets, n)
-    else:  # the part tracker's reports (a sensor: the station's truth ports are the metrics')
-        parts = builder.AddNamedSystem("tracked_parts", TrackedParts(n))
-        builder.Connect(st.GetOutputPort(TRACKER_PORT), parts.get_input_port())
+    parts, estimates, true_targets, line_camera = _part_source(builder, st, scenario, plan, places)
     _connect_parts(builder, parts, targets, n)
     limits = actuator_effort_limits(arm)
     saturation = builder.AddNamedSystem("saturation", Saturation(-limits, limits))
@@ -121,11 +117,32 @@ def build_pick(scenario: Scenario, replans: tuple[Replan, ...] = (), planning=No
                 for name, port in handles.log_ports.items()}
     if estimates is not None:
         loggers |= _camera_loggers(builder, st, estimates, true_targets, n)
+    if line_camera is not None:  # every frame's tracks (line.metrics: the IDSW, when each part was seen)
+        loggers["tracks"] = LogVectorOutput(line_camera.perception.GetOutputPort("tracks"), builder,
+                                            1.0 / scenario.measurement.rate_hz)
     diagram = builder.Build()
     diagram.set_name(scenario.name or "pick")
     install_stateless_derivatives(diagram)  # as simulation.build: Drake's nanobind bindings
     return PickBuilt(diagram, station, handles, plan, targets, loggers, arm, limits, observer, estimates,
-                     true_targets)
+                     true_targets, line_camera)
+
+
+def _part_source(builder: DiagramBuilder, st, scenario: Scenario, plan: PickPlan, places: list) -> tuple:
+    """(what the targets read, the camera's estimates, the targets read off the simulated parts, a
+    line's camera): the part tracker's reports (a sensor: the station's truth ports are the
+    metrics'), the camera's estimates of the declared parts, or a line's tracks (``line.seen``)."""
+    n = len(scenario.pick.parts)
+    if scenario.measurement is None or scenario.measurement.sensor != "rgbd":
+        parts = builder.AddNamedSystem("tracked_parts", TrackedParts(n))
+        builder.Connect(st.GetOutputPort(TRACKER_PORT), parts.get_input_port())
+        return parts, None, None, None
+    if scenario.pick.line is not None:  # a line's tracks of undeclared parts
+        line_camera = AddLineCamera(builder, st.GetOutputPort("depth_image"), scenario)
+        return line_camera.parts, None, None, line_camera
+    estimates = AddPartEstimates(builder, st.GetOutputPort("depth_image"), scenario)
+    true_targets = builder.AddNamedSystem("pick_targets_true", PickTargets(plan, n, places))
+    _connect_parts(builder, st, true_targets, n)
+    return estimates.parts, estimates, true_targets, None
 
 
 def _connect_parts(builder: DiagramBuilder, parts, targets: PickTargets, n: int) -> None:

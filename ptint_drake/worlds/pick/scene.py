@@ -212,7 +212,8 @@ def part_start_pose(part: PartConfig, belt: BeltConfig) -> RigidTransform:
 
 def AddPart(plant: MultibodyPlant, part: PartConfig, belt: BeltConfig, nubs: bool = False):
     """The part as a free body resting on ``belt`` (its default pose), with corner spheres for
-    point contact if ``nubs`` (a box's 8 corners, a cylinder's 8 rim points); returns the body."""
+    point contact if ``nubs`` (a box's 8 corners, a cylinder's 2 × ``RIM_NUBS`` rim points);
+    returns the body."""
     instance = plant.AddModelInstance(part.name)
     body = plant.AddRigidBody(part.name, instance, part_inertia(part))
     shape, height = part_shape(part)
@@ -225,11 +226,19 @@ def AddPart(plant: MultibodyPlant, part: PartConfig, belt: BeltConfig, nubs: boo
     return body
 
 
+# a cylinder's rim points per end: every 22.5°, so that pads closing at any yaw meet a nub within
+# r (1 − cos 11.25°) = 0.3 mm of the rim (30 mm disc).  With 4 (every 90°), pads closing 45° off
+# them pressed the bare cylinder 1.6 mm deep each side at the 30 N grip: the opening read 26.8 mm,
+# "empty" (line_two_belts_rgbd, whose camera gives a disc no yaw; the pose sensor gave the body's).
+RIM_NUBS = 16
+
+
 def _part_nub_points(part: PartConfig) -> list:
     if part.shape == "box":
         return box_corners(part.size, NUB_RADIUS)
     r, h = part.size[0] / 2 - NUB_RADIUS, part.size[1] / 2 - NUB_RADIUS
-    return [np.array([r * np.cos(a), r * np.sin(a), z]) for a in np.arange(4) * np.pi / 2 for z in (-h, h)]
+    angles = np.arange(RIM_NUBS) * 2.0 * np.pi / RIM_NUBS
+    return [np.array([r * np.cos(a), r * np.sin(a), z]) for a in angles for z in (-h, h)]
 
 
 def tray_pose(tray: TrayConfig) -> RigidTransform:

@@ -6,7 +6,9 @@ events read from what the run recorded — nothing is simulated or measured agai
 - ``seen``: with an RGB-D camera, the frame time of the first fit the part's track took (the
   track bound to the part in the perception's tracks log, series ``tracks_t`` / ``tracks``:
   ``systems.perception.track_system``), None when no track was ever bound to it; without a
-  camera (the parts' poses are given by the tracker sensor from the start) 0;
+  camera (the parts' poses are given by the tracker sensor from the start) 0; on a line, its
+  ``seen`` in metrics.json ``line.parts`` (``line.metrics``: the camera's first fit of it, or with
+  the pose sensor its release);
 - ``scheduled``: its task's start (the task's first approach, or the via before it), from
   metrics.json's ``segments``; None for a part no task picks;
 - ``grasped``: the pick's ``t_grasp`` (both pads on the part in its last attempt; None: never);
@@ -83,8 +85,11 @@ def task_reasons(metrics: dict) -> dict:
 def part_timelines(names: list[str], series: dict, metrics: dict, camera: bool) -> list[PartTimeline]:
     """Per declared part (``names``, in order) its ``PartTimeline`` (module docstring)."""
     lines = [PartTimeline(name) for name in names]
+    rows = metrics.get("line", {}).get("parts")  # a line: when each part was seen (``line.metrics``)
     for k, line in enumerate(lines):
-        if not camera:
+        if rows is not None:
+            line.seen = rows[k]["seen"]
+        elif not camera:
             line.seen = 0.0
         elif "tracks" in series:
             line.seen = first_track_fit(series["tracks"], k)

@@ -93,22 +93,23 @@ def cloud_intervals(clouds: list) -> list[tuple[str, float, float]]:
     return out
 
 
-def pick_legend(scenario, camera: bool) -> list:
-    """The legend of a pick replay (``replay.finish_page``)."""
+def pick_legend(scenario, camera: bool, line: bool = False) -> list:
+    """The legend of a pick replay (``replay.finish_page``); ``line``: a line's (tracks, no clouds)."""
     from ptint_drake.views.replay import FLOOR_COLOR, css_color  # noqa: PLC0415
 
     legend = [("rgba(40, 90, 200, 1)", "the parts, on their belts (dark), to the tray"),
               ("rgba(150, 150, 150, 1)", "the arm and its two-finger gripper")]
-    if camera:
+    if camera and not line:
         rgba = {k: "rgba({}, {}, {}, 1)".format(*(round(255 * c) for c in v[:3]))
                 for k, v in CLOUD_RGBA.items()}
         legend += [(rgba["first_fit"], "magenta points: the depth camera's point cloud at the pick's "
                     "first fit (shown until the grasp's frame; it stays where the part was)"),
                    (rgba["grasp"], "violet points: the cloud at the prescribed grasp"),
                    ("rgba(255, 217, 0, 1)", "yellow outline and axes: the part's estimate, what the arm aims "
-                    f"at (until {GRASP_TAIL:g} s past the grasp)"),
-                   ("rgba(26, 204, 230, 1)", "small spheres, a colour per track: the perception's "
-                    "confirmed tracks, each over its part at its estimated centre")]
+                    f"at (until {GRASP_TAIL:g} s past the grasp)")]
+    if camera:
+        legend.append(("rgba(26, 204, 230, 1)", "small spheres, a colour per track: the perception's "
+                       "confirmed tracks, each over its part at its estimated centre"))
     legend.append((css_color(FLOOR_COLOR), "floor, 10 cm grid"))
     return legend
 
@@ -178,11 +179,14 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: 
     draw_pick_floor(meshcat, plant, context)
     clouds, until, visible, tracks, heights = [], [], {}, [], []
     camera = scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
-    if camera:
+    line = metrics.get("line")  # a line seen by the camera: its tracks, no declared part's estimate
+    if camera and line is None:
         clouds = cloud_intervals(draw_camera_clouds(meshcat, scenario, series, metrics))
         draw_estimates(meshcat, scenario)
         until = estimate_shown_until(scenario, metrics)
-        tracks, heights = confirmed_tracks(series), class_heights(scenario)
+    if camera:
+        tracks = confirmed_tracks(series)
+        heights = [c["height"] for c in line["classes"]] if line else class_heights(scenario)
         draw_track_markers(meshcat, tracks)
     meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
     for t, x in zip(times, states):
@@ -206,7 +210,7 @@ def write_pick_replay(scenario, series: dict, metrics: dict, path: Path, title: 
     placed = sum(bool(p["placed"]) for p in metrics["picks"])
     heading = (f"{title or scenario.name}: {metrics.get('status', '')}, "
                f"{placed} of {len(metrics['picks'])} placed")
-    html = finish_page(meshcat, heading, pick_legend(scenario, camera))
+    html = finish_page(meshcat, heading, pick_legend(scenario, camera, line is not None))
     Path(path).write_text(html, encoding="utf-8")
     return len(html.encode("utf-8"))
 

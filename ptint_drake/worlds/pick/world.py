@@ -397,4 +397,4 @@ class PickWorld(World):
 
 
 def _has_camera(scenario: Scenario) -> bool:
-    return scenario.measurement is not None and scenario.measurement.sensor == "rgbd"
+    return scenario.pick.line is None and getattr(scenario.measurement, "sensor", "") == "rgbd"  # (no line)

@@ -1,13 +1,17 @@
 """A line scenario's checks before its run (one line naming the field, exit 2) and its warnings.
 
-``check_line_scenario``: the pose sensor only (the rgbd line is not built yet: ``measurement``
-refused), the cell (``config.check_pick_parts``), the ``pick.line`` block (``config.line.check_line``
-with the gripper's stroke read from its model), the pool on its belts, and every slot of the
-catalog reachable from above (Drake's IK from the start posture) at half its kind's height and
+``check_line_scenario``: the pose sensor (no ``measurement``) or the rendered camera
+(``measurement.sensor: rgbd``, ``seen``; its camera perceives the line's own belts and each track
+carries its own filter: ``camera.belts`` and an ``estimator`` other than ``auto`` refused), the
+cell (``config.check_pick_parts``), the ``pick.line`` block (``config.line.check_line`` with the
+gripper's stroke read from its model), the pool on its belts, and every slot of the catalog
+reachable from above (Drake's IK from the start posture) at half its kind's height and
 ``lift_height`` above — a slot out of reach is named ``pick.tray.slots[j]``.
 
 ``line_warnings``: the arrival rate against the planned capacity (60 / one pick's cycle with the
-tasks' defaults, per minute): above it, a warning with both numbers, and the run goes on.
+tasks' defaults, per minute): above it, a warning with both numbers, and the run goes on; a
+camera that sees no point of the line's belts' centre lines (every ``VIEW_STEP``): a warning
+(every part will be ``not seen``), and the run goes on.
 """
 
 from __future__ import annotations
@@ -20,13 +24,17 @@ from ptint_drake.config.line import check_line
 from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.robot.plant import nominal_plant
 from ptint_drake.robot.reachability import inverse_kinematics
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, describe_pose, in_view
 from ptint_drake.worlds.pick.config import check_pick_parts
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
 from ptint_drake.worlds.pick.line.driver import cycle_time
 from ptint_drake.worlds.pick.line.plan import line_plan
 
 __all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
-from ptint_drake.worlds.pick.scene import AddGripper, gripper_stroke, slot_pose
+from ptint_drake.worlds.pick.scene import (BIN_DROP_CLEARANCE, AddGripper, belt_frame, gripper_stroke,
+                                          slot_pose)
+
+VIEW_STEP = 0.01  # m, along a belt's centre line: the points a camera must see one of
 
 
 def stroke_of(gripper) -> float:
@@ -38,9 +46,13 @@ def stroke_of(gripper) -> float:
 
 def check_line_scenario(scenario) -> None:
     """ScenarioError naming the first bad field of a line scenario (module docstring)."""
-    if scenario.measurement is not None:
-        raise ScenarioError("measurement: a line aims by the pose sensor (leave measurement out); the line "
-                            "seen by the rgbd camera is not built yet")
+    m = scenario.measurement
+    if m is not None and m.camera is not None and m.camera.belts:
+        raise ScenarioError("measurement.camera.belts: a line's camera perceives the line's own belts "
+                            "(pick.belts): leave belts out")
+    if m is not None and m.estimator != "auto":
+        raise ScenarioError(f"measurement.estimator: a line's tracks each carry their own filter "
+                            f"(systems.perception.tracks): leave estimator auto, got {m.estimator!r}")
     pick = scenario.pick
     check_pick_parts(pick)
     task = PickTaskConfig()
@@ -50,8 +62,16 @@ def check_line_scenario(scenario) -> None:
     arm = nominal_plant(scenario)
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     guess = np.radians(scenario.robot.initial_q_deg)
+    bins = {b.name: (j, b) for j, b in enumerate(pick.bins)}
     for kind in pick.line.catalog:
         height = kind.size[2] if kind.shape == "box" else kind.size[1]
+        if kind.bin:
+            j, box = bins[kind.bin]
+            x = np.asarray(box.center, dtype=float) + [0.0, 0.0, box.size[2] + BIN_DROP_CLEARANCE
+                                                       + height / 2]
+            if inverse_kinematics(arm, frame, x, guess, down=True) is None:
+                raise ScenarioError(f"pick.bins[{j}] (its center and depth): {np.round(x, 3).tolist()} m is "
+                                    f"outside what the arm reaches from above")
         for j in kind.slots:
             x = slot_pose(pick.tray, j).translation() + [0.0, 0.0, height / 2]
             for where in (x, x + [0.0, 0.0, task.lift_height]):
@@ -61,11 +81,26 @@ def check_line_scenario(scenario) -> None:
                                         f"from above")
 
 
+def _blind(scenario) -> list[str]:
+    """A camera that sees no point of the line's belts (module docstring)."""
+    m, pick = scenario.measurement, scenario.pick
+    if m is None or m.sensor != "rgbd":
+        return []
+    names = {b.name for b in pick.line.belts}
+    points = [belt_frame(b).multiply([s, 0.0, 0.0]) for b in pick.belts if b.name in names
+              for s in np.arange(-b.length / 2, b.length / 2, VIEW_STEP)]
+    if np.any(in_view(camera_pose(m.camera), camera_info(m.camera), np.array(points))):
+        return []
+    return [f"measurement.camera: the camera at {describe_pose(m.camera)} sees none of the line's belts: "
+            f"every part will be not seen"]
+
+
 def line_warnings(scenario) -> list[str]:
-    """The arrival rate above the planned capacity (module docstring)."""
+    """The arrival rate above the planned capacity, a blind camera (module docstring)."""
     rate = 60.0 * sum(a.rate for a in scenario.pick.line.arrivals)
     capacity = 60.0 / cycle_time(PickTaskConfig())
     if rate <= capacity:
-        return []
-    return [f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's planned capacity "
-            f"{capacity:.1f} picks/min (60 / one pick's {cycle_time(PickTaskConfig()):.2f} s cycle)"]
+        return _blind(scenario)
+    return _blind(scenario) + [
+        f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's planned capacity "
+        f"{capacity:.1f} picks/min (60 / one pick's {cycle_time(PickTaskConfig()):.2f} s cycle)"]

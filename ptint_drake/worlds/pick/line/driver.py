@@ -136,8 +136,10 @@ class LineDriver:
         task's approach is checked towards where its part was seen."""
         pick = self.scenario.pick
         far = {"offset": FAR_UPSTREAM, "lateral": 0.0}
-        parts = [replace(p, **(dict(zip(("offset", "lateral", "yaw_deg"), self._beliefs[k]))
-                               if k in self._beliefs else far)) for k, p in enumerate(pick.parts)]
+        slots = self.view.slots_of(self._beliefs)  # the sensor's ids; a camera's tracks: their slots
+        beliefs = {slots[i]: b for i, b in self._beliefs.items() if i in slots}
+        parts = [replace(p, **(dict(zip(("offset", "lateral", "yaw_deg", "shape", "size"), beliefs[k]))
+                               if k in beliefs else far)) for k, p in enumerate(pick.parts)]
         belts = [replace(b, speed=self._speeds.get(b.name, b.speed)) for b in pick.belts]
         return replace(self.scenario, pick=replace(pick, parts=parts, belts=belts))
 
@@ -148,7 +150,8 @@ class LineDriver:
             belt = next(b for b in self.scenario.pick.belts if b.name == tr.belt)
             lateral = float(belt_frame(belt).inverse().multiply(np.asarray(tr.position))[1])
             yaw = float(np.degrees(np.arctan2(tr.axis[1], tr.axis[0])))  # world (``scene.part_start_pose``)
-            self._beliefs[tr.id] = (tr.s - tr.speed * t, lateral, yaw)
+            kind = next(c for c in self.line.catalog if c.name == tr.kind)  # (a camera's: as classified)
+            self._beliefs[tr.id] = (tr.s - tr.speed * t, lateral, yaw, kind.shape, list(kind.size))
             self._speeds[tr.belt] = tr.speed
 
     def add_metrics(self, metrics: dict, series: dict) -> None:
@@ -215,7 +218,8 @@ class LineDriver:
         keep = [k for k in range(len(tasks)) if k != replacing]
         assigned = {self.committed[k][0] for k in keep}
         used = {tasks[k].slot for k in keep}
-        free = {c.name: [j for j in c.slots if j not in used] for c in self.line.catalog}
+        free = {c.name: [c.bin] if c.bin else [j for j in c.slots if j not in used]
+                for c in self.line.catalog}
         decision = decide(t, tracks, windows, assigned, free, self.timing)
         if decision.track is not None:
             station = self.built.station
@@ -231,18 +235,29 @@ class LineDriver:
             self._last_look = look
             return False
         self._last_look = None
+        part = self._part_of(context, decision.track, tracks)
         self._believe(tracks, t)
-        self._commit(run, t, decision, replacing)
+        self._commit(run, t, decision, replacing, part)
         self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1})
         return True
 
-    def _commit(self, run, t: float, decision, replacing) -> None:
+    def _part_of(self, context, track: int, tracks: list) -> int:
+        """The pool part a decided track is: the sensor's identity; with the camera the truth names
+        it (``truth.part_under``: the metrics' name of the task) and the task aims at the track
+        (``view.aim``)."""
+        if not self.view.camera:
+            return track
+        part = self.truth.part_under(context, next(tr for tr in tracks if tr.id == track).position)
+        self.view.aim(part, track)
+        return part
+
+    def _commit(self, run, t: float, decision, replacing, part: int) -> None:
         """The decision's task into the run's tasks (and its per-task records)."""
         tasks, default = self.scenario.pick.tasks, PickTaskConfig()
-        name = self.built.station.config.parts[decision.track].name
+        name = self.built.station.config.parts[part].name
         if replacing is None:
             start = max(t, decision.grasp - self.timing.lead)
-            task = PickTaskConfig(part=name, slot=decision.slot, start=start)
+            task = PickTaskConfig(part=name, start=start, **_destination(decision.slot))
             tasks.append(task)
             run.replans.append(Replan())
             run.checks.append([])
@@ -250,9 +265,14 @@ class LineDriver:
             k = len(tasks) - 1
         else:
             tf = decision.grasp - default.descend.tf - t
-            task = PickTaskConfig(part=name, slot=decision.slot, start=t,
+            task = PickTaskConfig(part=name, start=t, **_destination(decision.slot),
                                   approach=MoveConfig(tf, default.approach.beta))
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
         task.close_delay = close_delay(self.line.truth, decision.track)  # the truth's jitter (robust)
         self.committed[k] = [decision.track, decision.grasp, decision.point]
+
+
+def _destination(where) -> dict:
+    """A decision's destination as a task's fields: a tray slot (an index) or a bin (its name)."""
+    return {"bin": where} if isinstance(where, str) else {"slot": where}

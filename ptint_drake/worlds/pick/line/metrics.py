@@ -18,35 +18,82 @@ and the run's records — the parts, not the tasks, are counted:
   the switch (N·m, the largest joint's change between the logged samples around it) beside the
   run's largest sample-to-sample change outside any switch;
 - ``tracking``: the pose sensor's identities are the sensor's (no association, no IDSW to count).
+
+With the rgbd camera (``seen``) the parts are counted by what the camera could see:
+
+- ``entered``: the part's centre, resting on its belt, inside the camera's view (its frustum and
+  depth range, ``rgbd_camera.in_view``: the geometry, whether or not a fit was made) at some
+  sample every ``VIEW_SAMPLE``; a part that reached the arm's reach window without entering the
+  view is not counted and is named ``not seen`` (``not_seen``: their count), as is a part that
+  entered and no track ever took a fit of;
+- ``tracking`` (``part_tracks.track_metrics`` against the truth: each frame's fits matched to
+  the nearest simulated part, from the probe's log): ``idsw`` (must be 0), the tracks of each
+  part, the parts of each track; the scheduler's skips of a part are those of its tracks;
+- per part ``seen``: the stamp of the first frame a track took a fit of it (the pose sensor's
+  line: its release, the sensor reports it from then on; never: None);
+- ``classes``: the catalog's kinds in order (name, height): what a track's class (the tracks log's
+  column, ``track_system``) is, for the replay's markers.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, in_view
 from ptint_drake.verdict.metrics import Reason
 from ptint_drake.worlds.pick.metrics import pick_reasons
+from ptint_drake.worlds.pick.part_tracks import frame_matches, frame_stamps, track_metrics
 from ptint_drake.worlds.pick.probe import PART_WIDTH
 from ptint_drake.worlds.pick.scene import belt_frame, part_shape
 
+VIEW_SAMPLE = 10  # probe samples (``cell.PROBE_PERIOD`` each) between the view checks of ``entered``
 
-def _entered(scenario, view, probe: np.ndarray, k: int) -> bool:
+
+def _on_belt(scenario, probe: np.ndarray, k: int) -> tuple:
+    """(the part's centres in its belt's frame, which samples rest on the belt, those in world)."""
     part = scenario.pick.parts[k]
     belt = {b.name: b for b in scenario.pick.belts}[part.belt]
-    X_BW = belt_frame(belt).inverse()
-    local = np.array([X_BW.multiply(p) for p in probe[:, PART_WIDTH * k: PART_WIDTH * k + 3]])
+    world = probe[:, PART_WIDTH * k: PART_WIDTH * k + 3]
+    local = belt_frame(belt).inverse().multiply(world.T).T
     on = (np.abs(local[:, 1]) <= belt.width / 2) & (np.abs(local[:, 2] - part_shape(part)[1] / 2) < 0.01)
+    return local, on, world
+
+
+def _entered(scenario, view, probe: np.ndarray, k: int) -> bool:
+    """Into the arm's reach window (the pose sensor's line; module docstring)."""
+    local, on, _ = _on_belt(scenario, probe, k)
     if not np.any(on):
         return False
-    s_in, _ = view.window_at(belt.name, float(np.median(local[on, 1])), float(np.median(local[on, 2])))
+    belt = scenario.pick.parts[k].belt
+    s_in, _ = view.window_at(belt, float(np.median(local[on, 1])), float(np.median(local[on, 2])))
     return bool(np.any(local[on, 0] >= s_in))
 
 
-def _unpicked_reason(k: int, decisions: list, passed: bool) -> str:
+def _in_view(scenario, probe: np.ndarray, k: int) -> bool:
+    """Into the camera's view, resting on its belt (module docstring)."""
+    _, on, world = _on_belt(scenario, probe[::VIEW_SAMPLE], k)
+    camera = scenario.measurement.camera
+    return bool(np.any(on) and np.any(in_view(camera_pose(camera), camera_info(camera), world[on])))
+
+
+def camera_tracking(scenario, series: dict) -> tuple[dict, dict]:
+    """With the camera: ``tracking`` (module docstring) and per part the stamp it was first seen."""
+    t, probe = series["t"], series["probe"]
+    log = (series["tracks_t"], series["tracks"])
+    truth = [(t, probe[:, PART_WIDTH * k: PART_WIDTH * k + 3]) for k in range(len(scenario.pick.parts))]
+    seen: dict = {}
+    frames, _ = frame_matches(log, truth)
+    for stamp, frame in zip(frame_stamps(log), frames):
+        for part, _track in frame:
+            seen.setdefault(part, stamp)
+    return track_metrics(log, truth, [p.name for p in scenario.pick.parts]), seen
+
+
+def _unpicked_reason(ids: list, decisions: list, passed: bool) -> str:
     last = None
     for d in decisions:
         for skip in d.get("skipped", []):
-            if skip["track"] == k:
+            if skip["track"] in ids:
                 last = skip["reason"]
     if last is None or last == "later deadline":
         return "passed unpicked" if passed else "on the belt at the end"
@@ -75,17 +122,22 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
     codes = {}
     for k, code in pick_reasons(metrics["picks"]):
         codes.setdefault(k, code)
-    truth, parts = driver.truth, []
+    truth, parts, camera = driver.truth, [], driver.view.camera
+    tracking, seen = camera_tracking(scenario, series) if camera else (None, {})
     for r in driver.releases:
-        k = r.part
-        row = {"part": scenario.pick.parts[k].name, "kind": r.kind, "belt": r.belt, "released": r.t,
-               "entered": k in truth.released and _entered(scenario, driver.view, probe, k),
+        k, name = r.part, scenario.pick.parts[r.part].name
+        reached = k in truth.released and _entered(scenario, driver.view, probe, k)
+        row = {"part": name, "kind": r.kind, "belt": r.belt, "released": r.t,
+               "entered": k in truth.released and (_in_view(scenario, probe, k) if camera else reached),
+               "seen": seen.get(k) if camera else (r.t if k in truth.released else None),
                "task": by_part[k][0] if k in by_part else None, "placed": False, "reason": None}
         if row["task"] is not None:
             row["placed"] = bool(by_part[k][1]["placed"])
-        if row["entered"] and not row["placed"]:
+        ids = tracking["tracks_per_part"].get(name, []) if camera else [k]
+        if (row["entered"] or reached) and not row["placed"]:
             row["reason"] = (codes.get(row["task"], "not placed") if row["task"] is not None
-                             else _unpicked_reason(k, driver.decisions, k in truth.passed))
+                             else "not seen" if row["seen"] is None
+                             else _unpicked_reason(ids, driver.decisions, k in truth.passed))
         parts.append(row)
     entered = sum(p["entered"] for p in parts)
     placed = sum(p["placed"] for p in parts)
@@ -100,10 +152,18 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
             "mean_cycle_s": float(np.mean(cycles)) if cycles else None,
             "passed": len(truth.passed), "parts": parts, "decisions": driver.decisions,
             "replaced": jumps, "largest_torque_step_elsewhere_Nm": usual,
-            "tracking": "pose sensor: identities are the sensor's (no association, no IDSW)"}
+            "not_seen": sum(p["reason"] == "not seen" for p in parts),
+            "classes": [{"name": c.name, "height": float(part_shape(c)[1])}
+                        for c in scenario.pick.line.catalog],
+            "idsw": tracking["idsw"] if camera else None,
+            "tracking": tracking or "pose sensor: identities are the sensor's (no association, no IDSW)"}
 
 
 def line_reasons(line: dict) -> list[Reason]:
-    """The verdict's reasons: every part that entered and was not placed, with its reason."""
-    return [Reason(None, p["reason"], f"{p['part']}: {p['reason']}") for p in line["parts"]
-            if p["entered"] and not p["placed"]]
+    """The verdict's reasons: every part that entered and was not placed, and every part not seen,
+    with its reason; with the camera, identity switches (``idsw`` > 0)."""
+    reasons = [Reason(None, p["reason"], f"{p['part']}: {p['reason']}") for p in line["parts"]
+               if (p["entered"] or p["reason"] == "not seen") and not p["placed"]]
+    if line.get("idsw"):  # the camera's tracks: a part's fits went to another track (must be 0)
+        reasons.append(Reason(None, "identity switch", f"tracking: {line['idsw']} identity switches"))
+    return reasons

@@ -6,7 +6,7 @@ assignments and the slots it has filled, the time), with every skip named.
 belt, moving at the belt's *known* velocity — the encoder's reading, or the declared speed) and
 finds its grasp time on a grid of ``Timing.step`` from the decision:
 
-1. a free slot of its kind, else ``tray full``;
+1. a free slot of its kind (a bin never fills), else ``tray full``;
 2. its reach window (``windows[id]`` = [s_in, s_out]: where along its belt a top-down grasp and
    the lift above it are reachable, found by Drake's IK, ``robot.reachability``) — the predicted
    coordinate s(t) = s + speed · (t − now) inside it at the grasp time;
@@ -88,7 +88,7 @@ class Decision:
     t: float
     track: Optional[int] = None
     grasp: Optional[float] = None
-    slot: Optional[int] = None
+    slot: Optional[int | str] = None  # a tray slot, or the name of the kind's bin
     deadline: Optional[float] = None
     point: Optional[tuple] = None
     skipped: list = field(default_factory=list)
@@ -140,7 +140,7 @@ def blocker(track: Track, tracks: list, grasp: float, now: float, timing: Timing
 def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: dict,
            timing: Timing) -> Decision:
     """The next pick among ``tracks`` not in ``assigned`` (module docstring); ``free_slots``: kind
-    → the slots still free for it, in filling order."""
+    → the slots still free for it, in filling order (a bin kind: [its bin's name])."""
     decision = Decision(now)
     feasible = []
     for track in tracks:

@@ -137,6 +137,16 @@ class LineTruth:
                 self._joint(k).Lock(pc)
         self._drive(context)
 
+    def part_under(self, context, position) -> int:
+        """The released part (not taken off) whose centre is nearest ``position`` (m, world): the
+        pool part a camera track's task picks, by the truth — the metrics' name for the task (its
+        targets read the track, never this); none on the line (a track of nothing): of all."""
+        pc = self.station.plant.GetMyContextFromRoot(context)
+        live = [k for k in self.released if k not in self.passed] or list(range(len(self.station.parts)))
+        far = [np.linalg.norm(self.station.plant.EvalBodyPoseInWorld(pc, self.station.parts[k]).translation()
+                              - np.asarray(position)) for k in live]
+        return live[int(np.argmin(far))]
+
     def in_view(self, k: int) -> bool:
         """Part k is on the line now (released, not taken off)."""
         return k in self.released and k not in self.passed

@@ -4,8 +4,15 @@ tracker's report, each belt's known speed, each track's reach window — never t
 - **the view**: a report is a track when it lies on a belt (within its width, resting on it) from
   ``VIEW_BEFORE`` upstream of the release point on; parked parts (under the floor), parts in the
   hand and in the tray are none.  Its kind is the catalog kind of the reported part's declared
-  shape and size (the pose sensor's object model, from the cell both sides build from; a camera
-  would classify by the measured size);
+  shape and size (the pose sensor's object model, from the cell both sides build from);
+- **with the rgbd camera** (``measurement``, ``seen``) the tracks are the perception's confirmed
+  tracks instead — ids, kinds classified by the measured size and shape, positions and velocities
+  from each track's own filter, yaws the mean of its fits — never the pool; a task's slot reads
+  the track it is aimed at (``aim``), and the plan's model holds each tracked part at the slot a
+  task aims at it, or at a slot no task uses (``slots_of``).  A track is reported once it is
+  classified: ``CLASSIFIED_FITS`` fits, ``CLASS_SHARE`` of them of one class (measured,
+  line_two_belts_rgbd seed 0: a cube's first 7 fits at the view's upstream edge, its top face cut
+  by the image's border, were classed as discs — its slot chosen on them was a disc's);
 - **the known speed** of a belt: its encoder's reading (the drive joint's rate) where the line
   declares ``encoder: true``, else the declared ``speed`` — a speed step is unknown then, until
   a track's drift shows it: the speed the sensor reports for that track is learned for the belt
@@ -37,6 +44,8 @@ KEY_STEP = 0.005  # m: windows are scanned at the lateral offset and height roun
 # (robot model, end effector, start posture, the belt's centre, direction and length, the rounded
 # lateral offset and height, the lift's height) → the window: the scans of this process
 _WINDOWS: dict = {}
+CLASSIFIED_FITS = 15  # fits of a camera track before it is reported (0.5 s at 30 Hz)
+CLASS_SHARE = 0.75  # of its fits of its class
 
 
 class LineView:
@@ -46,6 +55,9 @@ class LineView:
         self.scenario, self.line = scenario, scenario.pick.line
         self._windows: dict = {}
         self.built = None
+        m = scenario.measurement
+        self.camera = m is not None and m.sensor == "rgbd"  # the tracks are the camera's (``seen``)
+        self.aims: dict = {}  # with the camera: pool slot → the track id a task aims it at
         # belt → the speed learned from its tracks after a drift (no encoder: ``driver``)
         self.learned: dict = {}
 
@@ -53,6 +65,27 @@ class LineView:
         self.built = built
         self._arm = built.arm
         self._frame = built.arm.GetFrameByName(self.scenario.robot.end_effector)
+        if self.camera:
+            built.line_camera.parts.aim(self.aims)
+
+    def aim(self, slot: int, track: int) -> None:
+        """With the camera: the task of pool slot ``slot`` aims at track ``track`` (from the next build)."""
+        self.aims[slot] = track
+
+    def slots_of(self, ids) -> dict:
+        """{track id: the pool slot the plan's model holds it at}: the sensor's own identities; with
+        the camera the slot a task aims at it, else the free slots from the last one down."""
+        if not self.camera:
+            return {i: i for i in ids}
+        bound = {track: slot for slot, track in self.aims.items()}
+        free = [k for k in reversed(range(len(self.scenario.pick.parts))) if k not in self.aims]
+        out = {}
+        for i in sorted(ids):
+            if i in bound:
+                out[i] = bound[i]
+            elif free:
+                out[i] = free.pop(0)
+        return out
 
     def _known_speed(self, context, belt) -> float:
         encoder = {b.name: b.encoder for b in self.line.belts}.get(belt.name, False)
@@ -70,6 +103,8 @@ class LineView:
 
     def tracks(self, context, t: float) -> list[Track]:
         """The tracks (module docstring: the view) in the tracker's report now."""
+        if self.camera:
+            return self._camera_tracks(context, t)
         config, source = self.built.station.config, self.built.part_system()
         sc = source.GetMyContextFromRoot(context)
         belts = {b.name: b for b in config.belts}
@@ -88,6 +123,29 @@ class LineView:
                              tuple(belt.direction), self._known_speed(context, belt), tuple(R[:, 0]),
                              float(part.size[0]), reach(part.shape, part.size),
                              float(np.dot(pose[3:6], belt.direction))))
+        return out
+
+    def _camera_tracks(self, context, t: float) -> list[Track]:
+        """The perception's confirmed tracks on the line's belts, predicted to ``t`` along their belt."""
+        seen = self.built.line_camera.parts
+        belts, kinds = self.scenario.pick.belts, self.line.catalog
+        line_belts = {b.name for b in self.line.belts}
+        out = []
+        for tr, yaw in seen.confirmed(seen.GetMyContextFromRoot(context)):
+            if tr.hits < CLASSIFIED_FITS or tr.votes.max() < CLASS_SHARE * tr.votes.sum():
+                continue
+            belt, kind = belts[tr.belt], kinds[tr.kind]
+            u = np.asarray(belt.direction, float) / np.linalg.norm(belt.direction)
+            along = float(tr.x[2:4] @ u[0:2])
+            height = kind.size[2] if kind.shape == "box" else kind.size[1]
+            p = np.array([tr.x[0], tr.x[1], belt.center[2] + height / 2]) + along * u * (t - tr.t)
+            s = float(belt_frame(belt).inverse().multiply(p)[0])
+            if belt.name not in line_belts or abs(s) > belt.length / 2:
+                continue
+            speed = self._known_speed(context, belt)
+            axis = (math.cos(yaw), math.sin(yaw), 0.0)
+            out.append(Track(tr.id, kind.name, belt.name, tuple(p), s, tuple(u), speed, axis,
+                             float(kind.size[0]), reach(kind.shape, kind.size), along))
         return out
 
     def window(self, track: Track) -> tuple:
