@@ -77,8 +77,11 @@ def cmd_robust(args: argparse.Namespace) -> int:
           + f"worst seed {result['worst']['seed']}; wrote {out}/robust.json")
     if "pick_success_rate" in result:
         reasons = ", ".join(f"{k} ×{v}" for k, v in result["failures_by_reason"].items()) or "none"
-        print(f"pick success rate {100 * result['pick_success_rate']:.1f} % of the parts; "
-              f"failures: {reasons}")
+        held = (f" ({100 * result['pick_success_rate_holdable']:.1f} % of those that can be held; "
+                f"{result['cannot_be_held']} cannot)" if "cannot_be_held" in result else "")
+        print(f"pick success rate {100 * result['pick_success_rate']:.1f} % of the parts{held}; "
+              f"failures: {reasons}; placed with a collision: {result['placed_with_collision']}; "
+              f"CPU {result['cpu_s_per_sample']['mean']:.1f} s a sample")
     return 0
 
 

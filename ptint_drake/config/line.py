@@ -12,7 +12,10 @@ scenario, no ``pick.parts`` and no ``pick.tasks`` (the run makes them), and this
 - ``arrivals``: per belt, parts per second (a rate, not a spacing: a faster belt does not bring
   more parts), the process (``poisson`` or ``jittered``), the distributions of the lateral offset
   and the yaw, the kinds' mix;
-- ``speed_steps``: changes of a belt's speed at a time, which the controller side is not told of;
+- ``speed_steps``: changes of a belt's speed at a time (``t: 0``: from the start), which the
+  controller side is not told of;
+- ``truth``: what the pool's parts are where they differ from their kind, which the controller
+  side is not told of either (``PoolTruthConfig``: the robust study's per-part draws);
 - ``seed``: of the arrival process.
 
 The scenario's ``duration`` is the line's.  Plain dataclasses for Drake's ``yaml_load_typed`` (no
@@ -85,8 +88,22 @@ class SpeedStepConfig:
     """The belt ``belt`` runs at ``factor`` × its declared speed from ``t`` on (truth only)."""
 
     belt: str = ""
-    t: float = 0.0  # s
+    t: float = 0.0  # s (0: from the start)
     factor: float = 1.0
+
+
+@dataclass
+class PoolTruthConfig:
+    """The truth of the pool's parts (release order, ``line.arrivals``) where it differs from their
+    catalog kind; an empty list: the kind's.  The controller side reads the catalog (its object
+    model), never these.  ``lateral`` is added to the drawn offset (clipped to the belt's half
+    width); ``close_delay`` (s) to the close command of every task that picks the part (the
+    actuation's jitter, ``PickTaskConfig.close_delay``).  ``ptint robust`` fills them."""
+
+    mass: List[float] = field(default_factory=list)  # kg per pool part
+    friction: List[float] = field(default_factory=list)  # 1 per pool part
+    lateral: List[float] = field(default_factory=list)  # m per pool part
+    close_delay: List[float] = field(default_factory=list)  # s per pool part
 
 
 @dataclass
@@ -97,6 +114,7 @@ class LineConfig:
     catalog: List[KindConfig] = field(default_factory=list)
     arrivals: List[ArrivalConfig] = field(default_factory=list)
     speed_steps: List[SpeedStepConfig] = field(default_factory=list)
+    truth: PoolTruthConfig = field(default_factory=PoolTruthConfig)
     seed: int = 0
     decide_period: float = 0.1  # s, between the scheduler's looks while the arm is free
     redecide_mm: float = 10.0  # mm, the predicted grasp point's drift that calls a new decision
@@ -176,8 +194,8 @@ def check_line(pick, duration: float, stroke: float, margin: float) -> None:
     for k, step in enumerate(line.speed_steps):
         if step.belt not in belts:
             raise ScenarioError(f"pick.line.speed_steps[{k}].belt: no line belt named {step.belt!r}")
-        if not (0.0 < step.t < duration and 0.0 <= step.factor <= 5.0):
-            raise ScenarioError(f"pick.line.speed_steps[{k}]: t in (0, duration) and factor in [0, 5], "
+        if not (0.0 <= step.t < duration and 0.0 <= step.factor <= 5.0):
+            raise ScenarioError(f"pick.line.speed_steps[{k}]: t in [0, duration) and factor in [0, 5], "
                                 f"got t {step.t}, factor {step.factor}")
     if not (0.02 <= line.decide_period <= 1.0 and line.redecide_mm > 0.0):
         raise ScenarioError("pick.line.decide_period: in [0.02, 1] s (and redecide_mm > 0)")

@@ -42,7 +42,11 @@ A pick scenario (``pick``) draws ``mass`` and the five pick ranges only (its pla
 other deviation; the part in the hand is the payload) and is judged by its picks: robust.json
 adds ``pick_success_rate`` (parts placed with no collision / all parts) and ``failures_by_reason``
 (each failed pick's verdict reason without its index, each sample's error: their counts; every
-collision under ``collision``) and ``collisions_by_body`` (the bodies those collisions touched).  Every
+collision under ``collision``), ``collisions_by_body`` (the bodies those collisions touched) and
+``placed_with_collision``.  A line (``pick.line``, issue 44) draws the same per part of its pool, on
+the truth side only (its belts' speeds as speed steps at t = 0: the declared speeds unchanged), and
+is judged per part (``worlds/pick/line/robust.py``).  Every sample records ``cpu_s`` (its CPU time in
+its worker) and robust.json ``cpu_s_per_sample``.  Every
 sample ends with a verdict: a sample that is rejected before its run or raises is an error row,
 counted by its reason.
 
@@ -126,17 +130,21 @@ def sample_scenario(text: str, name: str, seed: int, ranges: dict = RANGES):
 
 def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dict:
     """One Monte Carlo sample: the scenario drawn from ``seed`` within ``ranges``, simulated;
-    its parameters, metrics and verdict (a failed run is a result too)."""
+    its parameters, metrics and verdict (a failed run is a result too), and ``cpu_s``: the CPU
+    seconds of the worker process over the sample (drawing, checks, run, metrics)."""
+    cpu = time.process_time()
     scenario, params = sample_scenario(text, name, seed, ranges)
     try:
         result = simulate(scenario)
     except (ScenarioError, RuntimeError) as exc:  # rejected before the run, or the integrator gave up
-        return {"seed": seed, "params": params, "ok": False, "status": "error",
-                "error": " ".join(str(exc).split())[:300]}
+        row = {"seed": seed, "params": params, "ok": False, "status": "error",
+               "error": " ".join(str(exc).split())[:300]}
     except Exception as exc:  # noqa: BLE001  (any other: still a verdict, named by its type)
-        return {"seed": seed, "params": params, "ok": False, "status": "error",
-                "error": " ".join(f"{type(exc).__name__}: {exc}".split())[:300]}
-    return world_of(scenario).robust_row(seed, params, result.metrics)
+        row = {"seed": seed, "params": params, "ok": False, "status": "error",
+               "error": " ".join(f"{type(exc).__name__}: {exc}".split())[:300]}
+    else:
+        row = world_of(scenario).robust_row(seed, params, result.metrics)
+    return row | {"cpu_s": time.process_time() - cpu}
 
 
 def segment_rows(rows: list) -> list:
@@ -192,6 +200,8 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
                   "params": worst["params"]},
         "wall_time_s": wall,
         "samples_per_s": samples / wall if wall > 0 else None,
+        "cpu_s_per_sample": _percentiles([r["cpu_s"] for r in rows if r.get("cpu_s") is not None])
+        | {"mean": float(np.mean([r.get("cpu_s") or 0.0 for r in rows]))},
         "workers": stats["workers"],
         "worker_starts": stats["worker_starts"],
         # resident set of a worker after each sample (MB): flat when nothing leaks
@@ -250,7 +260,7 @@ def _pick_histogram(result: dict, out_dir: Path) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
     for ax, key, label in ((axes[0], "place_error_mm", "place error [mm]"),
                            (axes[1], "place_error_deg", "place error [deg]")):
-        values = [min(p[key], 50.0) for p in picks]
+        values = [min(p[key], 50.0) for p in picks if p.get(key) is not None]  # (a line's untaken part: none)
         if values:
             ax.hist(values, bins=int(np.clip(2 * np.sqrt(len(values)), 5, 30)), edgecolor="white")
         ax.axvline(3.0, color="r", ls="--")

@@ -59,7 +59,8 @@ def test_harsh_ranges_reach_a_named_failure_and_mild_passes():
     assert passed["ok"] and not passed["reasons"], passed
     summary = robust_summary(rows)
     assert summary == {"pick_success_rate": 0.5, "cannot_be_held": 0, "pick_success_rate_holdable": 0.5,
-                       "failures_by_reason": {"late grasp": 1}, "collisions_by_body": {}}
+                       "failures_by_reason": {"late grasp": 1}, "collisions_by_body": {},
+                       "placed_with_collision": 0}
 
 
 def test_failures_are_counted_by_reason_without_the_pick_index():
@@ -97,7 +98,9 @@ def test_a_sample_that_raises_ends_with_a_verdict(monkeypatch):
     assert row["error"] == "ZeroDivisionError: in the middle of a run"
     assert robust_summary([row]) == {"pick_success_rate": 0.0, "cannot_be_held": 0,
                                      "pick_success_rate_holdable": 0.0, "failures_by_reason": {
-        "error: ZeroDivisionError: in the middle of a run": 1}, "collisions_by_body": {}}
+        "error: ZeroDivisionError: in the middle of a run": 1}, "collisions_by_body": {},
+        "placed_with_collision": 0}
+    assert row["cpu_s"] > 0.0  # the sample's CPU seconds, an error row's too
 
 
 def test_lateral_offset_moves_the_part_and_is_checked():

@@ -82,7 +82,7 @@ def _stage_or_fail(kind, out_dir):
 
 
 def _comparable(row):
-    return {k: v for k, v in row.items() if k != "realtime_factor"}  # wall-clock dependent
+    return {k: v for k, v in row.items() if k not in ("realtime_factor", "cpu_s")}  # clock dependent
 
 
 def _new_children(before):

@@ -20,6 +20,7 @@ from ptint_drake.config.pick import PHASES
 from ptint_drake.robot.mass_scaling import scale_in_context
 from ptint_drake.worlds.base import advance_over_stops, new_simulator
 from ptint_drake.worlds.pick.hold_limit import holdable
+from ptint_drake.worlds.pick.line.robust import line_row, line_sample
 from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.run import pick_simulator
@@ -61,7 +62,10 @@ def robust_sample(scenario, name: str, seed: int, u):
     part's mass and friction; every belt's speed (×); every task's close-command jitter (s, added
     to the close's time: ``close_delay``); every part's lateral offset on its belt (m, ``lateral``,
     clipped to the belt's half width); with an rgbd camera, last, its calibration error and depth
-    noise (``_camera_errors``) and every part's random placement (``_random_placement``)."""
+    noise (``_camera_errors``) and every part's random placement (``_random_placement``).  A line
+    draws per part of its pool instead (``line.robust``)."""
+    if scenario.pick.line is not None:
+        return line_sample(scenario, name, seed, u)
     scenario.plant.mass_scale = float(u("mass"))
     pick = scenario.pick
     for part in pick.parts:
@@ -96,7 +100,10 @@ def robust_sample(scenario, name: str, seed: int, u):
 
 
 def robust_row(seed: int, params: dict, m: dict) -> dict:
-    """What a pick sample keeps of its metrics: the picks, the reasons."""
+    """What a pick sample keeps of its metrics: the picks, the reasons (a line's: its parts,
+    ``line.robust``)."""
+    if "line" in m:
+        return line_row(seed, params, m)
     e_tf = [s["e_tf_norm"] for s in m["segments"]]
     keys = ("part", "grasped", "placed", "place_error_mm", "place_error_deg", "slip_mm", "t_grasp",
             "collision")
@@ -152,8 +159,9 @@ def robust_summary(rows: list) -> dict:
     """``pick_success_rate`` (picks that succeeded, ``picks_ok``, over all parts, a sample that
     could not run placing none), ``failures_by_reason`` ({reason: count}, ``failure_reason``:
     each reason of a sample's verdict, each sample's error; most frequent first; every
-    ``collision with <bodies>`` under the one key ``collision``) and ``collisions_by_body`` ({body:
-    how many of those collisions touched it}) of a pick study; {} otherwise."""
+    ``collision with <bodies>`` under the one key ``collision``), ``collisions_by_body`` ({body:
+    how many of those collisions touched it}) and ``placed_with_collision`` (parts placed by a
+    pick that collided: the collisions among the placed parts) of a pick study; {} otherwise."""
     if not any("picks" in r or "part_mass" in r.get("params", {}) for r in rows):
         return {}
     parts = sum(len(r["params"]["part_mass"]) for r in rows)
@@ -168,8 +176,10 @@ def robust_summary(rows: list) -> dict:
                 bodies.update(b.strip() for b in touched.split(",") if b.strip())
                 code = COLLISION
             reasons[code] += 1
+    touched = sum(1 for r in rows for p in r.get("picks", []) if p.get("placed") and p.get("collision"))
     return {"pick_success_rate": ok / parts if parts else 0.0, **holdable_counts(rows),
-            "failures_by_reason": _most_first(reasons), "collisions_by_body": _most_first(bodies)}
+            "failures_by_reason": _most_first(reasons), "collisions_by_body": _most_first(bodies),
+            "placed_with_collision": touched}
 
 
 COLLISION = "collision"  # failures_by_reason's key of every ``collision with <bodies>``

@@ -7,6 +7,9 @@ offset and the yaw (uniform in their [min, max]).  Each release becomes an ordin
 ``PartConfig`` (named ``<kind>_<n>``, n in release order over the whole line), so the station,
 the tracker, the metrics and the views take the pool as any list of parts; its ``offset`` is the
 release point on its belt.  The truth side parks every part until its release (``truth``).
+``line.truth`` (``config.line.PoolTruthConfig``) then gives pool part n its drawn mass, friction
+and lateral shift (the robust study's; the catalog, which the controller side reads, keeps the
+kind's).
 
 The process (a choice the issue leaves open): ``poisson`` is a Poisson process with a dead time
 — gaps ``min_gap`` + Exp(1/rate − ``min_gap``), so the mean gap stays 1/rate while no two parts
@@ -23,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
-from ptint_drake.config.line import ArrivalConfig, LineConfig
+from ptint_drake.config.line import ArrivalConfig, LineConfig, PoolTruthConfig
 from ptint_drake.config.pick import PartConfig
 
 
@@ -87,13 +90,39 @@ def line_pool(line: LineConfig, duration: float) -> tuple[list[PartConfig], list
     return parts, releases
 
 
+def pool_truth(parts: list[PartConfig], truth: PoolTruthConfig, belts: list) -> None:
+    """Pool part n's mass, friction and lateral shift from ``truth`` (``PoolTruthConfig``; the
+    shifted offset clipped to its belt's half width), in place; a list of another length than the
+    pool is named."""
+    half = {b.name: b.width / 2 for b in belts}
+    for name in ("mass", "friction", "lateral", "close_delay"):
+        values = getattr(truth, name)
+        if values and len(values) != len(parts):
+            raise ScenarioError(f"pick.line.truth.{name}: {len(values)} values for the pool's {len(parts)} "
+                                f"parts (one per part, release order, or none)")
+    for n, part in enumerate(parts):
+        part.mass = float(truth.mass[n]) if truth.mass else part.mass
+        part.friction = float(truth.friction[n]) if truth.friction else part.friction
+        if truth.lateral:
+            h = half[part.belt]
+            part.lateral = float(np.clip(part.lateral + truth.lateral[n], -h, h))
+
+
+def close_delay(truth: PoolTruthConfig, n: int) -> float:
+    """s added to the close command of a task picking pool part ``n`` (``truth.close_delay``; 0
+    without it): the actuation's jitter, the truth side's, which the plan does not foresee."""
+    return float(truth.close_delay[n]) if truth.close_delay else 0.0
+
+
 def line_scenario(scenario):
-    """A copy of the line ``scenario`` whose ``pick.parts`` is the pool (``line_pool``) and whose
-    ``pick.tasks`` is empty (the run appends what it decides); and the releases."""
+    """A copy of the line ``scenario`` whose ``pick.parts`` is the pool (``line_pool``, with its
+    truth: ``pool_truth``) and whose ``pick.tasks`` is empty (the run appends what it decides);
+    and the releases."""
     out = copy.deepcopy(scenario)
     parts, releases = line_pool(scenario.pick.line, scenario.duration)
     if not parts:
         raise ScenarioError("pick.line.arrivals: no part arrives before the scenario's end (rate, "
                             "start, until, duration)")
+    pool_truth(parts, scenario.pick.line.truth, scenario.pick.belts)
     out.pick.parts, out.pick.tasks = parts, []
     return out, releases

@@ -42,7 +42,7 @@ import numpy as np
 from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
-from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
 from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.metrics import line_metrics
@@ -374,5 +374,7 @@ class LineDriver:
         else:
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
+        part = [p.name for p in self.built.station.config.parts].index(task.part)
+        task.close_delay = close_delay(self.line.truth, part)  # the truth's jitter (robust)
         self.committed[k] = [decision.track, decision.grasp, decision.point]
 

@@ -11,8 +11,10 @@ when they run past its end; the belt drives' speed steps; the slabs kept under t
 - **Past the end**: a part on a belt whose centre is within ``END_MARGIN`` of the belt's downstream
   end is parked again (it passed unpicked: ``passed``), so nothing piles up on the floor.
 - **Speed steps** (``line.speed_steps``): at a step's time the belt's drive (its
-  ``ConstantVectorSource``'s value in the context) takes factor × the declared speed.  The
-  controller side is not told: the declared ``pick.belts[*].speed`` it builds from is unchanged.
+  ``ConstantVectorSource``'s value in the context) takes factor × the declared speed; a step at
+  t = 0 is the belt's speed from the start (``start``: the slab set moving at it too; the robust
+  study's drawn speed).  The controller side is not told: the declared ``pick.belts[*].speed`` it
+  builds from is unchanged.
 - **The slab** translates with the belt; over a long run it would leave its rail.  At every stop
   it is put back at its declared place (its joint's position to 0, its speed kept): the slab's top
   is a uniform plane, so the parts riding it feel nothing (measured in the same test: the part's
@@ -66,10 +68,17 @@ class LineTruth:
         return plant.get_joint(index)
 
     def start(self, context) -> None:
-        """At t = 0: every part parked (a release at 0 is done at its stop)."""
+        """At t = 0: every part parked (a release at 0 is done at its stop); the steps at 0 taken,
+        every slab moving at its drive's speed."""
         pc = self.station.plant.GetMyMutableContextFromRoot(context)
         for k in range(len(self.station.parts)):
             self._park(pc, k)
+        for step in self.steps:
+            if step.t <= 0.0:
+                self.factors[step.belt] = step.factor
+        self._drive(context)
+        for joint, belt in zip(self.station.belts, self.station.config.belts):
+            joint.set_translation_rate(pc, self.factors[belt.name] * belt.speed)
 
     def _park(self, pc, k: int) -> None:
         plant, body = self.station.plant, self.station.parts[k]
