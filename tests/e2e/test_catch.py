@@ -119,3 +119,15 @@ def test_the_impact_is_measured_apart_from_the_grip(caught):
     still = _run("catch.throw=1", "measurement.seed=1", "catch.match=0").metrics["catch"]
     ball = still["ball_speed_at_impact_m_s"]
     assert abs(still["impact_speed_m_s"] - ball) < 0.05 * ball
+
+
+def test_a_mass_variant_moves_the_simulated_arm_and_a_payload_is_refused(caught, ptint_here, tmp_path):
+    """``ptint compare``'s ``mass_xF`` variants reach the catch station's arm (in the first
+    diagram and in every one a new plan resumes); a payload is not modelled: one line, exit 2."""
+    heavy = _run("catch.throw=1", "measurement.seed=1", "plant.mass_scale=1.5").metrics["catch"]
+    light = caught.metrics["catch"]
+    assert heavy["outcome"] == "caught"
+    assert abs(heavy["joint_speed_ratio_max"] - light["joint_speed_ratio_max"]) > 1e-3
+    out = tmp_path / "out"
+    result = ptint_here("run", "catch_toss_iiwa14", "--out", out, "--set", "plant.payload_kg=1")
+    assert result.returncode == 2 and "plant.payload_kg" in result.stderr and not out.exists()

@@ -36,6 +36,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from ptint_drake.controllers import AddControllerTo
+from ptint_drake.robot.mass_scaling import scale_in_context
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.worlds.base import WorldRun
 from ptint_drake.worlds.catch.ball import BALL_DIAMETER
@@ -123,6 +124,8 @@ class CatchRun(WorldRun):
         start_from(settled(self.scenario), self, context)
         st = self.station
         pc = st.plant.GetMyMutableContextFromRoot(context)
+        # a mass_xF plant variant: the simulated arm only (the planner and the law keep the nominal)
+        scale_in_context(st.plant, pc, st.arm, self.scenario.plant.mass_scale)
         st.plant.SetFreeBodyPose(pc, st.ball, RigidTransform(np.array(self.throw.launch)))
         v0 = SpatialVelocity(np.zeros(3), np.array(self.throw.velocity))
         st.plant.SetFreeBodySpatialVelocity(pc, st.ball, v0)
@@ -183,6 +186,9 @@ class CatchRun(WorldRun):
         new_context.SetContinuousState(old_context.get_continuous_state_vector().CopyToVector())
         for i in range(old_context.num_discrete_state_groups()):
             new_context.SetDiscreteState(i, old_context.get_discrete_state(i).value())
+        st = self.station  # the new diagram's: its plant's parameters start nominal again
+        scale_in_context(st.plant, st.plant.GetMyMutableContextFromRoot(new_context), st.arm,
+                         self.scenario.plant.mass_scale)
 
     def finish(self, context, integrator) -> tuple[dict, dict, list[str]]:
         pieces = self._pieces + [tuple(log.FindLog(context) for log in self._logs())]

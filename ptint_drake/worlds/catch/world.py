@@ -13,6 +13,7 @@ from pathlib import Path
 
 from pydrake.common.yaml import yaml_load_typed
 
+from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.schema import Scenario
 from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.systems.task.schedule import Schedule, Segment
@@ -32,6 +33,16 @@ class CatchWorld(World):
     def schedule(self, scenario) -> Schedule:
         c = scenario.catch
         return Schedule([Segment(0.0, c.sensing, c.beta), Segment(c.sensing, 0.6, c.beta)])
+
+    def validate(self, scenario) -> None:
+        """The simulated arm may be scaled (``plant.mass_scale``: ``ptint compare``'s ``mass_xF``
+        variants, applied in ``CatchRun.initialize``); the other plant deviations are not
+        modelled in the catch station: one line naming the field."""
+        p = scenario.plant
+        if p.payload_kg != 0.0:
+            raise ScenarioError("plant.payload_kg: not used in a catch scenario (the hand is the payload)")
+        if p.damping_scale != 1.0 or p.coulomb or p.disturbance.amplitude or p.disturbance.step:
+            raise ScenarioError("plant: a catch scenario takes mass_scale only")
 
     def prepare(self, scenario, log: bool = True) -> CatchRun:
         return CatchRun(scenario, log)
