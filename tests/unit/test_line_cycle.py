@@ -128,3 +128,17 @@ def test_a_phase_split_by_a_via_gets_what_both_legs_need():
     scale = [needs[p] / getattr(scenario.pick.tasks[1], p).tf for p in phases]
     after = [model.demand(a, b, tf * f, v, m, beta, y) for (a, b, tf, v, m, beta, y), f in zip(legs, scale)]
     assert max(after) <= 1.0, after
+
+
+def test_the_model_plans_a_held_part_at_the_arms_rated_payload_less_its_hand():
+    """``cycle.held_mass``: a part's true mass is unknown on the controller side, so the min-tf
+    model plans at the most the arm may carry (the RV-M1: 1.2 kg less its 0.14 kg hand), never
+    below the declared mass, and at the declared mass on an arm without a rated payload."""
+    from ptint_drake.simulation.scenario import LoadedScenario
+    from ptint_drake.worlds.pick.line.cycle import held_mass
+
+    scenario = LoadedScenario.load("line_short").scenario
+    assert abs(held_mass(scenario, 0.1) - 1.06) < 0.01
+    assert held_mass(scenario, 1.5) == 1.5
+    scenario.robot.model = "not_rated"
+    assert held_mass(scenario, 0.1) == 0.1

@@ -43,7 +43,7 @@ from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
-from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate
+from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
@@ -331,7 +331,7 @@ class LineDriver:
         if replacing is not None and t >= tasks[replacing].start - 1e-9:
             begin = t  # its approach under way: restarted from the present state
         task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
-        mass = next(c.mass for c in self.line.catalog if c.name == track.kind)
+        mass = held_mass(self.scenario, next(c.mass for c in self.line.catalog if c.name == track.kind))
         self._vias = {}  # phase → the tf its via's legs need (the decision log's ``via_tf``)
         why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
         for _ in range(DETOUR_PASSES):
