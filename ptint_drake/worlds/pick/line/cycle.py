@@ -190,7 +190,7 @@ class LineCycles:
         task = replace(self.task, **destination(slot))
         place = _place(pick, slot, kind)
         return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
-                          place, place_target(pick, task)[2], _yaw(track),
+                          place, _place_yaw(pick, task, _yaw(track)), _yaw(track),
                           held_mass(self.scenario, kind.mass), task, start, yaw)
 
     def task_of(self, part: str, slot, grasp: float, now: float, cycle: Cycle,
@@ -247,7 +247,7 @@ def estimate(scenario, view, model: Optional[PhaseTimes] = None) -> tuple:
             x = belt_frame(belt).multiply(np.array([0.5 * (s_in + s_out), 0.0, height / 2]))
             where = kind.bin or kind.slots[0]
             place = _place(pick, where, part)
-            place_yaw = place_target(pick, replace(task, **destination(where)))[2]
+            place_yaw = _place_yaw(pick, replace(task, **destination(where)), 0.0)
             ride = belt.speed * np.asarray(belt.direction) / np.linalg.norm(belt.direction)
             cycle = cycle_time(model, x, ride, place, place_yaw, 0.0, held_mass(scenario, kind.mass), task)
             totals.append(cycle.total)
@@ -280,6 +280,12 @@ _HAND_KG: dict = {}
 def destination(where) -> dict:
     """A decision's destination as a task's fields: a tray slot (an index) or a bin (its name)."""
     return {"bin": where, "slot": None} if isinstance(where, str) else {"slot": where, "bin": ""}
+
+
+def _place_yaw(pick, task, grasp_yaw: float) -> float:
+    """rad: the tool's yaw at a task's place — its slot's on the tray, or over a bin the yaw it
+    grasped at (``tasks.place_target``: the tool keeps it; a line's part is declared nowhere)."""
+    return grasp_yaw if task.bin else place_target(pick, task)[2]
 
 
 def _place(pick, where, part) -> np.ndarray:
