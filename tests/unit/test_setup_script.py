@@ -25,6 +25,10 @@ exec {real} "$@"
 """
 
 
+DEFAULT_SIGINT = ("import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+                  "os.execvp('bash', ['bash', sys.argv[1]])")
+
+
 def _stand_ins(tmp_path) -> dict:
     """The environment of a run against the stand-ins (see the module's docstring)."""
     bin_dir = tmp_path / "bin"
@@ -59,8 +63,11 @@ def _run_setup(env: dict, on_line=None) -> tuple[int, list]:
     ``on_line(proc, line)`` sees each line as it comes.  Fails if anything of the script is still
     running (or holding its output open) a moment after it exited, and then ends that group."""
     started = time.monotonic()
-    proc = subprocess.Popen(["bash", str(SETUP)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, env=env, start_new_session=True)
+    # the script as a terminal starts it: SIGINT at its default.  A runner that starts the suite with
+    # SIGINT ignored (a job put in the background by a non-interactive shell) passes that on, and
+    # bash cannot trap a signal ignored on entry: the Ctrl-C cases then failed with pip's exit 7
+    proc = subprocess.Popen([sys.executable, "-c", DEFAULT_SIGINT, str(SETUP)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, env=env, start_new_session=True)
     stamped = []
 
     def read():
