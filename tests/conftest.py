@@ -133,6 +133,22 @@ def ptint_here(capfd):
     return ptint
 
 
+@pytest.fixture
+def refused_run(tmp_path, ptint_here):
+    """``ptint run SCENARIO --set OVERRIDE`` (no views) that must be refused: exit 2, one line on
+    stderr, no traceback, no output folder; returns that line for the test's own checks."""
+    def refused(scenario: str, override: str) -> str:
+        out = tmp_path / "out"
+        result = ptint_here("run", scenario, "--quiet", "--no-replay", "--no-figures", "--out", out,
+                            "--set", override)
+        lines = [line for line in result.stderr.splitlines() if line.strip()]
+        assert result.returncode == 2, result.stderr
+        assert len(lines) == 1 and "Traceback" not in result.stderr, result.stderr
+        assert not out.exists()
+        return lines[0]
+    return refused
+
+
 DYNAMICS = ("CalcMassMatrix", "CalcMassMatrixViaInverseDynamics", "CalcBiasTerm",
             "CalcGravityGeneralizedForces", "CalcInverseDynamics")
 

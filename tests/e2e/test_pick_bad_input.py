@@ -15,13 +15,7 @@ CASES = {
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_bad_pick_input_is_one_line_naming_the_field_and_exit_2(tmp_path, ptint_here, case):
+def test_bad_pick_input_is_one_line_naming_the_field_and_exit_2(refused_run, case):
     override, field, detail = CASES[case]
-    out = tmp_path / "out"
-    result = ptint_here("run", "conveyor_pick_place", "--quiet", "--no-replay", "--no-figures", "--out", out,
-                        "--set", override)
-    lines = [line for line in result.stderr.splitlines() if line.strip()]
-    assert result.returncode == 2, result.stderr
-    assert len(lines) == 1 and "Traceback" not in result.stderr, result.stderr
-    assert lines[0].startswith(f"ptint: error: {field}") and detail in lines[0], lines[0]
-    assert not out.exists()
+    line = refused_run("conveyor_pick_place", override)
+    assert line.startswith(f"ptint: error: {field}") and detail in line, line
