@@ -197,23 +197,24 @@ class Planner:
         ``SPEED_SHARE`` of the joints' limits."""
         if self.match <= 0.0:
             return 0.0
-        self.plant.SetPositions(self.context, q)
-        world = self.plant.world_frame()
-        J = self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
-                                                   np.zeros(3), world, world)[:, :7]
+        J = self._jacobian(q)
         J = np.vstack([ROT_SCALE * J[:3], J[3:]])
         qd = np.linalg.lstsq(J, np.concatenate([np.zeros(3), v]), rcond=None)[0]
         return float(min(self.match, SPEED_SHARE / np.max(np.abs(qd) / self.v_max)))
+
+    def _jacobian(self, q) -> np.ndarray:
+        """The tip's spatial Jacobian [ω; v] over the arm's 7 joint velocities at posture ``q``."""
+        self.plant.SetPositions(self.context, q)
+        world = self.plant.world_frame()
+        return self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
+                                                      np.zeros(3), world, world)[:, :7]
 
     def match_bound(self, q, v) -> float:
         """The largest fraction of the ball's velocity ``v`` the hand can have at posture ``q``
         with its orientation held and every joint at most at its speed limit (a linear program over
         q̇: J_ω q̇ = 0, J_v q̇ = u v/|v|, |q̇_j| ≤ q̇_max,j, u the largest): no matching at this
         posture takes more off the ball's speed relative to the hand, whatever the margins."""
-        self.plant.SetPositions(self.context, q)
-        world = self.plant.world_frame()
-        J = self.plant.CalcJacobianSpatialVelocity(self.context, JacobianWrtVariable.kV, self.frame,
-                                                   np.zeros(3), world, world)[:, :7]
+        J = self._jacobian(q)
         speed = float(np.linalg.norm(v))
         direction = np.concatenate([np.zeros(3), np.asarray(v) / speed])
         # unknowns [q̇ (7), u]: maximise u
