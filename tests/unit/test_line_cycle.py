@@ -142,3 +142,23 @@ def test_the_model_plans_a_held_part_at_the_arms_rated_payload_less_its_hand():
     assert held_mass(scenario, 1.5) == 1.5
     scenario.robot.model = "not_rated"
     assert held_mass(scenario, 0.1) == 0.1
+
+
+def test_an_estimate_kept_for_the_process_leaves_a_fresh_model_as_computing_it_does():
+    """``cycle.estimate`` asked of a fresh model is kept for the process (a study's samples share
+    the controller side's cell), and a hit leaves the model as the computation does — the postures
+    it solved and the riding phases' last tf, which the run's phases start from — so a sample's
+    run does not depend on what its worker ran before; another cell is computed anew."""
+    from ptint_drake.worlds.pick.line import cycle
+
+    scenario, _ = line_scenario(load_scenario("line_short"))
+    window = lambda belt, lateral, height: (-0.1, 0.1)  # noqa: E731
+    cycle._ESTIMATES.clear()
+    computed = PhaseTimes.of(scenario)
+    found = cycle.estimate(scenario, window, computed)
+    kept = PhaseTimes.of(scenario)
+    assert cycle.estimate(scenario, window, kept) == found and len(cycle._ESTIMATES) == 1
+    assert kept.postures.keys() == computed.postures.keys() and kept.last == computed.last
+    scenario.pick.belts[0].speed *= 1.2
+    faster = cycle.estimate(scenario, window, PhaseTimes.of(scenario))
+    assert len(cycle._ESTIMATES) == 2 and faster != found

@@ -23,7 +23,19 @@ scheduler asks again for the same ways); ``scripts/bench_phase_time.py`` measure
 Choices left open here: ``MARGIN`` = 1.15 over the model's bound (the model is an ideal tracker of
 the error dynamics; the runs measured peaks within 7 % of it, docs/pick_place.md "Checks before
 and during the run", and the torque bound sits on the unmodelled contact and grip loads);
-``SHORTEST`` = 0.05 s, the floor of a way that asks nothing (a zero error).
+``SHORTEST`` = 0.05 s, the floor of a way that asks nothing (a zero error).  ``TORQUE_SHARE`` =
+2/3: the model plans to two thirds of each effort limit, the headroom for what the controller
+side does not know — the model is the nominal arm, and the inverse dynamics is linear in the
+mass parameters, so an arm whose links weigh up to 1.5 × their nominal (the robust study's
+declared range, ``studies.robust.RANGES``) holding at most the rated payload (``line.cycle``
+plans every held part at it) asks at most 1.5 × the model's torque; the feedback's own demand
+comes on top, inside ``MARGIN``.  Measured on the harsh line study (line_assembly, 50 samples,
+docs/pick_place.md "The harsh study"): at the full limits the runaways were heavy parts on arms
+×1.2–1.46 — seed 7 (×1.20, a 0.96 kg cube): its lift, planned at 0.19 s, was commanded 5.5 × joint
+2's limit and the arm ran into the belts; at 2/3 that lift takes 0.25 s, its commands peak at
+1.8 × briefly (0.5 % of the run at a limit) and the arm runs on.
+``SPEED_SHARE`` = 1: a joint's speed |J⁺ẋ| is kinematic (no mass in it) — the runaways measured
+were torque-led, the speeds beyond their limits came after the torques saturated.
 
 ``cycle_time`` — one pick cycle from the min tfs: the approach from the last place's retreat point
 to ``clearance`` above a part riding its belt, the descend, the close dwell, the lift, the carry to
@@ -51,6 +63,8 @@ from ptint_drake.worlds.pick.tasks import place_target
 from ptint_drake.worlds.pick.ways import nominal
 
 MARGIN = 1.15  # over the model's shortest tf (module docstring)
+TORQUE_SHARE = 2.0 / 3.0  # of each effort limit the model plans to (module docstring)
+SPEED_SHARE = 1.0  # of each joint-speed limit the model plans to (module docstring)
 SHORTEST = 0.05  # s: the floor of a way that asks nothing
 TOLERANCE = 0.002  # s: a riding target's fixed point
 ITERATIONS = 5
@@ -81,6 +95,8 @@ class PhaseTimes:
     damping: float = 0.0
     gripper_speed: float = 0.05  # m/s per jaw: a descend is at least the fingers' close (``cycle_time``)
     samples: int = SPEED_SAMPLES  # of each profile (``COARSE``: fewer, faster)
+    torque_share: float = TORQUE_SHARE  # of the effort limits planned to
+    speed_share: float = SPEED_SHARE  # of the joint-speed limits planned to
     postures: dict = field(default_factory=dict)
     last: float = 1.0  # s: the last riding phase's tf, the next one's first guess
 
@@ -136,7 +152,13 @@ class PhaseTimes:
             return float("inf")
         speeds, torques = joint_demand(self.plant, self.tool, profile, self.instance, self.rot_scale,
                                        self.damping)
-        return float(max(np.max(speeds / self.speed_limits), np.max(torques / self.effort_limits)))
+        V, L = self.limits()
+        return float(max(np.max(speeds / V), np.max(torques / L)))
+
+    def limits(self) -> tuple:
+        """(joint speeds, rad/s; torques, N·m): the shares of the arm's limits the model plans to
+        (``speed_share``, ``torque_share``; module docstring)."""
+        return self.speed_share * self.speed_limits, self.torque_share * self.effort_limits
 
     def _postures(self, way: Way, tf: float, beta: float, guess: np.ndarray) -> np.ndarray:
         """``feasibility.way_postures``, cached by the way (to 0.1 mm, 1 mrad, 1 ms)."""
@@ -163,7 +185,7 @@ class PhaseTimes:
                                                     self.instance, self.rot_scale, self.damping)
         B, c2 = v1 - A, 0.5 * (t2 - 2.0 * t1 + t0)
         c1 = t1 - t0 - c2
-        V, L = self.speed_limits, self.effort_limits
+        V, L = self.limits()
         over = np.flatnonzero((np.abs(A) > V).any(axis=0) | (np.abs(t0) > L).any(axis=0))
         if len(over):
             j = int(over[0])
