@@ -18,9 +18,11 @@ arrive from above, never through its side).
 Where a way hits and has no via yet (``route``: the way around the base), ``obstacle_vias`` adds one
 (``tasks.Via``): a fixed point above the way's start, raised from the higher of the way's two ends in
 ``RISE`` steps until both legs keep clear and a top-down posture reaches it, so the tool rises
-first and the approach arrives from above.  Where no height up to ``MAX_RISE`` clears, no via is
-made and ``obstacle_warnings`` names the bodies before the run.  The links above the hand are not in
-the planning model: their contacts are found during the run (``collisions``).
+first and the approach arrives from above.  A carry's via above its start keeps the tool's yaw
+there (``_held_yaw``): the rise does not turn, the leg after it does.  Where no height up to
+``MAX_RISE`` clears, no via is made and ``obstacle_warnings`` names the bodies before the run.
+The links above the hand are not in the planning model: their contacts are found during the run
+(``collisions``).
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ from pydrake.systems.framework import DiagramBuilder
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.placement import nominal_parts
 from ptint_drake.worlds.pick.scene import (FINGER_JOINTS, belt_frame, bin_boxes, finger_extent, gripper_path,
+                                           slot_pose,
                                            part_shape, tray_pose)
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, segment_way
@@ -196,6 +199,7 @@ def _via_above(scene, world, pick, replans, vias, plan: PickPlan, i: int):
     seg = plan.segments[i]
     start, end = segment_way(world, plan, i, np.array([0.0, plan.schedule.segments[i].tf]))
     low = max(start[2], end[2])
+    held = _held_yaw(world, plan, i) if seg.phase == "carry" else None
     for z in np.arange(low + RISE, low + MAX_RISE, RISE):
         for above in (start, end):
             point = np.array([above[0], above[1], z])
@@ -203,13 +207,23 @@ def _via_above(scene, world, pick, replans, vias, plan: PickPlan, i: int):
                 continue
             first, second = np.linalg.norm(point - start), np.linalg.norm(end - point)
             share = float(first / (first + second))
-            candidate = Via(seg.task, seg.phase, tuple(float(c) for c in point), share)
+            yaw = held if above is start else None  # a rise keeps the yaw it starts with
+            candidate = Via(seg.task, seg.phase, tuple(float(c) for c in point), share, yaw)
             trial = pick_plan(pick, replans, vias + (candidate,))
             j = next(n for n, s in enumerate(trial.segments) if s.task == seg.task and s.phase == "via"
                      and s.kind == (VIA_PART if seg.phase == "approach" else VIA_SLOT))
             if way_hit(scene, world, trial, j) is None and way_hit(scene, world, trial, j + 1) is None:
                 return candidate
     return None
+
+
+def _held_yaw(world: Nominal, plan: PickPlan, i: int) -> float:
+    """rad: the yaw of the part carry segment i holds — the tool's yaw at the carry's start, modulo
+    π (``route.tool_yaws``: the top-down task turns to the branch of a target's yaw nearest the
+    tool's), so a via turned to it does not turn.  A carry's via above its start keeps it, so that
+    its short rise does not turn the wrist the whole way to the slot's yaw (the long leg after it
+    does): by the legs' lengths the rise got a few per cent of the carry's tf for the whole turn."""
+    return float(world.part_yaws[plan.segments[plan.segment_index(plan.segments[i].task, "approach")].index])
 
 
 def checked_segments(plan: PickPlan) -> list:
@@ -245,3 +259,29 @@ def obstacle_warnings(scenario, world: Nominal, plan: PickPlan) -> list[str]:
             if (seg.phase in CHECKED and seg.attempt == 0) or seg.phase == "via"]
     return [f"{h.describe()}: no via above clears it (the hand keeps {1e3 * HAND_MARGIN:g} mm)"
             for h in hits if h is not None]
+
+
+def slot_warnings(scenario, margin: float) -> list[str]:
+    """One warning per tray slot of a line's catalog where the open fingers placing a part of its
+    kind (the hand's cylinder of the planning model: half the opening, the kind's width +
+    ``margin``, plus a finger's thickness) come within ``HAND_MARGIN`` of a belt's slab whose top is
+    above the tray's (the fingers go down beside it): no via helps there, every place at that slot
+    touches the belt.  Measured, line_two_belts at 8f38957: its tray's column at x = 0.17 m, the
+    inner belt's edge at 0.195 m — the right finger 0.3 mm into the inner belt at the place and the
+    retreat, `collision with inner` in 20 of 61 placed picks."""
+    pick = scenario.pick
+    thickness = _hand_size(scenario)[2]
+    out = []
+    for kind in pick.line.catalog:
+        radius = (kind.size[0] + margin) / 2 + thickness
+        for j in kind.slots:
+            at = slot_pose(pick.tray, j).translation()
+            for belt in pick.belts:
+                local = belt_frame(belt).inverse().multiply(at)
+                gap = np.hypot(max(abs(local[0]) - belt.length / 2, 0.0),
+                               max(abs(local[1]) - belt.width / 2, 0.0))
+                if belt.center[2] > at[2] and gap - radius < HAND_MARGIN:
+                    out.append(f"pick.tray.slots[{j}]: the open fingers placing a {kind.name} there come "
+                               f"{1e3 * (gap - radius):.1f} mm from belt {belt.name!r} (below its top): "
+                               f"collision with {belt.name} at every place there")
+    return out

@@ -12,7 +12,9 @@ reachable from above (Drake's IK from the start posture) at half its kind's heig
 (``line.cycle.estimate``, picks per minute): above it, a warning with the numbers, and the run goes
 on.  The estimate, not a measurement: a measured throughput belongs to one cell and one commit
 (the surplus line's is measured by ``scripts/line_capacity.py``, docs/pick_place.md "The line's
-capacity").  A camera that sees no point of the line's belts' centre lines (every
+capacity").  A tray slot where the open fingers come down beside a belt
+(``obstacles.slot_warnings``): a warning naming the slot and the belt.  A camera that sees no
+point of the line's belts' centre lines (every
 ``VIEW_STEP``): a warning (every part will be ``not seen``), and the run goes on.
 """
 
@@ -32,6 +34,7 @@ from ptint_drake.worlds.pick.line.arrivals import line_scenario
 from ptint_drake.worlds.pick.line.cycle import estimate
 from ptint_drake.worlds.pick.line.driver import cycle_time
 from ptint_drake.worlds.pick.line.plan import line_plan
+from ptint_drake.worlds.pick.obstacles import slot_warnings
 from ptint_drake.worlds.pick.scene import (BIN_DROP_CLEARANCE, AddGripper, belt_frame, gripper_stroke,
                                           slot_pose)
 
@@ -103,6 +106,7 @@ def line_warnings(scenario, driver=None) -> list[str]:
     min-tf model's estimate when the run's ``driver`` (a bound ``LineDriver``) is given, else the
     tasks' default tfs."""
     rate = 60.0 * sum(a.rate for a in scenario.pick.line.arrivals)
+    fingers = slot_warnings(scenario, PickTaskConfig().margin)  # (obstacles: a slot beside a belt)
     if driver is not None and getattr(driver, "cycles", None) is not None:
         capacity, cycle = estimate(driver.scenario, driver.view.window_at, driver.cycles.model)
         how = (f"the feasibility model's estimate: 60 / a {cycle:.2f} s cycle at the min tfs, "
@@ -111,6 +115,7 @@ def line_warnings(scenario, driver=None) -> list[str]:
         cycle = cycle_time(PickTaskConfig())
         capacity, how = 60.0 / cycle, f"60 / one pick's {cycle:.2f} s cycle with the tasks' default tfs"
     if rate <= capacity:
-        return _blind(scenario)
-    return _blind(scenario) + [f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's capacity "
-                               f"{capacity:.1f} picks/min ({how}); the run goes on"]
+        return _blind(scenario) + fingers
+    return _blind(scenario) + fingers + [
+        f"pick.line.arrivals: {rate:.1f} parts/min arrive, above the arm's capacity "
+        f"{capacity:.1f} picks/min ({how}); the run goes on"]
