@@ -26,7 +26,9 @@ class CatchConfig:
     (``worlds.catch.target``): ``match`` (the fraction of the ball's velocity the hand has at the
     catch), ``match_time`` (s, how long before the catch the matching sets in), ``freeze`` (s
     before the catch from which the estimate is held); ``final`` (s: the catch segment split in two,
-    the second this long, so that a new segment starts from the state near the catch; 0: one)."""
+    the second this long, so that a new segment starts from the state near the catch; 0: one);
+    ``close_lag`` (s after the catch at which the closing jaws reach the ball's diameter: the palm
+    takes the impact first, ``worlds.catch.target``)."""
 
     throw: int = 0
     gripper: GripperConfig = field(default_factory=_wsg)
@@ -41,3 +43,4 @@ class CatchConfig:
     match_time: float = 0.2
     freeze: float = 0.06
     final: float = 0.0
+    close_lag: float = 0.004

@@ -9,12 +9,14 @@ and the jaws' squeeze, however strong, is not in it."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from pydrake.math import RigidTransform
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.systems.framework import DiagramBuilder
 
+from ptint_drake.config.catch import CatchConfig
 from ptint_drake.robot.plant import resolve_model
 from ptint_drake.worlds.base import new_simulator
 from ptint_drake.worlds.catch.ball import BALL_DIAMETER, AddBall
@@ -22,13 +24,15 @@ from ptint_drake.worlds.catch.outcome import BallContacts
 from ptint_drake.worlds.catch.station import FINGERS, _relax_hand
 
 PALM_TOP = 0.0725  # m above the gripper's flange (models/schunk_wsg_50_110_full.sdf)
+PALM_GAP = 0.0025  # m: the ball's centre beyond the fingertip centre when it touches the palm
 
 
 def _peak_force(step: float, relaxed: bool, speed: float = 3.0, squeeze: float = 0.0,
-                opening: float = 0.081, probe: list | None = None) -> float:
+                opening: float = 0.081, probe: list | None = None, trace: list | None = None) -> float:
     """The largest contact force on the ball shot down at ``speed`` into the open palm (or set on
     it at rest and squeezed by the jaws' actuators with ``squeeze`` N each), over 20 ms; ``probe``
-    gets the ``BallContacts`` of the run."""
+    gets the ``BallContacts`` of the run, ``trace`` (t, contacts, the ball's vertical speed) at
+    each step."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(
         time_step=step, contact_model="point", discrete_contact_approximation="sap"), builder)
@@ -58,6 +62,9 @@ def _peak_force(step: float, relaxed: bool, speed: float = 3.0, squeeze: float =
         results = plant.get_contact_results_output_port().Eval(context)
         for i in range(results.num_point_pair_contacts()):
             peak = max(peak, float(np.linalg.norm(results.point_pair_contact_info(i).contact_force())))
+        if trace is not None:
+            v = plant.EvalBodySpatialVelocityInWorld(context, plant.get_body(ball.index())).translational()
+            trace.append((t, results.num_point_pair_contacts(), float(v[2])))
     return peak
 
 
@@ -88,3 +95,18 @@ def test_the_jaws_squeeze_is_not_in_the_impact():
     (contacts,) = probe
     assert min(contacts.touched["left_finger"], contacts.touched["right_finger"]) > 20.0
     assert "axis" in contacts.impact and contacts.impact["peak"] < 5.0
+
+
+@pytest.mark.parametrize("speed", [3.0, 5.0])
+def test_the_jaws_reach_the_ball_once_the_palm_has_stopped_it_and_before_it_rebounds(speed):
+    """The close (``target.close_time``) brings the jaws to the ball ``catch.close_lag`` after the
+    catch time, when its centre is at the fingertip centre; at a relative speed ``speed`` the ball
+    touches the palm ``PALM_GAP`` / ``speed`` later.  By the jaws' arrival the palm has stopped the
+    ball's approach (its speed toward the palm below a tenth of the impact's: the pads' friction
+    then adds nothing along the palm's normal), and the ball has not yet left the palm."""
+    trace = []
+    _peak_force(0.001, True, speed, trace=trace)
+    touch = next(t for t, n, _ in trace if n > 0)
+    jaws = touch + CatchConfig().close_lag - PALM_GAP / speed
+    at_jaws = min(trace, key=lambda row: abs(row[0] - jaws))
+    assert at_jaws[1] > 0 and at_jaws[2] > -0.1 * speed

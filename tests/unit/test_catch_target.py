@@ -7,13 +7,15 @@ where the catch ended and stops; and the held rule of ``outcome`` takes the sque
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from ptint_drake.worlds.catch import oracle
 from ptint_drake.worlds.catch.ball import BALL_DIAMETER
 from ptint_drake.worlds.catch.outcome import _held
-from ptint_drake.worlds.catch.target import BRAKE_TIME, braking, catch_reference
+from ptint_drake.worlds.catch.target import BRAKE_TIME, braking, catch_reference, close_time
 
 G = np.array([0.0, 0.0, -9.81])
 P0, V0 = np.array([1.6, 0.1, 1.0]), np.array([-2.4, -0.1, 2.0])
@@ -66,6 +68,15 @@ def test_the_brake_starts_where_the_catch_ends_and_stops():
         step = braking(at_catch, (tau + h) * BRAKE_TIME) - braking(at_catch, (tau - h) * BRAKE_TIME)
         exact = braking(at_catch, tau * BRAKE_TIME)[3:9]
         assert np.allclose(step[0:6] / (2 * h * BRAKE_TIME), exact, atol=1e-5)
+
+
+def test_the_jaws_reach_the_balls_diameter_the_lag_after_the_catch_time():
+    plan = SimpleNamespace(t_catch=0.7)
+    preshape, speed, lag = 0.081, 0.42, 0.004
+    start = close_time(plan, preshape, BALL_DIAMETER, speed, lag)
+    jaw = 0.5 * preshape - speed * (0.7 + lag - start)  # each jaw closes at the driver's speed
+    assert abs(jaw - 0.5 * BALL_DIAMETER) < 1e-12
+    assert close_time(None, preshape, BALL_DIAMETER, speed, lag) == float("inf")
 
 
 def test_held_takes_the_squeezed_ball_and_refuses_an_empty_or_open_hand():

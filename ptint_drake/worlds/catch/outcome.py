@@ -16,8 +16,10 @@ HAND_BODIES = (PALM, "left_finger", "right_finger")
 
 
 class BallContacts(LeafSystem):
-    """At every step of the plant, the bodies touching the ball and the peak normal force on it by body
-    (``touched``: name → N, a dict shared across the run's diagrams), and the impact (``impact``,
+    """At every step of the plant, the bodies touching the ball and the peak force on it by body
+    (``touched``: name → N, the largest norm of the body's summed contact forces, a finger pinching
+    the ball with its pad and its stem at once counted whole; a dict shared across the run's
+    diagrams), and the impact (``impact``,
     shared the same way): ``time``, when the palm first touched the ball; ``axis``, the direction of
     that first palm force (the palm's normal, out of the palm); ``peak``, the largest component along
     it of the net contact force on the ball — the force that stops the ball's approach.  The jaws'
@@ -34,7 +36,7 @@ class BallContacts(LeafSystem):
 
     def _record(self, context) -> None:
         results = self.get_input_port().Eval(context)
-        net, palm = np.zeros(3), None
+        by_body = {}
         for i in range(results.num_point_pair_contacts()):
             info = results.point_pair_contact_info(i)
             a, b = info.bodyA_index(), info.bodyB_index()
@@ -42,11 +44,10 @@ class BallContacts(LeafSystem):
                 continue
             other = self._plant.get_body(b if a == self._ball else a).name()
             on_ball = np.asarray(info.contact_force()) * (1.0 if b == self._ball else -1.0)
-            net += on_ball
-            if other == PALM:
-                palm = on_ball if palm is None else palm + on_ball
-            force = float(np.linalg.norm(on_ball))
-            self.touched[other] = max(self.touched.get(other, 0.0), force)
+            by_body[other] = by_body.get(other, np.zeros(3)) + on_ball
+        for other, force in by_body.items():  # a body may touch the ball at more than one point
+            self.touched[other] = max(self.touched.get(other, 0.0), float(np.linalg.norm(force)))
+        net, palm = sum(by_body.values(), np.zeros(3)), by_body.get(PALM)
         if palm is not None and "axis" not in self.impact and np.linalg.norm(palm) > 0.0:
             self.impact.update(time=context.get_time(), axis=palm / np.linalg.norm(palm), peak=0.0)
         if "axis" in self.impact:

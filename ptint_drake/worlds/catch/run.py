@@ -98,7 +98,7 @@ class CatchRun(WorldRun):
         builder.Connect(st.estimate, target.get_input_port())
         close = builder.AddNamedSystem("close_command", CloseCommand(
             c.gripper.initial_opening, close_time(self.plan, c.gripper.initial_opening, BALL_DIAMETER,
-                                                  c.gripper.speed)))
+                                                  c.gripper.speed, c.close_lag)))
         builder.Connect(close.get_output_port(), st.command)
         view = CatchTargetView(target.GetOutputPort("target"), target.GetOutputPort("target_rotation"))
         self.controller = AddControllerTo(builder, plant=self.arm, frame=self.arm.GetFrameByName(TIP),

@@ -32,9 +32,19 @@ After t_catch the target brakes the same way: ẋ_r = u g(y), x_r = x_c + u τ_b
 y = min((t − t_catch) / τ_b, 1), u = ẋ_r(t_catch), τ_b = ``BRAKE_TIME``: at rest after τ_b,
 ½ u τ_b further on.
 
-``CloseCommand`` opens the hand to its pre-shape and closes it at ``close_time``: t_catch −
+``CloseCommand`` opens the hand to its pre-shape and closes it at ``close_time``: t_catch + lag −
 (pre-shape − ball) / 2 / jaw speed (each jaw moves at the driver's speed), so the jaws reach the
-ball when its centre reaches the fingertip centre.
+ball's diameter ``lag`` (``catch.close_lag``) after its centre reaches the fingertip centre.  The
+palm is 2.5 mm deeper (its face 35 mm below the fingertip centre, the ball's radius 32.5 mm): at
+3–5 m/s the ball touches it < 1 ms after t_catch, and the palm stops the ball's approach 3–3.5
+ms after that first touch (the ball shot into the open palm at 2, 3.5 and 5 m/s, at 1 and 0.25 ms
+steps; it leaves the palm 7–8 ms after the touch, at 0.42–0.48 of its speed).  The default lag,
+4 ms, lets the palm take the impact before the jaws grip: closed to reach the ball at t_catch (lag
+0, as first set), the pads met the ball while it still slid toward the palm at nearly its full
+relative speed, and their friction (the pads' μ = 1 on the jaws' squeeze) added 10–28 N along the
+palm's normal to the impact whether the hand moved with the ball or not (throws 0–19: 17 N median
+with matching, 18 N without; docs/catch.md).  The jaws still reach the ball while it rests on the
+palm, before it rebounds.
 """
 
 from __future__ import annotations
@@ -146,9 +156,10 @@ class CatchTargetView(TargetView):
         return self._rotation_port
 
 
-def close_time(plan, preshape: float, diameter: float, speed: float) -> float:
-    """When the jaws start closing (module docstring); never without a plan."""
+def close_time(plan, preshape: float, diameter: float, speed: float, lag: float = 0.0) -> float:
+    """When the jaws start closing so that they reach the ball's diameter ``lag`` s after t_catch
+    (module docstring); never without a plan."""
     if plan is None:
         return float("inf")
-    return plan.t_catch - 0.5 * (preshape - diameter) / speed
+    return plan.t_catch + lag - 0.5 * (preshape - diameter) / speed
 

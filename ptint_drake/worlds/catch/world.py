@@ -14,6 +14,7 @@ from pathlib import Path
 from pydrake.common.yaml import yaml_load_typed
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.fields import nonnegative
 from ptint_drake.config.schema import Scenario
 from ptint_drake.config.yaml_io import dump_yaml
 from ptint_drake.systems.task.schedule import Schedule, Segment
@@ -37,7 +38,9 @@ class CatchWorld(World):
     def validate(self, scenario) -> None:
         """The simulated arm may be scaled (``plant.mass_scale``: ``ptint compare``'s ``mass_xF``
         variants, applied in ``CatchRun.initialize``); the other plant deviations are not
-        modelled in the catch station: one line naming the field."""
+        modelled in the catch station: one line naming the field.  ``catch.close_lag`` ≥ 0 (the
+        jaws reach the ball after the catch time, not before)."""
+        nonnegative(scenario.catch.close_lag, "catch.close_lag")
         p = scenario.plant
         if p.payload_kg != 0.0:
             raise ScenarioError("plant.payload_kg: not used in a catch scenario (the hand is the payload)")
