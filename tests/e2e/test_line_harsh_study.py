@@ -22,13 +22,11 @@ def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
     result = json.loads((out / "robust.json").read_text())
     rows = json.loads((out / "samples.json").read_text())
     assert result["placed_with_collision"] == 0
-    # the rates are the 50-sample study's (docs/pick_place.md: 0.973 at the tasks' default tfs,
-    # 0.860 at the min-tf phases, where seed 7's ~0.95 kg parts on links x1.2 run away): here, that
-    # the part no grasp can hold is counted apart and the rates are reported from the parts
-    assert result["cannot_be_held"] == 1
-    placed = sum(p["placed"] for r in rows for p in r["picks"])
-    assert result["pick_success_rate"] == pytest.approx(placed / 6)
-    assert result["pick_success_rate_holdable"] == pytest.approx(placed / 5)
+    # seed 7's ~0.95 kg cube on links x1.2 ran away at the min-tf phases planned to the full effort
+    # limits (docs/pick_place.md: 0.860 over 50 samples); at two thirds of them
+    # (phase_time.TORQUE_SHARE) every part a grasp can hold is placed
+    assert result["cannot_be_held"] == 1 and result["pick_success_rate_holdable"] == 1.0
+    assert result["pick_success_rate"] == pytest.approx(5 / 6)
     assert result["cpu_s_per_sample"]["mean"] > 0.0 and all(r["cpu_s"] > 0.0 for r in rows)
     lead = 0.5 * PickTaskConfig().margin / GripperConfig().speed  # the close before the grasp time
     for row in rows:
@@ -38,9 +36,9 @@ def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
         assert max(abs(v / 0.1 - 1.0) for v in params["belt_speed"]) > 0.3
         for k, pick in enumerate(row["picks"]):
             assert (pick["placed"] and not pick["collision"]) or pick["reason"], pick
-            assert params["holdable"][k] or not pick["placed"], (row["seed"], pick)
+            assert pick["placed"] == params["holdable"][k], (row["seed"], pick)
             if pick["task"] is not None:  # the truth's close jitter on the task that picked part k
                 planned = pick["t_grasp_prescribed"] - lead
                 assert pick["t_close_command"] - planned == pytest.approx(params["close_delay"][k], abs=1e-9)
     (unheld,) = [p for r in rows for p, h in zip(r["picks"], r["params"]["holdable"]) if not h]
-    assert not unheld["placed"] and unheld["reason"], unheld
+    assert unheld["reason"] in ("dropped", "missed after retry", "not placed"), unheld
