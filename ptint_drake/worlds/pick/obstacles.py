@@ -28,6 +28,7 @@ The links above the hand are not in the planning model: their contacts are found
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from pydrake.geometry import Box, Cylinder, ProximityProperties
@@ -164,9 +165,16 @@ class PlanningScene:
 
 def _hand_size(scenario) -> tuple:
     """(reach, top, thickness, stroke) of the hand (m), from the gripper's model alone."""
+    return _gripper_size(scenario.pick.gripper.model)
+
+
+@lru_cache(maxsize=None)
+def _gripper_size(model: str) -> tuple:
+    """``_hand_size`` of the gripper ``model`` (``GripperConfig.model``), parsed once a process: the
+    planning scene of every replan and the slot warnings ask it of the same model."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-    (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(scenario.pick.gripper.model)))
+    (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(model)))
     plant.Finalize()
     stroke = sum(plant.GetJointByName(n, gripper).position_upper_limits()[0] for n in FINGER_JOINTS)
     reach, top, thickness = finger_extent(plant, scene_graph, gripper)
