@@ -117,11 +117,18 @@ def cmd_run(args: argparse.Namespace) -> int:
               f"(outputs up to then are in {out}/, metrics.json says status: failed)", file=sys.stderr)
         return 1
     if metrics["status"] == "missed":
-        print(f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])}); the gains may not fit "
-              f"this arm or tf: try `ptint tune {args.scenario}`")
+        print(missed_line(scenario, metrics, args.scenario))
         return 1
     print(f"{scenario.name}: ok (every segment meets the criteria)")
     return 0
+
+
+def missed_line(scenario, metrics: dict, name: str) -> str:
+    """A missed run's line: its reasons, and ``ptint tune`` suggested only where the scenario's
+    world can be tuned (``World.tune_refusal``: a catch's or a pick's miss is not the gains')."""
+    tunable = world_of(scenario).tune_refusal(name) is None
+    hint = f"; the gains may not fit this arm or tf: try `ptint tune {name}`" if tunable else ""
+    return f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])}){hint}"
 
 
 def cmd_diagram(args: argparse.Namespace) -> int:

@@ -161,3 +161,17 @@ def test_the_program_leaves_its_heap_out_of_the_exit_collections(monkeypatch, ca
     monkeypatch.setattr("sys.argv", ["ptint", "run", "no_such_scenario"])
     assert cli.console() == 2  # an error keeps its exit code
     gc.unfreeze()
+
+
+def test_a_missed_line_suggests_tune_only_where_the_world_can_be_tuned():
+    """A catch's miss (closed on nothing) is not the gains': no ``ptint tune`` in its line; an
+    interception's miss keeps the hint (``runs.missed_line``, ``World.tune_refusal``)."""
+    from ptint_drake.cli.runs import missed_line
+    from ptint_drake.simulation.scenario import LoadedScenario
+
+    missed = {"reasons": ["not caught: closed on nothing"]}
+    catch = LoadedScenario.load("catch_toss_iiwa14").scenario
+    assert missed_line(catch, missed, "catch_toss_iiwa14") == \
+        "catch_toss_iiwa14: MISSED (not caught: closed on nothing)"
+    curve = LoadedScenario.load("curve_b075_tf15").scenario
+    assert "try `ptint tune curve_b075_tf15`" in missed_line(curve, {"reasons": ["late"]}, "curve_b075_tf15")
