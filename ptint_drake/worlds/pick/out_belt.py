@@ -17,9 +17,9 @@ Choices the issue leaves open, made here:
   the centre line nearest the grasp point (the shortest carry), clipped so that the carry's
   target, the place and the retreat stay inside the arm's reach window on that belt
   (``LineView.window_at``: the same Drake IK from above, at the point and ``lift_height`` above,
-  that gives the grasp's window).  Of the free points — the preferred one, and one pitch before
-  or after each part already put on the belt (every task committed to it, a failed one too) —
-  the one nearest the preferred that keeps every pitch and lies in the window.
+  that gives the grasp's window).  Of the points that keep a pitch from every part already put on
+  the belt (every task committed to it, a failed one too) and lie in the window, the one nearest
+  the preferred (``free_point``: the preferred itself, a window's end, or a pitch from a part).
 - **The pitch** (``pitch``), centre to centre along the belt: half the longer of the new part's
   length along the belt and the open fingers' width (``grasp_gate.finger_extent``), half the
   placed part's length, and ``PLACE_GAP`` = 10 mm (the place's error, a few mm measured, and the
@@ -117,7 +117,9 @@ def free_point(preferred: float, lo: float, hi: float, part, placed: list, finge
     """The belt coordinate (t = 0) nearest ``preferred`` in [lo, hi] at least a pitch from every
     ``placed`` (belt_at, part) (module docstring); None where there is none."""
     gaps = [(a, pitch(part, p, finger_width)) for a, p in placed]
-    candidates = [preferred] + [a + s * g for a, g in gaps for s in (-1.0, 1.0)]
+    # the free set is [lo, hi] less an open stretch a pitch either side of each part: the nearest
+    # free point is the preferred one or an end of a stretch or of the window
+    candidates = [preferred, lo, hi] + [a + s * g for a, g in gaps for s in (-1.0, 1.0)]
     ok = [c for c in candidates if lo - 1e-9 <= c <= hi + 1e-9
           and all(abs(c - a) >= g - 1e-9 for a, g in gaps)]
     return min(ok, key=lambda c: abs(c - preferred)) if ok else None
