@@ -133,7 +133,7 @@ class LineCycles:
                 best = (approach, descend_at(ahead + wait + approach), wait, 0.0)
                 break
             except NoTfFits as error:
-                why = f"no tf fits: {error}"
+                why = why or f"no tf fits: {error}"  # the way from now (wait 0): where the part is
         if best is None:
             return why
         for wait in WAITS if ahead > 0.0 and track.id not in self.plain else ():
