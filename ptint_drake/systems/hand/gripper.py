@@ -47,7 +47,7 @@ class GripperDriver(LeafSystem):
         self._half_stroke, self._step, self._period = stroke / 2, speed * period, period
         self._closed = -CLOSE_MARGIN * max_force / kp
         q0 = initial_opening / 2
-        self.DeclareVectorInputPort("command", 1)
+        self._command = self.DeclareVectorInputPort("command", 1)
         self._fingers = self.DeclareVectorInputPort("finger_state", 4)
         self._reference = self.DeclareDiscreteState(BasicVector([q0, q0, 0.0, 0.0]))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
@@ -62,7 +62,12 @@ class GripperDriver(LeafSystem):
     def _update(self, context, state):
         # plain floats: this runs every millisecond (numpy's small-array calls cost ~10× more)
         q = context.get_discrete_state(self._reference).get_value()
-        goal = self.goal(float(self.get_input_port(0).Eval(context)[0]))
+        goal = self.goal(float(self._command.Eval(context)[0]))
+        if q[0] == goal and q[1] == goal and q[2] == 0.0 and q[3] == 0.0:
+            # at rest on the goal (most steps): the update below would write the same four values
+            # (step 0; no stall rule, which acts only below the goal), and Drake hands the handler
+            # ``state`` already holding them — skip the finger read and the write (bit-identical)
+            return
         fingers = self._fingers.Eval(context)
         out = [0.0, 0.0, 0.0, 0.0]
         for i in (0, 1):
