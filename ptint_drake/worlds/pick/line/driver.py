@@ -22,9 +22,9 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
   decides again from now and the task is replaced (``replaced``: an approach under way restarts
   from the present state, its tf stretched to the new grasp time; one not started yet starts at
-  the model's lead before it); nothing to replace it with, the task is given up (``give_up``:
-  ``abandoned``, the arm sent to a hold from its present state, the part ``not reachable in
-  time``).
+  the model's lead before it); nothing to replace it with, a task out of its window is given up
+  (``give_up``: ``abandoned``, the arm sent to a hold from its present state, the part ``not
+  reachable in time``), one only the model's approach does not fit goes on.
 
 Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
 a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
@@ -217,9 +217,8 @@ class LineDriver:
         task = self.scenario.pick.tasks[k]
         begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
         why = unserved(track, self.view.window(track), grasp, t, end, self.timing.slack)
-        if not why and not self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
-            why = "the model's approach and descend from the tool do not fit before the grasp"
-        if not why:  # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
+        fits = not why and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context)))
+        if fits:  # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False
@@ -227,8 +226,12 @@ class LineDriver:
             self.replaced.append({"t": t, "task": k, "drift_mm": 1e3 * drift})
             self.decisions[-1]["redecide"] = "replaced"
             return True
-        self._abandon(run, context, t, k, track, entry | {"why": why})
-        return True
+        if why:  # out of its window: given up (``give_up``)
+            self._abandon(run, context, t, k, track, entry | {"why": why})
+            return True
+        self.decisions.append(entry | {"redecide": "nothing feasible: kept (the model's approach: no fit)"})
+        self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
+        return False
 
     def _abandon(self, run, context, t: float, k: int, track, entry: dict) -> None:
         """Task k (the last, in its approach) given up (``give_up``): out of the run's tasks, its
