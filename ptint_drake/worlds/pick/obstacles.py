@@ -14,10 +14,11 @@ held part) to every obstacle.  A sample nearer than ``HAND_MARGIN`` to an obstac
 by its bodies (``Hit``).  The part an approach goes to take is an obstacle of that approach too:
 the way ends ``clearance`` above it (the descend then comes down onto it from above), and before
 that end the hand keeps ``HAND_MARGIN`` from it — or, where the way's end itself is nearer (a tall
-part, a small clearance), no nearer than the end.  Before, only a sample inside it was a hit:
-line_short seed 18 (8f38957) approached a cube from the low tray's retreat point, rising 35 mm
-over 100 mm, its planned way grazing the cube's top edge; the arm, 15 mm below its target on the
-way, struck the cube, and the targets followed the struck part into a runaway.
+part, a small clearance), no nearer than the end.  Before, only a sample inside it was a hit, and
+a way rising from a tray lower than the belt could graze the part's top edge: tests/low_tray_pick
+with its tray at z = 0.08 m passed 1.9 mm from its own box without a via (line_short seed 18 at
+8f38957 struck the cube it approached from the tray's retreat point and ran away; at 940e9c9 its
+approaches from there keep 6.7–8.9 mm from their parts, and one that went inside got a via).
 
 Where a way hits and has no via yet (``route``: the way around the base), ``obstacle_vias`` adds one
 (``tasks.Via``): a fixed point above the way's start, raised from the higher of the way's two ends in

@@ -209,7 +209,7 @@ class LineDriver:
         drift = track is not None and drifted(track, grasp, point, t, 1e-3 * self.line.redecide_mm)
         if not drift:
             return False
-        if np.isfinite(track.measured) and not self._has_encoder(track.belt):
+        if np.isfinite(track.measured) and not {track.belt} & {b.name for b in self.line.belts if b.encoder}:
             self.view.learned[track.belt] = track.measured  # the belt's speed, as its track shows it
             track = replace(track, speed=track.measured)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
@@ -237,19 +237,18 @@ class LineDriver:
         """Task k (the last, in its approach) given up (``give_up``): out of the run's tasks, its
         part named in the log, and a ``Hold`` from the arm's present state after the tasks."""
         q = self._arm_q(context)
-        tool, yaw = self._tool_now(q)
-        hold = hold_of(t, tool, yaw, np.asarray(track.position), lambda x: self.view.reachable(x, q))
+        hold = hold_of(t, *self._tool_now(q), np.asarray(track.position), lambda x: self.view.reachable(x, q))
         for records in (self.scenario.pick.tasks, run.replans, run.checks, run.refused):
             del records[k]
         del self.committed[k]
+        for record in self.decisions:  # its choice no longer names a task of the run (k is the next one's)
+            if record.get("task") == k:
+                record["task"], record["given up"] = None, round(t, 4)
         run.replans.append(hold)  # after the tasks' ``Replan`` entries (``plan.line_plan``)
         self.given_up.add(track.id)
         self.abandoned.append({"t": t, "task": k, "drift_mm": entry["drift_mm"]})
         self.decisions.append(entry | {"redecide": "abandoned", "hold": [round(c, 4) for c in hold.position],
                                        "skipped": [{"track": track.id, "reason": REASON}]})
-
-    def _has_encoder(self, belt: str) -> bool:
-        return any(b.name == belt and b.encoder for b in self.line.belts)
 
     def _choose(self, run, context, t: float, replacing=None) -> bool:
         """A decision from now, each track's lead from the min-tf model (``line.cycle``); a task
