@@ -34,6 +34,14 @@ def test_a_belt_seen_faster_puts_the_grasp_past_reach():
     assert why.startswith("past reach at the grasp (2.00 s)")
 
 
+def test_the_give_up_rule_asks_the_part_in_reach_at_the_lift_s_start_only():
+    # 0.16 m at the grasp: past the keeping rule's 0.135 m (the scheduler's slack, 0.5 s), but a
+    # dwell later (0.15 s: 0.18 m) still inside the window, where the lift starts above it
+    dwell = PickTaskConfig().dwell
+    assert unserved(_track(-0.1, 0.13), WINDOW, 2.0, 0.0, 1.0, dwell) == ""
+    assert unserved(_track(-0.1, 0.17), WINDOW, 2.0, 0.0, 1.0, dwell) != ""  # 0.24 m: beyond
+
+
 def test_a_belt_seen_slower_leaves_the_part_upstream_at_the_approach_end():
     why = unserved(_track(-0.3, 0.1), WINDOW, 2.0, 0.0, 1.0, SLACK)  # −0.2 m at t = 1
     assert why.startswith("upstream of reach at the approach's end (1.00 s)")

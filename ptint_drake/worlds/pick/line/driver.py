@@ -22,9 +22,10 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
   decides again from now and the task is replaced (``replaced``: an approach under way restarts
   from the present state, its tf stretched to the new grasp time; one not started yet starts at
-  the model's lead before it); nothing to replace it with, a task out of its window is given up
-  (``give_up``: ``abandoned``, the arm sent to a hold from its present state, the part ``not
-  reachable in time``), one only the model's approach does not fit goes on.
+  the model's lead before it); nothing to replace it with, a task whose part is out of its window
+  at the approach's end or at the lift's start (a dwell after the grasp) is given up (``give_up``:
+  ``abandoned``, the arm sent to a hold from its present state, the part ``not reachable in
+  time``), any other goes on (``nothing feasible: kept``).
 
 Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
 a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
@@ -216,9 +217,10 @@ class LineDriver:
                  "speed": round(track.speed, 4)}
         task = self.scenario.pick.tasks[k]
         begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
-        why = unserved(track, self.view.window(track), grasp, t, end, self.timing.slack)
-        fits = not why and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context)))
-        if fits:  # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
+        window = self.view.window(track)
+        if not unserved(track, window, grasp, t, end, self.timing.slack) \
+                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
+            # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
             return False
@@ -226,10 +228,11 @@ class LineDriver:
             self.replaced.append({"t": t, "task": k, "drift_mm": 1e3 * drift})
             self.decisions[-1]["redecide"] = "replaced"
             return True
-        if why:  # out of its window: given up (``give_up``)
+        why = unserved(track, window, grasp, t, end, task.dwell)  # the lift's start out of reach too
+        if why:  # given up (``give_up``)
             self._abandon(run, context, t, k, track, entry | {"why": why})
             return True
-        self.decisions.append(entry | {"redecide": "nothing feasible: kept (the model's approach: no fit)"})
+        self.decisions.append(entry | {"redecide": "nothing feasible: kept"})
         self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
         return False
 

@@ -13,21 +13,25 @@ followed the track to the edge of reach and the arm ran away (the harsh ``line_a
 seeds 8, 9, 22, 42: a grasp planned 0.06–0.12 s before the part's deadline, the belt then seen
 ×1.16–1.33 faster; the joints past 3 rad/s, torque at its limits).
 
-Abandoned instead, where ``unserved`` names a reason: the task leaves the run's tasks, its part
-is named ``not reachable in time`` in the decision log (so in the metrics' parts), and the arm
-goes to ``hold_of``'s point — a segment from the present state (as a replaced approach restarts:
-the torque's jump at the switch is the metrics' ``abandoned[*].torque_jump_Nm``) to the tool's
+Abandoned instead, where ``unserved`` names a reason with the lift's start in place of the
+scheduler's slack — the part upstream of its window at the approach's end, or past its end a
+``dwell`` after the grasp, where the lift starts above it (the window is where a top-down grasp
+and the lift above it have a posture): the task leaves the run's tasks, its part is named ``not
+reachable in time`` in the decision log (so in the metrics' parts), and the arm goes to
+``hold_of``'s point — a segment from the present state (as a replaced approach restarts: the
+torque's jump at the switch is the metrics' ``abandoned[*].torque_jump_Nm``) to the tool's
 present x, y at the lift's height above the part (``PickTaskConfig.lift_height``: the height a
 held part rides at, clear of the parts on the belt under it), or where that has no top-down
 posture, the tool's present point, in the tasks' default retreat tf.  Then the arm is free for
 the next part.
 
-Where only the model's approach does not fit (the part in its window), the task goes on as
-before: measured, harsh seed 9's first task, chosen at 0.5 s, was found at 0.7 s to have no
-top-down posture along the model's way from the moving arm (``NoTfFits``, not a tf too short);
-given up for it, its part was lost where the run without the rule placed it.  Choices the issue
-leaves open: the hold keeps the tool's yaw, and the abandoned part is not looked at again (it was
-already past what the scheduler could find for it).
+Otherwise the task goes on as before ("nothing feasible: kept").  Measured, two stricter rules
+lost parts the run without a rule placed: giving up where the model's approach did not fit (harsh
+seed 9's first task, chosen at 0.5 s, found at 0.7 s to have no top-down posture along the
+model's way from the moving arm: ``NoTfFits``, not a tf too short), and giving up by the
+scheduler's slack (seed 5's third part, its belt seen at 0.20 m/s against 0.10 m/s declared,
+placed when kept).  Choices the issue leaves open: the hold keeps the tool's yaw, and the
+abandoned part is not looked at again (it was already past what the scheduler could find for it).
 """
 
 from __future__ import annotations
