@@ -7,8 +7,9 @@ scenario, no ``pick.parts`` and no ``pick.tasks`` (the run makes them), and this
 - ``belts``: the belts the line uses, by name, each with or without an ``encoder`` (with one the
   controller side reads the belt's measured speed; without, only its declared ``speed``);
 - ``catalog``: the kinds of part (shape, size, mass, friction) and where each goes: the tray
-  ``slots`` it fills, in order, or a ``bin`` of ``pick.bins`` it is dropped into (which never
-  fills: "in the bin", no mm criterion; an outgoing belt is not built);
+  ``slots`` it fills, in order, a ``bin`` of ``pick.bins`` it is dropped into (which never
+  fills: "in the bin", no mm criterion), or an outgoing ``belt`` of ``pick.belts`` it is put on,
+  riding it (``worlds.pick.out_belt``: "on the belt", no mm criterion);
 - ``arrivals``: per belt, parts per second (a rate, not a spacing: a faster belt does not bring
   more parts), the process (``poisson`` or ``jittered``), the distributions of the lateral offset
   and the yaw, the kinds' mix;
@@ -43,8 +44,9 @@ class LineBeltConfig:
 
 @dataclass
 class KindConfig:
-    """A kind of part of the catalog and where it goes: its tray ``slots``, filled in order, or a
-    ``bin`` (the name of one of ``pick.bins``) — exactly one of the two."""
+    """A kind of part of the catalog and where it goes: its tray ``slots``, filled in order, a
+    ``bin`` (the name of one of ``pick.bins``) or an outgoing ``belt`` (the name of one of
+    ``pick.belts`` that no arrival feeds) — exactly one of the three."""
 
     name: str = "cube"
     shape: str = "box"  # "box" or "cylinder" (axis vertical)
@@ -53,6 +55,7 @@ class KindConfig:
     friction: float = 0.8  # 1, Coulomb friction of its surface
     slots: List[int] = field(default_factory=list)  # indices into pick.tray.slots
     bin: str = ""  # or the name of a bin (pick.bins[*].name): every part of the kind dropped into it
+    belt: str = ""  # or an outgoing belt (pick.belts[*].name): every part of the kind put on it
 
 
 @dataclass
@@ -125,9 +128,19 @@ def _pair(values: list, where: str) -> None:
         raise ScenarioError(f"{where}: [min, max] with min <= max, got {values}")
 
 
-def _check_kind(k: int, kind: KindConfig, slots: int, bins: list) -> None:
+def _check_kind(k: int, kind: KindConfig, slots: int, bins: list, outgoing: dict) -> None:
     where = f"pick.line.catalog[{k}]"
     check_part_shape(where, kind.shape, kind.size, kind.mass, kind.friction)
+    if kind.belt:
+        if kind.slots or kind.bin:
+            raise ScenarioError(f"{where}.belt: a kind goes to its slots, a bin or an outgoing belt: "
+                                f"exactly one")
+        if kind.belt not in outgoing:
+            raise ScenarioError(f"{where}.belt: no belt named {kind.belt!r} in pick.belts")
+        if outgoing[kind.belt] is None:
+            raise ScenarioError(f"{where}.belt: belt {kind.belt!r} is fed by pick.line.arrivals: an "
+                                f"outgoing belt takes no arrivals")
+        return
     if kind.bin:
         if kind.slots:
             raise ScenarioError(f"{where}.bin: a kind goes to its slots or to a bin, not both")
@@ -180,7 +193,9 @@ def check_line(pick, duration: float, stroke: float, margin: float) -> None:
     if not line.catalog:
         raise ScenarioError("pick.line.catalog: at least one kind of part is needed")
     for k, kind in enumerate(line.catalog):
-        _check_kind(k, kind, len(pick.tray.slots), [b.name for b in pick.bins])
+        fed = {a.belt for a in line.arrivals}
+        outgoing = {name: (None if name in fed else b) for name, b in declared.items()}
+        _check_kind(k, kind, len(pick.tray.slots), [b.name for b in pick.bins], outgoing)
         if kind.size[0] + margin > stroke:
             raise ScenarioError(f"pick.line.catalog[{k}].size: {kind.size[0]} m across the fingers + the "
                                 f"{margin} m margin exceeds the gripper's {stroke} m stroke")

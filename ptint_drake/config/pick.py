@@ -133,12 +133,14 @@ class MoveConfig:
 
 @dataclass
 class PickTaskConfig:
-    """One part picked off its belt and placed in one tray slot or dropped into one bin (see the
-    module docstring): exactly one of ``slot`` and ``bin``."""
+    """One part picked off its belt and placed in one tray slot, dropped into one bin or put on an
+    outgoing belt (see the module docstring): exactly one of ``slot``, ``bin`` and ``belt``."""
 
     part: str = ""  # the part's name (pick.parts[*].name)
     slot: Optional[int] = None  # index into pick.tray.slots
     bin: str = ""  # or the name of a bin (pick.bins[*].name): the part dropped into it
+    belt: str = ""  # or an outgoing belt (pick.belts[*].name): the part put on it, riding it
+    belt_at: float = 0.0  # m, the place point's coordinate along that belt at t = 0 (it rides on)
     start: float = 0.0  # s, the approach's start (0: right after the previous task)
     approach: MoveConfig = field(default_factory=lambda: MoveConfig(1.2))
     descend: MoveConfig = field(default_factory=lambda: MoveConfig(0.5))

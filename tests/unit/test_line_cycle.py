@@ -162,3 +162,12 @@ def test_an_estimate_kept_for_the_process_leaves_a_fresh_model_as_computing_it_d
     scenario.pick.belts[0].speed *= 1.2
     faster = cycle.estimate(scenario, window, PhaseTimes.of(scenario))
     assert len(cycle._ESTIMATES) == 2 and faster != found
+
+
+def test_a_lead_with_no_tf_names_the_way_to_where_the_part_is_now(cycles):
+    """Every wait failing, the reason is the first way's (the part where it is now), not the last
+    wait's 2 s downstream (line_two_belts: 'to y = 0.379 m' named a part then at 0.18 m)."""
+    cycles._leads.clear()
+    why = cycles.lead(cube(0.5), (-0.3, 0.3), 5.0, np.array([0.13, 0.2, 0.15]), 0.0)
+    assert isinstance(why, str) and why.startswith("no tf fits"), why
+    assert why.endswith("to [0.25, 0.5, 0.19] m"), why

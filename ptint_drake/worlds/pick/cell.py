@@ -13,7 +13,7 @@ import numpy as np
 from ptint_drake.config.schema import Scenario
 from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
 from ptint_drake.worlds.pick.placement import placed_parts
-from ptint_drake.worlds.pick.scene import bin_drop, slot_pose
+from ptint_drake.worlds.pick.scene import belt_frame, bin_drop, slot_pose
 from ptint_drake.worlds.pick.tasks import PLACES, PickPlan
 
 PROBE_PERIOD = 0.002  # s, between logged probe samples
@@ -36,26 +36,30 @@ def world_config(scenario: Scenario) -> PickWorldConfig:
     return config
 
 
-def place_point(config, kind: str, index: int, part) -> np.ndarray:
+def place_point(config, kind: str, index: int, part, along: float = 0.0) -> np.ndarray:
     """The place pose of ``part`` (its centre, world, m) at slot ``index`` (``kind`` "slot": resting
-    on the tray, ``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at) or over
-    bin ``index`` ("bin": ``scene.bin_drop``); ``config``: a ``PickWorldConfig`` or a ``pick`` block."""
+    on the tray, ``scene.slot_pose``: the pose the station's ``slot_k`` frame is welded at), over
+    bin ``index`` ("bin": ``scene.bin_drop``) or on belt ``index`` ("belt": resting on its top on its
+    centre line, ``along`` m along it — at t = 0: the point rides on, ``tasks.place_ride``);
+    ``config``: a ``PickWorldConfig`` or a ``pick`` block."""
     if kind == "bin":
         return bin_drop(config.bins[index], part)
     height = part.size[2] if part.shape == "box" else part.size[1]
+    if kind == "belt":
+        return belt_frame(config.belts[index]).multiply(np.array([along, 0.0, height / 2]))
     return slot_pose(config.tray, index).translation() + [0.0, 0.0, height / 2]
 
 
 def place_positions(config: PickWorldConfig, plan: PickPlan) -> list:
     """Per segment: the world position of its slot's place pose (the part's centre resting on the
-    tray; a bin's drop point, ``scene.bin_drop``), None for the segments that aim at a part — from
-    the declared tray, slots and bins alone (``place_point``), so the controller side needs no
-    station to find them."""
+    tray; a bin's drop point, ``scene.bin_drop``; an outgoing belt's place point at t = 0), None
+    for the segments that aim at a part — from the declared tray, slots, bins and belts alone
+    (``place_point``), so the controller side needs no station to find them."""
     out = []
     for seg in plan.segments:
         if seg.kind not in PLACES:
             out.append(None)
             continue
         part = config.parts[plan.segments[plan.segment_index(seg.task, "approach")].index]
-        out.append(place_point(config, seg.kind, seg.index, part))
+        out.append(place_point(config, seg.kind, seg.index, part, seg.along))
     return out

@@ -117,7 +117,7 @@ def _profiles(scenario, built) -> list:
     yaws = tool_yaws(world, plan)
     q, out = world.q0, []
     for i, (seg, s) in enumerate(zip(plan.segments, plan.schedule.segments)):
-        ride = world.parts[seg.index][1] if seg.kind == "part" else np.zeros(3)
+        ride = world.parts[seg.index][1] if seg.kind == "part" else np.asarray(seg.ride, float)
         task = scenario.pick.tasks[seg.task]
         held = seg.phase in HELD or seg.kind == VIA_SLOT
         payload = masses[names.index(task.part)] if held else 0.0

@@ -41,6 +41,8 @@ def pick_outcome(row: int, pick: dict) -> str:
     into = f"slot {pick['slot']}"
     if "bin" in pick:  # a bin: in it or not, no mm criterion
         place, into = ("in the bin" if pick["placed"] else "NOT in the bin"), f"bin {pick['bin']}"
+    if "belt" in pick:  # an outgoing belt: on it, upright, or not (``out_belt.on_belt``), no mm criterion
+        place, into = ("on the belt" if pick["placed"] else "NOT on the belt"), f"belt {pick['belt']}"
     attempts = len(pick.get("attempt_details") or [pick])
     retried = f" after {attempts} attempts" if attempts > 1 else ""
     return f"pick {row} ({pick['part']} → {into}): {grasp}{retried}, {place}"

@@ -62,11 +62,13 @@ from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
 
 from ptint_drake.systems.task.orientation import rotation_angle, tool_yaw, top_down_reference
+from ptint_drake.worlds.pick.out_belt import on_belt
 from ptint_drake.worlds.pick.collisions import pick_collisions, touched_before_close
 from ptint_drake.worlds.pick.part_tracks import track_metrics
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.worlds.pick.runaway import runaway_reasons
 from ptint_drake.worlds.pick.scene import in_bin
+from ptint_drake.worlds.pick.tasks import PLACES
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time
 EARLY_GRASP = 0.05  # s before it
@@ -78,15 +80,16 @@ def rotation_of(wxyz) -> np.ndarray:
     return RotationMatrix(Quaternion(q / np.linalg.norm(q))).matrix()
 
 
-def _aim(built, i: int, aims: dict, at_start: bool):
+def _aim(built, i: int, aims: dict, at_start: bool, t: float = 0.0):
     """(position, rotation 15) that segment i aims at, from the values at a stop."""
     seg = built.plan.segments[i]
     offset = np.asarray(seg.offset)
-    if seg.kind in ("slot", "bin"):  # a bin's: the rotation latched at the lift (targets.PickTargets)
+    if seg.kind in PLACES:  # a bin's: the rotation latched at the lift (targets.PickTargets)
         rot = np.zeros(15)
-        rot[0:9] = (RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind == "slot"
+        rot[0:9] = (RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind != "bin"
                     else aims["latched"][7:16])
-        return built.targets.places[i] + offset, rot
+        ride = np.asarray(seg.ride)  # (an outgoing belt's place rides it)
+        return built.targets.places[i] + offset + ride * t, rot
     if seg.kind == "via_slot":  # a via (pick.route): a fixed point turned to a yaw (via_part: as its part)
         rot = np.zeros(15)
         rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
@@ -114,7 +117,7 @@ def segment_rows(built, aims: dict) -> list:
             if t not in aims:
                 continue
             x, R = aims[t]["tool"]
-            target, rot = _aim(built, i, aims[t], at_start)
+            target, rot = _aim(built, i, aims[t], at_start, t)
             row[key] = float(np.linalg.norm(x - target))
             if key == "e_tf_norm":
                 R_r = np.reshape(top_down_reference(rot, tool_yaw(R))[0:9], (3, 3))
@@ -150,16 +153,23 @@ def _at(t: np.ndarray, when: float) -> int:
     return min(max(int(np.searchsorted(t, when + 1e-9, side="right")) - 1, 0), len(t) - 1)
 
 
-def _destination(built, k: int, part, end: np.ndarray) -> tuple:
-    """Task k's place as metrics: ({"slot": its slot} or {"slot": None, "bin", "in_bin"},
-    {"place_error_mm", "place_error_deg"}) from the part's probe row at the end, ``end``."""
+def _destination(built, k: int, part, end: np.ndarray, rest: np.ndarray, rest_t: float) -> tuple:
+    """Task k's place as metrics: ({"slot": its slot}, {"slot": None, "bin", "in_bin"} or
+    {"slot": None, "belt", "on_belt"}, {"place_error_mm", "place_error_deg"}) from the part's probe
+    row at the end, ``end`` (an outgoing belt's: ``rest``, at its retreat's end ``rest_t``)."""
     plan = built.plan
     i = plan.segment_index(k, "place")
     into = plan.segments[i]
     box = built.station.config.bins[into.index] if into.kind == "bin" else None
     where = ({"slot": into.index} if box is None
              else {"slot": None, "bin": box.name, "in_bin": in_bin(box, end[0:3])})
-    return where, {"place_error_mm": float(1e3 * np.linalg.norm(end[0:3] - built.targets.places[i])),
+    place = built.targets.places[i]
+    if into.kind == "belt":  # judged at the retreat's end (``out_belt.on_belt``), riding
+        belt, end = built.station.config.belts[into.index], rest
+        judged = on_belt(belt, end[0:3], rotation_of(end[3:7]), part)
+        where = {"slot": None, "belt": belt.name, "on_belt": judged, "belt_at": float(into.along)}
+        place = place + np.asarray(into.ride) * rest_t
+    return where, {"place_error_mm": float(1e3 * np.linalg.norm(end[0:3] - place)),
                    "place_error_deg": _place_angle(rotation_of(end[3:7]), into.yaw, part.shape, part.size)}
 
 
@@ -207,7 +217,8 @@ def _one_pick(built, k: int, logs: dict, outcome: dict) -> dict:
         details.append({"t_close_command": a.close, "t_grasp_prescribed": a.grasp, "t_check": t_check,
                         "state": checks[j]["state"] if j < len(checks) else None,
                         "peak_grip_force_N": float(np.max(grip[span])) if np.any(span) else 0.0})
-    where, error = _destination(built, k, part, block[-1])
+    rest_t = plan.schedule.segments[plan.segment_index(k, "retreat")].end
+    where, error = _destination(built, k, part, block[-1], block[_at(t, rest_t)], rest_t)
     return {"part": part.name, "part_index": part_index, **where,
             "grasped": grasped, "t_grasp": t_grasp, "t_grasp_prescribed": last.grasp,
             "t_close_command": last.close, "attempts": len(attempts), "attempt_details": details,
@@ -232,6 +243,7 @@ def pick_metrics(scenario, built, logs: dict, segments: list, outcome: dict) -> 
         pick["collision_with"] = [name for name in built.station.obstacles if name in touched]
         pick["collision"] = bool(pick["collision"] or pick["collision_with"])
         within = (pick["in_bin"] if "bin" in pick  # a bin: in it, no mm criterion
+                  else pick["on_belt"] if "belt" in pick  # an outgoing belt: on it (line.out_belt)
                   else pick["place_error_mm"] <= scenario.criteria.place_mm
                   and pick["place_error_deg"] <= scenario.criteria.place_deg)
         pick["placed"] = bool(pick["grasped"] and pick["held_at_place"] and within)
@@ -265,5 +277,6 @@ def pick_reasons(picks: list) -> list:
         if p["grasped"] and not p["held_at_place"]:
             out.append((k, "dropped"))
         elif not p["placed"]:
-            out.append((k, "not in the bin" if "bin" in p else "not placed"))
+            out.append((k, "not in the bin" if "bin" in p else "not on the belt" if "belt" in p
+                        else "not placed"))
     return out

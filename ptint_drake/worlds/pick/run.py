@@ -247,7 +247,8 @@ def check_pick_reachable(scenario: Scenario, built: PickBuilt) -> None:
         belt = belts[config.parts[part_index].belt]
         start = built.station.parts[part_index].EvalPoseInWorld(context).translation()
         grasp = start + belt.speed * plan.grasp_times[k] * np.asarray(belt.direction)
-        place = built.targets.places[plan.segment_index(k, "place")]
+        i = plan.segment_index(k, "place")  # (an outgoing belt's place: where it is at the place time)
+        place = built.targets.places[i] + np.asarray(plan.segments[i].ride) * plan.schedule.segments[i].end
         for where, x in ((f"pick.tasks[{k}].part", grasp), (f"pick.tasks[{k}].lift_height",
                                                            grasp + [0, 0, task.lift_height]),
                          (_place_field(scenario, task), place), (f"pick.tasks[{k}].lift_height",
@@ -266,6 +267,8 @@ def _place_field(scenario: Scenario, task) -> str:
     if task.bin:
         j = [b.name for b in scenario.pick.bins].index(task.bin)
         return f"pick.bins[{j}] (its center and depth)"
+    if task.belt:
+        return f"pick.tasks[{scenario.pick.tasks.index(task)}].belt_at"
     return _slot_field(task.slot)
 
 

@@ -60,7 +60,8 @@ def _waypoints(scenario, built) -> list:
         belt = belts[config.parts[i_part].belt]
         start = built.station.parts[i_part].EvalPoseInWorld(context).translation()
         grasp = start + belt.speed * plan.grasp_times[k] * np.asarray(belt.direction, dtype=float)
-        place = built.targets.places[plan.segment_index(k, "place")]
+        i = plan.segment_index(k, "place")  # (an outgoing belt's place: where it is at the place time)
+        place = built.targets.places[i] + np.asarray(plan.segments[i].ride) * plan.schedule.segments[i].end
         up = lambda h: np.array([0.0, 0.0, h])  # noqa: E731
         for phase, x in (("approach", grasp + up(task.clearance)), ("descend", grasp),
                          ("lift", grasp + up(task.lift_height)), ("carry", place + up(task.lift_height)),

@@ -220,10 +220,13 @@ def report(scenario, metrics: dict, out) -> int:
     for k, p in enumerate(metrics["picks"]):
         grasp = "never" if p["t_grasp"] is None else \
             f"{p['t_grasp']:.3f} s (prescribed {p['t_grasp_prescribed']:.3f} s)"
-        into = f"bin {p['bin']}" if "bin" in p else f"slot {p['slot']}"
+        into = (f"bin {p['bin']}" if "bin" in p else f"belt {p['belt']}" if "belt" in p
+                else f"slot {p['slot']}")
         place = (f"{'placed' if p['placed'] else 'NOT placed'} {p['place_error_mm']:.2f} mm "
-                 f"{p['place_error_deg']:.2f}° from its slot" if "bin" not in p
-                 else ("in the bin" if p["placed"] else "NOT in the bin"))
+                 f"{p['place_error_deg']:.2f}° from its slot" if "bin" not in p and "belt" not in p
+                 else ("in the bin" if p["placed"] else "NOT in the bin") if "bin" in p
+                 else (f"on the belt, {p['place_error_mm']:.2f} mm from its riding point" if p["placed"]
+                       else "NOT on the belt"))
         print(f"{scenario.name} pick {k} ({p['part']} → {into}): grasped at {grasp}, {place}, "
               f"slip {p['slip_mm'] or 0.0:.2f} mm, "
               f"contact grip {p['peak_grip_force_N']:.1f} N peak, {p.get('grip_force_N') or 0.0:.1f} N at "

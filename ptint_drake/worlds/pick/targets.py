@@ -26,7 +26,10 @@ A "latched" segment aims at where the part was at the segment's start + offset, 
 Discrete state ``latched`` = [p, v, t₀, R] (m, m/s, s, row-major), updated at each "latched"
 segment's start and at each grasp time.  A "slot" segment aims at the fixed place pose, turned
 to the slot's yaw about the vertical; a "bin" segment at the bin's drop point, turned as the part
-was at the lift's start (the latched rotation: the tool keeps the yaw it grasped at).  A via
+was at the lift's start (the latched rotation: the tool keeps the yaw it grasped at); a "belt"
+segment at its place point riding the outgoing belt (``PlanSegment.ride``, with that velocity)
+until the segment's end, then at rest there (the last task's retreat stays active after it: a
+target riding on would carry the arm out of reach), turned to the segment's yaw.  A via
 segment (``pick.route``: the way around the arm's base) aims at its fixed point, at rest, turned as the
 segment after it will be: as its part (``via_part``, before an approach), or to a yaw
 (``via_slot``, before a carry: the slot's, or halfway to it the other way round).
@@ -91,8 +94,11 @@ class PickTargets(LeafSystem):
         seg = self._plan.segments[i]
         offset = np.asarray(seg.offset)
         if seg.kind in PLACES:  # a bin's: no yaw of its own (None), the tool keeps the latched one
-            R = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind == "slot" else None
-            return (SLOT, None, offset, np.asarray(self.places[i]) + offset, R, None)
+            R = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind != "bin" else None
+            # (an outgoing belt's place: its point at t = 0, riding at ``seg.ride`` until the segment's
+            # end, then at rest — the last retreat's target must not ride on out of reach)
+            ride = (np.asarray(seg.ride, float), self._plan.schedule.segments[i].end)
+            return (SLOT, None, offset, np.asarray(self.places[i]) + offset, R, ride)
         if seg.kind in (VIA_PART, VIA_SLOT):  # a fixed point; turned as its part, or to a yaw
             return (VIA, seg.index if seg.kind == VIA_PART else None, offset, offset,
                     RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
@@ -151,8 +157,10 @@ class PickTargets(LeafSystem):
         i = max(bisect.bisect_right(self._starts, t) - 1, 0)  # the active segment (Schedule.active)
         kind, part, offset, place, R_slot, grasp = self._aims[i]
         value = np.zeros(24)
-        if kind == SLOT:
-            value[0:3] = place
+        if kind == SLOT:  # (``grasp``: the place's velocity, an outgoing belt's, else 0, and its end)
+            ride, end = grasp
+            value[0:3] = place + ride * min(t, end)
+            value[3:6] = ride if t < end else 0.0
             value[9:18] = (R_slot if R_slot is not None
                            else context.get_discrete_state(self._latched).get_value()[7:16])
             return value

@@ -22,7 +22,11 @@ other, each a prescribed-time interception (SPEC 2.1) of its own target:
 A task with a ``bin`` instead of a ``slot`` (``pick.bins``: an open box) carries the part to
 ``lift_height`` above the bin's drop point (``scene.bin_drop``: over its centre, the part's bottom
 ``scene.BIN_DROP_CLEARANCE`` above its walls), lowers it there, opens the fingers and retreats
-up; the tool keeps the yaw it grasped at (``place_target``).
+up; the tool keeps the yaw it grasped at (``place_target``).  A task with a ``belt`` (an
+outgoing belt of ``pick.belts``) puts the part on that belt at ``belt_at`` (its coordinate along
+the belt at t = 0): the carry, the place and the retreat aim at that point as it rides the belt at
+the belt's speed as the plan knows it (``PlanSegment.ride``), the part's closing axis across the
+belt (``place_target``); ``out_belt`` chooses the point.
 
 A *via* (``Via``: ``worlds.pick.route`` decides where one is needed) splits a task's first approach or
 its carry in two: first a segment of its own (phase ``via``) to a fixed point, then the approach or
@@ -52,8 +56,9 @@ class PlanSegment:
     """What one segment aims at: ``kind`` "part" (part ``index``'s simulated centre + ``offset``),
     "latched" (where part ``index`` was at the segment's start + ``offset``), "slot" (slot
     ``index``'s place pose + ``offset``, yaw ``yaw`` rad) or "bin" (bin ``index``'s drop point +
-    ``offset``; ``yaw``: the part's declared yaw, for planning); ``task``, ``phase`` and ``attempt``
-    (0: the first approach and descend, 1…: a retry's backoff, approach, descend) name it."""
+    ``offset``; ``yaw``: the part's declared yaw, for planning) or "belt" (outgoing belt ``index``'s
+    place point at t = 0 + ``offset``, riding at ``ride`` m/s, yaw ``yaw``); ``task``, ``phase`` and
+    ``attempt`` (0: the first approach and descend, 1…: a retry's backoff, approach, descend) name it."""
 
     task: int
     phase: str
@@ -62,10 +67,13 @@ class PlanSegment:
     offset: tuple
     yaw: float = 0.0
     attempt: int = 0
+    ride: tuple = (0.0, 0.0, 0.0)  # m/s, world: a "belt" place's velocity (0: a fixed place)
+    along: float = 0.0  # m: a "belt" place's coordinate along its belt at t = 0 (``task.belt_at``)
 
 
 VIA_PART, VIA_SLOT = "via_part", "via_slot"  # the kinds of a via segment (``Via``)
-PLACES = ("slot", "bin")  # the kinds of a fixed place target: a tray slot, or a bin (``place_target``)
+# the kinds of a place target (``place_target``): a tray slot, a bin, or an outgoing belt (riding it)
+PLACES = ("slot", "bin", "belt")
 
 
 @dataclass(frozen=True)
@@ -136,11 +144,11 @@ def _up(h: float) -> tuple:
 
 
 def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start: float, replan: Replan,
-                   hold: float = 0.0, vias: tuple = ()):
+                   hold: float = 0.0, vias: tuple = (), ride: tuple = (0.0, 0.0, 0.0)):
     """The segments of task k, their plan entries, the attempts' (start, grasp) and the end;
     ``place``: (kind, index, yaw) of its place target (``place_target``); ``hold``: how long the
     first attempt waits at its pre-grasp pose before its descend (s); ``vias``: the task's ``Via``
-    (at most one per phase)."""
+    (at most one per phase); ``ride``: its place's velocity (m/s, an outgoing belt's)."""
     segments, plans, attempts = [], [], []
     routes = {v.phase: v for v in vias if v.task == k}
 
@@ -156,7 +164,9 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start:
                                      yaw if via.yaw is None else float(via.yaw), attempt))
             t, tf = t + via.share * tf, end - (t + via.share * tf)  # (its end: t + tf, as without a via)
         segments.append(Segment(t, tf, move.beta))
-        plans.append(PlanSegment(k, phase, kind, index, offset, yaw, attempt))
+        belt = kind == "belt"
+        plans.append(PlanSegment(k, phase, kind, index, offset, yaw, attempt,
+                                 ride if belt else (0.0, 0.0, 0.0), task.belt_at if belt else 0.0))
         return end
 
     t = start
@@ -201,7 +211,7 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
         opening = width + task.margin
         first_close, hold = _closed_on_nothing(pick, task, start)
         segs, plan, tries, t = _task_segments(k, task, part, place_target(pick, task), start, replan, hold,
-                                              vias)
+                                              vias, place_ride(pick, task))
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):
@@ -230,12 +240,33 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
 def place_target(pick: PickConfig, task: PickTaskConfig) -> tuple:
     """(kind, index, yaw) of a task's place target: ("slot", the slot, its yaw on the tray), or
     ("bin", the bin, the part's declared yaw: the tool keeps the yaw it grasped at, and the targets
-    read it off the part at the lift, ``targets.PickTargets``) (rad)."""
+    read it off the part at the lift, ``targets.PickTargets``), or ("belt", the outgoing belt, the
+    yaw that turns the part's closing axis across the belt — of the two, the one nearer the part's
+    declared yaw: the open fingers stand beside it across the belt, never towards the parts before
+    and after it on the belt) (rad)."""
+    if task.belt:
+        index = [b.name for b in pick.belts].index(task.belt)
+        d = pick.belts[index].direction
+        across = float(np.arctan2(d[1], d[0])) + 0.5 * np.pi
+        declared = next(p.yaw_deg for p in pick.parts if p.name == task.part)
+        yaw = float(np.radians(declared)) if isinstance(declared, (int, float)) else across
+        return "belt", index, across + np.pi * round((yaw - across) / np.pi)
     if task.bin:
         yaw = next(p.yaw_deg for p in pick.parts if p.name == task.part)
         index = [b.name for b in pick.bins].index(task.bin)
         return "bin", index, float(np.radians(yaw)) if isinstance(yaw, (int, float)) else 0.0
     return "slot", task.slot, float(np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg))
+
+
+def place_ride(pick: PickConfig, task: PickTaskConfig) -> tuple:
+    """m/s (world): the velocity of a task's place target — its outgoing belt's declared speed along
+    its direction (the planning scenario's: a line's driver puts there what the controller side
+    knows), 0 for a slot or a bin."""
+    if not task.belt:
+        return (0.0, 0.0, 0.0)
+    belt = next(b for b in pick.belts if b.name == task.belt)
+    d = np.asarray(belt.direction, dtype=float)
+    return tuple(float(c) for c in belt.speed * d / np.linalg.norm(d))
 
 
 def _planned_close(grasp: float, task: PickTaskConfig, speed: float) -> float:
@@ -274,10 +305,13 @@ def _closed_on_nothing(pick: PickConfig, task: PickTaskConfig, start: float) -> 
 
 
 def _check_place(pick: PickConfig, task: PickTaskConfig, where: str) -> None:
-    """ScenarioError unless the task names exactly one place: a slot of the tray or a bin."""
-    if (task.slot is None) == (not task.bin):
-        raise ScenarioError(f"{where}.slot: give exactly one of slot (a tray slot) and bin (a bin's name)"
-                            + (f", got slot {task.slot} and bin {task.bin!r}" if task.bin else ""))
+    """ScenarioError unless the task names exactly one place: a slot of the tray, a bin or a belt."""
+    if (task.slot is not None) + bool(task.bin) + bool(task.belt) != 1:
+        raise ScenarioError(f"{where}.slot: give exactly one of slot (a tray slot), bin (a bin's name) and "
+                            f"belt (an outgoing belt's name), got slot {task.slot}, bin {task.bin!r}, "
+                            f"belt {task.belt!r}")
+    if task.belt and task.belt not in [b.name for b in pick.belts]:
+        raise ScenarioError(f"{where}.belt: no belt named {task.belt!r} in pick.belts")
     if task.bin and task.bin not in [b.name for b in pick.bins]:
         raise ScenarioError(f"{where}.bin: no bin named {task.bin!r} (bins: "
                             f"{', '.join(b.name for b in pick.bins) or 'none'})")

@@ -69,7 +69,7 @@ def nominal(scenario, arm) -> Nominal:
     places = []
     for task in pick.tasks:
         kind, index, _ = place_target(pick, task)
-        places.append(place_point(pick, kind, index, pick.parts[names.index(task.part)]))
+        places.append(place_point(pick, kind, index, pick.parts[names.index(task.part)], task.belt_at))
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     context = arm.CreateDefaultContext()
     q0 = np.radians(scenario.robot.initial_q_deg)
@@ -85,8 +85,8 @@ def segment_target(world: Nominal, plan: PickPlan, i: int, t) -> np.ndarray:
     offset = np.asarray(seg.offset, float)
     if seg.kind in (VIA_PART, VIA_SLOT):
         return np.tile(offset, (len(t), 1))
-    if seg.kind in PLACES:
-        return np.tile(world.places[seg.task] + offset, (len(t), 1))
+    if seg.kind in PLACES:  # (an outgoing belt's place rides it: ``PlanSegment.ride``)
+        return world.places[seg.task] + offset + np.outer(t, np.asarray(seg.ride, float))
     p0, v = world.parts[seg.index]
     if seg.kind == "latched":
         return np.tile(p0 + v * s.start + offset, (len(t), 1))

@@ -6,7 +6,8 @@ carries its own filter: ``camera.belts`` and an ``estimator`` other than ``auto`
 cell (``config.check_pick_parts``), the ``pick.line`` block (``config.line.check_line`` with the
 gripper's stroke read from its model), the pool on its belts, and every slot of the catalog
 reachable from above (Drake's IK from the start posture) at half its kind's height and
-``lift_height`` above — a slot out of reach is named ``pick.tray.slots[j]``.
+``lift_height`` above — a slot out of reach is named ``pick.tray.slots[j]``, an outgoing belt
+with no point in reach ``pick.line.catalog[k].belt``.
 
 ``line_warnings``: the arrival rate against the arm's capacity — the min-tf model's estimate
 (``line.cycle.estimate``, picks per minute): above it, a warning with the numbers, and the run goes
@@ -39,6 +40,7 @@ from ptint_drake.worlds.pick.scene import (BIN_DROP_CLEARANCE, AddGripper, belt_
                                           slot_pose)
 
 VIEW_STEP = 0.01  # m, along a belt's centre line: the points a camera must see one of
+OUT_STEP = 0.05  # m, along an outgoing belt's centre line: the points one of which the arm must reach
 
 __all__ = ["check_line_scenario", "line_plan", "line_warnings", "stroke_of"]
 
@@ -69,8 +71,10 @@ def check_line_scenario(scenario) -> None:
     frame = arm.GetFrameByName(scenario.robot.end_effector)
     guess = np.radians(scenario.robot.initial_q_deg)
     bins = {b.name: (j, b) for j, b in enumerate(pick.bins)}
-    for kind in pick.line.catalog:
+    for k, kind in enumerate(pick.line.catalog):
         height = kind.size[2] if kind.shape == "box" else kind.size[1]
+        if kind.belt:
+            _check_out_belt(arm, frame, guess, pick, k, height, task.lift_height)
         if kind.bin:
             j, box = bins[kind.bin]
             x = np.asarray(box.center, dtype=float) + [0.0, 0.0, box.size[2] + BIN_DROP_CLEARANCE
@@ -85,6 +89,21 @@ def check_line_scenario(scenario) -> None:
                     raise ScenarioError(f"pick.tray.slots[{j}] (pick.tray.center and the slot's offset): "
                                         f"{np.round(where, 3).tolist()} m is outside what the arm reaches "
                                         f"from above")
+
+
+def _check_out_belt(arm, frame, guess, pick, k: int, height: float, lift: float) -> None:
+    """ScenarioError naming ``pick.line.catalog[k].belt`` where no point of that outgoing belt's
+    centre line (every ``OUT_STEP``) is reachable from above at half the kind's height and
+    ``lift`` above (Drake's IK, as the reach windows)."""
+    name = pick.line.catalog[k].belt
+    belt = next(b for b in pick.belts if b.name == name)
+    for s in np.arange(-belt.length / 2, belt.length / 2 + 1e-9, OUT_STEP):
+        x = belt_frame(belt).multiply(np.array([s, 0.0, height / 2]))
+        q = inverse_kinematics(arm, frame, x, guess, down=True)
+        if q is not None and inverse_kinematics(arm, frame, x + [0.0, 0.0, lift], q, down=True) is not None:
+            return
+    raise ScenarioError(f"pick.line.catalog[{k}].belt: no point of belt {name!r} (its center "
+                        f"{list(belt.center)}) is within what the arm reaches from above")
 
 
 def _blind(scenario) -> list[str]:

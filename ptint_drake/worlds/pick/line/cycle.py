@@ -18,7 +18,10 @@ belt coordinate (a free arm looks every ``decide_period``; the tool holds still 
 
 The chosen task's tfs (``LineCycles.phases``) are one ``phase_time.cycle_time`` from the tool's
 point and yaw, the part at the approach's start riding its belt (approach, descend), the payload
-held (lift, carry, place), to its slot and back up (retreat).
+held (lift, carry, place), to its slot and back up (retreat); a part put on an outgoing belt:
+``out_belt.riding_cycle``, its carry, place and retreat riding that belt to the point
+``out_belt.choose`` picks (a task being replaced keeps its old point among the placed ones:
+conservative).
 
 ``detours`` — what the plan makes of a task: a phase the plan splits by a via (``route``: around
 the waist axis; ``obstacles``: above a part in the way) shares the phase's tf between its two legs
@@ -59,6 +62,8 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from ptint_drake.systems.hand.datasheets import RATED_PAYLOAD
 from ptint_drake.worlds.pick.scene import AddGripper, belt_frame
+from ptint_drake.worlds.pick.out_belt import (OutPlace, across_yaw, choose, place_of, placed_on,
+                                                   ride_of, riding_cycle)
 from ptint_drake.worlds.pick.tasks import place_target
 from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
 
@@ -71,9 +76,13 @@ PHASE_NAMES = ("approach", "descend", "lift", "carry", "place", "retreat")
 class LineCycles:
     """The min-tf model of a line's station and the leads it gave (module docstring)."""
 
-    def __init__(self, scenario, model: Optional[PhaseTimes] = None):
+    def __init__(self, scenario, model: Optional[PhaseTimes] = None, window_at=None,
+                 finger_width: float = 0.02):
         self.scenario = scenario
         self.model = model or PhaseTimes.of(scenario)
+        self.window_at = window_at  # (belt, lateral, height) → reach window (``LineView.window_at``)
+        self.finger_width = finger_width  # m, the open fingers' width along an outgoing belt
+        self.out_place: Optional[OutPlace] = None  # the last ``phases``' point on an outgoing belt
         self.task = PickTaskConfig()
         self._leads: dict = {}
         self.extra: dict = {}  # track → s its approach's via needs beyond the straight way (``detours``)
@@ -124,7 +133,7 @@ class LineCycles:
                 best = (approach, descend_at(ahead + wait + approach), wait, 0.0)
                 break
             except NoTfFits as error:
-                why = f"no tf fits: {error}"
+                why = why or f"no tf fits: {error}"  # the way from now (wait 0): where the part is
         if best is None:
             return why
         for wait in WAITS if ahead > 0.0 and track.id not in self.plain else ():
@@ -187,11 +196,35 @@ class LineCycles:
         if not isinstance(found, str):
             begin = max(now, grasp - found[0] - found[1] - self.extra.get(track.id, 0.0))
             self.model.last = found[0]  # the riding approach's fixed point from the lead's (``_early``)
+        if isinstance(slot, OutPlace):
+            return self._riding(track, grasp, now, begin, start, yaw, slot, kind)
         task = replace(self.task, **destination(slot))
         place = _place(pick, slot, kind)
         return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
                           place, _place_yaw(pick, task, _yaw(track)), _yaw(track),
                           held_mass(self.scenario, kind.mass), task, start, yaw)
+
+    def _riding(self, track, grasp: float, now: float, begin: float, start, yaw: float, slot, kind) -> Cycle:
+        """``phases`` of a part put on an outgoing belt (``out_belt.choose``: the point, then the
+        cycle to it riding the belt); the point chosen: ``out_place``."""
+        pick = self.scenario.pick
+        belt = next(b for b in pick.belts if b.name == slot.belt)
+        height = kind.size[2] if kind.shape == "box" else kind.size[1]
+        window = self.window_at(slot.belt, 0.0, height / 2)
+        put = across_yaw(belt, _yaw(track))
+        mass = held_mass(self.scenario, kind.mass)
+        ride = track.speed * np.asarray(track.direction)
+
+        def cycle_of(along: float) -> Cycle:
+            place0 = place_of(pick, slot.belt, kind, along)
+            return riding_cycle(self.model, track.at(begin, now), ride, place0, ride_of(belt), begin, put,
+                                _yaw(track), mass, self.task, start, yaw)
+
+        parts = {p.name: p for p in pick.parts}
+        self.out_place, cycle = choose(pick, slot.belt, window, grasp, cycle_of, kind,
+                                       placed_on(pick.tasks, slot.belt, parts), self.finger_width,
+                                       track.at(grasp, now))
+        return cycle
 
     def task_of(self, part: str, slot, grasp: float, now: float, cycle: Cycle,
                 begin: Optional[float] = None) -> PickTaskConfig:
@@ -274,10 +307,19 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
             height = part.size[2] if part.shape == "box" else part.size[1]
             s_in, s_out = view(arrival.belt, 0.0, height / 2)
             x = belt_frame(belt).multiply(np.array([0.5 * (s_in + s_out), 0.0, height / 2]))
+            ride = belt.speed * np.asarray(belt.direction) / np.linalg.norm(belt.direction)
+            if kind.belt:  # the point of its reach window's middle, at t = 0 (``out_belt``)
+                out = belts[kind.belt]
+                w = view(kind.belt, 0.0, height / 2)
+                place0 = place_of(pick, kind.belt, part, 0.5 * (w[0] + w[1]))
+                put = across_yaw(out, 0.0)
+                totals.append(riding_cycle(model, x, ride, place0, ride_of(out), 0.0, put, 0.0,
+                                           held_mass(scenario, kind.mass), task,
+                                           place0 + [0.0, 0.0, task.clearance], put).total)
+                continue
             where = kind.bin or kind.slots[0]
             place = _place(pick, where, part)
             place_yaw = _place_yaw(pick, replace(task, **destination(where)), 0.0)
-            ride = belt.speed * np.asarray(belt.direction) / np.linalg.norm(belt.direction)
             cycle = cycle_time(model, x, ride, place, place_yaw, 0.0, held_mass(scenario, kind.mass), task)
             totals.append(cycle.total)
     mean = float(np.mean(totals))
@@ -307,7 +349,10 @@ _HAND_KG: dict = {}
 
 
 def destination(where) -> dict:
-    """A decision's destination as a task's fields: a tray slot (an index) or a bin (its name)."""
+    """A decision's destination as a task's fields: a tray slot (an index), a bin (its name) or a
+    point on an outgoing belt (``out_belt.OutPlace``)."""
+    if isinstance(where, OutPlace):
+        return where.fields()
     return {"bin": where, "slot": None} if isinstance(where, str) else {"slot": where, "bin": ""}
 
 

@@ -50,12 +50,16 @@ from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
+from ptint_drake.worlds.pick.line.no_line import NoLine
+from ptint_drake.worlds.pick.out_belt import OutPlace
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
+
+__all__ = ["FAR_UPSTREAM", "LineDriver", "NoLine", "cycle_time", "view_scenario"]  # (NoLine: world's)
 
 FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
 DETOUR_PASSES = 3  # plans made to fit a task's vias (``LineDriver._fit``)
@@ -75,36 +79,6 @@ def view_scenario(scenario):
     expanded, _ = line_scenario(scenario)
     expanded.pick.line = None
     return expanded
-
-
-class NoLine:
-    """The pick run of a task list: no line (``PickRun`` calls the same hooks; they do nothing)."""
-
-    active = False
-
-    def __init__(self, scenario):
-        self.scenario = scenario
-
-    def bind(self, built) -> None:
-        pass
-
-    def start(self, context) -> None:
-        pass
-
-    def restore(self, context) -> None:
-        pass
-
-    def stops(self, duration: float) -> list[float]:
-        return []
-
-    def at_stop(self, run, context, t: float) -> bool:
-        return False
-
-    def add_metrics(self, metrics: dict, series: dict) -> None:
-        pass
-
-    def planning(self):
-        return None
 
 
 class LineDriver:
@@ -138,7 +112,8 @@ class LineDriver:
             task = PickTaskConfig()
             self.timing = Timing(lead=task.approach.tf + task.descend.tf, margin=task.margin,
                                  finger=finger_extent(built.station))
-            self.cycles = LineCycles(self.scenario)
+            self.cycles = LineCycles(self.scenario, window_at=self.view.window_at,  # (outbelt46: out_belt)
+                                     finger_width=self.timing.finger[1])
         self.truth.rebind(built.station)
         self.view.bind(built)
         self.built = built
@@ -263,8 +238,8 @@ class LineDriver:
         keep = [k for k in range(len(tasks)) if k != replacing]
         assigned = {self.committed[k][0] for k in keep} | self.given_up
         used = {tasks[k].slot for k in keep}
-        free = {c.name: [c.bin] if c.bin else [j for j in c.slots if j not in used]
-                for c in self.line.catalog}
+        free = {c.name: [c.bin] if c.bin else [OutPlace(c.belt)] if c.belt  # (outbelt46: an outgoing belt)
+                else [j for j in c.slots if j not in used] for c in self.line.catalog}
         q = self._arm_q(context)
         start, yaw = self._tool_now(q)  # the arm's present point and yaw
         decision = decide(t, tracks, windows, assigned, free, self.timing,
@@ -316,7 +291,10 @@ class LineDriver:
         fits a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
         try:
-            return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
+            cycle = self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
+            if isinstance(decision.slot, OutPlace):  # (outbelt46: the point on the outgoing belt chosen)
+                decision.slot = self.cycles.out_place
+            return cycle
         except NoTfFits as error:
             self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
             self.cycles.drop_early(track.id)  # the next look: the approach after the entry

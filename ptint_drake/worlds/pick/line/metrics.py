@@ -5,7 +5,8 @@ and the run's records — the parts, not the tasks, are counted:
   centre, resting on its belt, at or past the start of its reach window, ``view.window`` — the
   same Drake IK the scheduler uses); ``placed``: those a task placed (``picks[*].placed``: held
   at the place and within ``criteria.place_mm`` / ``place_deg`` at the end);
-- per part (``parts``): its kind, release time, whether it entered and was placed, its task and,
+- per part (``parts``): its kind, release time, whether it entered and was placed, its task, its
+  ``destination`` (``slot j``, ``bin <name>`` or ``belt <name>``: an outgoing belt) and,
   entered but not placed, a ``reason``: its task's failure (the pick verdict's codes, e.g.
   ``collision with <body>``, ``dropped``, ``missed after retry``, ``not placed``), or for a part
   no task took, the scheduler's last word on it (``not reachable in time``, ``blocked``, ``tray
@@ -138,7 +139,10 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
                "seen": seen.get(k) if camera else (r.t if k in truth.released else None),
                "task": by_part[k][0] if k in by_part else None, "placed": False, "reason": None}
         if row["task"] is not None:
-            row["placed"] = bool(by_part[k][1]["placed"])
+            pick = by_part[k][1]
+            row["placed"] = bool(pick["placed"])
+            row["destination"] = (f"belt {pick['belt']}" if "belt" in pick else f"bin {pick['bin']}"
+                                  if "bin" in pick else f"slot {pick['slot']}")
         ids = tracking["tracks_per_part"].get(name, []) if camera else [k]
         if (row["entered"] or reached) and not row["placed"]:
             row["reason"] = (codes.get(row["task"], "not placed") if row["task"] is not None

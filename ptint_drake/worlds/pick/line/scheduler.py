@@ -97,7 +97,8 @@ class Decision:
     def record(self) -> dict:
         """The decision log's entry (metrics.json ``line.decisions``)."""
         return {"t": round(self.t, 4), "track": self.track,
-                "grasp": None if self.grasp is None else round(self.grasp, 4), "slot": self.slot,
+                "grasp": None if self.grasp is None else round(self.grasp, 4),
+                "slot": self.slot.fields() if hasattr(self.slot, "fields") else self.slot,  # (outbelt46)
                 "deadline": None if self.deadline is None else round(self.deadline, 4),
                 "skipped": [{"track": i, "reason": r} | ({"deadline": round(self.rivals[i], 4)}
                                                           if i in self.rivals else {})
