@@ -46,11 +46,15 @@ def test_a_way_past_the_waist_axis_gets_a_via_on_the_far_side_and_keeps_every_pr
 
 def test_a_way_clear_of_the_axis_is_planned_as_before():
     """The same scenario with the tray moved to the parts' side, and the bundled pick scenarios:
-    no via, the plan identical to the one without routing."""
+    no via around the base, the plan identical to the one without routing.  (The moved tray's
+    second approach, rising from the tray's retreat point, grazes its own block at 1.9 mm: it gets
+    a via above, ``obstacles`` — only the way around the base is asked of it here.)"""
     scenario = load_scenario(MIRRORED)
     scenario.pick.tray.center = [0.08, 0.24, 0.10]
-    scenarios = [scenario] + [load_scenario(n) for n in ("conveyor_pick_place", "assembly_pick_place")]
-    for s in scenarios:
+    world = ways.nominal(scenario, nominal_plant(scenario))
+    assert route.plan_vias(scenario, world) == ()
+    assert {(v.task, v.phase) for v in route.routed_vias(scenario, world)} == {(1, "approach")}
+    for s in [load_scenario(n) for n in ("conveyor_pick_place", "assembly_pick_place")]:
         routed, straight = route.routed_plan(s), pick_plan(s.pick)
         assert [p.phase for p in routed.segments] == [p.phase for p in straight.segments], s.name
         assert routed.segments == straight.segments and routed.commands == straight.commands

@@ -11,9 +11,14 @@ tool point).  Each task's first approach and its carry are sampled along the pla
 (``ways.segment_way``, the one tracer) at most ``STEP`` apart, and at each sample Drake's
 ``QueryObject.ComputeSignedDistancePairwiseClosestPoints`` gives the distance of the hand (and the
 held part) to every obstacle.  A sample nearer than ``HAND_MARGIN`` to an obstacle is a hit, named
-by its bodies (``Hit``); the part an approach aims at is an obstacle too, but there a hit is a
-sample inside it (the way ends ``clearance`` above it, so the fingers pass just over it: they must
-arrive from above, never through its side).
+by its bodies (``Hit``).  The part an approach goes to take is an obstacle of that approach too:
+the way ends ``clearance`` above it (the descend then comes down onto it from above), and before
+that end the hand keeps ``HAND_MARGIN`` from it — or, where the way's end itself is nearer (a tall
+part, a small clearance), no nearer than the end.  Before, only a sample inside it was a hit, and
+a way rising from a tray lower than the belt could graze the part's top edge: tests/low_tray_pick
+with its tray at z = 0.08 m passed 1.9 mm from its own box without a via (line_short seed 18 at
+8f38957 struck the cube it approached from the tray's retreat point and ran away; at 940e9c9 its
+approaches from there keep 6.7–8.9 mm from their parts, and one that went inside got a via).
 
 Where a way hits and has no via yet (``route``: the way around the base), ``obstacle_vias`` adds one
 (``tasks.Via``): a fixed point above the way's start, raised from the higher of the way's two ends in
@@ -132,10 +137,30 @@ class PlanningScene:
         hands = {g for body in self.hands.values() for g in plant.GetCollisionGeometriesForBody(body)}
         self.obstacles = [g for g in inspector.GetAllGeometryIds() if g not in hands]
 
-    def nearest(self, world: Nominal, tool: np.ndarray, t: float, held: "int | None", radius: float) -> tuple:
+    def nearest(self, world: Nominal, tool: np.ndarray, t: float, held: "int | None", radius: float,
+                only: "int | None" = None) -> tuple:
         """(distance, (mover, obstacle)) of the hand of ``radius`` at ``tool`` — and the ``held``
-        part, its centre at the tool point — to the nearest obstacle, with the parts and belts
-        where they ride at time t."""
+        part, its centre at the tool point — to the nearest obstacle (``only``: to part ``only``),
+        with the parts and belts where they ride at time t."""
+        self._pose(world, tool, t, held, radius)
+        hand_ids = set(self.plant.GetCollisionGeometriesForBody(self.hands[radius]))
+        movers = hand_ids | (self.part_ids[held] if held is not None else set())
+        query = self.scene_graph.get_query_output_port().Eval(self.sg_context)
+        best = (np.inf, ("hand", ""))
+        # mover against obstacle only, pair by pair: the obstacles touch each other (a part resting
+        # on its belt), and Drake's box-box gradient of two touching boxes fails its own check
+        for mover in movers:
+            for other in self.obstacles if only is None else self.part_ids[only]:
+                if other in movers:
+                    continue
+                pair = query.ComputeSignedDistancePairClosestPoints(mover, other)
+                if pair.distance < best[0]:
+                    best = (pair.distance, ("hand" if mover in hand_ids else f"held {self.names[mover]}",
+                                            self.names[other]))
+        return best
+
+    def _pose(self, world: Nominal, tool: np.ndarray, t: float, held: "int | None", radius: float) -> None:
+        """The parts and belts where they ride at time t, the hand of ``radius`` at ``tool``."""
         set_pose = self.plant.SetFreeBodyPose
         for i, body in enumerate(self.parts):
             p0, v = world.parts[i]
@@ -146,21 +171,6 @@ class PlanningScene:
             set_pose(self.plant_context, body, RigidTransform(X0.rotation(), X0.translation() + v * t))
         for r, body in self.hands.items():
             set_pose(self.plant_context, body, RigidTransform(tool) if r == radius else self.PARKED)
-        hand_ids = set(self.plant.GetCollisionGeometriesForBody(self.hands[radius]))
-        movers = hand_ids | (self.part_ids[held] if held is not None else set())
-        query = self.scene_graph.get_query_output_port().Eval(self.sg_context)
-        best = (np.inf, ("hand", ""))
-        # mover against obstacle only, pair by pair: the obstacles touch each other (a part resting
-        # on its belt), and Drake's box-box gradient of two touching boxes fails its own check
-        for mover in movers:
-            for other in self.obstacles:
-                if other in movers:
-                    continue
-                pair = query.ComputeSignedDistancePairClosestPoints(mover, other)
-                if pair.distance < best[0]:
-                    best = (pair.distance, ("hand" if mover in hand_ids else f"held {self.names[mover]}",
-                                            self.names[other]))
-        return best
 
 
 def _hand_size(scenario) -> tuple:
@@ -192,10 +202,13 @@ def way_hit(scene: PlanningScene, world: Nominal, plan: PickPlan, i: int) -> Hit
     held = plan.segments[plan.segment_index(seg.task, "approach")].index if seg.phase == "carry" else None
     key = (seg.task, "carry" if seg.phase == "carry" or seg.kind == VIA_SLOT else "approach")
     worst = None
-    target = seg.index if seg.phase == "approach" else None  # the part the fingers come down around
+    own = HAND_MARGIN  # the part an approach goes to take: no nearer than where the way ends
+    if seg.phase == "approach":
+        own = min(own, scene.nearest(world, way[-1], s.end, None, scene.radius[key], seg.index)[0])
+    own_name = scene.parts_config[seg.index].name if seg.phase == "approach" else None
     for k in range(len(tau)):
         d, bodies = scene.nearest(world, way[k], s.start + tau[k], held, scene.radius[key])
-        limit = 0.0 if target is not None and bodies[1] == scene.parts_config[target].name else HAND_MARGIN
+        limit = own if bodies[1] == own_name else HAND_MARGIN
         if d < limit and (worst is None or d < worst.distance):
             worst = Hit(seg.task, seg.phase, float(s.start + tau[k]), float(d), bodies)
     return worst

@@ -22,7 +22,10 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
   decides again from now and the task is replaced (``replaced``: an approach under way restarts
   from the present state, its tf stretched to the new grasp time; one not started yet starts at
-  the model's lead before it; nothing feasible: the task goes on).
+  the model's lead before it); nothing to replace it with, a task whose part is out of its window
+  at the approach's end or at the lift's start (a dwell after the grasp) is given up (``give_up``:
+  ``abandoned``, the arm sent to a hold from its present state, the part ``not reachable in
+  time``), any other goes on (``nothing feasible: kept``).
 
 Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
 a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
@@ -45,7 +48,9 @@ from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
 from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass
 from ptint_drake.worlds.pick.phase_time import NoTfFits
+from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
+from ptint_drake.worlds.pick.line.no_line import NoLine
 from ptint_drake.worlds.pick.out_belt import OutPlace
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
@@ -53,6 +58,8 @@ from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
+
+__all__ = ["FAR_UPSTREAM", "LineDriver", "NoLine", "cycle_time", "view_scenario"]  # (NoLine: world's)
 
 FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
 DETOUR_PASSES = 3  # plans made to fit a task's vias (``LineDriver._fit``)
@@ -72,36 +79,6 @@ def view_scenario(scenario):
     expanded, _ = line_scenario(scenario)
     expanded.pick.line = None
     return expanded
-
-
-class NoLine:
-    """The pick run of a task list: no line (``PickRun`` calls the same hooks; they do nothing)."""
-
-    active = False
-
-    def __init__(self, scenario):
-        self.scenario = scenario
-
-    def bind(self, built) -> None:
-        pass
-
-    def start(self, context) -> None:
-        pass
-
-    def restore(self, context) -> None:
-        pass
-
-    def stops(self, duration: float) -> list[float]:
-        return []
-
-    def at_stop(self, run, context, t: float) -> bool:
-        return False
-
-    def add_metrics(self, metrics: dict, series: dict) -> None:
-        pass
-
-    def planning(self):
-        return None
 
 
 class LineDriver:
@@ -125,6 +102,8 @@ class LineDriver:
         self.cycles = None  # the min-tf model (``line.cycle``), built at the first bind
         self.planning_s: list = []  # wall s of each decision that chose (the scheduler and the model)
         self._vias: dict = {}
+        self.given_up: set = set()  # tracks whose task was abandoned (``give_up``): not chosen again
+        self.abandoned: list = []  # {"t", "task", "drift_mm"} of every task given up in its approach
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -191,9 +170,8 @@ class LineDriver:
         self.truth.at_stop(context, t)
         if t < IDLE_TF - 1e-9:
             return False
-        tasks = self.scenario.pick.tasks
-        if tasks and t < run.built.plan.end - 1e-9:
-            return self._watch(run, context, t)
+        if t < run.built.plan.end - 1e-9:  # a task (or a hold: ``give_up``) under way
+            return bool(self.scenario.pick.tasks) and self._watch(run, context, t)
         return self._choose(run, context, t)
 
     def _watch(self, run, context, t: float) -> bool:
@@ -204,21 +182,18 @@ class LineDriver:
             return False
         track_id, grasp, point = self.committed[k]
         track = next((tr for tr in self.view.tracks(context, t) if tr.id == track_id), None)
-        if track is None:
-            return False
-        drift = drifted(track, grasp, point, t, 1e-3 * self.line.redecide_mm)
+        drift = track is not None and drifted(track, grasp, point, t, 1e-3 * self.line.redecide_mm)
         if not drift:
             return False
-        if np.isfinite(track.measured) and not self._has_encoder(track.belt):
+        if np.isfinite(track.measured) and not {track.belt} & {b.name for b in self.line.belts if b.encoder}:
             self.view.learned[track.belt] = track.measured  # the belt's speed, as its track shows it
             track = replace(track, speed=track.measured)
-        s_in, s_out = self.view.window(track)
-        s = track.s + track.speed * (grasp - t)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
                  "speed": round(track.speed, 4)}
         task = self.scenario.pick.tasks[k]
         begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
-        if s_in <= track.s + track.speed * (end - t) and s <= s_out - track.speed * self.timing.slack \
+        window = self.view.window(track)
+        if not unserved(track, window, grasp, t, end, self.timing.slack) \
                 and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
             # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
@@ -228,12 +203,30 @@ class LineDriver:
             self.replaced.append({"t": t, "task": k, "drift_mm": 1e3 * drift})
             self.decisions[-1]["redecide"] = "replaced"
             return True
+        why = unserved(track, window, grasp, t, end, task.dwell)  # the lift's start out of reach too
+        if why:  # given up (``give_up``)
+            self._abandon(run, context, t, k, track, entry | {"why": why})
+            return True
         self.decisions.append(entry | {"redecide": "nothing feasible: kept"})
         self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
         return False
 
-    def _has_encoder(self, belt: str) -> bool:
-        return any(b.name == belt and b.encoder for b in self.line.belts)
+    def _abandon(self, run, context, t: float, k: int, track, entry: dict) -> None:
+        """Task k (the last, in its approach) given up (``give_up``): out of the run's tasks, its
+        part named in the log, and a ``Hold`` from the arm's present state after the tasks."""
+        q = self._arm_q(context)
+        hold = hold_of(t, *self._tool_now(q), np.asarray(track.position), lambda x: self.view.reachable(x, q))
+        for records in (self.scenario.pick.tasks, run.replans, run.checks, run.refused):
+            del records[k]
+        del self.committed[k]
+        for record in self.decisions:  # its choice no longer names a task of the run (k is the next one's)
+            if record.get("task") == k:
+                record["task"], record["given up"] = None, round(t, 4)
+        run.replans.append(hold)  # after the tasks' ``Replan`` entries (``plan.line_plan``)
+        self.given_up.add(track.id)
+        self.abandoned.append({"t": t, "task": k, "drift_mm": entry["drift_mm"]})
+        self.decisions.append(entry | {"redecide": "abandoned", "hold": [round(c, 4) for c in hold.position],
+                                       "skipped": [{"track": track.id, "reason": REASON}]})
 
     def _choose(self, run, context, t: float, replacing=None) -> bool:
         """A decision from now, each track's lead from the min-tf model (``line.cycle``); a task
@@ -243,7 +236,7 @@ class LineDriver:
         tracks = self.view.tracks(context, t)
         windows = {tr.id: self.view.window(tr) for tr in tracks}
         keep = [k for k in range(len(tasks)) if k != replacing]
-        assigned = {self.committed[k][0] for k in keep}
+        assigned = {self.committed[k][0] for k in keep} | self.given_up
         used = {tasks[k].slot for k in keep}
         free = {c.name: [c.bin] if c.bin else [OutPlace(c.belt)] if c.belt  # (outbelt46: an outgoing belt)
                 else [j for j in c.slots if j not in used] for c in self.line.catalog}
@@ -343,7 +336,7 @@ class LineDriver:
             scenario = self.planning()
             trial = [*tasks[:k], task, *tasks[k + 1:]]
             scenario = replace(scenario, pick=replace(scenario.pick, tasks=trial))
-            replans = (*run.replans[:k], Replan(), *run.replans[k + 1:])
+            replans = (*run.replans[:k], Replan(), *run.replans[k + (replacing is not None):])
             try:
                 needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
             except NoTfFits as error:
@@ -372,7 +365,7 @@ class LineDriver:
         tasks = self.scenario.pick.tasks
         if replacing is None:
             tasks.append(task)
-            run.replans.append(Replan())
+            run.replans.insert(len(tasks) - 1, Replan())  # before the holds (``plan.line_plan``)
             run.checks.append([])
             run.refused.append(None)
             k = len(tasks) - 1

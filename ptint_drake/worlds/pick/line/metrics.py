@@ -21,7 +21,9 @@ and the run's records — the parts, not the tasks, are counted:
 - ``decisions``: the decision log (``scheduler.Decision.record``, and the re-decisions);
 - ``replaced``: the tasks replaced in their approach, each with the commanded torque's jump at
   the switch (N·m, the largest joint's change between the logged samples around it) beside the
-  run's largest sample-to-sample change outside any switch;
+  run's largest sample-to-sample change outside any switch; ``abandoned``: the same of the tasks
+  given up in their approach (``give_up``: the arm sent to a hold, the part ``not reachable in
+  time``);
 - ``tracking``: the pose sensor's identities are the sensor's (no association, no IDSW to count).
 
 With the rgbd camera (``seen``) the parts are counted by what the camera could see:
@@ -156,7 +158,7 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
     segments = plan.schedule.segments
     span = (segments[plan.segment_index(len(cycles) - 1, "retreat")].end
             - segments[plan.segment_index(0, "approach", 0)].start) if cycles else None
-    jumps, usual = _torque_jumps(series, driver.replaced)
+    jumps, usual = _torque_jumps(series, driver.replaced + driver.abandoned)
     times = 1e3 * np.asarray(driver.planning_s)
     return {"released": len(truth.released), "entered": entered, "placed": placed,
             "placed_fraction": placed / entered if entered else None,
@@ -167,7 +169,8 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
                             "median": float(np.median(times)) if len(times) else None,
                             "max": float(np.max(times)) if len(times) else None},
             "passed": len(truth.passed), "parts": parts, "decisions": driver.decisions,
-            "replaced": jumps, "largest_torque_step_elsewhere_Nm": usual,
+            "replaced": jumps[:len(driver.replaced)], "abandoned": jumps[len(driver.replaced):],
+            "largest_torque_step_elsewhere_Nm": usual,
             "not_seen": sum(p["reason"] == "not seen" for p in parts),
             "classes": [{"name": c.name, "height": float(part_shape(c)[1])}
                         for c in scenario.pick.line.catalog],

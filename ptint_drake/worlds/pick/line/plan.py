@@ -5,16 +5,24 @@ begins with one ``IDLE_TF`` segment (phase ``idle``, task -1, a fixed point: kin
 aiming at the tool's start position and yaw, so the arm holds where it stands until the first
 task; every later task is an ordinary pick task (``tasks.pick_plan``) after it.  The scheduler
 decides nothing before the idle segment's end.
+
+A task the driver gives up in its approach (``driver``: it can no longer be served) leaves the
+tasks; in its place the plan holds a ``Hold``: a segment like the idle one (phase ``idle``, task
+-1, a fixed point) from the moment it was given up — the arm's present state, as a replaced
+approach restarts — to the hold's point.  The run passes the holds after the tasks' ``Replan``
+entries (``line_plan``'s ``replans``), and the segments are merged in time order.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.worlds.pick.route import routed_plan
-from ptint_drake.worlds.pick.tasks import VIA_SLOT, PickPlan, PlanSegment
+from ptint_drake.worlds.pick.tasks import VIA_SLOT, PickPlan, PlanSegment, Replan
 
 IDLE_TF = 0.5  # s
 IDLE_BETA = 0.75
@@ -26,6 +34,27 @@ def home_pose(scenario, arm) -> tuple:
     arm.SetPositions(context, np.radians(scenario.robot.initial_q_deg))
     X = arm.GetFrameByName(scenario.robot.end_effector).CalcPoseInWorld(context)
     return tuple(float(c) for c in X.translation()), float(tool_yaw(X.rotation().matrix()))
+
+
+@dataclass(frozen=True)
+class Hold:
+    """Where the tool goes when a task is given up (module docstring): from ``start`` (s) to the
+    fixed ``position`` (world, m) turned to ``yaw`` (rad) in ``tf`` s, the TBG's ``beta``."""
+
+    start: float
+    tf: float
+    beta: float
+    position: tuple
+    yaw: float
+
+    @property
+    def end(self) -> float:
+        return self.start + self.tf
+
+    def segment(self) -> tuple:
+        """(``Segment``, ``PlanSegment``) of the plan: a fixed point, as the idle segment."""
+        return (Segment(self.start, self.tf, self.beta),
+                PlanSegment(-1, "idle", VIA_SLOT, -1, tuple(self.position), self.yaw))
 
 
 _LAST: dict = {}  # the last plan made, by what it was made from (``line_plan``)
@@ -43,16 +72,22 @@ def line_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
 
 
 def _line_plan(scenario, replans: tuple, arm) -> PickPlan:
-    """``line_plan``, made."""
+    """``line_plan``, made: the tasks' plan with their ``Replan`` entries, the holds merged in."""
+    holds = [r.segment() for r in replans if isinstance(r, Hold)]
+    replans = tuple(r for r in replans if isinstance(r, Replan))
     if arm is None:
         from ptint_drake.robot.plant import nominal_plant  # noqa: PLC0415
 
         arm = nominal_plant(scenario)
     home, yaw = home_pose(scenario, arm)
     idle = (Segment(0.0, IDLE_TF, IDLE_BETA), PlanSegment(-1, "idle", VIA_SLOT, -1, home, yaw))
+    end = max([IDLE_TF, *(h[0].end for h in holds)])
     if not scenario.pick.tasks:
-        return PickPlan(Schedule([idle[0]]), (idle[1],), ((0.0, scenario.pick.gripper.initial_opening),),
-                        (), (), IDLE_TF)
+        merged = sorted([idle, *holds], key=lambda pair: pair[0].start)
+        return PickPlan(Schedule([m[0] for m in merged]), tuple(m[1] for m in merged),
+                        ((0.0, scenario.pick.gripper.initial_opening),), (), (), end)
     plan = routed_plan(scenario, replans, arm)
-    return PickPlan(Schedule([idle[0], *plan.schedule.segments]), (idle[1], *plan.segments), plan.commands,
-                    plan.close_times, plan.grasp_times, plan.end, plan.widths, plan.attempts)
+    pairs = [idle, *zip(plan.schedule.segments, plan.segments), *holds]
+    merged = sorted(pairs, key=lambda pair: pair[0].start)
+    return PickPlan(Schedule([m[0] for m in merged]), tuple(m[1] for m in merged), plan.commands,
+                    plan.close_times, plan.grasp_times, max(plan.end, end), plan.widths, plan.attempts)

@@ -1,0 +1,21 @@
+"""Issue 44: a task kept in its approach whose part leaves its reach window by the speed its
+belt is seen at is given up (``line.give_up``), not followed to the edge of reach — the harsh
+study's sample 8 (``ptint robust line_assembly --samples 1 --seed 8``): cube_2's grasp was
+planned 0.12 s before its deadline, conveyor3 (no encoder) then seen at 0.122 m/s.  Without the
+rule the targets followed the part and the arm ran away (joint 3 at 19 rad/s against its 3 rad/s,
+collision with conveyor1, conveyor3, cube_2)."""
+
+import json
+
+
+def test_a_task_out_of_its_window_is_given_up_without_a_runaway(tmp_path, ptint_here):
+    out = tmp_path / "robust"
+    done = ptint_here("robust", "line_assembly", "--samples", "1", "--seed", "8", "--workers", "1",
+                      "--quiet", "--out", out)
+    assert done.returncode == 0, done.stderr
+    (row,) = json.loads((out / "samples.json").read_text())
+    assert row["warnings"] == []  # no joint past its speed or position limit
+    assert [p["placed"] for p in row["picks"]] == [True, True, False]
+    assert not any(p["collision"] for p in row["picks"])
+    given_up = row["picks"][2]
+    assert given_up["reason"] == "not reachable in time" and given_up["task"] is None, given_up
