@@ -373,7 +373,11 @@ def test_realtime_lost_gripper_status_does_not_end_the_run(tmp_path):
     assert link["ticks"] + link["ticks_skipped"] == 5000, link  # (skipped: the hardware's own stalls)
     assert link["ticks_late"] >= 1  # the tick whose gripper status was lost went unanswered
     drive = json.loads((tmp_path / "dr" / "drive.json").read_text())
-    assert drive["fault"] is None and drive["companions_lost"] == 1 and drive["last_t"] >= 4.998, drive
+    # the drive answered to the end: its last status is the last tick's, less the ticks the hardware
+    # skipped after its own stalls (a skipped tick publishes no status; CI at load 3: 4.996 s)
+    last = 4.998 - 1e-3 * link["ticks_skipped"]
+    assert drive["fault"] is None and drive["companions_lost"] == 1 and drive["last_t"] >= last - 1e-9, \
+        (drive, link)
     # placed, unless the machine's load made enough late ticks to cost the accuracy (then exit 1)
     assert out["hw"]["rc"] == 0 or (out["hw"]["rc"] == 1 and link["ticks_late"] > 1), out
 
