@@ -39,8 +39,7 @@ import numpy as np
 
 from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.worlds.pick.cell import place_point
-from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes
-from ptint_drake.worlds.pick.route import nearest_branch
+from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.scene import belt_frame
 
 PLACE_GAP = 0.010  # m, between the open fingers (or the part) and the part put before it
@@ -76,36 +75,6 @@ def ride_of(belt) -> np.ndarray:
     """m/s (world): belt's declared velocity."""
     d = np.asarray(belt.direction, dtype=float)
     return belt.speed * d / np.linalg.norm(d)
-
-
-def riding_cycle(model: PhaseTimes, part, ride, place0, place_ride, begin: float, place_yaw: float,
-                 part_yaw: float, mass: float, task: PickTaskConfig, start, yaw: float) -> Cycle:
-    """One pick cycle (``phase_time.cycle_time``'s phases, each ``model.min_tf``) whose place rides
-    at ``place_ride`` from ``place0`` (the part's centre there at t = 0); the approach starts at
-    ``begin`` (s) with the part at ``part`` riding at ``ride``; the carry, the place and the
-    retreat each aim at the place point where it is when the phase starts, riding on."""
-    part, ride, place0, v = (np.asarray(x, dtype=float) for x in (part, ride, place0, place_ride))
-    up = lambda h: np.array([0.0, 0.0, h])  # noqa: E731
-    grip = nearest_branch(yaw, part_yaw)
-    put = nearest_branch(grip, place_yaw)
-    beta = {p: getattr(task, p).beta for p in ("approach", "descend", "lift", "carry", "place", "retreat")}
-    tf = {"approach": model.min_tf(start, part + up(task.clearance), ride, 0.0, beta["approach"],
-                                   (yaw, grip))}
-    at = part + ride * tf["approach"]
-    tf["descend"] = max(model.min_tf(at + up(task.clearance), at, ride, 0.0, beta["descend"], (grip, grip)),
-                        task.margin / model.gripper_speed)
-    lifted = at + ride * (tf["descend"] + task.dwell)
-    tf["lift"] = model.min_tf(lifted, lifted + up(task.lift_height), None, mass, beta["lift"], (grip, grip))
-    t = begin + tf["approach"] + tf["descend"] + task.dwell + tf["lift"]
-    tf["carry"] = model.min_tf(lifted + up(task.lift_height), place0 + v * t + up(task.lift_height), v, mass,
-                               beta["carry"], (grip, put))
-    t += tf["carry"]
-    tf["place"] = model.min_tf(place0 + v * t + up(task.lift_height), place0 + v * t, v, mass, beta["place"],
-                               (put, put))
-    t += tf["place"] + task.dwell
-    tf["retreat"] = model.min_tf(place0 + v * t, place0 + v * t + up(task.clearance), v, 0.0,
-                                 beta["retreat"], (put, put))
-    return Cycle(tf, task.dwell)
 
 
 def placed_on(tasks: list, belt: str, parts: dict, skip: Optional[int] = None) -> list:

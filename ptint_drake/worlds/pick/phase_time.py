@@ -232,14 +232,17 @@ class Cycle:
 
 def cycle_time(model: PhaseTimes, part, ride, place, place_yaw: float = 0.0, part_yaw: float = 0.0,
                mass: float = 0.1, task: Optional[PickTaskConfig] = None, start=None,
-               yaw: Optional[float] = None) -> Cycle:
+               yaw: Optional[float] = None, place_ride=None, begin: float = 0.0) -> Cycle:
     """One pick cycle (module docstring) of a part whose centre is at ``part`` (m) when the
     approach starts, riding at ``ride`` (m/s), of ``mass`` (kg) and yaw ``part_yaw``, to the
     place pose ``place`` (the part's centre, m) at ``place_yaw`` (rad); the tool starts at
     ``start`` turned to ``yaw`` (default: ``clearance`` above the place, turned to its yaw: where
     the last retreat ended).  ``task``: clearance, lift height, dwell, margin and each phase's β
     (default: a task's defaults).  A descend takes at least ``margin`` / the jaws' speed: the
-    fingers close in at most half of it (``tasks.check_tasks``)."""
+    fingers close in at most half of it (``tasks.check_tasks``).  ``place_ride`` (m/s; None: a
+    fixed place): the place rides at that velocity from ``place`` at t = 0 (an outgoing belt,
+    ``out_belt``), the approach starting at ``begin`` (s); the carry, the place and the retreat each
+    aim at the place point where it is when the phase starts, riding on."""
     task = task or PickTaskConfig()
     part, ride, place = (np.asarray(v, dtype=float) for v in (part, ride, place))
     up = lambda h: np.array([0.0, 0.0, h])  # noqa: E731
@@ -254,10 +257,17 @@ def cycle_time(model: PhaseTimes, part, ride, place, place_yaw: float = 0.0, par
                         task.margin / model.gripper_speed)
     lifted = at + ride * (tf["descend"] + task.dwell)
     tf["lift"] = model.min_tf(lifted, lifted + up(task.lift_height), None, mass, beta["lift"], (grip, grip))
-    above = place + up(task.lift_height)
-    tf["carry"] = model.min_tf(lifted + up(task.lift_height), above, None, mass, beta["carry"], (grip, put))
-    tf["place"] = model.min_tf(above, place, None, mass, beta["place"], (put, put))
-    tf["retreat"] = model.min_tf(place, place + up(task.clearance), None, 0.0, beta["retreat"], (put, put))
+    v = None if place_ride is None else np.asarray(place_ride, dtype=float)
+    place_at = lambda t: place if v is None else place + v * t  # noqa: E731  (a phase starting at t)
+    t = begin + tf["approach"] + tf["descend"] + task.dwell + tf["lift"]
+    tf["carry"] = model.min_tf(lifted + up(task.lift_height), place_at(t) + up(task.lift_height), v, mass,
+                               beta["carry"], (grip, put))
+    t += tf["carry"]
+    tf["place"] = model.min_tf(place_at(t) + up(task.lift_height), place_at(t), v, mass, beta["place"],
+                               (put, put))
+    t += tf["place"] + task.dwell
+    tf["retreat"] = model.min_tf(place_at(t), place_at(t) + up(task.clearance), v, 0.0, beta["retreat"],
+                                 (put, put))
     return Cycle(tf, task.dwell)
 
 

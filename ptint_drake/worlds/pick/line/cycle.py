@@ -19,7 +19,7 @@ belt coordinate (a free arm looks every ``decide_period``; the tool holds still 
 The chosen task's tfs (``LineCycles.phases``) are one ``phase_time.cycle_time`` from the tool's
 point and yaw, the part at the approach's start riding its belt (approach, descend), the payload
 held (lift, carry, place), to its slot and back up (retreat); a part put on an outgoing belt:
-``out_belt.riding_cycle``, its carry, place and retreat riding that belt to the point
+``phase_time.cycle_time`` with its place riding that belt (carry, place and retreat) to the point
 ``out_belt.choose`` picks (a task being replaced keeps its old point among the placed ones:
 conservative).
 
@@ -62,8 +62,7 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from ptint_drake.systems.hand.datasheets import RATED_PAYLOAD
 from ptint_drake.worlds.pick.scene import AddGripper, belt_frame
-from ptint_drake.worlds.pick.out_belt import (OutPlace, across_yaw, choose, place_of, placed_on,
-                                                   ride_of, riding_cycle)
+from ptint_drake.worlds.pick.out_belt import OutPlace, across_yaw, choose, place_of, placed_on, ride_of
 from ptint_drake.worlds.pick.tasks import place_target
 from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
 
@@ -217,8 +216,8 @@ class LineCycles:
 
         def cycle_of(along: float) -> Cycle:
             place0 = place_of(pick, slot.belt, kind, along)
-            return riding_cycle(self.model, track.at(begin, now), ride, place0, ride_of(belt), begin, put,
-                                _yaw(track), mass, self.task, start, yaw)
+            return cycle_time(self.model, track.at(begin, now), ride, place0, put, _yaw(track), mass,
+                              self.task, start, yaw, place_ride=ride_of(belt), begin=begin)
 
         parts = {p.name: p for p in pick.parts}
         self.out_place, cycle = choose(pick, slot.belt, window, grasp, cycle_of, kind,
@@ -313,9 +312,9 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
                 w = view(kind.belt, 0.0, height / 2)
                 place0 = place_of(pick, kind.belt, part, 0.5 * (w[0] + w[1]))
                 put = across_yaw(out, 0.0)
-                totals.append(riding_cycle(model, x, ride, place0, ride_of(out), 0.0, put, 0.0,
-                                           held_mass(scenario, kind.mass), task,
-                                           place0 + [0.0, 0.0, task.clearance], put).total)
+                totals.append(cycle_time(model, x, ride, place0, put, 0.0, held_mass(scenario, kind.mass),
+                                         task, place0 + [0.0, 0.0, task.clearance], put,
+                                         place_ride=ride_of(out)).total)
                 continue
             where = kind.bin or kind.slots[0]
             place = _place(pick, where, part)

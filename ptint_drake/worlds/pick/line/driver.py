@@ -185,7 +185,7 @@ class LineDriver:
         drift = track is not None and drifted(track, grasp, point, t, 1e-3 * self.line.redecide_mm)
         if not drift:
             return False
-        if np.isfinite(track.measured) and not {track.belt} & {b.name for b in self.line.belts if b.encoder}:
+        if np.isfinite(track.measured) and not self._has_encoder(track.belt):
             self.view.learned[track.belt] = track.measured  # the belt's speed, as its track shows it
             track = replace(track, speed=track.measured)
         entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
@@ -210,6 +210,9 @@ class LineDriver:
         self.decisions.append(entry | {"redecide": "nothing feasible: kept"})
         self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
         return False
+
+    def _has_encoder(self, belt: str) -> bool:
+        return any(b.name == belt and b.encoder for b in self.line.belts)
 
     def _abandon(self, run, context, t: float, k: int, track, entry: dict) -> None:
         """Task k (the last, in its approach) given up (``give_up``): out of the run's tasks, its
