@@ -30,8 +30,8 @@ straight way.  Measured (line_surplus seed 2 at 22.19 s): a 0.264 s approach got
 the slot, its leg 0.1 s with a 90° turn, and the wrist ran at 9 rad/s, 766 N·m commanded, into the
 conveyor.  So the task's plan is made (``plan.line_plan``, what the run will follow) and each via's
 two legs are asked of the model on their own — from the previous segment's target, as the plan's
-way starts — and the phase takes the longest of tf₁ / share and tf₂ / (1 − share), the plan's own
-split kept (``driver`` stretches the task, or gives it up where its grasp then leaves reach).
+way starts — and the phase is split to give each leg its own (``via_split``: the driver stretches
+the task, or gives it up where its grasp then leaves reach).
 
 The start state: the model starts each phase at rest on its way, from the tool's present point
 (the arm's posture read at the decision).  Measured over 110 segment starts of two runs
@@ -239,9 +239,10 @@ class LineCycles:
 
 
     def detours(self, scenario, plan, k: int, mass: float) -> dict:
-        """phase → the tf (s) that task ``k``'s phase split by a via needs in ``plan`` (the plan
-        of ``scenario``; module docstring), ``mass`` (kg) held on a carry; only phases with a via.
-        ``NoTfFits`` where a leg has none."""
+        """phase → (tf₁, tf₂, share): the min tfs (s) of the via's leg and of the rest of task
+        ``k``'s phase split by a via in ``plan`` (the plan of ``scenario``; module docstring), and
+        the share of the phase's tf the plan gives the via's leg; ``mass`` (kg) held on a carry;
+        only phases with a via.  ``NoTfFits`` where a leg has none."""
         world = nominal(scenario, self.model.arm)
         yaws = tool_yaws(world, plan)
         segments, times = plan.segments, plan.schedule.segments
@@ -256,8 +257,7 @@ class LineCycles:
             first = self.model.min_tf(via + start_error(world, plan, i), via, None, payload, s0.beta, yaws[i])
             second = self.model.min_tf(via, segment_target(world, plan, i + 1, s1.start)[0], ride, payload,
                                        s1.beta, yaws[i + 1])
-            share = s0.tf / (s0.tf + s1.tf)
-            needs[nxt.phase] = max(first / share, second / (1.0 - share))
+            needs[nxt.phase] = (first, second, s0.tf / (s0.tf + s1.tf))
         return needs
 
 

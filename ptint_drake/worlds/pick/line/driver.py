@@ -28,8 +28,9 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   time``), any other goes on (``nothing feasible: kept``).
 
 Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
-a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
-the approach is stretched, and the task is not started where that grasp leaves reach.
+a via gets what the via's two legs need (``line.cycle.LineCycles.detours``, ``via_split``), its
+grasp later where the approach is stretched, and the task is not started where that grasp leaves
+reach.
 
 Every decision goes to the log (``decisions``: metrics.json ``line.decisions``); looks that find
 nothing new are not repeated in it.
@@ -42,7 +43,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ptint_drake.config.pick import MoveConfig, PickTaskConfig
+from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
@@ -55,6 +56,7 @@ from ptint_drake.worlds.pick.out_belt import OutPlace
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
+from ptint_drake.worlds.pick.line.via_split import fitted
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
@@ -333,7 +335,7 @@ class LineDriver:
             begin = t  # its approach under way: restarted from the present state
         task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
         mass = held_mass(self.scenario, next(c.mass for c in self.line.catalog if c.name == track.kind))
-        self._vias = {}  # phase → the tf its via's legs need (the decision log's ``via_tf``)
+        self._vias = {}  # phase → the min tfs of its via's two legs (the decision log's ``via_tf``)
         why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
         for _ in range(DETOUR_PASSES):
             scenario = self.planning()
@@ -345,11 +347,11 @@ class LineDriver:
             except NoTfFits as error:
                 why = f"no tf fits a via's leg: {error}"
                 break
-            short = {p: v for p, v in needs.items() if v > getattr(task, p).tf + 1e-3}
-            self._vias = {p: round(v, 3) for p, v in needs.items()}
+            short = fitted(task, needs, cycle.phases)
+            self._vias = {p: [round(v, 3) for v in legs[:2]] for p, legs in needs.items()}
             if not short:
                 return task
-            task = replace(task, **{p: MoveConfig(v, getattr(task, p).beta) for p, v in short.items()})
+            task = replace(task, **short)
             grasp = task.start + task.approach.tf + task.descend.tf
             if "approach" in short:
                 self.cycles.extra[track.id] = self.cycles.extra.get(track.id, 0.0) + grasp - decision.grasp
