@@ -189,7 +189,7 @@ class LineCycles:
         """The cycle of a grasp of ``track`` (reach ``window``) at ``grasp`` (module docstring), its
         approach starting its min tf and the descend's before it (or now)."""
         pick = self.scenario.pick
-        kind = _kind_part(pick, track.kind)
+        kind = kind_part(pick, track.kind)
         found = self.found(track, window, start, yaw)
         begin = now
         if not isinstance(found, str):
@@ -298,7 +298,7 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
     belts = {b.name: b for b in pick.belts}
     totals = []
     for kind in pick.line.catalog:
-        part = _kind_part(pick, kind.name)
+        part = kind_part(pick, kind.name)
         for arrival in pick.line.arrivals:
             if arrival.mix and not arrival.mix.get(kind.name):
                 continue
@@ -386,7 +386,7 @@ def _yaw(track) -> float:
     return float(math.atan2(track.axis[1], track.axis[0]))
 
 
-def _kind_part(pick, kind: str) -> PartConfig:
+def kind_part(pick, kind: str) -> PartConfig:
     """A ``PartConfig`` of the catalog kind ``kind`` (its shape, size, mass and friction)."""
     k = next(c for c in pick.line.catalog if c.name == kind)
     return PartConfig(name=k.name, shape=k.shape, size=list(k.size), mass=k.mass, friction=k.friction)

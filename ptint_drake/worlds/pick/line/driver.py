@@ -47,7 +47,7 @@ from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
-from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass
+from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass, kind_part
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
@@ -56,6 +56,7 @@ from ptint_drake.worlds.pick.out_belt import OutPlace
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
+from ptint_drake.worlds.pick.line.slot_choice import choose, nearest
 from ptint_drake.worlds.pick.line.via_split import fitted
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
@@ -255,7 +256,7 @@ class LineDriver:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
             else:
-                cycle = self._cycle(decision, tracks, windows, t, start, yaw)
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw, free)
                 if cycle is None:
                     return False
                 if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
@@ -291,12 +292,21 @@ class LineDriver:
         self.view.aim(part, track)
         return part
 
-    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float):
-        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``); None where no tf
-        fits a phase (logged)."""
+    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, free: dict):
+        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``), to the free slot
+        its kind's ``fill`` takes (``slot_choice``: ``decision.slot`` set); None where no tf fits
+        a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
+        kind = next(c for c in self.line.catalog if c.name == track.kind)
         try:
-            cycle = self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
+            def cycle_of(slot):
+                return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot)
+            if kind.fill == "cycle" and isinstance(decision.slot, int):
+                near = nearest(self.scenario.pick, kind_part(self.scenario.pick, kind.name), free[kind.name],
+                               decision.point)
+                decision.slot, cycle = choose(cycle_of, near)
+            else:
+                cycle = cycle_of(decision.slot)
             if isinstance(decision.slot, OutPlace):  # (outbelt46: the point on the outgoing belt chosen)
                 decision.slot = self.cycles.out_place
             return cycle
