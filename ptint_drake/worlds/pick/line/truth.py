@@ -21,13 +21,11 @@ when they run past its end; the belt drives' speed steps; the slabs kept under t
   velocity before and after within 1e-6 m/s).  Between two stops (at most ``RESET_PERIOD``, the
   line's own stops) it drifts at most speed × ``RESET_PERIOD`` — the slack its length must leave.
 
-- **At rest** (``rest_lock``): a released part resting off the belts (in its slot, a bin, on the
-  floor) is locked, and unlocked when anything moving comes near it.
 - **The line done** (``done``, ``run_end``): the run's duration is a cap (sized for the slowest
   belt); the line is done at a stop when no release is left after it and every released part is
-  parked past its belt's end, locked at rest, or at rest (``rest_lock.at_rest``) off
-  every belt — a part on a belt, even at rest on a stopped one, can still be
-  picked.  With the arm holding (the plan over: ``PickRun``), the run ends ``SETTLE`` after the
+  parked past its belt's end or at rest (``at_rest``: below ``REST_SPEED`` and ``REST_RATE``) off
+  every belt — a part on a belt, even at rest on a stopped one, can still be picked.  With the arm
+  holding (its plan over, no new task at the stop: ``PickRun``), the run ends ``SETTLE`` after the
   first stop that found it done, if it is done still then (else it goes on to the next stop that
   finds it done).  The metrics judge the end's poses, as at the cap: a placed part was at rest
   ``SETTLE`` before (measured, ``line_assembly`` seeds 0–5: the third part's last 0.1 mm of motion
@@ -42,7 +40,6 @@ from __future__ import annotations
 import numpy as np
 from pydrake.math import RigidTransform
 
-from ptint_drake.worlds.pick.line.rest_lock import RestLock, at_rest
 from ptint_drake.worlds.pick.scene import belt_frame, part_shape, part_start_pose
 
 PARK_Z = -0.5  # m: under the floor slab (its bottom at -0.1 m)
@@ -50,6 +47,14 @@ PARK_SPACING = 0.1  # m
 END_MARGIN = 0.05  # m, from the belt's downstream end (at its declared place)
 RESET_PERIOD = 0.5  # s, the line's own stops (the slab's reset, parts past the end)
 SETTLE = 0.2  # s, from the first stop that finds the line done to the run's end (``run_end``)
+REST_SPEED = 1e-3  # m/s; a part resting in its slot creeps at ~3e-5 m/s, 2e-3 rad/s (line_assembly)
+REST_RATE = 0.02  # rad/s
+
+
+def at_rest(plant, pc, body) -> bool:
+    """A free body's speed below ``REST_SPEED`` and its turn rate below ``REST_RATE``."""
+    V = plant.EvalBodySpatialVelocityInWorld(pc, body)
+    return bool(np.linalg.norm(V.translational()) < REST_SPEED and np.linalg.norm(V.rotational()) < REST_RATE)
 
 
 def parking_pose(k: int) -> RigidTransform:
@@ -66,19 +71,15 @@ class LineTruth:
         self.released = {}  # part → its release time (s)
         self.passed = {}  # part → when it was taken off past its belt's end (s)
         self.factors = {b.name: 1.0 for b in station.config.belts}
-        self.rest = RestLock(station)
-        self.now = 0.0  # s, the last stop
         self.done_since = None  # the first stop of the run's end (``run_end``)
 
     def rebind(self, station) -> None:
         """The new station of a rebuilt diagram (same configuration)."""
         self.station = station
-        self.rest.rebind(station)
 
     def stops(self, duration: float) -> list[float]:
         times = {r.t for r in self.releases} | {s.t for s in self.steps}
         times |= set(np.arange(RESET_PERIOD, duration, RESET_PERIOD).round(9))
-        times |= set(self.rest.stops(self.now, duration))
         return sorted(t for t in times if 0.0 < t <= duration)
 
     def _joint(self, k: int):
@@ -104,7 +105,6 @@ class LineTruth:
         plant.SetFreeBodyPose(pc, body, parking_pose(k))
         plant.SetVelocities(pc, body.model_instance(), np.zeros(6))
         self._joint(k).Lock(pc)
-        self.rest.forget(k)
 
     def at_stop(self, context, t: float) -> None:
         """The releases, steps, parts past the end and slab resets due at ``t``."""
@@ -121,14 +121,11 @@ class LineTruth:
                 self._release(pc, r.part, belts[r.belt], joints[r.belt])
                 self.released[r.part] = t
         for k in self.released:
-            if k not in self.passed and k not in self.rest.locked and self._past_end(pc, k, belts):
+            if k not in self.passed and self._past_end(pc, k, belts):
                 self._park(pc, k)
                 self.passed[k] = t
         for joint in station.belts:
             joint.set_translation(pc, 0.0)
-        free = [k for k in self.released if k not in self.passed]
-        self.rest.check(pc, t, free, lambda k: self.on_belt(pc, k))
-        self.now = t
 
     def on_belt(self, pc, k: int) -> bool:
         """Part k's centre over a belt's top (any belt), within its largest size above it."""
@@ -143,12 +140,12 @@ class LineTruth:
 
     def done(self, context, t: float) -> bool:
         """The line done at ``t`` (module docstring): no release after it, every released part
-        parked, locked, or at rest off the belts."""
+        parked or at rest off the belts."""
         if len(self.released) < len(self.releases):
             return False
         plant, pc = self.station.plant, self.station.plant.GetMyContextFromRoot(context)
         for k in self.released:
-            if k in self.passed or k in self.rest.locked:
+            if k in self.passed:
                 continue
             if not at_rest(plant, pc, self.station.parts[k]) or self.on_belt(pc, k):
                 return False
@@ -193,7 +190,6 @@ class LineTruth:
         for k in range(len(self.station.parts)):
             if k not in self.released or k in self.passed:
                 self._joint(k).Lock(pc)
-        self.rest.restore(pc)
         self._drive(context)
 
     def part_under(self, context, position) -> int:
