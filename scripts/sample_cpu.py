@@ -4,7 +4,8 @@
 
 A study's worker runs sample after sample in one process, so one sample (seed ``S + 1000``) is run
 first as a warm-up (imports, the numba kernels, the line's reach windows), then sample ``S`` plainly
-— its ``cpu_s`` as ``ptint robust`` records it (``time.process_time``) — and once more under
+— its ``cpu_s`` as ``ptint robust`` records it (``time.process_time``), and its ``simulated_s`` (a line's
+run ends when the line is done, ``worlds/pick/line/truth.py``) — and once more under
 cProfile, its time split by who spends it:
 
 - ``drake_cxx``: the time inside ``AdvanceTo`` not spent in a Python system (the discrete plant
@@ -116,7 +117,7 @@ def main() -> None:
     profiler.disable()
     profiled = time.process_time() - t0
     report = {"scenario": name, "seed": args.seed, "ranges": args.ranges, "status": row["status"],
-              "cpu_s": row["cpu_s"], "profiled_cpu_s": profiled,
+              "cpu_s": row["cpu_s"], "simulated_s": row.get("simulated_s"), "profiled_cpu_s": profiled,
               "profiled_split_s": split(pstats.Stats(profiler))}
     if args.plant:
         from ptint_drake.studies.robust import sample_scenario  # noqa: PLC0415

@@ -46,7 +46,8 @@ collision under ``collision``), ``collisions_by_body`` (the bodies those collisi
 ``placed_with_collision``.  A line (``pick.line``, issue 44) draws the same per part of its pool, on
 the truth side only (its belts' speeds as speed steps at t = 0: the declared speeds unchanged), and
 is judged per part (``worlds/pick/line/robust.py``).  Every sample records ``cpu_s`` (its CPU time in
-its worker) and robust.json ``cpu_s_per_sample``.  Every
+its worker) and robust.json ``cpu_s_per_sample``, and ``simulated_s`` (the simulated time: a line's run
+ends when the line is done, ``worlds/pick/line/truth.py``) and robust.json ``simulated_s_per_sample``.  Every
 sample ends with a verdict: a sample that is rejected before its run or raises is an error row,
 counted by its reason.
 
@@ -144,6 +145,7 @@ def robust_sample(text: str, name: str, seed: int, ranges: dict = RANGES) -> dic
                "error": " ".join(f"{type(exc).__name__}: {exc}".split())[:300]}
     else:
         row = world_of(scenario).robust_row(seed, params, result.metrics)
+        row["simulated_s"] = result.metrics["sim"]["simulated_s"]  # (a line's run ends when it is done)
     return row | {"cpu_s": time.process_time() - cpu}
 
 
@@ -202,6 +204,7 @@ def run_robust(loaded: LoadedScenario, samples: int, seed: int = 0, workers: int
         "samples_per_s": samples / wall if wall > 0 else None,
         "cpu_s_per_sample": _percentiles([r["cpu_s"] for r in rows if r.get("cpu_s") is not None])
         | {"mean": float(np.mean([r.get("cpu_s") or 0.0 for r in rows]))},
+        "simulated_s_per_sample": _percentiles([r["simulated_s"] for r in rows if "simulated_s" in r]),
         "workers": stats["workers"],
         "worker_starts": stats["worker_starts"],
         # resident set of a worker after each sample (MB): flat when nothing leaks

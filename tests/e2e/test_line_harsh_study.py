@@ -28,6 +28,9 @@ def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
     assert result["cannot_be_held"] == 1 and result["pick_success_rate_holdable"] == 1.0
     assert result["pick_success_rate"] == pytest.approx(5 / 6)
     assert result["cpu_s_per_sample"]["mean"] > 0.0 and all(r["cpu_s"] > 0.0 for r in rows)
+    # each run's simulated time (a line's ends when it is done: ``line.truth.run_end``), summarised
+    assert all(r["simulated_s"] > 0.0 for r in rows)
+    assert result["simulated_s_per_sample"]["max"] == max(r["simulated_s"] for r in rows)
     lead = 0.5 * PickTaskConfig().margin / GripperConfig().speed  # the close before the grasp time
     for row in rows:
         params = row["params"]

@@ -6,24 +6,23 @@
 the segments and ``picks``) and verdict (``metrics.pick_reasons``), its figure and replay
 (``views``).  The runner (``worlds.runner``) simulates it.
 
-The confirmed grasp: every ``SENSE_PERIOD`` from a close command (``empty`` or ``lost`` act at
-once) and at each task's check (its lift's planned start, prescribed grasp time + ``dwell``)
-``PickRun.at_stop`` reads the ``GraspObserver``'s state (what the gripper senses).
-``holding``: the plan goes on.  ``closing`` (still moving): the lift waits, ``GRASP_WAIT`` at a
-time, up to ``pick.grasp_window`` after the prescribed grasp time.  ``empty``, ``lost``, or the
-window over: while ``pick.retries`` allow, a retry is planned from that moment and the part's
-current (simulated) pose — a backoff (up ``clearance``, the fingers opening), a new approach and
-descend, then the task's lift, carry, place and retreat, later tasks shifted — if its grasp and
-lift points (the part's position extrapolated at its current velocity to the new grasp time) are
-reachable from above; otherwise (``refused``) the arm backs off the same way, fingers open,
-and the task goes on with an empty hand (``tasks.Replan.abort``).  A new plan means a new
-diagram (the controller's schedule is built into it): ``replan`` builds it and ``resume``
-carries the numeric state (time, plant, controller, drive, observer, targets) into its
-context; the runner goes on from there.  If the retries push
-the plan's end later, the run is lengthened by as much (metrics ``duration``).
+The confirmed grasp: every ``SENSE_PERIOD`` from a close command (``empty`` or ``lost`` act at once) and
+at each task's check (its lift's planned start, prescribed grasp time + ``dwell``) ``PickRun.at_stop``
+reads the ``GraspObserver``'s state (what the gripper senses). ``holding``: the plan goes on.  ``closing``
+(still moving): the lift waits, ``GRASP_WAIT`` at a time, up to ``pick.grasp_window`` after the prescribed
+grasp time.  ``empty``, ``lost``, or the window over: while ``pick.retries`` allow, a retry is planned
+from that moment and the part's current (simulated) pose — a backoff (up ``clearance``, the fingers
+opening), a new approach and descend, then the task's lift, carry, place and retreat, later tasks shifted
+— if its grasp and lift points (the part's position extrapolated at its current velocity to the new grasp
+time) are reachable from above; otherwise (``refused``) the arm backs off the same way, fingers open, and
+the task goes on with an empty hand (``tasks.Replan.abort``).  A new plan means a new diagram (the
+controller's schedule is built into it): ``replan`` builds it and ``resume`` carries the numeric state
+(time, plant, controller, drive, observer, targets) into its context; the runner goes on from there.  If
+the retries push the plan's end later, the run is lengthened by as much (metrics ``duration``).
 
 A line (``pick.line``, issue 44): ``line.driver`` makes its pool of parts, acts for the truth side
-and decides its tasks at the stops (``NoLine``, without a line: the same hooks, doing nothing).
+and decides its tasks at the stops (``NoLine``, without a line: the same hooks, doing nothing); its
+truth ends the run before the duration (a cap) once the line is done (``line.truth.run_end``).
 """
 
 from __future__ import annotations
@@ -84,11 +83,10 @@ class PickRun(WorldRun):
         self._aims: dict = {}
         n = len(scenario.pick.tasks)
         self.replans = [Replan() for _ in range(n)]
-        # per task, per attempt: {"state": the observer's at the check, "t": the check's time}
-        self.checks: list[list[dict]] = [[] for _ in range(n)]
+        self.checks: list[list[dict]] = [[] for _ in range(n)]  # per task, attempt: {state, t} at the check
         self.refused: list = [None] * n  # why a retry was not planned (out of reach / of retries)
         self.estimates: dict = {}  # with a camera, per task: the estimate at the grasp and the truth
-        self.end = scenario.duration
+        self.end = self.cap = scenario.duration  # (a line's run may end earlier: ``at_stop``)
         self._tail = 0.0 if self.line.active else scenario.duration - self.built.plan.end  # (a line's end)
         self._pieces: list = []  # the logs of the diagrams a replan replaced
         self._rebuilt = False
@@ -144,6 +142,8 @@ class PickRun(WorldRun):
                 if not plan_stands(state, "sense"):  # nothing between the fingers: no need to wait
                     self._check(context, k, t, state)
         self._rebuilt |= self.line.at_stop(self, context, t)  # a line's decision: a new task
+        if self.line.active:  # a line done ends the run before its cap (``line.truth.run_end``)
+            self.end = self.line.truth.run_end(context, t, self._rebuilt, self.built.plan.end, self.cap)
 
     def _unseen(self, context, k: int, t: float) -> bool:
         """With a camera, at task k's descend start: if the part was never seen — or fitted fewer
@@ -238,7 +238,7 @@ class PickRun(WorldRun):
         self.built = build_pick(self.scenario, tuple(self.replans), self.line.planning())
         self.diagram, self.controller = self.built.diagram, self.built.controller
         self.line.bind(self.built)
-        self.end = max(self.scenario.duration, self.built.plan.end + self._tail)
+        self.end = self.cap = max(self.scenario.duration, self.built.plan.end + self._tail)
         return True
 
     def resume(self, new_context, old_context) -> None:

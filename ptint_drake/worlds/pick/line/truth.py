@@ -21,6 +21,16 @@ when they run past its end; the belt drives' speed steps; the slabs kept under t
   velocity before and after within 1e-6 m/s).  Between two stops (at most ``RESET_PERIOD``, the
   line's own stops) it drifts at most speed × ``RESET_PERIOD`` — the slack its length must leave.
 
+- **The line done** (``done``, ``run_end``): the run's duration is a cap (sized for the slowest
+  belt); the line is done at a stop when no release is left after it and every released part is
+  parked past its belt's end or at rest (``at_rest``: below ``REST_SPEED`` and ``REST_RATE``) off
+  every belt — a part on a belt, even at rest on a stopped one, can still be picked.  With the arm
+  holding (its plan over, no new task at the stop: ``PickRun``), the run ends ``SETTLE`` after the
+  first stop that found it done, if it is done still then (else it goes on to the next stop that
+  finds it done).  The metrics judge the end's poses, as at the cap: a placed part was at rest
+  ``SETTLE`` before (measured, ``line_assembly`` seeds 0–5: the third part's last 0.1 mm of motion
+  0.33–0.34 s before its retreat's end).
+
 Parameters (the locks, the drives' values) are not part of the numeric state a replan carries
 (``PickRun.resume``): ``restore`` sets them again in a new context.
 """
@@ -36,6 +46,15 @@ PARK_Z = -0.5  # m: under the floor slab (its bottom at -0.1 m)
 PARK_SPACING = 0.1  # m
 END_MARGIN = 0.05  # m, from the belt's downstream end (at its declared place)
 RESET_PERIOD = 0.5  # s, the line's own stops (the slab's reset, parts past the end)
+SETTLE = 0.2  # s, from the first stop that finds the line done to the run's end (``run_end``)
+REST_SPEED = 1e-3  # m/s; a part resting in its slot creeps at ~3e-5 m/s, 2e-3 rad/s (line_assembly)
+REST_RATE = 0.02  # rad/s
+
+
+def at_rest(plant, pc, body) -> bool:
+    """A free body's speed below ``REST_SPEED`` and its turn rate below ``REST_RATE``."""
+    V = plant.EvalBodySpatialVelocityInWorld(pc, body)
+    return bool(np.linalg.norm(V.translational()) < REST_SPEED and np.linalg.norm(V.rotational()) < REST_RATE)
 
 
 def parking_pose(k: int) -> RigidTransform:
@@ -52,6 +71,7 @@ class LineTruth:
         self.released = {}  # part → its release time (s)
         self.passed = {}  # part → when it was taken off past its belt's end (s)
         self.factors = {b.name: 1.0 for b in station.config.belts}
+        self.done_since = None  # the first stop of the run's end (``run_end``)
 
     def rebind(self, station) -> None:
         """The new station of a rebuilt diagram (same configuration)."""
@@ -106,6 +126,41 @@ class LineTruth:
                 self.passed[k] = t
         for joint in station.belts:
             joint.set_translation(pc, 0.0)
+
+    def on_belt(self, pc, k: int) -> bool:
+        """Part k's centre over a belt's top (any belt), within its largest size above it."""
+        p = self.station.plant.EvalBodyPoseInWorld(pc, self.station.parts[k]).translation()
+        reach = max(self.station.config.parts[k].size)
+        for belt in self.station.config.belts:
+            local = belt_frame(belt).inverse().multiply(p)
+            if abs(local[0]) <= belt.length / 2 and abs(local[1]) <= belt.width / 2 + reach / 2 \
+                    and 0.0 < local[2] < reach + 0.01:
+                return True
+        return False
+
+    def done(self, context, t: float) -> bool:
+        """The line done at ``t`` (module docstring): no release after it, every released part
+        parked or at rest off the belts."""
+        if len(self.released) < len(self.releases):
+            return False
+        plant, pc = self.station.plant, self.station.plant.GetMyContextFromRoot(context)
+        for k in self.released:
+            if k in self.passed:
+                continue
+            if not at_rest(plant, pc, self.station.parts[k]) or self.on_belt(pc, k):
+                return False
+        return True
+
+    def run_end(self, context, t: float, rebuilt: bool, plan_end: float, cap: float) -> float:
+        """The run's end as known at the stop ``t`` (module docstring): ``SETTLE`` after the first
+        stop that found the line done with the arm free — no new plan at ``t`` (``rebuilt``), its
+        plan over (``plan_end``, s) — while it stays so; else ``cap`` (s)."""
+        if rebuilt or t < plan_end - 1e-9 or not self.done(context, t):
+            self.done_since = None
+            return cap
+        if self.done_since is None:
+            self.done_since = t
+        return min(cap, self.done_since + SETTLE)
 
     def _release(self, pc, k: int, belt, joint) -> None:
         plant, body = self.station.plant, self.station.parts[k]
