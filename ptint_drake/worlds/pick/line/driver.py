@@ -56,6 +56,8 @@ from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
+from ptint_drake.systems.perception.part_fit import reach
+from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
 
@@ -113,7 +115,7 @@ class LineDriver:
             self.timing = Timing(lead=task.approach.tf + task.descend.tf, margin=task.margin,
                                  finger=finger_extent(built.station))
             self.cycles = LineCycles(self.scenario, window_at=self.view.window_at,  # (outbelt46: out_belt)
-                                     finger_width=self.timing.finger[1])
+                                     finger=self.timing.finger)
         self.truth.rebind(built.station)
         self.view.bind(built)
         self.built = built
@@ -194,7 +196,8 @@ class LineDriver:
         begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
         window = self.view.window(track)
         if not unserved(track, window, grasp, t, end, self.timing.slack) \
-                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
+                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context)),
+                                     task.grip_yaw):
             # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
@@ -246,14 +249,15 @@ class LineDriver:
         q = self._arm_q(context)
         start, yaw = self._tool_now(q)  # the arm's present point and yaw
         decision = decide(t, tracks, windows, assigned, free, self.timing,
-                          lambda tr, w: self.cycles.lead(tr, w, t, start, yaw))
+                          lambda tr, w: self.cycles.lead(tr, w, t, start, yaw),
+                          lambda tr: self.cycles.axis(tr, windows[tr.id], start, yaw))
         cycle = None
         if decision.track is not None:
             if self.view.reachable(np.asarray(decision.point), q) is None:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
             else:
-                cycle = self._cycle(decision, tracks, windows, t, start, yaw)
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw, self._filled(keep))
                 if cycle is None:
                     return False
                 if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
@@ -289,18 +293,29 @@ class LineDriver:
         self.view.aim(part, track)
         return part
 
-    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float):
-        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``); None where no tf
-        fits a phase (logged)."""
+    def _filled(self, keep: list) -> list:
+        """[(centre, radius)] of the parts tasks ``keep`` put in the tray (``grip.puts``)."""
+        pick, parts = self.scenario.pick, {p.name: p for p in self.scenario.pick.parts}
+        return [(place_point(pick, "slot", pick.tasks[k].slot, parts[pick.tasks[k].part]),
+                 reach(parts[pick.tasks[k].part].shape, parts[pick.tasks[k].part].size))
+                for k in keep if pick.tasks[k].slot is not None]
+
+    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, filled: list):
+        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``, ``filled``: the
+        tray's parts); None where no tf fits a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
         try:
-            cycle = self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot)
+            cycle = self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot,
+                                       filled)
             if isinstance(decision.slot, OutPlace):  # (outbelt46: the point on the outgoing belt chosen)
                 decision.slot = self.cycles.out_place
             return cycle
         except NoTfFits as error:
             self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
+            found = self.cycles.found(track, windows[track.id], start, yaw)  # (cached: the lead's)
             self.cycles.drop_early(track.id)  # the next look: the approach after the entry
+            if not isinstance(found, str):
+                self.cycles.drop_grip(track.id, found[4])  # and the next grip yaw (``grip``)
             return None
 
     def _arm_q(self, context) -> np.ndarray:
@@ -344,6 +359,7 @@ class LineDriver:
                 needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
             except NoTfFits as error:
                 why = f"no tf fits a via's leg: {error}"
+                self.cycles.drop_grip(track.id, cycle.yaws[0])  # the next look: the next grip yaw
                 break
             short = {p: v for p, v in needs.items() if v > getattr(task, p).tf + 1e-3}
             self._vias = {p: round(v, 3) for p, v in needs.items()}
@@ -353,7 +369,8 @@ class LineDriver:
             grasp = task.start + task.approach.tf + task.descend.tf
             if "approach" in short:
                 self.cycles.extra[track.id] = self.cycles.extra.get(track.id, 0.0) + grasp - decision.grasp
-            hit = blocker(track, tracks, grasp, t, self.timing)
+            axis = (np.cos(cycle.yaws[0]), np.sin(cycle.yaws[0]), 0.0)  # the fingers' at the chosen grip
+            hit = blocker(replace(track, axis=axis), tracks, grasp, t, self.timing)
             if grasp > decision.deadline + 1e-9 or hit is not None:
                 why = (f"the approach's via needs {task.approach.tf:.3f} s: grasp at {grasp:.2f} s "
                        + (f"blocked (track {hit})" if hit is not None else
