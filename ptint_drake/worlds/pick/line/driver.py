@@ -48,6 +48,7 @@ from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
 from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass
 from ptint_drake.worlds.pick.phase_time import NoTfFits
+from ptint_drake.worlds.pick.line.grip import in_tray
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.no_line import NoLine
@@ -56,8 +57,6 @@ from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.view import LineView
-from ptint_drake.systems.perception.part_fit import reach
-from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
 
@@ -257,7 +256,8 @@ class LineDriver:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
             else:
-                cycle = self._cycle(decision, tracks, windows, t, start, yaw, self._filled(keep))
+                filled = in_tray(self.scenario.pick, keep)  # the tray's parts (``grip.puts``)
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw, filled)
                 if cycle is None:
                     return False
                 if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
@@ -278,8 +278,12 @@ class LineDriver:
             return False
         self._commit(run, t, decision, replacing, task)
         record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
+        chosen = next(tr for tr in tracks if tr.id == decision.track)
+        lead = self.cycles.found(chosen, windows[chosen.id], start, yaw)  # (cached) its wait for a posture
         self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1,
-                                        "tf": {p: round(v, 3) for p, v in cycle.phases.items()}})
+                                        "tf": {p: round(v, 3) for p, v in cycle.phases.items()},
+                                        "wait": None if isinstance(lead, str) else lead[2],
+                                        "yaws_deg": [round(float(np.degrees(y)), 1) for y in cycle.yaws]})
         self.planning_s.append(time.perf_counter() - clock)
         return True
 
@@ -292,13 +296,6 @@ class LineDriver:
         part = self.truth.part_under(context, next(tr for tr in tracks if tr.id == track).position)
         self.view.aim(part, track)
         return part
-
-    def _filled(self, keep: list) -> list:
-        """[(centre, radius)] of the parts tasks ``keep`` put in the tray (``grip.puts``)."""
-        pick, parts = self.scenario.pick, {p.name: p for p in self.scenario.pick.parts}
-        return [(place_point(pick, "slot", pick.tasks[k].slot, parts[pick.tasks[k].part]),
-                 reach(parts[pick.tasks[k].part].shape, parts[pick.tasks[k].part].size))
-                for k in keep if pick.tasks[k].slot is not None]
 
     def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, filled: list):
         """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``, ``filled``: the

@@ -39,6 +39,8 @@ import math
 
 import numpy as np
 
+from ptint_drake.systems.perception.part_fit import reach
+from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grasp_gate import FINGER_MARGIN, finger_clearance
 from ptint_drake.worlds.pick.route import nearest_branch
@@ -98,3 +100,11 @@ def puts(part, place: np.ndarray, slot_yaw: float, grip: float, filled: list, fi
                                          >= FINGER_MARGIN for centre, radius in filled):
             out.append(yaw)
     return out
+
+
+def in_tray(pick, keep: list) -> list:
+    """[(centre, radius)] of the parts the tasks ``keep`` (indices into ``pick.tasks``) put in the
+    tray (``puts``'s ``filled``): each slot's place point and its part's top-face radius."""
+    parts = {p.name: p for p in pick.parts}
+    placed = [(pick.tasks[k].slot, parts[pick.tasks[k].part]) for k in keep if pick.tasks[k].slot is not None]
+    return [(place_point(pick, "slot", slot, part), reach(part.shape, part.size)) for slot, part in placed]
