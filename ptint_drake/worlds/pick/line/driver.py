@@ -355,8 +355,7 @@ class LineDriver:
             try:
                 needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
             except NoTfFits as error:
-                why = f"no tf fits a via's leg: {error}"
-                self.cycles.drop_grip(track.id, cycle.yaws[0])  # the next look: the next grip yaw
+                why = f"no tf fits a via's leg: {error}"  # (its grip kept: ``grip``)
                 break
             short = {p: v for p, v in needs.items() if v > getattr(task, p).tf + 1e-3}
             self._vias = {p: round(v, 3) for p, v in needs.items()}

@@ -14,12 +14,15 @@ across either pair of faces, or at any yaw, so the decision chooses (``grips``):
 - a cylinder: the tool's own yaw (no turn), then ±45°, then ±81° (``CYLINDER_TURNS``).
 
 ``line.cycle`` asks the min-tf model for each candidate in this order at each wait and keeps
-the first that fits (``LineCycles._lead``); a grip whose cycle or plan then finds no tf (a via's
-leg, the carry) is dropped for the track and the next look takes the next (``drop_grip``: line_two_belts
-seed 7 at main, a disc's approach via around the base found no posture on its way for 1.6 s of
-looks, the wrist's roll at its limit).  The chosen yaw is the task's ``grip_yaw`` for its
-whole life (``tasks.aimed_yaw``: the targets then follow the part's estimated yaw by whole
-periods nearest it, so an estimate that moves by less than half a period keeps the branch).
+the first that fits (``LineCycles._lead``); a grip whose cycle then finds no tf (the carry, the
+place) is dropped for the track and the next look takes the next (``drop_grip``).  A grip whose
+plan's via leg finds none is kept: such a leg fits a few looks later, the via moving with the part
+(line_two_belts seed 1 at main: 10 looks, then the grasp at 24.4 s), and dropping it for the next
+grip measured worse — seed 1's cube then grasped at 28.6 s on the other pair of faces, a later
+part lost; seed 7's disc at 29.0 s, 2.8 s after main's, on its fifth grip.  The chosen yaw is the
+task's ``grip_yaw`` for its whole life (``tasks.aimed_yaw``: the targets then follow the part's
+estimated yaw by whole periods nearest it, so an estimate that moves by less than half a period
+keeps the branch).
 
 The place (``puts``): first the slot's own yaw modulo π nearest the grip — the tray's design
 direction of the fingers, and the tool's yaw after each place kept where it was, so the wrist's
