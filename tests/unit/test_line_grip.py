@@ -143,3 +143,35 @@ def test_the_cycle_at_the_default_yaws_is_the_old_one(cycles):
     old = cycle_time(cycles.model, x, ride, place, 0.0, 0.6, 0.1, None, start, 0.0)
     new = cycle_time(cycles.model, x, ride, place, 0.0, 0.6, 0.1, None, start, 0.0, grip=0.6, put=0.0)
     assert new.phases == old.phases and old.yaws == (0.6, 0.0)
+
+
+def test_the_targets_aim_the_tool_at_the_chosen_grip_while_the_part_is_followed():
+    """``PickTargets`` of a task with ``grip_yaw`` −10° and a cube (``aimed_yaw``): at the approach
+    the target rotation is the part's (80°) turned a quarter to −10°; the slot's place at
+    ``place_yaw``; a disc's target stays at the chosen yaw however it is turned."""
+    from ptint_drake.worlds.pick.config import BeltConfig, SlotConfig, TrayConfig
+    from ptint_drake.worlds.pick.targets import PickTargets
+    from ptint_drake.worlds.pick.tasks import PickConfig
+
+    def aim(shape: str, size: list, part_yaw: float) -> tuple:  # (approach, place) yaws
+        pick = PickConfig(belts=[BeltConfig()], parts=[PartConfig(name="a", shape=shape, size=size)],
+                          tray=TrayConfig(slots=[SlotConfig()]),
+                          tasks=[PickTaskConfig(part="a", slot=0, grip_yaw=-10 * DEG, place_yaw=90 * DEG)])
+        plan = pick_plan(pick)
+        system = PickTargets(plan, 1, [np.array([0.1, 0.2, 0.115]) if s.kind == "slot" else None
+                                       for s in plan.segments])
+        context = system.CreateDefaultContext()
+        R = RotationMatrix.MakeZRotation(part_yaw).matrix()
+        system.GetInputPort("part_0_pose").FixValue(context, np.r_[0.3, -0.05, 0.15, 0.0, 0.1, 0.0, 0, 0, 0])
+        system.GetInputPort("part_0_rotation").FixValue(context, np.r_[R.ravel(), np.zeros(6)])
+        context.SetTime(0.5)
+        approach = system.GetOutputPort("target_rotation").Eval(context)[0:9].reshape(3, 3)
+        context.SetTime(plan.schedule.segments[4].start + 0.1)
+        place = system.GetOutputPort("target_rotation").Eval(context)[0:9].reshape(3, 3)
+        return math.atan2(approach[1, 0], approach[0, 0]), math.atan2(place[1, 0], place[0, 0])
+
+    grip, put = aim("box", [0.03, 0.03, 0.03], 80 * DEG)
+    assert grip == pytest.approx(-10 * DEG) and put == pytest.approx(90 * DEG)
+    assert aim("box", [0.03, 0.03, 0.03], 60 * DEG)[0] == pytest.approx(-30 * DEG)  # (the estimate moved)
+    assert aim("cylinder", [0.03, 0.03], 1.0)[0] == pytest.approx(-10 * DEG)
+    assert aim("cylinder", [0.03, 0.03], -2.0)[0] == pytest.approx(-10 * DEG)
