@@ -175,3 +175,21 @@ def test_the_targets_aim_the_tool_at_the_chosen_grip_while_the_part_is_followed(
     assert aim("box", [0.03, 0.03, 0.03], 60 * DEG)[0] == pytest.approx(-30 * DEG)  # (the estimate moved)
     assert aim("cylinder", [0.03, 0.03], 1.0)[0] == pytest.approx(-10 * DEG)
     assert aim("cylinder", [0.03, 0.03], -2.0)[0] == pytest.approx(-10 * DEG)
+
+
+def test_from_the_trays_near_column_the_chosen_grip_fits_where_the_parts_axis_has_no_posture(cycles):
+    """Session 46's case: from above the tray's near column (x = 0.06 m) with the tool at yaw 0, a
+    part at yaw −1.5 rad on the inner belt at y = 0.2 m — its x axis's branch (the grip before) has
+    no top-down posture all along the approach (the wrist's roll at its limit: the lead waited);
+    the cube's quarter-turned branch (4°) and the disc at the tool's yaw fit with no wait."""
+    from ptint_drake.worlds.pick.phase_time import NoTfFits
+
+    start, up, ride = np.array([0.06, 0.16, 0.155]), np.array([0.0, 0.0, 0.04]), np.array([0.0, 0.05, 0.0])
+    for k, kind in enumerate(("cube", "disc")):
+        track = Track(40 + k, kind, "inner", (0.22, 0.2, 0.15), 0.2, (0.0, 1.0, 0.0), 0.05,
+                      (math.cos(-1.5), math.sin(-1.5), 0.0), 0.03, 0.0212)
+        approach, _, wait, _, grip = cycles.found(track, (-0.3, 0.3), start, 0.0)
+        assert wait == 0.0 and abs(grip) < 0.1, (kind, grip)
+        cycles.model.last = approach
+        with pytest.raises(NoTfFits):
+            cycles.model.min_tf(start, np.asarray(track.position) + up, ride, 0.0, 0.75, (0.0, -1.5))
