@@ -7,9 +7,10 @@ scenario, no ``pick.parts`` and no ``pick.tasks`` (the run makes them), and this
 - ``belts``: the belts the line uses, by name, each with or without an ``encoder`` (with one the
   controller side reads the belt's measured speed; without, only its declared ``speed``);
 - ``catalog``: the kinds of part (shape, size, mass, friction) and where each goes: the tray
-  ``slots`` it fills, in order, a ``bin`` of ``pick.bins`` it is dropped into (which never
-  fills: "in the bin", no mm criterion), or an outgoing ``belt`` of ``pick.belts`` it is put on,
-  riding it (``worlds.pick.out_belt``: "on the belt", no mm criterion);
+  ``slots`` it fills (``fill``: the free one of the shorter cycle, or in order), a ``bin`` of
+  ``pick.bins`` it is dropped into (which never fills: "in the bin", no mm criterion), or an
+  outgoing ``belt`` of ``pick.belts`` it is put on, riding it (``worlds.pick.out_belt``: "on the
+  belt", no mm criterion);
 - ``arrivals``: per belt, parts per second (a rate, not a spacing: a faster belt does not bring
   more parts), the process (``poisson`` or ``jittered``), the distributions of the lateral offset
   and the yaw, the kinds' mix;
@@ -32,6 +33,7 @@ from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.part_shape import check_part_shape
 
 PROCESSES = ("poisson", "jittered")
+FILLS = ("cycle", "order")  # how a kind's free tray slot is chosen (``KindConfig.fill``)
 
 
 @dataclass
@@ -44,9 +46,12 @@ class LineBeltConfig:
 
 @dataclass
 class KindConfig:
-    """A kind of part of the catalog and where it goes: its tray ``slots``, filled in order, a
-    ``bin`` (the name of one of ``pick.bins``) or an outgoing ``belt`` (the name of one of
-    ``pick.belts`` that no arrival feeds) — exactly one of the three."""
+    """A kind of part of the catalog and where it goes: its tray ``slots``, a ``bin`` (the name of
+    one of ``pick.bins``) or an outgoing ``belt`` (the name of one of ``pick.belts`` that no
+    arrival feeds) — exactly one of the three.  ``fill``: which free slot a pick takes — ``cycle``
+    (of the two free slots nearest the grasp, the one whose pick cycle the min-tf model finds
+    shorter: ``worlds.pick.line.slot_choice``) or ``order`` (the first free one as listed: a kit
+    filled in a set order)."""
 
     name: str = "cube"
     shape: str = "box"  # "box" or "cylinder" (axis vertical)
@@ -56,6 +61,7 @@ class KindConfig:
     slots: List[int] = field(default_factory=list)  # indices into pick.tray.slots
     bin: str = ""  # or the name of a bin (pick.bins[*].name): every part of the kind dropped into it
     belt: str = ""  # or an outgoing belt (pick.belts[*].name): every part of the kind put on it
+    fill: str = "cycle"  # "cycle" (the free slot of the shorter cycle) or "order" (as listed)
 
 
 @dataclass
@@ -147,6 +153,8 @@ def _check_kind(k: int, kind: KindConfig, slots: int, bins: list, outgoing: dict
         if kind.bin not in bins:
             raise ScenarioError(f"{where}.bin: no bin named {kind.bin!r} in pick.bins")
         return
+    if kind.fill not in FILLS:
+        raise ScenarioError(f"{where}.fill: {kind.fill!r} is not one of {', '.join(FILLS)}")
     if not kind.slots or any(not 0 <= j < slots for j in kind.slots):
         raise ScenarioError(f"{where}.slots: tray slots 0 … {slots - 1} for this kind, got {kind.slots}")
 

@@ -125,10 +125,13 @@ PHASES = ("approach", "descend", "lift", "carry", "place", "retreat")
 
 @dataclass
 class MoveConfig:
-    """One prescribed-time segment of a task: its duration tf (s) and TBG shape β."""
+    """One prescribed-time segment of a task: its duration tf (s) and TBG shape β; where the plan
+    splits the phase by a via (``worlds.pick.route``, ``worlds.pick.obstacles``), the share of tf
+    the via's leg takes (``via_share``; None: the share its length takes of the two legs')."""
 
     tf: float = 1.0  # s
     beta: float = 0.75  # 1, in (0, 1)
+    via_share: Optional[float] = None  # 1, in (0, 1), or None: by the legs' lengths
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """Issue 44: bad line input gets one line naming the field and exit 2, nothing written — an
 unknown belt, a catalog part wider than the gripper's stroke less the margin, a slot out of reach,
-a kind's slot that is not the tray's, an unknown kind in the mix."""
+a kind's slot that is not the tray's, an unknown way to fill them, an unknown kind in the mix."""
 
 import pytest
 
@@ -16,6 +16,8 @@ CASES = {
                             "outside what the arm reaches"),
     "a kind's slot the tray does not have": ("pick.line.catalog[0].slots=[0,99]",
                                              "pick.line.catalog[0].slots", "tray slots"),
+    "an unknown way to fill a kind's slots": ("pick.line.catalog[0].fill=nearest",
+                                              "pick.line.catalog[0].fill", "not one of cycle, order"),
     "an unknown kind in the mix": ("pick.line.arrivals[0].mix={disc: 1.0}", "pick.line.arrivals[0].mix",
                                    "not a catalog kind"),
 }

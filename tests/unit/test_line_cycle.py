@@ -11,8 +11,10 @@ import pytest
 
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.line.arrivals import line_scenario
+from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 from ptint_drake.worlds.pick.line.cycle import LineCycles
 from ptint_drake.worlds.pick.line.scheduler import Track
+from ptint_drake.worlds.pick.line.via_split import fitted, split
 from ptint_drake.worlds.pick.phase_time import PhaseTimes, cycle_time
 from ptint_drake.worlds.pick.route import routed_plan, tool_yaws
 from ptint_drake.worlds.pick.tasks import VIA_SLOT
@@ -114,7 +116,8 @@ def test_a_phase_split_by_a_via_gets_what_both_legs_need():
     """two_belt_pick_mirrored on rvm1_5dof: pick 1's approach and carry each go through a via, the
     phase's tf shared by the legs by their lengths, the via's leg turning the tool.  At the
     scenario's 1.2 s a leg asks a joint for more than its limit (the model's check, ``demand``);
-    with each phase at the tf ``detours`` gives, its share kept, both legs are within the limits."""
+    split as ``via_split`` fits it to the legs' min tfs (``detours``), both legs are within the
+    limits, and the phase is no longer than the length share kept would make it."""
     scenario = load_scenario(MIRRORED)
     cycles = LineCycles(scenario)
     model, mass = cycles.model, scenario.pick.parts[1].mass
@@ -124,10 +127,53 @@ def test_a_phase_split_by_a_via_gets_what_both_legs_need():
     legs = _legs(nominal(scenario, model.arm), plan, 1, mass)
     assert [leg[2] for leg in legs[:2]] == pytest.approx([plan.schedule[6].tf, plan.schedule[7].tf])
     assert max(model.demand(a, b, tf, v, m, beta, y) for a, b, tf, v, m, beta, y in legs) > 1.0
-    phases = ["approach", "approach", "carry", "carry"]  # via, approach, via, carry
-    scale = [needs[p] / getattr(scenario.pick.tasks[1], p).tf for p in phases]
-    after = [model.demand(a, b, tf * f, v, m, beta, y) for (a, b, tf, v, m, beta, y), f in zip(legs, scale)]
-    assert max(after) <= 1.0, after
+    task, tfs = scenario.pick.tasks[1], []
+    for phase in ("approach", "carry"):  # via, approach, via, carry
+        first, second, share = needs[phase]
+        move = split(getattr(task, phase), first, second, share)
+        assert move is not None and move.tf <= max(first / share, second / (1.0 - share)) + 1e-9
+        tfs += [move.via_share * move.tf, (1.0 - move.via_share) * move.tf]
+    after = [model.demand(a, b, tf, v, m, beta, y) for (a, b, _, v, m, beta, y), tf in zip(legs, tfs)]
+    assert max(after) <= 1.0 + 1e-6, after
+
+
+def test_a_via_split_gives_each_leg_its_own_and_no_more():
+    """``via_split.split``: an approach (its end the chosen grasp) whose share already gives both
+    legs their min tfs is kept; a short one becomes tf₁ + tf₂ split tf₁ : tf₂ (the length share
+    would have stretched it to tf₁ / share); one long enough in all but split wrong keeps its tf,
+    its share moved the least.  A carry takes tf₁ + tf₂ even where that is shorter."""
+    move = MoveConfig(2.0, 0.6)
+    assert split(move, 0.9, 1.0, 0.5) is None
+    short = split(move, 1.5, 1.0, 0.5)
+    assert short.tf == pytest.approx(2.5) and short.via_share == pytest.approx(0.6) and short.beta == 0.6
+    assert short.tf < 1.5 / 0.5
+    moved = split(move, 1.2, 0.5, 0.5)
+    assert moved.tf == 2.0 and moved.via_share == pytest.approx(0.6)
+    carry = split(MoveConfig(3.3, 0.6), 1.5, 1.0, 0.5, fixed_end=False)
+    assert carry.tf == pytest.approx(2.5) and carry.via_share == pytest.approx(0.6)
+    assert split(MoveConfig(2.52, 0.6), 1.5, 1.0, 0.6, fixed_end=False) is None
+
+
+def test_a_phase_whose_via_went_keeps_the_models_straight_tf():
+    """``via_split.fitted``: a carry shortened for its via's legs goes back to the model's
+    straight tf when a later plan has no via there (an obstacle cleared by the new timing); an
+    approach stretched to its grasp is never cut."""
+    task = PickTaskConfig(part="p", slot=0, approach=MoveConfig(2.0), carry=MoveConfig(1.0, 0.6, 0.4))
+    straight = {"approach": 0.8, "carry": 1.6}
+    assert fitted(task, {}, straight) == {"carry": MoveConfig(1.6, 0.6)}
+    out = fitted(task, {"approach": (1.5, 1.0, 0.5)}, straight)
+    assert out["approach"].tf == pytest.approx(2.5) and out["carry"].tf == 1.6
+
+
+def test_a_via_share_outside_0_1_is_refused():
+    """A task's ``via_share`` is a fraction of the phase's tf: 0 or 1 leaves a leg no time."""
+    from ptint_drake.config.errors import ScenarioError
+    from ptint_drake.worlds.pick.tasks import check_tasks
+
+    scenario = load_scenario(MIRRORED)
+    scenario.pick.tasks[1].carry.via_share = 1.0
+    with pytest.raises(ScenarioError, match=r"pick.tasks\[1\].carry.via_share"):
+        check_tasks(scenario.pick)
 
 
 def test_the_model_plans_a_held_part_at_the_arms_rated_payload_less_its_hand():

@@ -91,9 +91,9 @@ def test_the_lead_takes_the_cube_turned_a_quarter_and_the_task_carries_it(cycles
 def test_a_dropped_grip_gives_the_next_one(cycles):
     start, cube = np.array([0.11, 0.2, 0.15]), part("cube", 80.0, -0.05)
     first = cycles.found(cube, (-0.3, 0.3), start, 0.0)[4]
-    cycles.drop_grip(cube.id, first)
+    cycles.drop_grip(cube, (-0.3, 0.3), start, 0.0)  # (its cycle found no tf: ``driver``)
     assert cycles.found(cube, (-0.3, 0.3), start, 0.0)[4] == pytest.approx(80 * DEG)
-    cycles.drop_grip(cube.id, 80 * DEG)  # every one dropped: all of them offered again
+    cycles.drop_grip(cube, (-0.3, 0.3), start, 0.0)  # every one dropped: all of them offered again
     assert cycles.grips(cube, 0.0)[0] == pytest.approx(first)
     cycles.choice.dropped.clear()
 

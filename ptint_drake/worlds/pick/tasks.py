@@ -97,7 +97,9 @@ class Via:
     """A fixed point on the way of task ``task``'s ``phase`` ("approach": its first attempt's, or
     "carry"): a segment of its own (phase ``via``, kind ``via_part`` before an approach: the tool
     turned as part ``index`` is; ``via_slot`` before a carry: turned to the slot's yaw) aims at
-    ``position`` (world, m) for the fraction ``share`` of the phase's tf, the phase the rest;
+    ``position`` (world, m) for the fraction ``share`` of the phase's tf (the phase's
+    ``MoveConfig.via_share`` instead where it gives one: a line's task, ``line.via_split``), the
+    phase the rest;
     ``yaw`` (rad; before a carry only): the tool's yaw there instead of the slot's (the way the
     wrist turns: ``route``)."""
 
@@ -175,11 +177,12 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start:
         end = t + tf
         via = routes.get(phase) if attempt == 0 else None
         if via is not None:  # the way around the base: the phase's tf shared by the via and the phase
-            segments.append(Segment(t, via.share * tf, move.beta))
+            share = via.share if move.via_share is None else move.via_share
+            segments.append(Segment(t, share * tf, move.beta))
             plans.append(PlanSegment(k, "via", VIA_PART if phase == "approach" else VIA_SLOT,
                                      index, tuple(float(c) for c in via.position),
                                      yaw if via.yaw is None else float(via.yaw), attempt, grip=grip))
-            t, tf = t + via.share * tf, end - (t + via.share * tf)  # (its end: t + tf, as without a via)
+            t, tf = t + share * tf, end - (t + share * tf)  # (its end: t + tf, as without a via)
         segments.append(Segment(t, tf, move.beta))
         belt = kind == "belt"
         plans.append(PlanSegment(k, phase, kind, index, offset, yaw, attempt,
@@ -373,6 +376,8 @@ def check_tasks(pick: PickConfig) -> None:
                 raise ScenarioError(f"{where}.{phase}.tf: must be positive, got {move.tf}")
             if not 0.0 < move.beta < 1.0:
                 raise ScenarioError(f"{where}.{phase}.beta: must be in (0, 1), got {move.beta}")
+            if move.via_share is not None and not 0.0 < move.via_share < 1.0:
+                raise ScenarioError(f"{where}.{phase}.via_share: must be in (0, 1), got {move.via_share}")
         for name in ("clearance", "lift_height", "dwell", "margin"):
             if not getattr(task, name) > 0.0:
                 raise ScenarioError(f"{where}.{name}: must be positive, got {getattr(task, name)}")

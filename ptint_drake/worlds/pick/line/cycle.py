@@ -31,8 +31,8 @@ straight way.  Measured (line_surplus seed 2 at 22.19 s): a 0.264 s approach got
 the slot, its leg 0.1 s with a 90° turn, and the wrist ran at 9 rad/s, 766 N·m commanded, into the
 conveyor.  So the task's plan is made (``plan.line_plan``, what the run will follow) and each via's
 two legs are asked of the model on their own — from the previous segment's target, as the plan's
-way starts — and the phase takes the longest of tf₁ / share and tf₂ / (1 − share), the plan's own
-split kept (``driver`` stretches the task, or gives it up where its grasp then leaves reach).
+way starts — and the phase is split to give each leg its own (``via_split``: the driver stretches
+the task, or gives it up where its grasp then leaves reach).
 
 The start state: the model starts each phase at rest on its way, from the tool's present point
 (the arm's posture read at the decision).  Measured over 110 segment starts of two runs
@@ -58,7 +58,7 @@ import numpy as np
 from ptint_drake.config.pick import MoveConfig, PartConfig, PickTaskConfig
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time, held_mass
-from ptint_drake.worlds.pick.line.grip import Grips, puts
+from ptint_drake.worlds.pick.line.grip import Grips, grip_axis, puts
 from ptint_drake.worlds.pick.route import nearest_branch, tool_yaws
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.out_belt import OutPlace, across_yaw, choose, place_of, placed_on, ride_of
@@ -148,11 +148,11 @@ class LineCycles:
                 continue
         return best
 
-    def drop_grip(self, track_id: int, grip: float) -> None:
-        """The track's leads from now on without grip yaw ``grip`` (its cycle, or its plan's via,
-        found no tf: ``driver``); the next candidate is tried at the next look (``grips``)."""
-        self.choice.drop(track_id, grip)
-        self._leads = {k: v for k, v in self._leads.items() if k[0] != track_id}
+    def drop_grip(self, track, window: tuple, start, yaw: float) -> None:
+        """The track's leads from now on without the grip yaw its lead chose (``found``: its cycle
+        found no tf, ``driver``); the next candidate is tried at the next look (``grips``)."""
+        self.choice.drop(track.id, self.found(track, window, start, yaw))
+        self._leads = {k: v for k, v in self._leads.items() if k[0] != track.id}
 
     def drop_early(self, track_id: int) -> None:
         """The track's leads from now on without an early approach (its cycle found none: ``driver``)."""
@@ -197,11 +197,11 @@ class LineCycles:
     def axis(self, track, window: tuple, start, yaw: float) -> tuple:
         """The fingers' closing axis (world) at the grip yaw the lead chose (``found``)."""
         found = self.found(track, window, start, yaw)
-        return track.axis if isinstance(found, str) else (math.cos(found[4]), math.sin(found[4]), 0.0)
+        return track.axis if isinstance(found, str) else grip_axis(found[4])
 
     def grips(self, track, yaw: float) -> list:
         """rad: the grip yaws of ``track`` for the tool at ``yaw``, preferred first (``grip.Grips``)."""
-        return self.choice.of(track.id, _kind_part(self.scenario.pick, track.kind), _yaw(track), yaw)
+        return self.choice.of(track.id, kind_part(self.scenario.pick, track.kind), _yaw(track), yaw)
 
     def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot,
                filled: tuple = ()) -> Cycle:
@@ -209,7 +209,7 @@ class LineCycles:
         approach starting its min tf and the descend's before it (or now), at the lead's grip yaw and
         the first place yaw that fits (``grip.puts``, ``filled``: the tray's parts): ``Cycle.yaws``."""
         pick = self.scenario.pick
-        kind = _kind_part(pick, track.kind)
+        kind = kind_part(pick, track.kind)
         found = self.found(track, window, start, yaw)
         begin, grip = now, self.grips(track, yaw)[0]
         if not isinstance(found, str):
@@ -268,9 +268,10 @@ class LineCycles:
 
 
     def detours(self, scenario, plan, k: int, mass: float) -> dict:
-        """phase → the tf (s) that task ``k``'s phase split by a via needs in ``plan`` (the plan
-        of ``scenario``; module docstring), ``mass`` (kg) held on a carry; only phases with a via.
-        ``NoTfFits`` where a leg has none."""
+        """phase → (tf₁, tf₂, share): the min tfs (s) of the via's leg and of the rest of task
+        ``k``'s phase split by a via in ``plan`` (the plan of ``scenario``; module docstring), and
+        the share of the phase's tf the plan gives the via's leg; ``mass`` (kg) held on a carry;
+        only phases with a via.  ``NoTfFits`` where a leg has none."""
         world = nominal(scenario, self.model.arm)
         yaws = tool_yaws(world, plan)
         segments, times = plan.segments, plan.schedule.segments
@@ -285,8 +286,7 @@ class LineCycles:
             first = self.model.min_tf(via + start_error(world, plan, i), via, None, payload, s0.beta, yaws[i])
             second = self.model.min_tf(via, segment_target(world, plan, i + 1, s1.start)[0], ride, payload,
                                        s1.beta, yaws[i + 1])
-            share = s0.tf / (s0.tf + s1.tf)
-            needs[nxt.phase] = max(first / share, second / (1.0 - share))
+            needs[nxt.phase] = (first, second, s0.tf / (s0.tf + s1.tf))
         return needs
 
 
@@ -327,7 +327,7 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
     belts = {b.name: b for b in pick.belts}
     totals = []
     for kind in pick.line.catalog:
-        part = _kind_part(pick, kind.name)
+        part = kind_part(pick, kind.name)
         for arrival in pick.line.arrivals:
             if arrival.mix and not arrival.mix.get(kind.name):
                 continue
@@ -393,7 +393,7 @@ def _yaw(track) -> float:
     return float(math.atan2(track.axis[1], track.axis[0]))
 
 
-def _kind_part(pick, kind: str) -> PartConfig:
+def kind_part(pick, kind: str) -> PartConfig:
     """A ``PartConfig`` of the catalog kind ``kind`` (its shape, size, mass and friction)."""
     k = next(c for c in pick.line.catalog if c.name == kind)
     return PartConfig(name=k.name, shape=k.shape, size=list(k.size), mass=k.mass, friction=k.friction)

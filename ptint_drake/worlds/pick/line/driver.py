@@ -28,8 +28,9 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   time``), any other goes on (``nothing feasible: kept``).
 
 Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
-a via gets what the via's two legs need (``line.cycle.LineCycles.detours``), its grasp later where
-the approach is stretched, and the task is not started where that grasp leaves reach.
+a via gets what the via's two legs need (``line.cycle.LineCycles.detours``, ``via_split``), its
+grasp later where the approach is stretched, and the task is not started where that grasp leaves
+reach.
 
 Every decision goes to the log (``decisions``: metrics.json ``line.decisions``); looks that find
 nothing new are not repeated in it.
@@ -42,13 +43,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from ptint_drake.config.pick import MoveConfig, PickTaskConfig
+from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
-from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass
+from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass, kind_part
 from ptint_drake.worlds.pick.phase_time import NoTfFits
-from ptint_drake.worlds.pick.line.grip import in_tray
+from ptint_drake.worlds.pick.line.grip import grip_axis, in_tray, logged
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.no_line import NoLine
@@ -56,6 +57,8 @@ from ptint_drake.worlds.pick.out_belt import OutPlace
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
 from ptint_drake.worlds.pick.line.truth import LineTruth
+from ptint_drake.worlds.pick.line.slot_choice import choose, nearest
+from ptint_drake.worlds.pick.line.via_split import fitted
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
@@ -256,8 +259,7 @@ class LineDriver:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
             else:
-                filled = in_tray(self.scenario.pick, keep)  # the tray's parts (``grip.puts``)
-                cycle = self._cycle(decision, tracks, windows, t, start, yaw, filled)
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw, free, keep)
                 if cycle is None:
                     return False
                 if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
@@ -279,11 +281,9 @@ class LineDriver:
         self._commit(run, t, decision, replacing, task)
         record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
         chosen = next(tr for tr in tracks if tr.id == decision.track)
-        lead = self.cycles.found(chosen, windows[chosen.id], start, yaw)  # (cached) its wait for a posture
+        record |= logged(self.cycles.found(chosen, windows[chosen.id], start, yaw), cycle)  # (cached)
         self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1,
-                                        "tf": {p: round(v, 3) for p, v in cycle.phases.items()},
-                                        "wait": None if isinstance(lead, str) else lead[2],
-                                        "yaws_deg": [round(float(np.degrees(y)), 1) for y in cycle.yaws]})
+                                        "tf": {p: round(v, 3) for p, v in cycle.phases.items()}})
         self.planning_s.append(time.perf_counter() - clock)
         return True
 
@@ -297,22 +297,29 @@ class LineDriver:
         self.view.aim(part, track)
         return part
 
-    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, filled: list):
-        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``, ``filled``: the
-        tray's parts); None where no tf fits a phase (logged)."""
+    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, free: dict, keep: list):
+        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``; the tray's parts
+        those of tasks ``keep``, ``grip.in_tray``), to the free slot its kind's ``fill`` takes
+        (``slot_choice``: ``decision.slot`` set); None where no tf fits a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
+        kind = next(c for c in self.line.catalog if c.name == track.kind)
         try:
-            cycle = self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, decision.slot,
-                                       filled)
+            def cycle_of(slot):
+                return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot,
+                                          in_tray(self.scenario.pick, keep))
+            if kind.fill == "cycle" and isinstance(decision.slot, int):
+                near = nearest(self.scenario.pick, kind_part(self.scenario.pick, kind.name), free[kind.name],
+                               decision.point)
+                decision.slot, cycle = choose(cycle_of, near)
+            else:
+                cycle = cycle_of(decision.slot)
             if isinstance(decision.slot, OutPlace):  # (outbelt46: the point on the outgoing belt chosen)
                 decision.slot = self.cycles.out_place
             return cycle
         except NoTfFits as error:
             self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
-            found = self.cycles.found(track, windows[track.id], start, yaw)  # (cached: the lead's)
-            self.cycles.drop_early(track.id)  # the next look: the approach after the entry
-            if not isinstance(found, str):
-                self.cycles.drop_grip(track.id, found[4])  # and the next grip yaw (``grip``)
+            self.cycles.drop_grip(track, windows[track.id], start, yaw)  # the next look: the next grip
+            self.cycles.drop_early(track.id)  # and the approach after the entry
             return None
 
     def _arm_q(self, context) -> np.ndarray:
@@ -345,7 +352,7 @@ class LineDriver:
             begin = t  # its approach under way: restarted from the present state
         task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
         mass = held_mass(self.scenario, next(c.mass for c in self.line.catalog if c.name == track.kind))
-        self._vias = {}  # phase → the tf its via's legs need (the decision log's ``via_tf``)
+        self._vias = {}  # phase → the min tfs of its via's two legs (the decision log's ``via_tf``)
         why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
         for _ in range(DETOUR_PASSES):
             scenario = self.planning()
@@ -357,16 +364,15 @@ class LineDriver:
             except NoTfFits as error:
                 why = f"no tf fits a via's leg: {error}"  # (its grip kept: ``grip``)
                 break
-            short = {p: v for p, v in needs.items() if v > getattr(task, p).tf + 1e-3}
-            self._vias = {p: round(v, 3) for p, v in needs.items()}
+            short = fitted(task, needs, cycle.phases)
+            self._vias = {p: [round(v, 3) for v in legs[:2]] for p, legs in needs.items()}
             if not short:
                 return task
-            task = replace(task, **{p: MoveConfig(v, getattr(task, p).beta) for p, v in short.items()})
+            task = replace(task, **short)
             grasp = task.start + task.approach.tf + task.descend.tf
             if "approach" in short:
                 self.cycles.extra[track.id] = self.cycles.extra.get(track.id, 0.0) + grasp - decision.grasp
-            axis = (np.cos(cycle.yaws[0]), np.sin(cycle.yaws[0]), 0.0)  # the fingers' at the chosen grip
-            hit = blocker(replace(track, axis=axis), tracks, grasp, t, self.timing)
+            hit = blocker(replace(track, axis=grip_axis(cycle.yaws[0])), tracks, grasp, t, self.timing)
             if grasp > decision.deadline + 1e-9 or hit is not None:
                 why = (f"the approach's via needs {task.approach.tf:.3f} s: grasp at {grasp:.2f} s "
                        + (f"blocked (track {hit})" if hit is not None else

@@ -80,9 +80,11 @@ class Grips:
             self.dropped.pop(track_id, None)
         return left or every
 
-    def drop(self, track_id: int, grip: float) -> None:
-        """Grip yaw ``grip`` (rad) found no tf in the track's cycle or plan: not offered again."""
-        self.dropped.setdefault(track_id, set()).add(round(grip, 2))
+    def drop(self, track_id: int, found) -> None:
+        """The grip yaw of a lead ``found`` (``LineCycles.found``; a str: none) found no tf in the
+        track's cycle: not offered again."""
+        if not isinstance(found, str):
+            self.dropped.setdefault(track_id, set()).add(round(found[4], 2))
 
 
 def puts(part, place: np.ndarray, slot_yaw: float, grip: float, filled: list, finger: tuple,
@@ -111,3 +113,15 @@ def in_tray(pick, keep: list) -> list:
     parts = {p.name: p for p in pick.parts}
     placed = [(pick.tasks[k].slot, parts[pick.tasks[k].part]) for k in keep if pick.tasks[k].slot is not None]
     return [(place_point(pick, "slot", slot, part), reach(part.shape, part.size)) for slot, part in placed]
+
+
+def grip_axis(yaw: float) -> tuple:
+    """The fingers' closing axis (world) of the tool at ``yaw`` (rad)."""
+    return (math.cos(yaw), math.sin(yaw), 0.0)
+
+
+def logged(found, cycle) -> dict:
+    """The decision log's ``wait`` (s, the lead ``found`` waited for a posture; None: no lead) and
+    ``yaws_deg`` (the cycle's grip and place yaws, deg) of a chosen task."""
+    return {"wait": None if isinstance(found, str) else found[2],
+            "yaws_deg": [round(math.degrees(y), 1) for y in cycle.yaws]}
