@@ -156,6 +156,11 @@ class PickTaskConfig:
     dwell: float = 0.15  # s, the grip building up after the close, and the fingers opening
     margin: float = 0.012  # m, the open fingers' clearance around the part (opening − width)
     close_delay: float = 0.0  # s, added to the close command's time (negative: early; robust's jitter)
+    # rad (world), a line's decision (``line.cycle``): the yaw the top-down tool grips at — the part's
+    # symmetric yaw nearest it (a cylinder: this yaw) — and its yaw at the slot (None: the part's x
+    # axis and the slot's yaw, each modulo π)
+    grip_yaw: Optional[float] = None
+    place_yaw: Optional[float] = None
     # a retry's first segment: the tool rises ``clearance`` above where the part is while the
     # fingers open (then a new approach and descend, with this task's tf and β)
     backoff: MoveConfig = field(default_factory=lambda: MoveConfig(0.3))

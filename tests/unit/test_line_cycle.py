@@ -72,7 +72,7 @@ def test_an_upstream_parts_approach_ends_as_the_part_enters_its_reach(cycles):
     """The approach starts before the part enters its window, so that it ends as the part enters:
     the lead counts from the entry (the descend and what is left), not the whole approach."""
     start, part, window = np.array([0.13, 0.2, 0.15]), cube(-0.5), (-0.3, 0.3)
-    approach, descend, wait, early = cycles.found(part, window, start, 0.0)
+    approach, descend, wait, early, _ = cycles.found(part, window, start, 0.0)
     ahead = 2.0  # s until the part's centre is at -0.3 m at 0.1 m/s
     assert early > 0.0
     assert ahead + wait - early >= 0.0  # not before now

@@ -68,6 +68,7 @@ from ptint_drake.worlds.pick.part_tracks import track_metrics
 from ptint_drake.worlds.pick.probe import BELT, LEFT, OTHER, PART_WIDTH, RIGHT
 from ptint_drake.worlds.pick.runaway import runaway_reasons
 from ptint_drake.worlds.pick.scene import in_bin
+from ptint_drake.worlds.pick.targets import turned
 from ptint_drake.worlds.pick.tasks import PLACES
 
 LATE_GRASP = 0.05  # s after the prescribed grasp time
@@ -87,7 +88,7 @@ def _aim(built, i: int, aims: dict, at_start: bool, t: float = 0.0):
     if seg.kind in PLACES:  # a bin's: the rotation latched at the lift (targets.PickTargets)
         rot = np.zeros(15)
         rot[0:9] = (RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel() if seg.kind != "bin"
-                    else aims["latched"][7:16])
+                    else turned(aims["latched"][7:16], seg.grip))
         ride = np.asarray(seg.ride)  # (an outgoing belt's place rides it)
         return built.targets.places[i] + offset + ride * t, rot
     if seg.kind == "via_slot":  # a via (pick.route): a fixed point turned to a yaw (via_part: as its part)
@@ -95,6 +96,8 @@ def _aim(built, i: int, aims: dict, at_start: bool, t: float = 0.0):
         rot[0:9] = RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel()
         return offset, rot
     pose, rot = aims["parts"][seg.index]
+    if seg.grip:  # a task's chosen grip turns its part's rotation (``targets.turned``)
+        rot = np.r_[turned(rot[0:9], seg.grip), rot[9:15]]
     if seg.kind == "via_part":
         rot = rot.copy()
         rot[9:15] = 0.0

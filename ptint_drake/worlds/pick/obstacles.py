@@ -48,7 +48,7 @@ from ptint_drake.worlds.pick.placement import nominal_parts
 from ptint_drake.worlds.pick.scene import (FINGER_JOINTS, belt_frame, bin_boxes, finger_extent, gripper_path,
                                            slot_pose,
                                            part_shape, tray_pose)
-from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
+from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, aimed_yaw, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, segment_way
 
 HAND_MARGIN = 0.003  # m: the least distance wanted between the hand (or a held part) and an obstacle
@@ -244,7 +244,8 @@ def _held_yaw(world: Nominal, plan: PickPlan, i: int) -> float:
     tool's), so a via turned to it does not turn.  A carry's via above its start keeps it, so that
     its short rise does not turn the wrist the whole way to the slot's yaw (the long leg after it
     does): by the legs' lengths the rise got a few per cent of the carry's tf for the whole turn."""
-    return float(world.part_yaws[plan.segments[plan.segment_index(plan.segments[i].task, "approach")].index])
+    approach = plan.segments[plan.segment_index(plan.segments[i].task, "approach")]
+    return aimed_yaw(world.part_yaws[approach.index], approach.grip)  # (a chosen grip: turned)
 
 
 def checked_segments(plan: PickPlan) -> list:

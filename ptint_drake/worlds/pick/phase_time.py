@@ -27,8 +27,8 @@ and during the run", and the torque bound sits on the unmodelled contact and gri
 2/3: the model plans to two thirds of each effort limit, the headroom for what the controller
 side does not know — the model is the nominal arm, and the inverse dynamics is linear in the
 mass parameters, so an arm whose links weigh up to 1.5 × their nominal (the robust study's
-declared range, ``studies.robust.RANGES``) holding at most the rated payload (``line.cycle``
-plans every held part at it) asks at most 1.5 × the model's torque; the feedback's own demand
+declared range, ``studies.robust.RANGES``) holding at most the rated payload (a line plans
+every held part at it, ``held_mass``) asks at most 1.5 × the model's torque; the feedback's own demand
 comes on top, inside ``MARGIN``.  Measured on the harsh line study (line_assembly, 50 samples,
 docs/pick_place.md "The harsh study"): at the full limits the runaways were heavy parts on arms
 ×1.2–1.46 — seed 7 (×1.20, a 0.96 kg cube): its lift, planned at 0.19 s, was commanded 5.5 × joint
@@ -43,6 +43,7 @@ to ``clearance`` above a part riding its belt, the descend, the close dwell, the
 starting where the previous one ended (the straight way: a via, ``route``, shares its phase's
 tf); ``Cycle.capacity`` = 60 / cycle, picks per minute, and ``capacity`` of a sequence of cycles
 (``task_cycles``: a scenario's tasks one after the other).
+``held_mass`` — the mass the model plans a held part at (a line's: the arm's rated payload).
 """
 
 from __future__ import annotations
@@ -52,12 +53,16 @@ from typing import Optional
 
 import numpy as np
 
+from pydrake.multibody.plant import MultibodyPlant
+
 from ptint_drake.config.pick import PHASES, PickTaskConfig
+from ptint_drake.systems.hand.datasheets import RATED_PAYLOAD
 from ptint_drake.robot.plant import effort_limits, nominal_plant
 from ptint_drake.verdict.run_warnings import SPEED_SAMPLES, joint_demand, joint_terms_of
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.feasibility import Way, way_motion, way_postures, way_profile
 from ptint_drake.worlds.pick.route import nearest_branch
+from ptint_drake.worlds.pick.scene import AddGripper
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.tasks import place_target
 from ptint_drake.worlds.pick.ways import nominal
@@ -218,6 +223,7 @@ class Cycle:
 
     phases: dict
     dwell: float
+    yaws: tuple = ()  # rad: (grip, put), the tool's yaw at the grasp and at the place
 
     @property
     def total(self) -> float:
@@ -232,7 +238,8 @@ class Cycle:
 
 def cycle_time(model: PhaseTimes, part, ride, place, place_yaw: float = 0.0, part_yaw: float = 0.0,
                mass: float = 0.1, task: Optional[PickTaskConfig] = None, start=None,
-               yaw: Optional[float] = None, place_ride=None, begin: float = 0.0) -> Cycle:
+               yaw: Optional[float] = None, place_ride=None, begin: float = 0.0,
+               grip: Optional[float] = None, put: Optional[float] = None) -> Cycle:
     """One pick cycle (module docstring) of a part whose centre is at ``part`` (m) when the
     approach starts, riding at ``ride`` (m/s), of ``mass`` (kg) and yaw ``part_yaw``, to the
     place pose ``place`` (the part's centre, m) at ``place_yaw`` (rad); the tool starts at
@@ -242,14 +249,17 @@ def cycle_time(model: PhaseTimes, part, ride, place, place_yaw: float = 0.0, par
     fingers close in at most half of it (``tasks.check_tasks``).  ``place_ride`` (m/s; None: a
     fixed place): the place rides at that velocity from ``place`` at t = 0 (an outgoing belt,
     ``out_belt``), the approach starting at ``begin`` (s); the carry, the place and the retreat each
-    aim at the place point where it is when the phase starts, riding on."""
+    aim at the place point where it is when the phase starts, riding on.  ``grip`` and ``put``
+    (rad): the tool's yaw at the grasp and at the place (a line's choice by the part's symmetry,
+    ``line.cycle``); default the top-down task's, the part's and then the place's yaw modulo π
+    nearest the tool's."""
     task = task or PickTaskConfig()
     part, ride, place = (np.asarray(v, dtype=float) for v in (part, ride, place))
     up = lambda h: np.array([0.0, 0.0, h])  # noqa: E731
     x = place + up(task.clearance) if start is None else np.asarray(start, dtype=float)
     yaw = place_yaw if yaw is None else yaw
-    grip = nearest_branch(yaw, part_yaw)
-    put = nearest_branch(grip, place_yaw)
+    grip = nearest_branch(yaw, part_yaw) if grip is None else grip
+    put = nearest_branch(grip, place_yaw) if put is None else put
     beta = {p: getattr(task, p).beta for p in PHASES}
     tf = {"approach": model.min_tf(x, part + up(task.clearance), ride, 0.0, beta["approach"], (yaw, grip))}
     at = part + ride * tf["approach"]
@@ -268,7 +278,29 @@ def cycle_time(model: PhaseTimes, part, ride, place, place_yaw: float = 0.0, par
     t += tf["place"] + task.dwell
     tf["retreat"] = model.min_tf(place_at(t), place_at(t) + up(task.clearance), v, 0.0, beta["retreat"],
                                  (put, put))
-    return Cycle(tf, task.dwell)
+    return Cycle(tf, task.dwell, (grip, put))
+
+
+def held_mass(scenario, declared: float) -> float:
+    """kg the model plans a held part at: the arm's rated payload less its hand's mass
+    (``datasheets.RATED_PAYLOAD``), the most the arm may be asked to carry — a part's true mass is
+    not known on the controller side, and a part heavier than its kind declares, run at tfs fitted
+    to the declared mass, saturated the arm (the harsh line study, parts drawn up to 1.06 kg on the
+    RV-M1: 4 of 10 samples, 0.63 of the parts placed, against 0.97 with the tasks' default tfs).
+    Never less than the ``declared`` mass; the declared mass on an arm without a rated payload."""
+    rated = RATED_PAYLOAD.get(scenario.robot.model)
+    if rated is None:
+        return declared
+    gripper = scenario.pick.gripper
+    key = (scenario.robot.model, repr(gripper))
+    if key not in _HAND_KG:
+        plant = MultibodyPlant(0.0)
+        instance = AddGripper(plant, plant.world_frame(), gripper)
+        _HAND_KG[key] = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(instance))
+    return max(declared, rated - _HAND_KG[key])
+
+
+_HAND_KG: dict = {}
 
 
 def task_cycles(scenario, model: Optional[PhaseTimes] = None) -> list:

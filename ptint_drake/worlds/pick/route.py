@@ -48,7 +48,7 @@ import numpy as np
 
 from ptint_drake.worlds.pick.obstacles import obstacle_vias
 from ptint_drake.robot.reachability import inverse_kinematics
-from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan, Via, pick_plan
+from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan, Via, aimed_yaw, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, nominal, nominal_paths
 
 INNER_MARGIN = 0.04  # m: a way closer than this to the inner edge of the top-down workspace is too near
@@ -146,13 +146,16 @@ def nearest_branch(yaw: float, target: float) -> float:
 def tool_yaws(world: Nominal, plan: PickPlan) -> list:
     """Per segment: the tool's yaw (rad, unwrapped) at its start and at its end, as the top-down
     task turns it: to the branch (modulo π) of the target's yaw nearest the tool's yaw
-    (``orientation.top_down_of``), from the start posture's, with the parts at their nominal yaws."""
+    (``orientation.top_down_of``), from the start posture's, with the parts at their nominal yaws
+    (a task's chosen grip: turned by their symmetry, ``tasks.aimed_yaw``)."""
     context = world.arm.CreateDefaultContext()
     world.arm.SetPositions(context, world.q0)
     R = world.frame.CalcPoseInWorld(context).rotation().matrix()
     yaw, out = float(np.arctan2(R[1, 0], R[0, 0])), []
     for seg in plan.segments:
         target = seg.yaw if seg.kind in (*PLACES, VIA_SLOT) else world.part_yaws[seg.index]
+        if seg.kind in ("part", "latched", "bin", VIA_PART):  # (a chosen grip: ``tasks.aimed_yaw``)
+            target = aimed_yaw(target, seg.grip)
         end = nearest_branch(yaw, target)
         out.append((yaw, end))
         yaw = end

@@ -33,6 +33,11 @@ target riding on would carry the arm out of reach), turned to the segment's yaw.
 segment (``pick.route``: the way around the arm's base) aims at its fixed point, at rest, turned as the
 segment after it will be: as its part (``via_part``, before an approach), or to a yaw
 (``via_slot``, before a carry: the slot's, or halfway to it the other way round).
+A task with a chosen grip (``PlanSegment.grip``: a line's decision, ``line.cycle``) turns every
+rotation read off its part — live, latched, or at a bin — about the vertical to the part's yaw by
+its symmetry nearest the chosen yaw (``tasks.aimed_yaw``; a cylinder: the chosen yaw, its spin
+about the vertical not followed), so the top-down task's branch, modulo π nearest the tool's yaw
+(``orientation.top_down_of``), is the one the decision chose.
 
 ``GripperSequence`` — the gripper's opening command (m; 0 = close with the force limit) as a
 function of time: the plan's commands, piecewise constant (output ``command``), and the width of
@@ -43,6 +48,7 @@ carries, for ``systems.hand.gripper.GraspObserver``).
 from __future__ import annotations
 
 import bisect
+import math
 from typing import Sequence
 
 import numpy as np
@@ -54,7 +60,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from ptint_drake.controllers import TargetView
 from ptint_drake.systems.task.cache import DeclareVectorCache
 from ptint_drake.systems.task.schedule import ONE_SHOT_PERIOD, DeclareSegmentStartEvents
-from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan
+from ptint_drake.worlds.pick.tasks import PLACES, VIA_PART, VIA_SLOT, PickPlan, aimed_yaw
 
 PART, LATCHED, SLOT, VIA = 0, 1, 2, 3  # a segment's kind ("part", "latched", "slot", "via_*") in ``_aims``
 
@@ -90,7 +96,7 @@ class PickTargets(LeafSystem):
 
     def _segment_aim(self, i: int) -> tuple:
         """Segment i's (kind, part, offset, slot position, slot rotation (row-major), the
-        prescribed grasp time of a descend (None otherwise))."""
+        prescribed grasp time of a descend (None otherwise), its task's grip (``turned``))."""
         seg = self._plan.segments[i]
         offset = np.asarray(seg.offset)
         if seg.kind in PLACES:  # a bin's: no yaw of its own (None), the tool keeps the latched one
@@ -98,12 +104,12 @@ class PickTargets(LeafSystem):
             # (an outgoing belt's place: its point at t = 0, riding at ``seg.ride`` until the segment's
             # end, then at rest — the last retreat's target must not ride on out of reach)
             ride = (np.asarray(seg.ride, float), self._plan.schedule.segments[i].end)
-            return (SLOT, None, offset, np.asarray(self.places[i]) + offset, R, ride)
+            return (SLOT, None, offset, np.asarray(self.places[i]) + offset, R, ride, seg.grip)
         if seg.kind in (VIA_PART, VIA_SLOT):  # a fixed point; turned as its part, or to a yaw
             return (VIA, seg.index if seg.kind == VIA_PART else None, offset, offset,
-                    RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None)
+                    RotationMatrix.MakeZRotation(seg.yaw).matrix().ravel(), None, seg.grip)
         end = self._plan.schedule.segments[i].end if seg.phase == "descend" else None
-        return (PART if seg.kind == "part" else LATCHED, seg.index, offset, None, None, end)
+        return (PART if seg.kind == "part" else LATCHED, seg.index, offset, None, None, end, seg.grip)
 
     def _active(self, context) -> int:
         return max(self._plan.schedule.active(context.get_time()), 0)
@@ -155,30 +161,46 @@ class PickTargets(LeafSystem):
         latched motion."""
         t = context.get_time()
         i = max(bisect.bisect_right(self._starts, t) - 1, 0)  # the active segment (Schedule.active)
-        kind, part, offset, place, R_slot, grasp = self._aims[i]
+        kind, part, offset, place, R_slot, grasp, grip = self._aims[i]
         value = np.zeros(24)
         if kind == SLOT:  # (``grasp``: the place's velocity, an outgoing belt's, else 0, and its end)
             ride, end = grasp
             value[0:3] = place + ride * min(t, end)
             value[3:6] = ride if t < end else 0.0
             value[9:18] = (R_slot if R_slot is not None
-                           else context.get_discrete_state(self._latched).get_value()[7:16])
+                           else turned(context.get_discrete_state(self._latched).get_value()[7:16], grip))
             return value
         if kind == VIA:
             value[0:3] = place
-            value[9:18] = R_slot if part is None else self._rotations[part].Eval(context)[0:9]
+            value[9:18] = R_slot if part is None else turned(self._rotations[part].Eval(context)[0:9], grip)
             return value
         latched = context.get_discrete_state(self._latched).get_value()
         if kind == LATCHED:
-            value[0:3], value[9:18] = latched[0:3] + offset, latched[7:16]
+            value[0:3], value[9:18] = latched[0:3] + offset, turned(latched[7:16], grip)
         elif grasp is not None and abs(latched[6] - grasp) < 1e-9:  # holding
             value[0:3] = latched[0:3] + latched[3:6] * (t - latched[6]) + offset
-            value[3:6], value[9:18] = latched[3:6], latched[7:16]
+            value[3:6], value[9:18] = latched[3:6], turned(latched[7:16], grip)
         else:
             pose = self._poses[part].Eval(context)
             value[0:3], value[3:6] = pose[0:3] + offset, pose[3:6]
             value[9:21] = self._rotations[part].Eval(context)[0:12]
+            if grip:
+                value[9:18] = turned(value[9:18], grip)
+                if grip[1] <= 0.0:
+                    value[20] = 0.0  # (any yaw: the part's spin about the vertical not followed)
         return value
+
+
+def turned(rotation: np.ndarray, grip: tuple) -> np.ndarray:
+    """A part's rotation (9, row-major) turned about the world's vertical so that its x axis's yaw
+    is ``tasks.aimed_yaw`` of it (``grip``: ``PlanSegment.grip``; () leaves it as it is)."""
+    if not grip:
+        return rotation
+    yaw = math.atan2(rotation[3], rotation[0])
+    d = aimed_yaw(yaw, grip) - yaw
+    c, s = math.cos(d), math.sin(d)
+    R = np.reshape(rotation, (3, 3))
+    return np.vstack([c * R[0] - s * R[1], s * R[0] + c * R[1], R[2]]).ravel()
 
 
 def _zero_order_hold(pairs: Sequence) -> PiecewisePolynomial:

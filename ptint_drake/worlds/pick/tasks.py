@@ -47,6 +47,7 @@ import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.pick import PHASES, MoveConfig, PickConfig, PickTaskConfig  # noqa: F401
+from ptint_drake.systems.perception.part_fit import yaw_symmetry
 from ptint_drake.systems.task.schedule import Schedule, Segment
 from ptint_drake.worlds.pick.config import grasp_width
 
@@ -69,9 +70,24 @@ class PlanSegment:
     attempt: int = 0
     ride: tuple = (0.0, 0.0, 0.0)  # m/s, world: a "belt" place's velocity (0: a fixed place)
     along: float = 0.0  # m: a "belt" place's coordinate along its belt at t = 0 (``task.belt_at``)
+    grip: tuple = ()  # (yaw, symmetry) rad of a task with a chosen grip (``aimed_yaw``); () none
 
 
 VIA_PART, VIA_SLOT = "via_part", "via_slot"  # the kinds of a via segment (``Via``)
+
+
+def aimed_yaw(part_yaw: float, grip: tuple) -> float:
+    """rad: the yaw a segment aims the tool at for a part at ``part_yaw``: with a chosen grip
+    (``PlanSegment.grip`` = (yaw, symmetry), ``PickTaskConfig.grip_yaw``) the part's yaw turned by
+    whole ``symmetry`` periods nearest the chosen yaw — the chosen yaw itself where the symmetry is
+    0 (a cylinder: any yaw) — so an estimate that moves less than half a period keeps the branch;
+    ``part_yaw`` without one."""
+    if not grip:
+        return float(part_yaw)
+    yaw, symmetry = grip
+    if symmetry <= 0.0:
+        return float(yaw)
+    return float(part_yaw + symmetry * np.rint((yaw - part_yaw) / symmetry))
 # the kinds of a place target (``place_target``): a tray slot, a bin, or an outgoing belt (riding it)
 PLACES = ("slot", "bin", "belt")
 
@@ -146,11 +162,12 @@ def _up(h: float) -> tuple:
 
 
 def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start: float, replan: Replan,
-                   hold: float = 0.0, vias: tuple = (), ride: tuple = (0.0, 0.0, 0.0)):
+                   hold: float = 0.0, vias: tuple = (), ride: tuple = (0.0, 0.0, 0.0), grip: tuple = ()):
     """The segments of task k, their plan entries, the attempts' (start, grasp) and the end;
     ``place``: (kind, index, yaw) of its place target (``place_target``); ``hold``: how long the
     first attempt waits at its pre-grasp pose before its descend (s); ``vias``: the task's ``Via``
-    (at most one per phase); ``ride``: its place's velocity (m/s, an outgoing belt's)."""
+    (at most one per phase); ``ride``: its place's velocity (m/s, an outgoing belt's); ``grip``:
+    every segment's ``PlanSegment.grip``."""
     segments, plans, attempts = [], [], []
     routes = {v.phase: v for v in vias if v.task == k}
 
@@ -164,12 +181,12 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start:
             segments.append(Segment(t, share * tf, move.beta))
             plans.append(PlanSegment(k, "via", VIA_PART if phase == "approach" else VIA_SLOT,
                                      index, tuple(float(c) for c in via.position),
-                                     yaw if via.yaw is None else float(via.yaw), attempt))
+                                     yaw if via.yaw is None else float(via.yaw), attempt, grip=grip))
             t, tf = t + share * tf, end - (t + share * tf)  # (its end: t + tf, as without a via)
         segments.append(Segment(t, tf, move.beta))
         belt = kind == "belt"
         plans.append(PlanSegment(k, phase, kind, index, offset, yaw, attempt,
-                                 ride if belt else (0.0, 0.0, 0.0), task.belt_at if belt else 0.0))
+                                 ride if belt else (0.0, 0.0, 0.0), task.belt_at if belt else 0.0, grip))
         return end
 
     t = start
@@ -213,8 +230,9 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
         width = grasp_width(pick.parts[part])
         opening = width + task.margin
         first_close, hold = _closed_on_nothing(pick, task, start)
+        grip = () if task.grip_yaw is None else (float(task.grip_yaw), part_symmetry(pick.parts[part]))
         segs, plan, tries, t = _task_segments(k, task, part, place_target(pick, task), start, replan, hold,
-                                              vias, place_ride(pick, task))
+                                              vias, place_ride(pick, task), grip)
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):
@@ -258,7 +276,15 @@ def place_target(pick: PickConfig, task: PickTaskConfig) -> tuple:
         yaw = next(p.yaw_deg for p in pick.parts if p.name == task.part)
         index = [b.name for b in pick.bins].index(task.bin)
         return "bin", index, float(np.radians(yaw)) if isinstance(yaw, (int, float)) else 0.0
+    if task.place_yaw is not None:  # (a line's decision: the slot's yaw by the part's symmetry)
+        return "slot", task.slot, float(task.place_yaw)
     return "slot", task.slot, float(np.radians(pick.tray.yaw_deg + pick.tray.slots[task.slot].yaw_deg))
+
+
+def part_symmetry(part) -> float:
+    """rad: a part's yaw symmetry about the vertical (``part_fit.yaw_symmetry``: π/2 for a
+    square-topped box, π for another box, 0 — any — for a cylinder)."""
+    return yaw_symmetry(part.shape, part.size)
 
 
 def place_ride(pick: PickConfig, task: PickTaskConfig) -> tuple:

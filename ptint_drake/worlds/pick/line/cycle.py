@@ -21,7 +21,8 @@ point and yaw, the part at the approach's start riding its belt (approach, desce
 held (lift, carry, place), to its slot and back up (retreat); a part put on an outgoing belt:
 ``phase_time.cycle_time`` with its place riding that belt (carry, place and retreat) to the point
 ``out_belt.choose`` picks (a task being replaced keeps its old point among the placed ones:
-conservative).
+conservative).  The grip and place yaws are chosen by the part's symmetry (``grip``), and the
+task carries them (``grip_yaw``, ``place_yaw``) to the plan and the targets.
 
 ``detours`` — what the plan makes of a task: a phase the plan splits by a via (``route``: around
 the waist axis; ``obstacles``: above a part in the way) shares the phase's tf between its two legs
@@ -56,12 +57,10 @@ import numpy as np
 
 from ptint_drake.config.pick import MoveConfig, PartConfig, PickTaskConfig
 from ptint_drake.worlds.pick.cell import place_point
-from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time
+from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time, held_mass
+from ptint_drake.worlds.pick.line.grip import Grips, grip_axis, puts
 from ptint_drake.worlds.pick.route import nearest_branch, tool_yaws
-from pydrake.multibody.plant import MultibodyPlant
-
-from ptint_drake.systems.hand.datasheets import RATED_PAYLOAD
-from ptint_drake.worlds.pick.scene import AddGripper, belt_frame
+from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.out_belt import OutPlace, across_yaw, choose, place_of, placed_on, ride_of
 from ptint_drake.worlds.pick.tasks import place_target
 from ptint_drake.worlds.pick.ways import nominal, segment_target, start_error
@@ -76,16 +75,18 @@ class LineCycles:
     """The min-tf model of a line's station and the leads it gave (module docstring)."""
 
     def __init__(self, scenario, model: Optional[PhaseTimes] = None, window_at=None,
-                 finger_width: float = 0.02):
+                 finger: tuple = (0.006, 0.02)):
         self.scenario = scenario
         self.model = model or PhaseTimes.of(scenario)
         self.window_at = window_at  # (belt, lateral, height) → reach window (``LineView.window_at``)
-        self.finger_width = finger_width  # m, the open fingers' width along an outgoing belt
+        self.finger = finger  # m, the open fingers' (thickness, width) (``grasp_gate.finger_extent``)
+        self.finger_width = finger[1]  # m, the open fingers' width along an outgoing belt
         self.out_place: Optional[OutPlace] = None  # the last ``phases``' point on an outgoing belt
         self.task = PickTaskConfig()
         self._leads: dict = {}
         self.extra: dict = {}  # track → s its approach's via needs beyond the straight way (``detours``)
         self.plain: set = set()  # tracks whose approach starts after the entry (``drop_early``)
+        self.choice = Grips()  # the grip yaws of the tracks (``grip``)
 
     def lead(self, track, window: tuple, now: float, start, yaw: float):
         """s from now, or from the part's entry into its ``window`` if later, to the earliest grasp
@@ -97,21 +98,21 @@ class LineCycles:
         return float(_lead_of(found)) + self.extra.get(track.id, 0.0)
 
     def found(self, track, window: tuple, start, yaw: float):
-        """(approach, descend, wait, early) of ``_lead``, cached, or a str."""
+        """(approach, descend, wait, early, grip) of ``_lead``, cached, or a str."""
         ahead, key = _key(track, window, start, yaw)
         if key not in self._leads:
             self._leads[key] = self._lead(track, ahead, start, yaw)
         return self._leads[key]
 
     def _lead(self, track, ahead: float, start, yaw: float):
-        """(approach, descend, wait, early) or a str naming why no tf fits (module docstring): the
-        approach starting at the entry (or now) + wait, the first of ``WAITS`` whose ways have a
-        top-down posture all along; then, for a part upstream, one that starts ``early`` s before
-        and ends at the entry + a wait (the first of ``WAITS`` that fits, ``_early``), where its
-        lead is the shorter."""
+        """(approach, descend, wait, early, grip) or a str naming why no tf fits (module docstring):
+        the approach starting at the entry (or now) + wait, the first of ``WAITS`` at which one of
+        the track's grip yaws (``grip.grips``, in their order) has a top-down posture all along its
+        ways; then, for a part upstream, one that starts ``early`` s before and ends at the entry +
+        a wait (the first of ``WAITS`` that fits, ``_early``), where its lead is the shorter."""
         ride = track.speed * np.asarray(track.direction)
         up = np.array([0.0, 0.0, self.task.clearance])
-        grip = nearest_branch(yaw, _yaw(track))
+        grip = 0.0
 
         def approach_from(t: float, guess: Optional[float] = None) -> float:
             """The approach's min tf, the part where it is at t (the fixed point from ``guess``: a
@@ -126,10 +127,10 @@ class LineCycles:
                        self.task.margin / self.model.gripper_speed)
 
         best, why = None, ""
-        for wait in WAITS:
+        for wait, grip in ((w, g) for w in WAITS for g in self.grips(track, yaw)):
             try:
                 approach = approach_from(ahead + wait)
-                best = (approach, descend_at(ahead + wait + approach), wait, 0.0)
+                best = (approach, descend_at(ahead + wait + approach), wait, 0.0, grip)
                 break
             except NoTfFits as error:
                 why = why or f"no tf fits: {error}"  # the way from now (wait 0): where the part is
@@ -141,11 +142,17 @@ class LineCycles:
             found = self._early(approach_from, ahead, wait)
             try:
                 if found is not None:
-                    early = (found[0], descend_at(ahead + wait - found[1] + found[0]), wait, found[1])
+                    early = (found[0], descend_at(ahead + wait - found[1] + found[0]), wait, found[1], grip)
                     return early if _lead_of(early) < _lead_of(best) else best
             except NoTfFits:
                 continue
         return best
+
+    def drop_grip(self, track, window: tuple, start, yaw: float) -> None:
+        """The track's leads from now on without the grip yaw its lead chose (``found``: its cycle
+        found no tf, ``driver``); the next candidate is tried at the next look (``grips``)."""
+        self.choice.drop(track.id, self.found(track, window, start, yaw))
+        self._leads = {k: v for k, v in self._leads.items() if k[0] != track.id}
 
     def drop_early(self, track_id: int) -> None:
         """The track's leads from now on without an early approach (its cycle found none: ``driver``)."""
@@ -168,13 +175,15 @@ class LineCycles:
             trial = tf  # it would end before the part enters: start it later
         return None
 
-    def fits(self, track, begin: float, grasp: float, now: float, start, yaw: float) -> bool:
+    def fits(self, track, begin: float, grasp: float, now: float, start, yaw: float,
+             grip: Optional[float] = None) -> bool:
         """Whether an approach from the tool at ``start`` (turned to ``yaw``) starting at ``begin``
         and the descend make the grasp of ``track`` at ``grasp``: their min tfs, the part where it
-        is at ``begin`` (a kept task, ``driver``); False where no tf fits."""
+        is at ``begin`` (a kept task, ``driver``: ``grip``, its chosen grip yaw — default the
+        track's first, ``grips``); False where no tf fits."""
         ride = track.speed * np.asarray(track.direction)
         up = np.array([0.0, 0.0, self.task.clearance])
-        grip = nearest_branch(yaw, _yaw(track))
+        grip = self.grips(track, yaw)[0] if grip is None else nearest_branch(yaw, grip)
         try:
             part = np.asarray(track.at(begin, now))
             approach = self.model.min_tf(start, part + up, ride, 0.0, self.task.approach.beta, (yaw, grip))
@@ -185,39 +194,58 @@ class LineCycles:
             return False
         return begin + approach + descend + self.extra.get(track.id, 0.0) <= grasp + 1e-9
 
-    def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot) -> Cycle:
+    def axis(self, track, window: tuple, start, yaw: float) -> tuple:
+        """The fingers' closing axis (world) at the grip yaw the lead chose (``found``)."""
+        found = self.found(track, window, start, yaw)
+        return track.axis if isinstance(found, str) else grip_axis(found[4])
+
+    def grips(self, track, yaw: float) -> list:
+        """rad: the grip yaws of ``track`` for the tool at ``yaw``, preferred first (``grip.Grips``)."""
+        return self.choice.of(track.id, kind_part(self.scenario.pick, track.kind), _yaw(track), yaw)
+
+    def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot,
+               filled: tuple = ()) -> Cycle:
         """The cycle of a grasp of ``track`` (reach ``window``) at ``grasp`` (module docstring), its
-        approach starting its min tf and the descend's before it (or now)."""
+        approach starting its min tf and the descend's before it (or now), at the lead's grip yaw and
+        the first place yaw that fits (``grip.puts``, ``filled``: the tray's parts): ``Cycle.yaws``."""
         pick = self.scenario.pick
         kind = kind_part(pick, track.kind)
         found = self.found(track, window, start, yaw)
-        begin = now
+        begin, grip = now, self.grips(track, yaw)[0]
         if not isinstance(found, str):
             begin = max(now, grasp - found[0] - found[1] - self.extra.get(track.id, 0.0))
-            self.model.last = found[0]  # the riding approach's fixed point from the lead's (``_early``)
+            self.model.last, grip = found[0], found[4]  # (the riding approach's fixed point: ``_early``)
         if isinstance(slot, OutPlace):
-            return self._riding(track, grasp, now, begin, start, yaw, slot, kind)
+            return self._riding(track, grasp, now, begin, start, yaw, slot, kind, grip)
         task = replace(self.task, **destination(slot))
         place = _place(pick, slot, kind)
-        return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
-                          place, _place_yaw(pick, task, _yaw(track)), _yaw(track),
-                          held_mass(self.scenario, kind.mass), task, start, yaw)
+        options = [grip] if isinstance(slot, str) else puts(  # a bin: the tool keeps its grasp's yaw
+            kind, place, _place_yaw(pick, task, grip), grip, list(filled), self.finger, task.margin)
+        for i, put in enumerate(options):
+            try:
+                return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
+                                  place, put, _yaw(track), held_mass(self.scenario, kind.mass), task, start,
+                                  yaw, grip=grip, put=put)
+            except NoTfFits:
+                if i == len(options) - 1:
+                    raise
 
-    def _riding(self, track, grasp: float, now: float, begin: float, start, yaw: float, slot, kind) -> Cycle:
+    def _riding(self, track, grasp: float, now: float, begin: float, start, yaw: float, slot, kind,
+                grip: float) -> Cycle:
         """``phases`` of a part put on an outgoing belt (``out_belt.choose``: the point, then the
         cycle to it riding the belt); the point chosen: ``out_place``."""
         pick = self.scenario.pick
         belt = next(b for b in pick.belts if b.name == slot.belt)
         height = kind.size[2] if kind.shape == "box" else kind.size[1]
         window = self.window_at(slot.belt, 0.0, height / 2)
-        put = across_yaw(belt, _yaw(track))
+        put = across_yaw(belt, grip)
         mass = held_mass(self.scenario, kind.mass)
         ride = track.speed * np.asarray(track.direction)
 
         def cycle_of(along: float) -> Cycle:
             place0 = place_of(pick, slot.belt, kind, along)
             return cycle_time(self.model, track.at(begin, now), ride, place0, put, _yaw(track), mass,
-                              self.task, start, yaw, place_ride=ride_of(belt), begin=begin)
+                              self.task, start, yaw, place_ride=ride_of(belt), begin=begin, grip=grip)
 
         parts = {p.name: p for p in pick.parts}
         self.out_place, cycle = choose(pick, slot.belt, window, grasp, cycle_of, kind,
@@ -235,7 +263,8 @@ class LineCycles:
             begin = max(now, grasp - tf["approach"] - tf["descend"])
         moves = {p: MoveConfig(tf[p], getattr(self.task, p).beta) for p in PHASE_NAMES}
         moves["approach"] = MoveConfig(grasp - tf["descend"] - begin, self.task.approach.beta)
-        return replace(self.task, part=part, start=begin, **destination(slot), **moves)
+        yaws = {"grip_yaw": cycle.yaws[0], "place_yaw": cycle.yaws[1] if isinstance(slot, int) else None}
+        return replace(self.task, part=part, start=begin, **destination(slot), **moves, **yaws)
 
 
     def detours(self, scenario, plan, k: int, mass: float) -> dict:
@@ -325,28 +354,6 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
     return 60.0 / mean, mean
 
 
-def held_mass(scenario, declared: float) -> float:
-    """kg the model plans a held part at: the arm's rated payload less its hand's mass
-    (``datasheets.RATED_PAYLOAD``), the most the arm may be asked to carry — a part's true mass is
-    not known on the controller side, and a part heavier than its kind declares, run at tfs fitted
-    to the declared mass, saturated the arm (the harsh line study, parts drawn up to 1.06 kg on the
-    RV-M1: 4 of 10 samples, 0.63 of the parts placed, against 0.97 with the tasks' default tfs).
-    Never less than the ``declared`` mass; the declared mass on an arm without a rated payload."""
-    rated = RATED_PAYLOAD.get(scenario.robot.model)
-    if rated is None:
-        return declared
-    gripper = scenario.pick.gripper
-    key = (scenario.robot.model, repr(gripper))
-    if key not in _HAND_KG:
-        plant = MultibodyPlant(0.0)
-        instance = AddGripper(plant, plant.world_frame(), gripper)
-        _HAND_KG[key] = sum(plant.get_body(b).default_mass() for b in plant.GetBodyIndices(instance))
-    return max(declared, rated - _HAND_KG[key])
-
-
-_HAND_KG: dict = {}
-
-
 def destination(where) -> dict:
     """A decision's destination as a task's fields: a tray slot (an index), a bin (its name) or a
     point on an outgoing belt (``out_belt.OutPlace``)."""
@@ -369,8 +376,8 @@ def _place(pick, where, part) -> np.ndarray:
 
 
 def _lead_of(found: tuple) -> float:
-    """s from the entry (or now) to the grasp of a ``_lead`` (approach, descend, wait, early)."""
-    approach, descend, wait, early = found
+    """s from the entry (or now) to the grasp of a ``_lead`` (approach, descend, wait, early, grip)."""
+    approach, descend, wait, early = found[:4]
     return approach + descend + wait - early
 
 

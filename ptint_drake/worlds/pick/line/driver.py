@@ -49,6 +49,7 @@ from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
 from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass, kind_part
 from ptint_drake.worlds.pick.phase_time import NoTfFits
+from ptint_drake.worlds.pick.line.grip import grip_axis, in_tray, logged
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.no_line import NoLine
@@ -116,7 +117,7 @@ class LineDriver:
             self.timing = Timing(lead=task.approach.tf + task.descend.tf, margin=task.margin,
                                  finger=finger_extent(built.station))
             self.cycles = LineCycles(self.scenario, window_at=self.view.window_at,  # (outbelt46: out_belt)
-                                     finger_width=self.timing.finger[1])
+                                     finger=self.timing.finger)
         self.truth.rebind(built.station)
         self.view.bind(built)
         self.built = built
@@ -197,7 +198,8 @@ class LineDriver:
         begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
         window = self.view.window(track)
         if not unserved(track, window, grasp, t, end, self.timing.slack) \
-                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context))):
+                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context)),
+                                     task.grip_yaw):
             # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
             self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
             self.decisions.append(entry | {"redecide": "kept"})
@@ -249,14 +251,15 @@ class LineDriver:
         q = self._arm_q(context)
         start, yaw = self._tool_now(q)  # the arm's present point and yaw
         decision = decide(t, tracks, windows, assigned, free, self.timing,
-                          lambda tr, w: self.cycles.lead(tr, w, t, start, yaw))
+                          lambda tr, w: self.cycles.lead(tr, w, t, start, yaw),
+                          lambda tr: self.cycles.axis(tr, windows[tr.id], start, yaw))
         cycle = None
         if decision.track is not None:
             if self.view.reachable(np.asarray(decision.point), q) is None:
                 decision.skipped.append((decision.track, "out of reach by IK at the grasp"))
                 decision.track = decision.grasp = decision.slot = decision.point = None
             else:
-                cycle = self._cycle(decision, tracks, windows, t, start, yaw, free)
+                cycle = self._cycle(decision, tracks, windows, t, start, yaw, free, keep)
                 if cycle is None:
                     return False
                 if decision.grasp - cycle.phases["descend"] + cycle.total - cycle.phases["approach"] \
@@ -277,6 +280,8 @@ class LineDriver:
             return False
         self._commit(run, t, decision, replacing, task)
         record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
+        chosen = next(tr for tr in tracks if tr.id == decision.track)
+        record |= logged(self.cycles.found(chosen, windows[chosen.id], start, yaw), cycle)  # (cached)
         self.decisions.append(record | {"task": replacing if replacing is not None else len(tasks) - 1,
                                         "tf": {p: round(v, 3) for p, v in cycle.phases.items()}})
         self.planning_s.append(time.perf_counter() - clock)
@@ -292,15 +297,16 @@ class LineDriver:
         self.view.aim(part, track)
         return part
 
-    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, free: dict):
-        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``), to the free slot
-        its kind's ``fill`` takes (``slot_choice``: ``decision.slot`` set); None where no tf fits
-        a phase (logged)."""
+    def _cycle(self, decision, tracks, windows, t: float, start, yaw: float, free: dict, keep: list):
+        """The chosen grasp's cycle from the min-tf model (``LineCycles.phases``; the tray's parts
+        those of tasks ``keep``, ``grip.in_tray``), to the free slot its kind's ``fill`` takes
+        (``slot_choice``: ``decision.slot`` set); None where no tf fits a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
         kind = next(c for c in self.line.catalog if c.name == track.kind)
         try:
             def cycle_of(slot):
-                return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot)
+                return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot,
+                                          in_tray(self.scenario.pick, keep))
             if kind.fill == "cycle" and isinstance(decision.slot, int):
                 near = nearest(self.scenario.pick, kind_part(self.scenario.pick, kind.name), free[kind.name],
                                decision.point)
@@ -312,7 +318,8 @@ class LineDriver:
             return cycle
         except NoTfFits as error:
             self.decisions.append(decision.record() | {"not started": f"no tf fits: {error}"})
-            self.cycles.drop_early(track.id)  # the next look: the approach after the entry
+            self.cycles.drop_grip(track, windows[track.id], start, yaw)  # the next look: the next grip
+            self.cycles.drop_early(track.id)  # and the approach after the entry
             return None
 
     def _arm_q(self, context) -> np.ndarray:
@@ -355,7 +362,7 @@ class LineDriver:
             try:
                 needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
             except NoTfFits as error:
-                why = f"no tf fits a via's leg: {error}"
+                why = f"no tf fits a via's leg: {error}"  # (its grip kept: ``grip``)
                 break
             short = fitted(task, needs, cycle.phases)
             self._vias = {p: [round(v, 3) for v in legs[:2]] for p, legs in needs.items()}
@@ -365,7 +372,7 @@ class LineDriver:
             grasp = task.start + task.approach.tf + task.descend.tf
             if "approach" in short:
                 self.cycles.extra[track.id] = self.cycles.extra.get(track.id, 0.0) + grasp - decision.grasp
-            hit = blocker(track, tracks, grasp, t, self.timing)
+            hit = blocker(replace(track, axis=grip_axis(cycle.yaws[0])), tracks, grasp, t, self.timing)
             if grasp > decision.deadline + 1e-9 or hit is not None:
                 why = (f"the approach's via needs {task.approach.tf:.3f} s: grasp at {grasp:.2f} s "
                        + (f"blocked (track {hit})" if hit is not None else

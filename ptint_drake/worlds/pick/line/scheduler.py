@@ -33,7 +33,7 @@ beyond the tolerance, the run decides again (``driver``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Optional
 
 import numpy as np
@@ -141,13 +141,15 @@ def blocker(track: Track, tracks: list, grasp: float, now: float, timing: Timing
 
 
 def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: dict,
-           timing: Timing, leads=None) -> Decision:
+           timing: Timing, leads=None, axes=None) -> Decision:
     """The next pick among ``tracks`` not in ``assigned`` (module docstring); ``free_slots``: kind
     → the slots still free for it, in filling order (a bin kind: [its bin's name]); ``leads``: a
     callable (track, window) → the track's lead (s, ``line.cycle.LineCycles.lead``: the min-tf
     model) or a str naming why no tf fits — None: ``timing.lead`` for every track.  A deadline does
     not depend on the lead, so the tracks are looked at in deadline order, and with ``leads`` the
-    model is asked no further than the first feasible one (the rest read ``later deadline``)."""
+    model is asked no further than the first feasible one (the rest read ``later deadline``);
+    ``axes``: a callable track → the fingers' closing axis at its grasp (the grip the lead chose,
+    ``LineCycles.axis``; None: ``Track.axis``)."""
     decision = Decision(now)
     order = []
     for track in tracks:
@@ -167,7 +169,7 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
         if feasible and leads is not None:
             feasible.append((deadline, None, track))
             continue
-        reason, grasp = _feasible(track, tracks, windows[track.id], now, timing, leads)
+        reason, grasp = _feasible(track, tracks, windows[track.id], now, timing, leads, axes)
         if reason:
             decision.skipped.append((track.id, reason))
         else:
@@ -183,7 +185,8 @@ def decide(now: float, tracks: list, windows: dict, assigned: set, free_slots: d
     return decision
 
 
-def _feasible(track: Track, tracks: list, window: tuple, now: float, timing: Timing, leads) -> tuple:
+def _feasible(track: Track, tracks: list, window: tuple, now: float, timing: Timing, leads,
+              axes=None) -> tuple:
     """("", grasp time) of a track the arm can take (its lead, its grasp time in its window, the
     fingers clear of the others), else (the reason, None)."""
     lead = None if leads is None else leads(track, window)
@@ -192,7 +195,8 @@ def _feasible(track: Track, tracks: list, window: tuple, now: float, timing: Tim
     grasp, deadline = grasp_time(track, window, now, timing, lead)
     if grasp is None:
         return deadline, None
-    hit = blocker(track, tracks, grasp, now, timing)
+    gripped = track if axes is None else replace(track, axis=tuple(axes(track)))
+    hit = blocker(gripped, tracks, grasp, now, timing)
     return (f"blocked (track {hit})", None) if hit is not None else ("", grasp)
 
 

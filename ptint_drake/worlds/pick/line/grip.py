@@ -1,0 +1,127 @@
+"""The line's grasp and place yaws, chosen by the part's symmetry (issue 44).
+
+The top-down tool grips a part across the faces its closing axis meets, and the controller's
+task turns the tool to its target's yaw modulo π, on the branch nearest the tool's own yaw
+(``orientation.top_down_of``).  A part that looks the same turned by its yaw symmetry
+(``part_fit.yaw_symmetry``: a 30 mm cube π/2, another box π, a cylinder any yaw) can be gripped
+across either pair of faces, or at any yaw, so the decision chooses (``grips``):
+
+- a box with no symmetry below π: the part's yaw modulo π nearest the tool's (as before: one
+  branch);
+- a square-topped box: the part's yaw modulo π/2 nearest the tool's (a turn of at most 45°), then
+  the other pair of faces (a turn of 45–90°) — where the first way has no top-down posture (the
+  wrist's roll at its limit) the second may;
+- a cylinder: the tool's own yaw (no turn), then ±45°, then ±81° (``CYLINDER_TURNS``).
+
+``line.cycle`` asks the min-tf model for each candidate in this order at each wait and keeps
+the first that fits (``LineCycles._lead``); a grip whose cycle then finds no tf (the carry, the
+place) is dropped for the track and the next look takes the next (``drop_grip``).  A grip whose
+plan's via leg finds none is kept: such a leg fits a few looks later, the via moving with the part
+(line_two_belts seed 1 at main: 10 looks, then the grasp at 24.4 s), and dropping it for the next
+grip measured worse — seed 1's cube then grasped at 28.6 s on the other pair of faces, a later
+part lost; seed 7's disc at 29.0 s, 2.8 s after main's, on its fifth grip.  The chosen yaw is the
+task's ``grip_yaw`` for its whole life (``tasks.aimed_yaw``: the targets then follow the part's
+estimated yaw by whole periods nearest it, so an estimate that moves by less than half a period
+keeps the branch).
+
+The place (``puts``): first the slot's own yaw modulo π nearest the grip — the tray's design
+direction of the fingers, and the tool's yaw after each place kept where it was, so the wrist's
+roll does not wander cycle after cycle — then, for a cube, the slot's yaw turned 90°, for a
+cylinder the grip's yaw (no turn on the carry): each only where the open fingers there clear
+every part already in the tray (``grasp_gate.finger_clearance``, its ``FINGER_MARGIN``).  On
+line_two_belts' tray the slots are 50 mm apart in x and 40 mm in y: the open fingers reach 27 mm
+from a 30 mm cube's centre, a neighbour's half diagonal 21 mm — across y they would touch the
+neighbour, so a turned place is taken only where that neighbour is not there yet.  A bin keeps the
+yaw the part was gripped at (``tasks.place_target``).  ``LineCycles.phases`` keeps the first
+candidate whose cycle fits.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ptint_drake.systems.perception.part_fit import reach
+from ptint_drake.worlds.pick.cell import place_point
+from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.grasp_gate import FINGER_MARGIN, finger_clearance
+from ptint_drake.worlds.pick.route import nearest_branch
+from ptint_drake.worlds.pick.tasks import aimed_yaw, part_symmetry
+
+# rad: a cylinder's grips, turns from the tool's yaw (below 90°: the controller's branch, modulo π)
+CYLINDER_TURNS = (0.0, -0.25 * math.pi, 0.25 * math.pi, -0.45 * math.pi, 0.45 * math.pi)
+
+
+def grips(part, part_yaw: float, tool_yaw: float) -> list:
+    """rad: the grip yaws of ``part`` (a ``PartConfig``: its shape and size) at ``part_yaw`` for
+    the tool at ``tool_yaw``, preferred first (module docstring), each within π/2 of ``tool_yaw``
+    (the controller's branch)."""
+    symmetry = part_symmetry(part)
+    if symmetry <= 0.0:
+        return [tool_yaw + turn for turn in CYLINDER_TURNS]
+    if symmetry >= math.pi - 1e-9:
+        return [nearest_branch(tool_yaw, part_yaw)]
+    first = aimed_yaw(part_yaw, (tool_yaw, symmetry))
+    return [first, nearest_branch(tool_yaw, first + symmetry)]
+
+
+class Grips:
+    """The grip yaws of a line's tracks (``grips``), less those dropped for a track (``drop``)."""
+
+    def __init__(self):
+        self.dropped: dict = {}  # track id → the grip yaws (rad, rounded) its cycle or plan found no tf for
+
+    def of(self, track_id: int, part, part_yaw: float, tool_yaw: float) -> list:
+        """``grips`` less the track's dropped ones (all of them dropped: all again)."""
+        every = grips(part, part_yaw, tool_yaw)
+        left = [g for g in every if round(g, 2) not in self.dropped.get(track_id, ())]
+        if not left:
+            self.dropped.pop(track_id, None)
+        return left or every
+
+    def drop(self, track_id: int, found) -> None:
+        """The grip yaw of a lead ``found`` (``LineCycles.found``; a str: none) found no tf in the
+        track's cycle: not offered again."""
+        if not isinstance(found, str):
+            self.dropped.setdefault(track_id, set()).add(round(found[4], 2))
+
+
+def puts(part, place: np.ndarray, slot_yaw: float, grip: float, filled: list, finger: tuple,
+         margin: float) -> list:
+    """rad: the tool's yaws at a tray slot (its part's centre at ``place``, the slot's yaw
+    ``slot_yaw``) for ``part`` gripped at ``grip``, preferred first (module docstring); ``filled``:
+    [(centre, radius)] of the parts already in the tray; ``finger``: (thickness, width), m;
+    ``margin``: the open fingers' clearance around the part (m)."""
+    own = nearest_branch(grip, slot_yaw)
+    symmetry = part_symmetry(part)
+    others = ([grip] if symmetry <= 0.0 else
+              [nearest_branch(grip, own + symmetry)] if symmetry < math.pi - 1e-9 else [])
+    opening = grasp_width(part) + margin
+    out = [own]
+    for yaw in others:
+        axis = (math.cos(yaw), math.sin(yaw))
+        if abs(yaw - own) > 1e-9 and all(finger_clearance(place, axis, opening, finger, centre, radius)
+                                         >= FINGER_MARGIN for centre, radius in filled):
+            out.append(yaw)
+    return out
+
+
+def in_tray(pick, keep: list) -> list:
+    """[(centre, radius)] of the parts the tasks ``keep`` (indices into ``pick.tasks``) put in the
+    tray (``puts``'s ``filled``): each slot's place point and its part's top-face radius."""
+    parts = {p.name: p for p in pick.parts}
+    placed = [(pick.tasks[k].slot, parts[pick.tasks[k].part]) for k in keep if pick.tasks[k].slot is not None]
+    return [(place_point(pick, "slot", slot, part), reach(part.shape, part.size)) for slot, part in placed]
+
+
+def grip_axis(yaw: float) -> tuple:
+    """The fingers' closing axis (world) of the tool at ``yaw`` (rad)."""
+    return (math.cos(yaw), math.sin(yaw), 0.0)
+
+
+def logged(found, cycle) -> dict:
+    """The decision log's ``wait`` (s, the lead ``found`` waited for a posture; None: no lead) and
+    ``yaws_deg`` (the cycle's grip and place yaws, deg) of a chosen task."""
+    return {"wait": None if isinstance(found, str) else found[2],
+            "yaws_deg": [round(math.degrees(y), 1) for y in cycle.yaws]}
