@@ -157,12 +157,14 @@ def test_a_via_split_gives_each_leg_its_own_and_no_more():
 def test_a_phase_whose_via_went_keeps_the_models_straight_tf():
     """``via_split.fitted``: a carry shortened for its via's legs goes back to the model's
     straight tf when a later plan has no via there (an obstacle cleared by the new timing); an
-    approach stretched to its grasp is never cut."""
+    approach stretched to its grasp is never cut, and one shorter than the model's is stretched."""
     task = PickTaskConfig(part="p", slot=0, approach=MoveConfig(2.0), carry=MoveConfig(1.0, 0.6, 0.4))
     straight = {"approach": 0.8, "carry": 1.6}
     assert fitted(task, {}, straight) == {"carry": MoveConfig(1.6, 0.6)}
     out = fitted(task, {"approach": (1.5, 1.0, 0.5)}, straight)
     assert out["approach"].tf == pytest.approx(2.5) and out["carry"].tf == 1.6
+    squeezed = PickTaskConfig(part="p", slot=0, approach=MoveConfig(2.06), carry=MoveConfig(1.6))
+    assert fitted(squeezed, {}, {"approach": 3.08, "carry": 1.6}) == {"approach": MoveConfig(3.08)}
 
 
 def test_a_via_share_outside_0_1_is_refused():

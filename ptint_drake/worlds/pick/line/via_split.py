@@ -17,11 +17,14 @@ seed 25's first carry: 3.32 s straight, its legs 1.51 + 0.98 s) — unless its t
 within ``SHORTER`` of that.  The rule it replaces stretched the phase to max(tf₁ / share,
 tf₂ / (1 − share)) with the length share kept, and never shortened it.
 
-``fitted``: every phase of a task, the plan's vias as ``split`` makes them; a phase the plan no
-longer splits (an obstacle's via depends on when the phase passes the parts riding by: a changed
-tf may clear it) back to at least the model's straight tf.  Measured on seed 25 at 1c48563: the
-second task's carry stretched 0.96 → 2.65 s for a via that the stretch then made needless; with
-the split the via's leg took 0.23 s and the carry 0.96 s.
+``fitted``: every phase of a task, the plan's vias as ``split`` makes them; a phase the plan does
+not split (or no longer: an obstacle's via depends on when the phase passes the parts riding by,
+a changed tf may clear it) at least the model's straight tf — an approach too, its grasp then
+later (measured at 3d30e76, line_two_belts seed 8: a lead that waited 0.25 s for a posture gave a
+grasp 2.3 s after the decision while the cycle's approach from the decision was 3.08 s; the
+approach was commanded in 2.06 s, joint 1 at 1.35 × its speed limit; 1 of 237 tasks).
+Measured on seed 25 at 1c48563: the second task's carry stretched 0.96 → 2.65 s for a via that
+the stretch then made needless; with the split the via's leg took 0.23 s and the carry 0.96 s.
 """
 
 from __future__ import annotations
@@ -51,8 +54,8 @@ def split(move: MoveConfig, first: float, second: float, share: float,
 
 def fitted(task: PickTaskConfig, needs: dict, straight: dict) -> dict:
     """phase → the ``MoveConfig`` it needs instead of ``task``'s: ``needs`` (phase → (tf₁, tf₂,
-    share), ``LineCycles.detours``) split (``split``: the approach's end fixed), and a phase after
-    the grasp shorter than its ``straight`` tf (phase → s, the model's) without a via back to that."""
+    share), ``LineCycles.detours``) split (``split``: the approach's end fixed), and a phase
+    without a via shorter than its ``straight`` tf (phase → s, the model's) stretched to that."""
     out = {}
     for phase, legs in needs.items():
         move = split(getattr(task, phase), *legs, fixed_end=phase == "approach")
@@ -60,6 +63,6 @@ def fitted(task: PickTaskConfig, needs: dict, straight: dict) -> dict:
             out[phase] = move
     for phase, tf in straight.items():
         move = getattr(task, phase)
-        if phase not in needs and phase != "approach" and move.tf < tf - SLACK:
+        if phase not in needs and move.tf < tf - SLACK:
             out[phase] = MoveConfig(tf, move.beta)
     return out
