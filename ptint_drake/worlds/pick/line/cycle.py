@@ -80,7 +80,6 @@ class LineCycles:
         self.model = model or PhaseTimes.of(scenario)
         self.window_at = window_at  # (belt, lateral, height) → reach window (``LineView.window_at``)
         self.finger = finger  # m, the open fingers' (thickness, width) (``grasp_gate.finger_extent``)
-        self.finger_width = finger[1]  # m, the open fingers' width along an outgoing belt
         self.out_place: Optional[OutPlace] = None  # the last ``phases``' point on an outgoing belt
         self.task = PickTaskConfig()
         self._leads: dict = {}
@@ -249,7 +248,7 @@ class LineCycles:
 
         parts = {p.name: p for p in pick.parts}
         self.out_place, cycle = choose(pick, slot.belt, window, grasp, cycle_of, kind,
-                                       placed_on(pick.tasks, slot.belt, parts), self.finger_width,
+                                       placed_on(pick.tasks, slot.belt, parts), self.finger[1],
                                        track.at(grasp, now))
         return cycle
 

@@ -47,8 +47,8 @@ from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.worlds.pick.grasp_gate import finger_extent
 from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
-from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, held_mass, kind_part
-from ptint_drake.worlds.pick.phase_time import NoTfFits
+from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, kind_part
+from ptint_drake.worlds.pick.phase_time import NoTfFits, held_mass
 from ptint_drake.worlds.pick.line.grip import grip_axis, in_tray, logged
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
@@ -303,10 +303,10 @@ class LineDriver:
         (``slot_choice``: ``decision.slot`` set); None where no tf fits a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
         kind = next(c for c in self.line.catalog if c.name == track.kind)
+        filled = in_tray(self.scenario.pick, keep)
+        def cycle_of(slot):
+            return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot, filled)
         try:
-            def cycle_of(slot):
-                return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot,
-                                          in_tray(self.scenario.pick, keep))
             if kind.fill == "cycle" and isinstance(decision.slot, int):
                 near = nearest(self.scenario.pick, kind_part(self.scenario.pick, kind.name), free[kind.name],
                                decision.point)

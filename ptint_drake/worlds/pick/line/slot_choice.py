@@ -8,7 +8,8 @@ before its deadline.  ``fill: cycle`` (the default) asks the min-tf model instea
 (``LineCycles.phases``, the whole cycle from the tool's present point: its carry, place and
 retreat to that slot) for the ``NEAREST`` free slots nearest the grasp point (horizontal
 distance: a cheap first cut, so a decision asks the model for one more cycle, not one per free
-slot), and takes the shorter, the listed order breaking a tie.  ``fill: order`` keeps the listed
+slot; the listed order breaks a tie in distance), and takes the shorter cycle (the nearer slot
+on a tie).  ``fill: order`` keeps the listed
 order (a kit filled in a set order).  The next approach, from where the place leaves the tool, is
 not in the choice: the next part is not chosen yet.
 """
