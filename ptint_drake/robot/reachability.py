@@ -17,7 +17,7 @@ the solver's own, so no caller's result changes —
   two frames share their origin), and the second joint's distance from the first joint's axis;
   a point farther from that axis's foot than their sum (plus the position box's half-diagonal) has
   no posture — None at once.  Measured (line_assembly harsh, seed 3): 150 of the 174 failing
-  solves of a sample, the scan of a reach window along a belt and the ways that leave reach;
+  solves of a sample (a reach window's scan runs the belt's whole length);
 - **a question asked before** (``_ANSWERS``): the same plant and frame, the same point, start
   posture and constraints to the bit — Drake's SNOPT solve is deterministic, so the answer is the
   first one's (a copy).  Kept per plant while it lives (``weakref``), ``ANSWERS_SIZE`` at most.
