@@ -41,11 +41,11 @@ from ptint_drake.worlds.pick.line.grip import grip_axis, in_tray, logged
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.no_line import NoLine
 from ptint_drake.worlds.pick.out_belt import OutPlace
-from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
+from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan, unpinned
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.slot_choice import choose, nearest
-from ptint_drake.worlds.pick.line.via_split import fitted
+from ptint_drake.worlds.pick.line.via_split import DETOUR_PASSES, fitted
 from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.line.watch import watch
 from ptint_drake.worlds.pick.scene import belt_frame
@@ -54,7 +54,6 @@ from ptint_drake.worlds.pick.tasks import Replan
 __all__ = ["FAR_UPSTREAM", "LineDriver", "NoLine", "cycle_time", "view_scenario"]  # (NoLine: world's)
 
 FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
-DETOUR_PASSES = 3  # plans made to fit a task's vias (``LineDriver._fit``)
 
 
 def cycle_time(task: PickTaskConfig) -> float:
@@ -96,6 +95,7 @@ class LineDriver:
         self._vias: dict = {}
         self.given_up: set = set()  # tracks whose task was abandoned (``give_up``): not chosen again
         self.abandoned: list = []  # {"t", "task", "drift_mm"} of every task given up in its approach
+        self.straight: dict = {}  # task → the model's tf of each of its phases (a kept task: ``watch``)
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -209,6 +209,7 @@ class LineDriver:
         if task is None:
             return False
         self._commit(run, t, decision, replacing, task)
+        self.straight[replacing if replacing is not None else len(tasks) - 1] = dict(cycle.phases)
         record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
         chosen = next(tr for tr in tracks if tr.id == decision.track)
         record |= logged(self.cycles.found(chosen, windows[chosen.id], start, yaw), cycle)  # (cached)
@@ -288,7 +289,7 @@ class LineDriver:
             scenario = self.planning()
             trial = [*tasks[:k], task, *tasks[k + 1:]]
             scenario = replace(scenario, pick=replace(scenario.pick, tasks=trial))
-            replans = (*run.replans[:k], Replan(), *run.replans[k + (replacing is not None):])
+            replans = (*run.replans[:k], Replan(), *unpinned(run.replans[k + (replacing is not None):], k))
             try:
                 needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
             except NoTfFits as error:
@@ -324,6 +325,7 @@ class LineDriver:
         else:
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
+            run.replans[:] = unpinned(run.replans, k)  # (its approach restarts: ``watch``)
         part = [p.name for p in self.built.station.config.parts].index(task.part)
         task.close_delay = close_delay(self.line.truth, part)  # the truth's jitter (robust)
         self.committed[k] = [decision.track, decision.grasp, decision.point]
