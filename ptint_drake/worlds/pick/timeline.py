@@ -83,9 +83,11 @@ def task_reasons(metrics: dict) -> dict:
 
 
 def part_timelines(names: list[str], series: dict, metrics: dict, camera: bool) -> list[PartTimeline]:
-    """Per declared part (``names``, in order) its ``PartTimeline`` (module docstring)."""
-    lines = [PartTimeline(name) for name in names]
+    """Per declared part (``names``, in order) its ``PartTimeline`` (module docstring); a line's
+    parts are those its run released (the first of the pool, in release order: a draw that released
+    none keeps one part parked, ``line.arrivals.idle_part``)."""
     rows = metrics.get("line", {}).get("parts")  # a line: when each part was seen (``line.metrics``)
+    lines = [PartTimeline(name) for name in (names if rows is None else names[:len(rows)])]
     for k, line in enumerate(lines):
         if rows is not None:
             line.seen = rows[k]["seen"]
@@ -123,7 +125,9 @@ def timeline_figure(lines: list[PartTimeline], metrics: dict, path: Path, title:
         for row, line in enumerate(lines):
             _timeline_row(ax, row, line)
         ax.set_yticks(range(len(lines)), [tl.name for tl in lines])
-        ax.set_ylim(len(lines) - 0.5, -0.5)  # the first part on top
+        ax.set_ylim(max(len(lines), 1) - 0.5, -0.5)  # the first part on top
+        if not lines:
+            ax.text(0.5 * end, 0.0, "no part arrived", ha="center", va="center", color="0.4")
         ax.set_xlim(0.0, end)
         ax.set_xlabel("t (s)")
         ax.set_title("each part: seen → scheduled → grasped → placed, or failed (why)")
