@@ -91,6 +91,8 @@ def part_timelines(names: list[str], series: dict, metrics: dict, camera: bool) 
     for k, line in enumerate(lines):
         if rows is not None:
             line.seen = rows[k]["seen"]
+            if rows[k].get("task") is None and rows[k].get("reason"):  # lost with no task (``line.metrics``)
+                line.failed, line.ended = [rows[k]["reason"]], rows[k].get("failed_at")
         elif not camera:
             line.seen = 0.0
         elif "tracks" in series:
