@@ -125,7 +125,7 @@ def timeline_figure(lines: list[PartTimeline], metrics: dict, path: Path, title:
         fig.suptitle(f"{title or metrics.get('scenario', '')}: {metrics.get('status', '')} — {placed} of "
                      f"{len(lines)} parts placed", fontsize=FONT_SIZE + 2, fontweight="bold")
         for row, line in enumerate(lines):
-            _timeline_row(ax, row, line)
+            _timeline_row(ax, row, line, end)
         ax.set_yticks(range(len(lines)), [tl.name for tl in lines])
         ax.set_ylim(max(len(lines), 1) - 0.5, -0.5)  # the first part on top
         if not lines:
@@ -143,8 +143,9 @@ def timeline_figure(lines: list[PartTimeline], metrics: dict, path: Path, title:
     return path
 
 
-def _timeline_row(ax, row: int, line: PartTimeline) -> None:
-    """One part's row: a line over its events, each event's mark, a failure's cross and reasons."""
+def _timeline_row(ax, row: int, line: PartTimeline, end: float) -> None:
+    """One part's row: a line over its events, each event's mark, a failure's cross and reasons
+    (written to the cross's left in the last third of the run's ``end``, inside the axes)."""
     events = line.events()
     times = list(events.values()) + ([line.ended] if line.failed and line.ended is not None else [])
     if len(times) > 1:
@@ -156,8 +157,10 @@ def _timeline_row(ax, row: int, line: PartTimeline) -> None:
     if line.failed:
         t = line.ended if line.ended is not None else (max(times) if times else 0.0)
         ax.plot([t], [row], marker="X", color="tab:red", ms=11, ls="none", label="failed", zorder=3)
-        ax.annotate("failed: " + ", ".join(line.failed), (t, row), xytext=(8, 8),
-                    textcoords="offset points", color="tab:red", fontsize=FONT_SIZE - 1)
+        late = t > 2.0 * end / 3.0
+        ax.annotate("failed: " + ", ".join(line.failed), (t, row), xytext=(-8 if late else 8, 8),
+                    textcoords="offset points", color="tab:red", fontsize=FONT_SIZE - 1,
+                    ha="right" if late else "left")
     elif not events:
         ax.annotate("never seen, no task", (0.0, row), xytext=(4, 0), textcoords="offset points",
                     color="0.4", fontsize=FONT_SIZE - 1, va="center")
