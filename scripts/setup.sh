@@ -13,6 +13,8 @@
 #   DRAKE='drake==1.51.1'    a pip requirement for Drake (default: the newest the Python admits)
 #   PTINT_EDITABLE=1         install the package in editable mode (for development)
 #   HEARTBEAT_S=6            seconds between the "still running" lines of a long step
+#   SYSTEM_TOOLS=0           leave the system tools alone (.ci/run: the other end's setup,
+#                            running beside this one, installs them; apt-get takes one lock)
 # An existing environment built on another Python version than the one chosen is rebuilt.
 #
 # Progress: every step prints what it does when it starts and how long it took when it ends
@@ -92,7 +94,9 @@ trap 'exit 143' TERM
 need=()
 command -v dot >/dev/null 2>&1 || need+=(graphviz)
 command -v chromium >/dev/null 2>&1 || need+=(chromium)
-if [ ${#need[@]} -gt 0 ]; then
+if [ "${SYSTEM_TOOLS:-1}" = 0 ]; then
+  say "system tools: not checked (SYSTEM_TOOLS=0)"
+elif [ ${#need[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ]; then SUDO=""; elif command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else SUDO="none"; fi
   if [ "$SUDO" = none ]; then
     say "cannot install ${need[*]} (not root, no sudo); the tests that need them will fail"
@@ -189,11 +193,12 @@ step_begin "check" "the installed package finds its bundled model"
 (cd / && "$venv_abs/bin/python" -c "import ptint_drake.robot.rvm1 as r; assert r.model_path().is_file(), r.model_path()")
 step_end
 # Compile the controller's numba kernels once (into numba's cache), so the first `ptint run`
-# does not pay for it; the warm-up prints a line per run it compiles.  A cold cache took 58 s,
-# 96 s and 122 s on a shared 2-core x86_64 machine at load averages of about 2.5 to 7 (2026-12-05,
-# Python 3.13, Drake 1.58) and 135 s / 182 s in CI (2026-12-03, the two Drake ends, .ci/run):
-# 1-3 minutes; a warm cache a few seconds.
-step_begin "compile" "the controller's numba kernels, once (1-3 min when numba's cache is cold, seconds when warm)"
+# does not pay for it; the warm-up prints a line per run it compiles.  Two processes compile
+# disjoint kernels side by side (ptint_drake/cli/warm_up.py): a cold cache took 49 s, against 73 s
+# in one process, on a 2-core x86_64 machine with nothing else running (2026-12-06, Python 3.13,
+# Drake 1.58); in one process 58-122 s at load averages of about 2.5 to 7 (2026-12-05) and 135 s /
+# 182 s in CI (2026-12-03, the two Drake ends, .ci/run); a warm cache a few seconds.
+step_begin "compile" "the controller's numba kernels, once (about 1 min when numba's cache is cold, seconds when warm)"
 (cd / && "$venv_abs/bin/python" -m ptint_drake.cli.warm_up)
 step_end
 info=$("$venv_abs/bin/python" -c 'import sys, importlib.metadata as m

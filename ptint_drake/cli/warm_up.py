@@ -16,63 +16,95 @@ run compiles them when it first needs them (``jit_notice``).
 
 from __future__ import annotations
 
+import multiprocessing
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Callable
 
 import numpy as np
 
-# scenario, ``--set`` overrides: each reaches kernels (or argument types) the others do not
+# scenario, ``--set`` overrides: each reaches kernels (or argument types) the others do not.  Two
+# shares, run side by side (``warm_up``), that compile disjoint kernels: the position task's fused
+# rows, the IMM and the baselines; the pose and top-down rows and the five blocks.  Measured on a
+# cold cache, 2 cores, nothing else running (2026-12-06, Python 3.13, Drake 1.58): in one process
+# the shares' runs took 38 s and 33 s (the first run of each 23 s: its fused rows); dealt to two
+# processes run by run, 67 s against 73 s in one, since the top-down rows were compiled in both.
 _RUNS = (
-    ("curve_b075_tf15", []),
-    ("curve_b075_tf15", ["controller.implementation=blocks"]),
-    ("conveyor_pair", ["controller.switching=sat", "controller.pinv_damping=0.01"]),
-    ("conveyor_pair_camera", []),
-    ("throw_camera", []),
-    ("curve_pose", []),
-    ("conveyor_yaw_camera", []),  # the top-down task from a filter, the orientation filter's output
-    ("curve_b075_tf15", ["controller.type=smc"]),
-    ("curve_b075_tf15", ["controller.type=ct_quintic"]),  # pinv_solve (``ptint paper``'s comparisons)
+    (("curve_b075_tf15", []),
+     ("conveyor_pair", ["controller.switching=sat", "controller.pinv_damping=0.01"]),
+     ("conveyor_pair_camera", []),
+     ("throw_camera", []),
+     ("curve_b075_tf15", ["controller.type=smc"]),
+     ("curve_b075_tf15", ["controller.type=ct_quintic"]),  # pinv_solve (``ptint paper``'s comparisons)
+     None),  # the TBG, orientation and IMM kernels
+    (("curve_pose", []),
+     ("conveyor_yaw_camera", []),  # the top-down task from a filter, the orientation filter's output
+     ("curve_b075_tf15", ["controller.implementation=blocks"])),
 )
 
 
-def warm_up(duration: float = 0.05, report: Callable[[str], None] | None = None) -> float:
+def warm_up(duration: float = 0.05, report: Callable[[str], None] | None = None, workers: int = 2) -> float:
     """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
-    telemetry of the last state, as a run's outputs do); the wall time in s.  ``report(line)``
-    gets a line as each run and the last kernels are done (what compiled, how long it took)."""
+    telemetry of the last state, as a run's outputs do), then call the TBG, orientation and IMM
+    kernels; the wall time in s.  ``report(line)`` gets a line as each part is done (what
+    compiled, how long it took).
+
+    numba compiles on one core, so with ``workers`` = 2 the two shares of ``_RUNS`` (disjoint
+    kernels) run side by side in two processes (``spawn``: a fresh interpreter each), compiling
+    into the same cache (numba writes each entry to a temporary file and renames it into place);
+    ``workers`` = 1 runs them one after the other here."""
+    t0 = time.perf_counter()
+    say = report or (lambda line: None)
+    total = sum(len(share) for share in _RUNS)
+    if workers <= 1:
+        for i, line in enumerate((line for share in _RUNS for line in _compile(share, duration)), start=1):
+            say(f"[{i}/{total}] {line}")
+        return time.perf_counter() - t0
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        done = as_completed([pool.submit(_compile, share, duration) for share in _RUNS])
+        lines = [line for future in done for line in future.result()]
+    for i, line in enumerate(lines, start=1):
+        say(f"[{i}/{total}] {line}")
+    return time.perf_counter() - t0
+
+
+def _compile(share, duration: float) -> list[str]:
+    """Run each of ``share`` (a ``_RUNS`` entry: None is the TBG, orientation and IMM kernels) in
+    this process (``warm_up``); a line per run: what it was and its wall time."""
+    return [_run(run, duration) for run in share]
+
+
+def _run(run, duration: float) -> str:
+    """One entry of a share (``_compile``), simulated (or the kernels called); its line."""
     from ptint_drake.simulation import build, make_simulator  # noqa: PLC0415
     from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text  # noqa: PLC0415
     from ptint_drake.systems.task.tbg import alpha_gain, alpha_peak, tbg_profile  # noqa: PLC0415
 
-    say = report or (lambda line: None)
-    t0 = time.perf_counter()
-    steps = len(_RUNS) + 1
-    for i, (name, overrides) in enumerate(_RUNS, start=1):
-        t_run = time.perf_counter()
-        _, text = scenario_text(name)
-        scenario = parse_with_overrides(text, overrides, name)
-        built = build(scenario, log=False)
-        simulator = make_simulator(built)
-        simulator.AdvanceTo(duration)
-        law = getattr(built.controller.system, "law", None)
-        system = built.controller.system
-        if law is not None:
-            law.load_general_kernels()
-        if law is not None and not system.has_target_input and not system.has_rotation_input:
-            context = law.GetMyContextFromRoot(simulator.get_context())
-            qv, sigma, captured, _ = law.loop_values(context)
-            system.telemetry_at([duration], qv[None], sigma[None], captured[None])
-        say(f"[{i}/{steps}] {name}{' ' + ' '.join(overrides) if overrides else ''}: "
-            f"{time.perf_counter() - t_run:.1f} s")
-    t_rest = time.perf_counter()
-    alpha_peak(1.5, 0.75)
-    tbg_profile(0.5, 1.5, 0.75)
-    xi, xi_dot, _, _ = tbg_profile(np.linspace(0.0, 1.5, 5), 1.5, 0.75)
-    alpha_gain(xi, xi_dot)  # arrays, as ``figures.tbg_family_figure`` (``ptint paper``) calls it
-    _orientation_kernels()
-    _imm_kernels()
-    say(f"[{steps}/{steps}] TBG, orientation and IMM kernels: {time.perf_counter() - t_rest:.1f} s")
-    return time.perf_counter() - t0
+    t_run = time.perf_counter()
+    if run is None:
+        alpha_peak(1.5, 0.75)
+        tbg_profile(0.5, 1.5, 0.75)
+        xi, xi_dot, _, _ = tbg_profile(np.linspace(0.0, 1.5, 5), 1.5, 0.75)
+        alpha_gain(xi, xi_dot)  # arrays, as ``figures.tbg_family_figure`` (``ptint paper``) calls it
+        _orientation_kernels()
+        _imm_kernels()
+        return f"TBG, orientation and IMM kernels: {time.perf_counter() - t_run:.1f} s"
+    name, overrides = run
+    _, text = scenario_text(name)
+    scenario = parse_with_overrides(text, overrides, name)
+    built = build(scenario, log=False)
+    simulator = make_simulator(built)
+    simulator.AdvanceTo(duration)
+    law = getattr(built.controller.system, "law", None)
+    system = built.controller.system
+    if law is not None:
+        law.load_general_kernels()
+    if law is not None and not system.has_target_input and not system.has_rotation_input:
+        context = law.GetMyContextFromRoot(simulator.get_context())
+        qv, sigma, captured, _ = law.loop_values(context)
+        system.telemetry_at([duration], qv[None], sigma[None], captured[None])
+    return f"{' '.join([name, *overrides])}: {time.perf_counter() - t_run:.1f} s"
 
 
 def _orientation_kernels() -> None:
@@ -110,6 +142,7 @@ def _report(line: str) -> None:
 
 
 if __name__ == "__main__":
-    _report(f"compiling (or loading from numba's cache) the kernels of {len(_RUNS)} short runs, then "
-            f"the rest; a few seconds when the cache is warm")
+    runs = sum(run is not None for share in _RUNS for run in share)
+    _report(f"compiling (or loading from numba's cache) the kernels of {runs} short runs and the rest, "
+            f"in two processes; a few seconds when the cache is warm")
     print(f"warm-up: compiled kernels ready in {warm_up(report=_report):.1f} s", file=sys.stderr)

@@ -44,3 +44,24 @@ def test_the_pool_is_ordinary_parts_named_by_kind_in_release_order():
     assert [r.t for r in releases] == sorted(r.t for r in releases)
     assert all(r.t < 60.0 - 12.0 for r in releases) and scenario.pick.tasks == []
     assert all(-0.015 <= p.lateral <= 0.015 and p.offset == -0.7 for p in scenario.pick.parts)
+
+
+def test_a_draw_that_releases_no_part_keeps_one_parked_and_a_closed_window_is_refused():
+    """A Poisson line at a low rate releases nothing for some seeds (line_two_belts: seed 4 of
+    0-36): the run goes on with one pool part never released (``idle_part``), not exit 2; only
+    arrivals that cannot release anything before the end (start ≥ duration − until) are refused."""
+    from ptint_drake.config.errors import ScenarioError  # noqa: PLC0415
+
+    scenario = load_scenario("line_two_belts")
+    for arrival in scenario.pick.line.arrivals:
+        arrival.rate = 0.001  # a mean gap of 1000 s against 36 s of window
+    expanded, releases = line_scenario(scenario)
+    assert releases == [] and len(expanded.pick.parts) == 1
+    kind = scenario.pick.line.catalog[0]
+    (part,) = expanded.pick.parts
+    assert part.shape == kind.shape and part.size == list(kind.size) and part.belt == "outer"
+    closed = copy.deepcopy(scenario)
+    for arrival in closed.pick.line.arrivals:
+        arrival.start = closed.duration - arrival.until
+    with pytest.raises(ScenarioError, match="pick.line.arrivals: no part arrives"):
+        line_scenario(closed)

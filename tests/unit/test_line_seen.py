@@ -112,6 +112,18 @@ def test_a_line_part_is_on_the_timeline_when_the_line_saw_it():
         assert [line.seen for line in lines] == [9.87, None]
 
 
+def test_a_line_part_lost_with_no_task_is_failed_on_the_timeline_and_a_part_never_released_absent():
+    # cube_0 given up or never taken (``line.metrics``: its reason and when, no task); the pool's
+    # third part never released (``arrivals.idle_part``): no row, no line on the timeline
+    rows = [{"seen": 1.5, "task": None, "reason": "not reachable in time", "failed_at": 13.9},
+            {"seen": 2.0, "task": None, "reason": None}]
+    metrics = {"picks": [], "segments": [], "reason_codes": [], "line": {"parts": rows}}
+    lines = part_timelines(["cube_0", "cube_1", "cube_2"], {}, metrics, False)
+    assert [line.name for line in lines] == ["cube_0", "cube_1"]
+    assert lines[0].failed == ["not reachable in time"] and lines[0].ended == 13.9
+    assert lines[1].failed == [] and lines[1].ended is None
+
+
 def test_a_slot_aimed_between_frames_reads_its_track_at_once():
     config, system = _system()
     tracker = Tracker(config.tracking)

@@ -76,13 +76,18 @@ def pick_figure(series: dict, metrics: dict, path: Path, title: str = "") -> Pat
 
     picks = metrics["picks"]
     with plt.rc_context({"font.size": FONT_SIZE}):
-        fig = plt.figure(figsize=(13, 7.2 * len(picks) + 0.6), layout="constrained")
+        fig = plt.figure(figsize=(13, 7.2 * len(picks) + 0.6 if picks else 2.0), layout="constrained")
         placed = sum(bool(p["placed"]) for p in picks)
         fig.suptitle(f"{title or metrics.get('scenario', '')}: {metrics.get('status', '')} — "
                      f"{placed} of {len(picks)} parts placed", fontsize=FONT_SIZE + 3, fontweight="bold")
-        blocks = np.atleast_1d(fig.subfigures(len(picks), 1))
-        for row, (block_fig, pick) in enumerate(zip(blocks, picks)):
-            _pick_block(block_fig, row, pick, series)
+        if not picks:  # a line that decided no task (nothing entered, nothing seen)
+            codes = sorted({r["code"] for r in metrics.get("reason_codes", [])})
+            fig.text(0.5, 0.4, "no pick was made" + (f": {', '.join(codes)}" if codes else ""),
+                     ha="center", va="center", fontsize=FONT_SIZE + 1)
+        else:
+            blocks = np.atleast_1d(fig.subfigures(len(picks), 1))
+            for row, (block_fig, pick) in enumerate(zip(blocks, picks)):
+                _pick_block(block_fig, row, pick, series)
         fig.savefig(path, dpi=100)
     plt.close(fig)
     return path

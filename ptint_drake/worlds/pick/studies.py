@@ -243,7 +243,9 @@ def report(scenario, metrics: dict, out) -> int:
     if metrics["status"] == "missed":
         print(f"{scenario.name}: MISSED ({'; '.join(metrics['reasons'])})")
         return 1
-    print(f"{scenario.name}: ok (every part placed)")
+    line = metrics.get("line")
+    none = line is not None and not line["released"]  # (a line's draw that released no part)
+    print(f"{scenario.name}: ok ({'no part arrived' if none else 'every part placed'})")
     return 0
 
 

@@ -83,12 +83,16 @@ def task_reasons(metrics: dict) -> dict:
 
 
 def part_timelines(names: list[str], series: dict, metrics: dict, camera: bool) -> list[PartTimeline]:
-    """Per declared part (``names``, in order) its ``PartTimeline`` (module docstring)."""
-    lines = [PartTimeline(name) for name in names]
+    """Per declared part (``names``, in order) its ``PartTimeline`` (module docstring); a line's
+    parts are those its run released (the first of the pool, in release order: a draw that released
+    none keeps one part parked, ``line.arrivals.idle_part``)."""
     rows = metrics.get("line", {}).get("parts")  # a line: when each part was seen (``line.metrics``)
+    lines = [PartTimeline(name) for name in (names if rows is None else names[:len(rows)])]
     for k, line in enumerate(lines):
         if rows is not None:
             line.seen = rows[k]["seen"]
+            if rows[k].get("task") is None and rows[k].get("reason"):  # lost with no task (``line.metrics``)
+                line.failed, line.ended = [rows[k]["reason"]], rows[k].get("failed_at")
         elif not camera:
             line.seen = 0.0
         elif "tracks" in series:
@@ -121,9 +125,11 @@ def timeline_figure(lines: list[PartTimeline], metrics: dict, path: Path, title:
         fig.suptitle(f"{title or metrics.get('scenario', '')}: {metrics.get('status', '')} — {placed} of "
                      f"{len(lines)} parts placed", fontsize=FONT_SIZE + 2, fontweight="bold")
         for row, line in enumerate(lines):
-            _timeline_row(ax, row, line)
+            _timeline_row(ax, row, line, end)
         ax.set_yticks(range(len(lines)), [tl.name for tl in lines])
-        ax.set_ylim(len(lines) - 0.5, -0.5)  # the first part on top
+        ax.set_ylim(max(len(lines), 1) - 0.5, -0.5)  # the first part on top
+        if not lines:
+            ax.text(0.5 * end, 0.0, "no part arrived", ha="center", va="center", color="0.4")
         ax.set_xlim(0.0, end)
         ax.set_xlabel("t (s)")
         ax.set_title("each part: seen → scheduled → grasped → placed, or failed (why)")
@@ -137,8 +143,9 @@ def timeline_figure(lines: list[PartTimeline], metrics: dict, path: Path, title:
     return path
 
 
-def _timeline_row(ax, row: int, line: PartTimeline) -> None:
-    """One part's row: a line over its events, each event's mark, a failure's cross and reasons."""
+def _timeline_row(ax, row: int, line: PartTimeline, end: float) -> None:
+    """One part's row: a line over its events, each event's mark, a failure's cross and reasons
+    (written to the cross's left in the last third of the run's ``end``, inside the axes)."""
     events = line.events()
     times = list(events.values()) + ([line.ended] if line.failed and line.ended is not None else [])
     if len(times) > 1:
@@ -150,8 +157,10 @@ def _timeline_row(ax, row: int, line: PartTimeline) -> None:
     if line.failed:
         t = line.ended if line.ended is not None else (max(times) if times else 0.0)
         ax.plot([t], [row], marker="X", color="tab:red", ms=11, ls="none", label="failed", zorder=3)
-        ax.annotate("failed: " + ", ".join(line.failed), (t, row), xytext=(8, 8),
-                    textcoords="offset points", color="tab:red", fontsize=FONT_SIZE - 1)
+        late = t > 2.0 * end / 3.0
+        ax.annotate("failed: " + ", ".join(line.failed), (t, row), xytext=(-8 if late else 8, 8),
+                    textcoords="offset points", color="tab:red", fontsize=FONT_SIZE - 1,
+                    ha="right" if late else "left")
     elif not events:
         ax.annotate("never seen, no task", (0.0, row), xytext=(4, 0), textcoords="offset points",
                     color="0.4", fontsize=FONT_SIZE - 1, va="center")

@@ -90,6 +90,17 @@ def line_pool(line: LineConfig, duration: float) -> tuple[list[PartConfig], list
     return parts, releases
 
 
+def idle_part(line: LineConfig) -> PartConfig:
+    """The pool of a draw that released no part (a Poisson process at a low rate, one seed in
+    many): one part of the first block's first kind, never released — parked the whole run
+    (``truth``), so the station is built as for any line and the run reports nothing entered."""
+    arrival = line.arrivals[0]
+    names, weights = _kinds(line, arrival)
+    c = next(c for c in line.catalog if c.name == names[int(np.argmax(weights))])
+    return PartConfig(name=f"{c.name}_0", belt=arrival.belt, shape=c.shape, size=list(c.size),
+                      offset=arrival.release, mass=c.mass, friction=c.friction)
+
+
 def pool_truth(parts: list[PartConfig], truth: PoolTruthConfig, belts: list) -> None:
     """Pool part n's mass, friction and lateral shift from ``truth`` (``PoolTruthConfig``; the
     shifted offset clipped to its belt's half width), in place; a list of another length than the
@@ -119,10 +130,13 @@ def line_scenario(scenario):
     truth: ``pool_truth``) and whose ``pick.tasks`` is empty (the run appends what it decides);
     and the releases."""
     out = copy.deepcopy(scenario)
-    parts, releases = line_pool(scenario.pick.line, scenario.duration)
+    line = scenario.pick.line
+    parts, releases = line_pool(line, scenario.duration)
     if not parts:
-        raise ScenarioError("pick.line.arrivals: no part arrives before the scenario's end (rate, "
-                            "start, until, duration)")
+        if all(a.start >= scenario.duration - a.until for a in line.arrivals):
+            raise ScenarioError("pick.line.arrivals: no part arrives before the scenario's end (rate, "
+                                "start, until, duration)")
+        parts = [idle_part(line)]  # a draw that released nothing: the run goes on with its pool parked
     pool_truth(parts, scenario.pick.line.truth, scenario.pick.belts)
     out.pick.parts, out.pick.tasks = parts, []
     return out, releases

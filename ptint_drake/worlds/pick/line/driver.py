@@ -11,21 +11,9 @@ belt speeds, the reach windows; the arm's state; its own tasks):
   defaults, ``start`` = its grasp time − the default approach and descend) is appended and the
   diagram rebuilt (the pick run's replan and resume).  A task whose cycle would end after the
   scenario's end is not started;
-- **while a task approaches** (before its descend), the grasp point predicted now is compared with
-  the committed one; beyond ``line.redecide_mm`` (a belt without an encoder running faster or
-  slower than declared: its speed is then learned from the track, ``view.LineView.learned``) the
-  scheduler's rule is checked again with that speed: the part in its window from the approach's
-  end to the committed grasp and the lift, and the min-tf model's approach and descend from the
-  tool's present point (``line.cycle.LineCycles.fits``) fitting between the approach's start (or
-  now, under way) and the grasp — measured without the first condition (the belt slowed to 0.3×,
-  tests/e2e): the approach kept aimed at a part still upstream of reach and the arm ran away.  Still in it and
-  time enough, the task goes on (the targets follow the track: ``kept``); else the scheduler
-  decides again from now and the task is replaced (``replaced``: an approach under way restarts
-  from the present state, its tf stretched to the new grasp time; one not started yet starts at
-  the model's lead before it); nothing to replace it with, a task whose part is out of its window
-  at the approach's end or at the lift's start (a dwell after the grasp) is given up (``give_up``:
-  ``abandoned``, the arm sent to a hold from its present state, the part ``not reachable in
-  time``), any other goes on (``nothing feasible: kept``).
+- **while a task approaches** (before its descend), ``watch`` compares the grasp point predicted
+  now with the committed one and, beyond ``line.redecide_mm``, keeps the task, replaces it or
+  gives it up (``watch``'s docstring).
 
 Every chosen task is fitted to the plan the run will follow (``_fit``): a phase the plan splits by
 a via gets what the via's two legs need (``line.cycle.LineCycles.detours``, ``via_split``), its
@@ -50,23 +38,22 @@ from ptint_drake.worlds.pick.line.arrivals import close_delay, line_scenario
 from ptint_drake.worlds.pick.line.cycle import LineCycles, estimate, kind_part
 from ptint_drake.worlds.pick.phase_time import NoTfFits, held_mass
 from ptint_drake.worlds.pick.line.grip import grip_axis, in_tray, logged
-from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.no_line import NoLine
 from ptint_drake.worlds.pick.out_belt import OutPlace
-from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan
-from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide, drifted
+from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan, unpinned
+from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide
 from ptint_drake.worlds.pick.line.truth import LineTruth
 from ptint_drake.worlds.pick.line.slot_choice import choose, nearest
-from ptint_drake.worlds.pick.line.via_split import fitted
+from ptint_drake.worlds.pick.line.via_split import DETOUR_PASSES, fitted
 from ptint_drake.worlds.pick.line.view import LineView
+from ptint_drake.worlds.pick.line.watch import watch
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.tasks import Replan
 
 __all__ = ["FAR_UPSTREAM", "LineDriver", "NoLine", "cycle_time", "view_scenario"]  # (NoLine: world's)
 
 FAR_UPSTREAM = -1000.0  # m along its belt: where the plan's model puts a part it does not see
-DETOUR_PASSES = 3  # plans made to fit a task's vias (``LineDriver._fit``)
 
 
 def cycle_time(task: PickTaskConfig) -> float:
@@ -108,6 +95,7 @@ class LineDriver:
         self._vias: dict = {}
         self.given_up: set = set()  # tracks whose task was abandoned (``give_up``): not chosen again
         self.abandoned: list = []  # {"t", "task", "drift_mm"} of every task given up in its approach
+        self.straight: dict = {}  # task → the model's tf of each of its phases (a kept task: ``watch``)
 
     def bind(self, built) -> None:
         """The (re)built diagram's handles."""
@@ -175,66 +163,8 @@ class LineDriver:
         if t < IDLE_TF - 1e-9:
             return False
         if t < run.built.plan.end - 1e-9:  # a task (or a hold: ``give_up``) under way
-            return bool(self.scenario.pick.tasks) and self._watch(run, context, t)
+            return bool(self.scenario.pick.tasks) and watch(self, run, context, t)
         return self._choose(run, context, t)
-
-    def _watch(self, run, context, t: float) -> bool:
-        """The last task's grasp point against the committed one, before its descend."""
-        k = len(self.scenario.pick.tasks) - 1
-        plan = run.built.plan
-        if t >= plan.schedule.segments[plan.segment_index(k, "descend", 0)].start - 1e-9:
-            return False
-        track_id, grasp, point = self.committed[k]
-        track = next((tr for tr in self.view.tracks(context, t) if tr.id == track_id), None)
-        drift = track is not None and drifted(track, grasp, point, t, 1e-3 * self.line.redecide_mm)
-        if not drift:
-            return False
-        if np.isfinite(track.measured) and not self._has_encoder(track.belt):
-            self.view.learned[track.belt] = track.measured  # the belt's speed, as its track shows it
-            track = replace(track, speed=track.measured)
-        entry = {"t": round(t, 4), "task": k, "track": track_id, "drift_mm": round(1e3 * drift, 2),
-                 "speed": round(track.speed, 4)}
-        task = self.scenario.pick.tasks[k]
-        begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
-        window = self.view.window(track)
-        if not unserved(track, window, grasp, t, end, self.timing.slack) \
-                and self.cycles.fits(track, begin, grasp, t, *self._tool_now(self._arm_q(context)),
-                                     task.grip_yaw):
-            # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
-            self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
-            self.decisions.append(entry | {"redecide": "kept"})
-            return False
-        if self._choose(run, context, t, replacing=k):
-            self.replaced.append({"t": t, "task": k, "drift_mm": 1e3 * drift})
-            self.decisions[-1]["redecide"] = "replaced"
-            return True
-        why = unserved(track, window, grasp, t, end, task.dwell)  # the lift's start out of reach too
-        if why:  # given up (``give_up``)
-            self._abandon(run, context, t, k, track, entry | {"why": why})
-            return True
-        self.decisions.append(entry | {"redecide": "nothing feasible: kept"})
-        self.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
-        return False
-
-    def _has_encoder(self, belt: str) -> bool:
-        return any(b.name == belt and b.encoder for b in self.line.belts)
-
-    def _abandon(self, run, context, t: float, k: int, track, entry: dict) -> None:
-        """Task k (the last, in its approach) given up (``give_up``): out of the run's tasks, its
-        part named in the log, and a ``Hold`` from the arm's present state after the tasks."""
-        q = self._arm_q(context)
-        hold = hold_of(t, *self._tool_now(q), np.asarray(track.position), lambda x: self.view.reachable(x, q))
-        for records in (self.scenario.pick.tasks, run.replans, run.checks, run.refused):
-            del records[k]
-        del self.committed[k]
-        for record in self.decisions:  # its choice no longer names a task of the run (k is the next one's)
-            if record.get("task") == k:
-                record["task"], record["given up"] = None, round(t, 4)
-        run.replans.append(hold)  # after the tasks' ``Replan`` entries (``plan.line_plan``)
-        self.given_up.add(track.id)
-        self.abandoned.append({"t": t, "task": k, "drift_mm": entry["drift_mm"]})
-        self.decisions.append(entry | {"redecide": "abandoned", "hold": [round(c, 4) for c in hold.position],
-                                       "skipped": [{"track": track.id, "reason": REASON}]})
 
     def _choose(self, run, context, t: float, replacing=None) -> bool:
         """A decision from now, each track's lead from the min-tf model (``line.cycle``); a task
@@ -279,6 +209,7 @@ class LineDriver:
         if task is None:
             return False
         self._commit(run, t, decision, replacing, task)
+        self.straight[replacing if replacing is not None else len(tasks) - 1] = dict(cycle.phases)
         record = decision.record() | ({"via_tf": self._vias} if self._vias else {})
         chosen = next(tr for tr in tracks if tr.id == decision.track)
         record |= logged(self.cycles.found(chosen, windows[chosen.id], start, yaw), cycle)  # (cached)
@@ -358,7 +289,7 @@ class LineDriver:
             scenario = self.planning()
             trial = [*tasks[:k], task, *tasks[k + 1:]]
             scenario = replace(scenario, pick=replace(scenario.pick, tasks=trial))
-            replans = (*run.replans[:k], Replan(), *run.replans[k + (replacing is not None):])
+            replans = (*run.replans[:k], Replan(), *unpinned(run.replans[k + (replacing is not None):], k))
             try:
                 needs = self.cycles.detours(scenario, line_plan(scenario, replans, self.built.arm), k, mass)
             except NoTfFits as error:
@@ -394,6 +325,7 @@ class LineDriver:
         else:
             tasks[replacing], k = task, replacing
             run.replans[k], run.checks[k], run.refused[k] = Replan(), [], None
+            run.replans[:] = unpinned(run.replans, k)  # (its approach restarts: ``watch``)
         part = [p.name for p in self.built.station.config.parts].index(task.part)
         task.close_delay = close_delay(self.line.truth, part)  # the truth's jitter (robust)
         self.committed[k] = [decision.track, decision.grasp, decision.point]

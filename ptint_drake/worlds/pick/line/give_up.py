@@ -1,7 +1,7 @@
 """The give-up rule of the line (issue 44): a task kept in its approach that can no longer be
 served is abandoned, and the arm is sent to a safe hold from its present state.
 
-While a task approaches, the driver (``driver.LineDriver._watch``) checks its committed grasp
+While a task approaches, the driver (``watch.watch``) checks its committed grasp
 again when the part's predicted grasp point drifts (a belt without an encoder running faster or
 slower than declared: its speed learned from the track).  ``unserved`` names why the grasp can no
 longer be made where it is so — the part still upstream of its reach window at the approach's end,

@@ -11,7 +11,8 @@ and the run's records — the parts, not the tasks, are counted:
   ``collision with <body>``, ``dropped``, ``missed after retry``, ``not placed``), or for a part
   no task took, the scheduler's last word on it (``not reachable in time``, ``blocked``, ``tray
   full``), ``passed unpicked`` (taken off past the belt's end, never looked at: the arm busy
-  throughout) or ``on the belt at the end``;
+  throughout) or ``on the belt at the end``, and when it was lost (``failed_at``: the last
+  decision that skipped it, else the run's end; the timeline's cross);
 - ``placed_fraction`` (placed / entered), ``picks_per_minute`` (placed / duration),
   ``cycle_s`` (per task: its approach's start to its retreat's end) and their mean;
   ``tasks_span_s`` (the first approach's start to the last retreat's end) and
@@ -107,6 +108,12 @@ def _unpicked_reason(ids: list, decisions: list, passed: bool) -> str:
     return "blocked" if last.startswith("blocked") else last
 
 
+def _last_skipped(ids: list, decisions: list):
+    """The time of the last decision that skipped one of tracks ``ids`` (None: none did)."""
+    times = [d["t"] for d in decisions for skip in d.get("skipped", []) if skip["track"] in ids]
+    return float(times[-1]) if times else None
+
+
 def _torque_jumps(series: dict, replaced: list) -> tuple[list, float]:
     t, tau = series["t"], np.asarray(series["tau"])
     steps = np.max(np.abs(np.diff(tau, axis=0)), axis=1)
@@ -148,6 +155,8 @@ def line_metrics(scenario, driver, metrics: dict, series: dict) -> dict:
             row["reason"] = (codes.get(row["task"], "not placed") if row["task"] is not None
                              else "not seen" if row["seen"] is None
                              else _unpicked_reason(ids, driver.decisions, k in truth.passed))
+            if row["task"] is None:  # when it was lost: the last decision that skipped it, else the end
+                row["failed_at"] = _last_skipped(ids, driver.decisions) or float(series["t"][-1])
         parts.append(row)
     entered = sum(p["entered"] for p in parts)
     placed = sum(p["placed"] for p in parts)

@@ -11,18 +11,25 @@ tasks; in its place the plan holds a ``Hold``: a segment like the idle one (phas
 -1, a fixed point) from the moment it was given up — the arm's present state, as a replaced
 approach restarts — to the hold's point.  The run passes the holds after the tasks' ``Replan``
 entries (``line_plan``'s ``replans``), and the segments are merged in time order.
+
+A task kept after a drift (``watch``) is planned again at the new belief, its approach excepted:
+a ``Pin`` (passed with the holds) keeps the approach's via — or its having none — as the run
+follows it, whatever the routing (``route.routed_vias``) finds at the new belief, so that a
+rebuild in the approach does not move the target it is under way to, and its grasp time stays.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
 from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.systems.task.schedule import Schedule, Segment
-from ptint_drake.worlds.pick.route import routed_plan
-from ptint_drake.worlds.pick.tasks import VIA_SLOT, PickPlan, PlanSegment, Replan
+from ptint_drake.worlds.pick.route import routed_plan, routed_vias
+from ptint_drake.worlds.pick.tasks import VIA_SLOT, PickPlan, PlanSegment, Replan, Via, pick_plan
+from ptint_drake.worlds.pick.ways import nominal
 
 IDLE_TF = 0.5  # s
 IDLE_BETA = 0.75
@@ -57,6 +64,30 @@ class Hold:
                 PlanSegment(-1, "idle", VIA_SLOT, -1, tuple(self.position), self.yaw))
 
 
+@dataclass(frozen=True)
+class Pin:
+    """Task ``task``'s first approach as the run follows it (module docstring): its ``via`` (a
+    ``tasks.Via``; None: the approach has none) kept in every later plan."""
+
+    task: int
+    via: Optional[Via]
+
+
+def pin_of(plan: PickPlan, k: int) -> Pin:
+    """The ``Pin`` of task k's first approach in ``plan``: its via's point and share, if any."""
+    i = plan.segment_index(k, "approach", 0)
+    before = plan.segments[i - 1]
+    if before.task != k or before.phase != "via":
+        return Pin(k, None)
+    leg, rest = plan.schedule.segments[i - 1], plan.schedule.segments[i]
+    return Pin(k, Via(k, "approach", tuple(before.offset), leg.tf / (leg.tf + rest.tf)))
+
+
+def unpinned(replans, k: int) -> list:
+    """``replans`` without task k's ``Pin`` (a task replaced or given up)."""
+    return [r for r in replans if not (isinstance(r, Pin) and r.task == k)]
+
+
 _LAST: dict = {}  # the last plan made, by what it was made from (``line_plan``)
 
 
@@ -74,6 +105,7 @@ def line_plan(scenario, replans: tuple = (), arm=None) -> PickPlan:
 def _line_plan(scenario, replans: tuple, arm) -> PickPlan:
     """``line_plan``, made: the tasks' plan with their ``Replan`` entries, the holds merged in."""
     holds = [r.segment() for r in replans if isinstance(r, Hold)]
+    pins = {r.task: r.via for r in replans if isinstance(r, Pin)}
     replans = tuple(r for r in replans if isinstance(r, Replan))
     if arm is None:
         from ptint_drake.robot.plant import nominal_plant  # noqa: PLC0415
@@ -86,8 +118,15 @@ def _line_plan(scenario, replans: tuple, arm) -> PickPlan:
         merged = sorted([idle, *holds], key=lambda pair: pair[0].start)
         return PickPlan(Schedule([m[0] for m in merged]), tuple(m[1] for m in merged),
                         ((0.0, scenario.pick.gripper.initial_opening),), (), (), end)
-    plan = routed_plan(scenario, replans, arm)
+    plan = routed_plan(scenario, replans, arm) if not pins else _pinned_plan(scenario, replans, arm, pins)
     pairs = [idle, *zip(plan.schedule.segments, plan.segments), *holds]
     merged = sorted(pairs, key=lambda pair: pair[0].start)
     return PickPlan(Schedule([m[0] for m in merged]), tuple(m[1] for m in merged), plan.commands,
                     plan.close_times, plan.grasp_times, max(plan.end, end), plan.widths, plan.attempts)
+
+
+def _pinned_plan(scenario, replans: tuple, arm, pins: dict) -> PickPlan:
+    """``route.routed_plan`` with the first approach of each pinned task as its ``Pin`` keeps it."""
+    vias = routed_vias(scenario, nominal(scenario, arm), replans)
+    vias = tuple(v for v in vias if not (v.phase == "approach" and v.task in pins))
+    return pick_plan(scenario.pick, replans, vias + tuple(v for v in pins.values() if v is not None))

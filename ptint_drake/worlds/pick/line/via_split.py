@@ -33,6 +33,7 @@ from typing import Optional
 
 from ptint_drake.config.pick import MoveConfig, PickTaskConfig
 
+DETOUR_PASSES = 3  # plans made to fit a task's vias (``driver.LineDriver._fit``, ``watch``)
 SLACK = 1e-3  # s: a leg this much short of its min tf still fits (the fit's tolerance)
 SHORTER = 0.05  # s: a phase after the grasp this much longer than its legs need is shortened
 
