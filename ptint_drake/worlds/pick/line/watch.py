@@ -24,6 +24,16 @@ tf; the grasp time does not change), and the phases after the grasp get the vias
 that belief, each fitted to what its via's legs need (``LineCycles.detours``, ``via_split.fitted``
 with the model's straight tfs of the decision); where that plan differs from the run's, the run is
 rebuilt (the pick run's replan and resume: the approach goes on towards the same target).  The
+phases after the grasp are at least the model's tfs from where the part is now (``ahead``, at the
+task's grip and place yaws), not only those of the decision's belief: harsh ``line_assembly``
+seeds 0-11 at 4c93d1b, a late carry of a kept task warned joint 1 at 1.34x (seed 1), 1.19x (6)
+and 1.08x (3) its speed limit, and none with it; seed 2's joint 3 went from 1.02x to 1.08x; the
+parts placed as before.  Where
+the model finds no top-down posture along a phase at that yaw (``ahead`` in the log) the task goes
+on as it was: giving it up then (tried) lost two parts in those twelve seeds that the run placed
+(seeds 0 and 10: a descend at y = 0.10-0.13 m the controller made, tool yaw off), to save seed
+13's, whose arm ran away in the carry (a 1.0 kg cube on links x1.39 at 2x belt speed: joint 5 at
+16.7 rad/s against its 4, collisions): that runaway is not fixed.  The
 log's entry names the phases planned anew (``replanned``) and their vias' legs (``via_tf``).
 Measured before (7100bb4, ``ptint robust line_assembly --samples 1 --seed 22``): only the
 committed point followed the track, the plan held the part where the decision had seen it, and
@@ -33,17 +43,20 @@ planned at 0.106 s: joint 3 at 8.8 rad/s against its 3.
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
 
+from ptint_drake.worlds.pick.cell import place_point
+from ptint_drake.worlds.pick.line.cycle import kind_part
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.plan import line_plan, pin_of, unpinned
 from ptint_drake.worlds.pick.line.scheduler import drifted
 from ptint_drake.worlds.pick.line.via_split import DETOUR_PASSES, fitted
-from ptint_drake.worlds.pick.phase_time import NoTfFits, held_mass
+from ptint_drake.worlds.pick.phase_time import NoTfFits, cycle_time, held_mass
 
-__all__ = ["AFTER", "abandon", "has_encoder", "keep", "watch"]
+__all__ = ["AFTER", "abandon", "ahead", "has_encoder", "keep", "watch"]
 
 AFTER = ("lift", "carry", "place", "retreat")  # the phases a kept task plans anew
 
@@ -68,12 +81,14 @@ def watch(driver, run, context, t: float) -> bool:
     task = driver.scenario.pick.tasks[k]
     begin, end = max(t, task.start), task.start + task.approach.tf  # the approach's (rest and) end
     window = driver.view.window(track)
-    if not unserved(track, window, grasp, t, end, driver.timing.slack) \
-            and driver.cycles.fits(track, begin, grasp, t, *driver._tool_now(driver._arm_q(context)),
-                                   task.grip_yaw):
+    tool = driver._tool_now(driver._arm_q(context))  # (point, yaw)
+    fits = not unserved(track, window, grasp, t, end, driver.timing.slack) \
+        and driver.cycles.fits(track, begin, grasp, t, *tool, task.grip_yaw)
+    if fits:
         # in reach from the approach's end to the lift (``scheduler``), the model's approach fits
         driver.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
-        return keep(driver, run, context, t, k, track.kind, entry | {"redecide": "kept"})
+        return keep(driver, run, context, t, k, track.kind,
+                    entry | {"redecide": "kept"} | ahead(driver, t, k, track, tool))
     if driver._choose(run, context, t, replacing=k):
         driver.replaced.append({"t": t, "task": k, "drift_mm": 1e3 * drift})
         driver.decisions[-1]["redecide"] = "replaced"
@@ -83,7 +98,35 @@ def watch(driver, run, context, t: float) -> bool:
         abandon(driver, run, context, t, k, track, entry | {"why": why})
         return True
     driver.committed[k][2] = tuple(float(c) for c in track.at(grasp, t))
-    return keep(driver, run, context, t, k, track.kind, entry | {"redecide": "nothing feasible: kept"})
+    return keep(driver, run, context, t, k, track.kind,
+                entry | {"redecide": "nothing feasible: kept"} | ahead(driver, t, k, track, tool))
+
+
+def ahead(driver, t: float, k: int, track, tool: tuple) -> dict:
+    """Raise committed task k's straight tfs after the grasp (``LineDriver.straight``, which
+    ``refit`` stretches the phases to) to the min-tf model's for ``track`` as seen at ``t`` — its
+    slot or bin, its grip and place yaws, its approach from the tool's present (point, yaw)
+    ``tool``; {} done, else {"ahead": why not} for the log (``NoTfFits``: no top-down posture
+    along a phase at that yaw, the task going on as it was).  An outgoing belt's riding place is
+    not checked."""
+    task = driver.scenario.pick.tasks[k]
+    if task.slot is None and not task.bin:
+        return {}
+    pick = driver.scenario.pick
+    kind = kind_part(pick, track.kind)
+    place = place_point(pick, "bin", [b.name for b in pick.bins].index(task.bin), kind) if task.bin \
+        else place_point(pick, "slot", task.slot, kind)
+    try:
+        cycle = cycle_time(driver.cycles.model, track.at(max(t, task.start), t),
+                           track.speed * np.asarray(track.direction), place, task.place_yaw,
+                           math.atan2(track.axis[1], track.axis[0]), held_mass(driver.scenario, kind.mass),
+                           task, *tool, grip=task.grip_yaw, put=task.place_yaw)
+    except NoTfFits as error:
+        return {"ahead": f"no tf fits from where it is now: {error}"}
+    straight = driver.straight.setdefault(k, {})
+    for phase in AFTER:
+        straight[phase] = max(straight.get(phase, 0.0), cycle.phases[phase])
+    return {}
 
 
 def has_encoder(line, belt: str) -> bool:
