@@ -47,8 +47,8 @@ _RUNS = (
 def warm_up(duration: float = 0.05, report: Callable[[str], None] | None = None, workers: int = 2) -> float:
     """Simulate the first ``duration`` s of each of ``_RUNS`` (and recompute the fused system's
     telemetry of the last state, as a run's outputs do), then call the TBG, orientation and IMM
-    kernels; the wall time in s.  ``report(line)`` gets a line as each part is done (what
-    compiled, how long it took).
+    kernels; the wall time in s.  ``report(line)`` gets a line per run (what compiled, how long it
+    took): as each is done in one process, as each share is done in two.
 
     numba compiles on one core, so with ``workers`` = 2 the two shares of ``_RUNS`` (disjoint
     kernels) run side by side in two processes (``spawn``: a fresh interpreter each), compiling
