@@ -200,7 +200,7 @@ class LineCycles:
 
     def grips(self, track, yaw: float) -> list:
         """rad: the grip yaws of ``track`` for the tool at ``yaw``, preferred first (``grip.Grips``)."""
-        return self.choice.of(track.id, kind_part(self.scenario.pick, track.kind), _yaw(track), yaw)
+        return self.choice.of(track.id, kind_part(self.scenario.pick, track.kind), track_yaw(track), yaw)
 
     def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot,
                filled: tuple = ()) -> Cycle:
@@ -217,14 +217,14 @@ class LineCycles:
         if isinstance(slot, OutPlace):
             return self._riding(track, grasp, now, begin, start, yaw, slot, kind, grip)
         task = replace(self.task, **destination(slot))
-        place = _place(pick, slot, kind)
+        place = destination_place(pick, slot, kind)
         options = [grip] if isinstance(slot, str) else puts(  # a bin: the tool keeps its grasp's yaw
             kind, place, _place_yaw(pick, task, grip), grip, list(filled), self.finger, task.margin)
         for i, put in enumerate(options):
             try:
                 return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
-                                  place, put, _yaw(track), held_mass(self.scenario, kind.mass), task, start,
-                                  yaw, grip=grip, put=put)
+                                  place, put, track_yaw(track), held_mass(self.scenario, kind.mass), task,
+                                  start, yaw, grip=grip, put=put)
             except NoTfFits:
                 if i == len(options) - 1:
                     raise
@@ -243,7 +243,7 @@ class LineCycles:
 
         def cycle_of(along: float) -> Cycle:
             place0 = place_of(pick, slot.belt, kind, along)
-            return cycle_time(self.model, track.at(begin, now), ride, place0, put, _yaw(track), mass,
+            return cycle_time(self.model, track.at(begin, now), ride, place0, put, track_yaw(track), mass,
                               self.task, start, yaw, place_ride=ride_of(belt), begin=begin, grip=grip)
 
         parts = {p.name: p for p in pick.parts}
@@ -345,7 +345,7 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
                                          place_ride=ride_of(out)).total)
                 continue
             where = kind.bin or kind.slots[0]
-            place = _place(pick, where, part)
+            place = destination_place(pick, where, part)
             place_yaw = _place_yaw(pick, replace(task, **destination(where)), 0.0)
             cycle = cycle_time(model, x, ride, place, place_yaw, 0.0, held_mass(scenario, kind.mass), task)
             totals.append(cycle.total)
@@ -367,7 +367,7 @@ def _place_yaw(pick, task, grasp_yaw: float) -> float:
     return grasp_yaw if task.bin else place_target(pick, task)[2]
 
 
-def _place(pick, where, part) -> np.ndarray:
+def destination_place(pick, where, part) -> np.ndarray:
     """The place point of ``part`` at a tray slot (an index) or over a bin (its name)."""
     if isinstance(where, str):
         return place_point(pick, "bin", [b.name for b in pick.bins].index(where), part)
@@ -387,7 +387,7 @@ def _key(track, window: tuple, start, yaw: float) -> tuple:
                    tuple(np.round(np.asarray(start), 3)), round(yaw, 2))
 
 
-def _yaw(track) -> float:
+def track_yaw(track) -> float:
     """rad: the yaw of a track's closing axis (world)."""
     return float(math.atan2(track.axis[1], track.axis[0]))
 

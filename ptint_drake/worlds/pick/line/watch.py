@@ -33,8 +33,8 @@ the model finds no top-down posture along a phase at that yaw (``ahead`` in the 
 on as it was: giving it up then (tried) lost two parts in those twelve seeds that the run placed
 (seeds 0 and 10: a descend at y = 0.10-0.13 m the controller made, tool yaw off), to save seed
 13's, whose arm ran away in the carry (a 1.0 kg cube on links x1.39 at 2x belt speed: joint 5 at
-16.7 rad/s against its 4, collisions): that runaway is not fixed.  The
-log's entry names the phases planned anew (``replanned``) and their vias' legs (``via_tf``).
+16.7 rad/s against its 4, collisions): that runaway is not fixed.  The log's entry names the
+phases planned anew (``replanned``) and their vias' legs (``via_tf``).
 Measured before (7100bb4, ``ptint robust line_assembly --samples 1 --seed 22``): only the
 committed point followed the track, the plan held the part where the decision had seen it, and
 the carry's via — above where the lift was to end — was 78 mm from the lift's real end, a leg
@@ -43,13 +43,11 @@ planned at 0.106 s: joint 3 at 8.8 rad/s against its 3.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import numpy as np
 
-from ptint_drake.worlds.pick.cell import place_point
-from ptint_drake.worlds.pick.line.cycle import kind_part
+from ptint_drake.worlds.pick.line.cycle import destination_place, kind_part, track_yaw
 from ptint_drake.worlds.pick.line.give_up import REASON, hold_of, unserved
 from ptint_drake.worlds.pick.line.plan import line_plan, pin_of, unpinned
 from ptint_drake.worlds.pick.line.scheduler import drifted
@@ -114,12 +112,11 @@ def ahead(driver, t: float, k: int, track, tool: tuple) -> dict:
         return {}
     pick = driver.scenario.pick
     kind = kind_part(pick, track.kind)
-    place = place_point(pick, "bin", [b.name for b in pick.bins].index(task.bin), kind) if task.bin \
-        else place_point(pick, "slot", task.slot, kind)
+    place = destination_place(pick, task.bin or task.slot, kind)
     try:
         cycle = cycle_time(driver.cycles.model, track.at(max(t, task.start), t),
                            track.speed * np.asarray(track.direction), place, task.place_yaw,
-                           math.atan2(track.axis[1], track.axis[0]), held_mass(driver.scenario, kind.mass),
+                           track_yaw(track), held_mass(driver.scenario, kind.mass),
                            task, *tool, grip=task.grip_yaw, put=task.place_yaw)
     except NoTfFits as error:
         return {"ahead": f"no tf fits from where it is now: {error}"}
