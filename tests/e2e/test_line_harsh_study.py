@@ -34,9 +34,12 @@ def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
     assert result["placed_with_collision"] == 0
     # seed 7's ~0.95 kg cube on links x1.2 ran away at the min-tf phases planned to the full effort
     # limits (docs/pick_place.md: 0.860 over 50 samples); at two thirds of them
-    # (phase_time.TORQUE_SHARE) every part a grasp can hold is placed, but seed 8's given up
-    assert result["cannot_be_held"] == 1 and result["pick_success_rate_holdable"] == pytest.approx(7 / 8)
-    assert result["pick_success_rate"] == pytest.approx(7 / 9)
+    # (phase_time.TORQUE_SHARE) every part a grasp can hold is placed, but seed 8's third, given up,
+    # and seed 6's third: on a belt at 0.068 m/s it comes into reach too late for a task to end
+    # within the run's 14.5 s, since the first cube is gripped across the faces that need no turn on
+    # its carry (``line.grip``: its approach turns 67.5°, the first task ends 0.3 s later)
+    assert result["cannot_be_held"] == 1 and result["pick_success_rate_holdable"] == pytest.approx(6 / 8)
+    assert result["pick_success_rate"] == pytest.approx(6 / 9)
     assert result["cpu_s_per_sample"]["mean"] > 0.0 and all(r["cpu_s"] > 0.0 for r in rows)
     # each run's simulated time (a line's ends when it is done: ``line.truth.run_end``), summarised
     assert all(r["simulated_s"] > 0.0 for r in rows)
@@ -45,12 +48,16 @@ def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
     # seed 6's third task, kept at 10.1 s after its belt showed 0.068 m/s (0.1 declared), has its
     # lift and carry at least the model's tfs from where the part is then (``line.watch.ahead``);
     # planned at the decision's belief, its carry drove joint 1 to 3.56 rad/s against its 3 (4c93d1b)
-    (six,) = [row for row in rows if row["seed"] == 6]
-    assert six["warnings"] == []
-    (eight,) = [row for row in rows if row["seed"] == 8]
-    assert eight["warnings"] == []  # no joint past its speed or position limit
-    assert all(p["placed"] or (p["reason"] == "not reachable in time" and p["task"] is None)
-               for p in eight["picks"]), eight["picks"]  # placed, or given up by name (no task)
+    # seed 7's first carry, planned turning the tool +90° (the wrist's roll 5°), was turned −90° by
+    # the top-down task (its branch nearest the tool's actual yaw), the roll 176° at 4.49 rad/s
+    # against its 4 (e58b1cd); a near-quarter turn is now planned the slower way round
+    # (``route.turn_ways``).  No sample has a joint past its speed or position limit.
+    assert [row["warnings"] for row in rows] == [[], [], []]
+    named = {6: "on the belt at the end", 8: "not reachable in time"}  # (no task: not started)
+    for seed, reason in named.items():
+        (row,) = [row for row in rows if row["seed"] == seed]
+        assert [p["placed"] for p in row["picks"]] == [True, True, False], row["picks"]
+        assert row["picks"][2]["reason"] == reason and row["picks"][2]["task"] is None, row["picks"]
     for row in rows:
         params = row["params"]
         assert len(row["picks"]) == 3 and params["belt_encoder"] == [False] * 3
@@ -58,7 +65,7 @@ def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
         assert max(abs(v / 0.1 - 1.0) for v in params["belt_speed"]) > 0.3
         for k, pick in enumerate(row["picks"]):
             assert (pick["placed"] and not pick["collision"]) or pick["reason"], pick
-            given_up = pick["reason"] == "not reachable in time" and pick["task"] is None
+            given_up = pick["reason"] in named.values() and pick["task"] is None
             assert pick["placed"] == params["holdable"][k] or given_up, (row["seed"], pick)
             if pick["task"] is not None:  # the truth's close jitter on the task that picked part k
                 planned = pick["t_grasp_prescribed"] - lead

@@ -51,6 +51,21 @@ def test_a_cube_is_gripped_across_the_faces_nearest_the_tools_yaw_a_disc_at_the_
     assert grips(BLOCK, 80 * DEG, 0.0) == [pytest.approx(80 * DEG)]
 
 
+def test_a_cube_that_would_turn_a_near_quarter_to_its_slot_is_gripped_across_the_other_faces():
+    """The controller may take a near-quarter turn either way round (``route.turn_ways``) and the
+    model plans the slower: harsh line_assembly's first cube, at the slot's yaw 0, gripped at 90°
+    from the start posture's 112.5° then carried to 0° or 180°; across the other faces (180°, a 67.5°
+    approach) its carry turns nothing."""
+    turned = grips(CUBE, 0.0, 112.5 * DEG, place_yaw=0.0)
+    assert turned == [pytest.approx(math.pi), pytest.approx(0.5 * math.pi)]
+    # no slot known: the nearer pair of faces first, as before
+    assert grips(CUBE, 0.0, 112.5 * DEG, place_yaw=None)[0] == pytest.approx(0.5 * math.pi)
+    # the other pair's approach would turn a near quarter itself: the order kept
+    assert grips(CUBE, 0.0, 95 * DEG, place_yaw=0.0)[0] == pytest.approx(0.5 * math.pi)
+    # the nearer grip's carry is no near quarter (a 30° part to the slot at 0°): the order kept
+    assert grips(CUBE, 30 * DEG, 112.5 * DEG, place_yaw=0.0)[0] == pytest.approx(120 * DEG)
+
+
 def test_the_chosen_grip_keeps_its_branch_while_the_estimate_moves():
     """The targets turn the part's estimated yaw by whole periods nearest the chosen yaw: an
     estimate that moves by less than half a period (45° for a cube) keeps the tool's branch."""

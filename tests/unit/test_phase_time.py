@@ -10,6 +10,7 @@ from ptint_drake.config.pick import PHASES
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.feasibility import feasibility_warnings
 from ptint_drake.worlds.pick.phase_time import MARGIN, NoTfFits, PhaseTimes, rounded_up, task_cycles
+from ptint_drake.worlds.pick.route import TURN_DOUBT, turn_ways
 from ptint_drake.worlds.pick.run import build_pick
 
 MIN_TF_PICK = str(Path(__file__).resolve().parents[1] / "min_tf_pick.yaml")
@@ -55,6 +56,34 @@ def test_the_returned_tf_fits_and_four_fifths_of_it_does_not(model, phase):
     assert model.demand(start, target, 0.8 * tf, ride, payload, yaws=yaws) > 1.0
     # the model's own bound: 1/MARGIN of the limit at the returned tf (a riding target within 3 %)
     assert model.demand(start, target, tf, ride, payload, yaws=yaws) == pytest.approx(1.0 / MARGIN, rel=0.03)
+
+
+def test_a_near_quarter_turn_may_go_either_way_round():
+    """The top-down task turns the tool to its target's branch (modulo π) nearest the tool's actual
+    yaw, so a turn within ``TURN_DOUBT`` of 90° may go either way; any other turn has one way."""
+    h = 0.5 * np.pi
+    assert turn_ways((h, np.pi)) == [(h, np.pi), (h, 0.0)]
+    assert turn_ways((h, 0.0)) == [(h, 0.0), (h, np.pi)]
+    near = h - 0.9 * TURN_DOUBT
+    assert turn_ways((0.0, -near)) == [(0.0, -near), (0.0, np.pi - near)]
+    for turn in (0.0, 0.7, -0.7, h - 1.1 * TURN_DOUBT, -(h - 1.1 * TURN_DOUBT)):
+        assert turn_ways((0.3, 0.3 + turn)) == [(0.3, 0.3 + turn)]
+
+
+def test_a_near_quarter_turn_gets_the_slower_way_round(model):
+    """A carry from above the belt to above the slot with the tool turned 90°: the two ways round
+    ask very different things of the wrist, and the controller may take either (harsh line_assembly
+    at e58b1cd: first carries planned +90°, the wrist's roll 5°, were turned −90° in 5 of 12 samples,
+    the roll 176° at 4.3–5.1 rad/s against its 4).  Its tf is at least each way's own, one way
+    turned 76.5° each way round (outside the doubt: one way each), and the same however the
+    target's branch is written."""
+    start, target, h = np.array([0.3, -0.05, 0.2]), PLACE + [0.0, 0.0, 0.05], 0.5 * np.pi
+    one_way = [model.min_tf(start, target, None, 0.1, yaws=(h, h + s * 0.85 * h)) for s in (1.0, -1.0)]
+    assert max(one_way) > 1.3 * min(one_way), one_way  # (the ways differ: 1.28 s and 1.95 s)
+    either = model.min_tf(start, target, None, 0.1, yaws=(h, np.pi))
+    assert either >= max(one_way) and either == model.min_tf(start, target, None, 0.1, yaws=(h, 0.0))
+    assert model.demand(start, target, either, None, 0.1, yaws=(h, np.pi)) <= 1.0
+    assert model.demand(start, target, 0.8 * either, None, 0.1, yaws=(h, np.pi)) > 1.0
 
 
 def test_no_posture_along_the_way_is_named(model):

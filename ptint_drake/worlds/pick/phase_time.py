@@ -67,7 +67,7 @@ from ptint_drake.robot.plant import effort_limits, nominal_plant
 from ptint_drake.verdict.run_warnings import SPEED_SAMPLES, joint_demand, joint_terms_of
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.feasibility import Way, way_motion, way_postures, way_profile
-from ptint_drake.worlds.pick.route import nearest_branch
+from ptint_drake.worlds.pick.route import nearest_branch, turn_ways
 from ptint_drake.worlds.pick.scene import AddGripper
 from ptint_drake.worlds.pick.station import MakePickStation
 from ptint_drake.worlds.pick.tasks import place_target
@@ -130,7 +130,8 @@ class PhaseTimes:
                yaws: tuple = (0.0, 0.0), q: Optional[np.ndarray] = None, margin: float = MARGIN) -> float:
         """The shortest tf (s) of a phase from the tool point ``start`` to ``target`` (where it is
         at the phase's start; riding at ``velocity``, m/s, default at rest), holding ``payload``
-        (kg), with TBG shape ``beta``, the tool turning from yaw ``yaws[0]`` to ``yaws[1]`` (rad),
+        (kg), with TBG shape ``beta``, the tool turning from yaw ``yaws[0]`` to ``yaws[1]`` (rad; a
+        near-quarter turn either way round, the slower: ``route.turn_ways``),
         the postures solved from ``q`` (default: the start posture), times ``margin`` (module
         docstring; a call asked again: its first answer).  ``NoTfFits`` names why none does."""
         riding = velocity is not None and bool(np.any(velocity))
@@ -149,8 +150,13 @@ class PhaseTimes:
 
     def _min_tf(self, start, target, velocity, payload: float, beta: float, yaws: tuple,
                 q: Optional[np.ndarray], margin: float) -> float:
-        """``min_tf``, computed."""
-        way = _way(start, target, velocity, payload, yaws)
+        """``min_tf``, computed: the slower of the ways the tool may turn (``route.turn_ways``: a
+        near-quarter turn either way round; ``NoTfFits`` where either has none)."""
+        return max(self._min_tf_way(_way(start, target, velocity, payload, ways), q, beta, margin)
+                   for ways in turn_ways(yaws))
+
+    def _min_tf_way(self, way: Way, q: Optional[np.ndarray], beta: float, margin: float) -> float:
+        """``_min_tf`` of one way."""
         guess = self.q0 if q is None else np.asarray(q, dtype=float)
         if not np.any(way.ride):  # a fixed target: its way does not depend on tf
             return margin * self._shortest(way, self._postures(way, 1.0, beta, guess), beta)
@@ -175,14 +181,17 @@ class PhaseTimes:
         largest ratio of a joint's speed or torque to its limit along the whole profile
         (``feasibility.way_profile``, ``run_warnings.joint_demand``), inf where a sample has no
         top-down posture; ≤ 1 fits."""
-        way = _way(start, target, velocity, payload, yaws)
-        profile = way_profile(self.arm, self.frame, way, tf, beta, self.q0 if q is None else np.asarray(q))
-        if profile is None:
-            return float("inf")
-        speeds, torques = joint_demand(self.plant, self.tool, profile, self.instance, self.rot_scale,
-                                       self.damping)
         V, L = self.limits()
-        return float(max(np.max(speeds / V), np.max(torques / L)))
+        worst, q = 0.0, self.q0 if q is None else np.asarray(q)
+        for ways in turn_ways(yaws):  # (a near-quarter turn: either way round, the worse)
+            way = _way(start, target, velocity, payload, ways)
+            profile = way_profile(self.arm, self.frame, way, tf, beta, q)
+            if profile is None:
+                return float("inf")
+            speeds, torques = joint_demand(self.plant, self.tool, profile, self.instance, self.rot_scale,
+                                           self.damping)
+            worst = max(worst, float(max(np.max(speeds / V), np.max(torques / L))))
+        return worst
 
     def limits(self) -> tuple:
         """(joint speeds, rad/s; torques, N·m): the shares of the arm's limits the model plans to

@@ -58,6 +58,7 @@ ROUTED = ("approach", "carry")  # the phases a via may split (the first attempt'
 TURN_SAMPLES = 9  # samples of a carry's joint-space continuation
 FULL_TOP_DOWN = 6  # joints: an arm with as many has no via (module docstring)
 JUMP = np.radians(60.0)  # rad: a joint moving more than this between two samples breaks a continuation
+TURN_DOUBT = np.radians(10.0)  # rad: a turn this near a quarter turn may go either way (``turn_ways``)
 
 
 def _nearest(world: Nominal, path: np.ndarray) -> tuple:
@@ -141,6 +142,21 @@ def _via_for(world: Nominal, pick, replans: tuple, vias: tuple, k: int, phase: s
 def nearest_branch(yaw: float, target: float) -> float:
     """The top-down branch of ``target`` (rad, modulo π) nearest ``yaw``: where the task turns the tool."""
     return float(target + np.pi * np.rint((yaw - target) / np.pi))
+
+
+def turn_ways(yaws: tuple) -> list:
+    """The ways (start, end yaw; rad) the top-down task may turn the tool from ``yaws[0]`` to the
+    branch ``yaws[1]``: that way, and where the turn is within ``TURN_DOUBT`` of a quarter turn,
+    the other way round too.  The task turns to its target's branch (modulo π) nearest the tool's
+    *actual* yaw when a segment starts (``orientation.top_down_of``), and a tool a few degrees off
+    the planned yaw (the part's estimate, the grasp's tracking) takes a near-quarter turn either
+    way: harsh line_assembly's first carries, planned +90° (the wrist's roll 5°), were turned
+    −90° in 5 of 12 samples (the roll 176°, beyond its speed limit: 4.3–5.1 rad/s against 4)."""
+    start, end = (float(y) for y in yaws)
+    turn = end - start
+    if abs(abs(turn) - 0.5 * np.pi) < TURN_DOUBT:
+        return [(start, end), (start, end - float(np.copysign(np.pi, turn)))]
+    return [(start, end)]
 
 
 def tool_yaws(world: Nominal, plan: PickPlan) -> list:

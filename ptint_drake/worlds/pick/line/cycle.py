@@ -58,7 +58,7 @@ import numpy as np
 from ptint_drake.config.pick import MoveConfig, PartConfig, PickTaskConfig
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time, held_mass
-from ptint_drake.worlds.pick.line.grip import Grips, grip_axis, puts
+from ptint_drake.worlds.pick.line.grip import Grips, grip_axis, puts, slot_yaw
 from ptint_drake.worlds.pick.route import nearest_branch, tool_yaws
 from ptint_drake.worlds.pick.scene import belt_frame
 from ptint_drake.worlds.pick.out_belt import OutPlace, across_yaw, choose, place_of, placed_on, ride_of
@@ -200,7 +200,9 @@ class LineCycles:
 
     def grips(self, track, yaw: float) -> list:
         """rad: the grip yaws of ``track`` for the tool at ``yaw``, preferred first (``grip.Grips``)."""
-        return self.choice.of(track.id, kind_part(self.scenario.pick, track.kind), track_yaw(track), yaw)
+        pick = self.scenario.pick
+        return self.choice.of(track.id, kind_part(pick, track.kind), track_yaw(track), yaw,
+                              slot_yaw(pick, track.kind))
 
     def phases(self, track, window: tuple, grasp: float, now: float, start, yaw: float, slot,
                filled: tuple = ()) -> Cycle:

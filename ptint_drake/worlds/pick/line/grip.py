@@ -10,7 +10,11 @@ across either pair of faces, or at any yaw, so the decision chooses (``grips``):
   branch);
 - a square-topped box: the part's yaw modulo π/2 nearest the tool's (a turn of at most 45°), then
   the other pair of faces (a turn of 45–90°) — where the first way has no top-down posture (the
-  wrist's roll at its limit) the second may;
+  wrist's roll at its limit) the second may.  The other pair first where the nearer grip would
+  turn a near quarter (``route.turn_ways``) to the slot's own yaw and the other would not, nor on
+  its approach: the controller may take a near-quarter turn either way round, and the model then
+  plans the slower (harsh line_assembly: the first cube, at the tray's yaw, gripped at 90° from the
+  start posture's 112.5° and carried to 0°, got a carry 0.8 s longer than across the other faces);
 - a cylinder: the tool's own yaw (no turn), then ±45°, then ±81° (``CYLINDER_TURNS``).
 
 ``line.cycle`` asks the min-tf model for each candidate in this order at each wait and keeps
@@ -39,6 +43,7 @@ candidate whose cycle fits.
 from __future__ import annotations
 
 import math
+from typing import Optional
 
 import numpy as np
 
@@ -46,24 +51,42 @@ from ptint_drake.systems.perception.part_fit import reach
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grasp_gate import FINGER_MARGIN, finger_clearance
-from ptint_drake.worlds.pick.route import nearest_branch
+from ptint_drake.worlds.pick.route import nearest_branch, turn_ways
 from ptint_drake.worlds.pick.tasks import aimed_yaw, part_symmetry
 
 # rad: a cylinder's grips, turns from the tool's yaw (below 90°: the controller's branch, modulo π)
 CYLINDER_TURNS = (0.0, -0.25 * math.pi, 0.25 * math.pi, -0.45 * math.pi, 0.45 * math.pi)
 
 
-def grips(part, part_yaw: float, tool_yaw: float) -> list:
+def grips(part, part_yaw: float, tool_yaw: float, place_yaw: Optional[float] = None) -> list:
     """rad: the grip yaws of ``part`` (a ``PartConfig``: its shape and size) at ``part_yaw`` for
     the tool at ``tool_yaw``, preferred first (module docstring), each within π/2 of ``tool_yaw``
-    (the controller's branch)."""
+    (the controller's branch); ``place_yaw``: the slot's yaw it goes to, if known (a square-topped
+    box whose nearer grip would turn a near quarter to it is gripped across the other faces first)."""
     symmetry = part_symmetry(part)
     if symmetry <= 0.0:
         return [tool_yaw + turn for turn in CYLINDER_TURNS]
     if symmetry >= math.pi - 1e-9:
         return [nearest_branch(tool_yaw, part_yaw)]
     first = aimed_yaw(part_yaw, (tool_yaw, symmetry))
-    return [first, nearest_branch(tool_yaw, first + symmetry)]
+    second = nearest_branch(tool_yaw, first + symmetry)
+    if place_yaw is not None and doubtful(first, nearest_branch(first, place_yaw)) \
+            and not doubtful(second, nearest_branch(second, place_yaw)) and not doubtful(tool_yaw, second):
+        return [second, first]
+    return [first, second]
+
+
+def slot_yaw(pick, kind: str) -> Optional[float]:
+    """rad: the yaw of the first tray slot the catalog's ``kind`` goes to (``grips``' hint); None
+    where it goes to a bin or an outgoing belt."""
+    slots = next(c for c in pick.line.catalog if c.name == kind).slots
+    return math.radians(pick.tray.yaw_deg + pick.tray.slots[slots[0]].yaw_deg) if slots else None
+
+
+def doubtful(start: float, end: float) -> bool:
+    """Whether the top-down task may turn the tool from yaw ``start`` to the branch ``end`` (rad)
+    either way round (``route.turn_ways``: a near-quarter turn)."""
+    return len(turn_ways((start, end))) > 1
 
 
 class Grips:
@@ -72,9 +95,10 @@ class Grips:
     def __init__(self):
         self.dropped: dict = {}  # track id → the grip yaws (rad, rounded) its cycle or plan found no tf for
 
-    def of(self, track_id: int, part, part_yaw: float, tool_yaw: float) -> list:
+    def of(self, track_id: int, part, part_yaw: float, tool_yaw: float,
+           place_yaw: Optional[float] = None) -> list:
         """``grips`` less the track's dropped ones (all of them dropped: all again)."""
-        every = grips(part, part_yaw, tool_yaw)
+        every = grips(part, part_yaw, tool_yaw, place_yaw)
         left = [g for g in every if round(g, 2) not in self.dropped.get(track_id, ())]
         if not left:
             self.dropped.pop(track_id, None)
