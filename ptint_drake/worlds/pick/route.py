@@ -150,8 +150,9 @@ def turn_ways(yaws: tuple) -> list:
     the other way round too.  The task turns to its target's branch (modulo π) nearest the tool's
     *actual* yaw when a segment starts (``orientation.top_down_of``), and a tool a few degrees off
     the planned yaw (the part's estimate, the grasp's tracking) takes a near-quarter turn either
-    way: harsh line_assembly's first carries, planned +90° (the wrist's roll 5°), were turned
-    −90° in 5 of 12 samples (the roll 176°, beyond its speed limit: 4.3–5.1 rad/s against 4)."""
+    way: harsh line_assembly's first carries planned +90° (the wrist's roll 5°) ran the roll
+    beyond its speed limit in 5 of 12 samples (4.3–5.1 rad/s against 4): turned −90°, the roll
+    176° (seed 13: from −30° to 145.6°)."""
     start, end = (float(y) for y in yaws)
     turn = end - start
     if abs(abs(turn) - 0.5 * np.pi) < TURN_DOUBT:

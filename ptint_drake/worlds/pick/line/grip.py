@@ -13,8 +13,9 @@ across either pair of faces, or at any yaw, so the decision chooses (``grips``):
   wrist's roll at its limit) the second may.  The other pair first where the nearer grip would
   turn a near quarter (``route.turn_ways``) to the slot's own yaw and the other would not, nor on
   its approach: the controller may take a near-quarter turn either way round, and the model then
-  plans the slower (harsh line_assembly: the first cube, at the tray's yaw, gripped at 90° from the
-  start posture's 112.5° and carried to 0°, got a carry 0.8 s longer than across the other faces);
+  plans the slower (harsh line_assembly seed 11: the first cube, at the slot's yaw, gripped at 90°
+  from the start posture's 112.5°, got a carry of 2.3 s planned both ways round; with no turn on
+  it the same carry took 1.5 s);
 - a cylinder: the tool's own yaw (no turn), then ±45°, then ±81° (``CYLINDER_TURNS``).
 
 ``line.cycle`` asks the min-tf model for each candidate in this order at each wait and keeps
