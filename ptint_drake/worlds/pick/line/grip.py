@@ -48,12 +48,13 @@ from typing import Optional
 
 import numpy as np
 
+from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.systems.perception.part_fit import reach
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grasp_gate import FINGER_MARGIN, finger_clearance
 from ptint_drake.worlds.pick.route import nearest_branch, turn_ways
-from ptint_drake.worlds.pick.tasks import aimed_yaw, part_symmetry
+from ptint_drake.worlds.pick.tasks import aimed_yaw, part_symmetry, place_target
 
 # rad: a cylinder's grips, turns from the tool's yaw (below 90°: the controller's branch, modulo π)
 CYLINDER_TURNS = (0.0, -0.25 * math.pi, 0.25 * math.pi, -0.45 * math.pi, 0.45 * math.pi)
@@ -81,7 +82,7 @@ def slot_yaw(pick, kind: str) -> Optional[float]:
     """rad: the yaw of the first tray slot the catalog's ``kind`` goes to (``grips``' hint); None
     where it goes to a bin or an outgoing belt."""
     slots = next(c for c in pick.line.catalog if c.name == kind).slots
-    return math.radians(pick.tray.yaw_deg + pick.tray.slots[slots[0]].yaw_deg) if slots else None
+    return place_target(pick, PickTaskConfig(slot=slots[0]))[2] if slots else None
 
 
 def doubtful(start: float, end: float) -> bool:
