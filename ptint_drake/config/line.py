@@ -128,6 +128,14 @@ class LineConfig:
     decide_period: float = 0.1  # s, between the scheduler's looks while the arm is free
     redecide_mm: float = 10.0  # mm, the predicted grasp point's drift that calls a new decision
 
+    def kind(self, name: str) -> KindConfig:
+        """The catalog's kind named ``name`` (a track's class, a pool part's kind); KeyError when
+        none is (the scenario checks refuse an arrival ``mix`` naming no kind)."""
+        for kind in self.catalog:
+            if kind.name == name:
+                return kind
+        raise KeyError(f"pick.line.catalog: no kind named {name!r}")
+
 
 def _pair(values: list, where: str) -> None:
     if len(values) != 2 or not values[0] <= values[1] or not np.all(np.isfinite(values)):

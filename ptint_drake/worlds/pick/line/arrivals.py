@@ -96,7 +96,7 @@ def idle_part(line: LineConfig) -> PartConfig:
     (``truth``), so the station is built as for any line and the run reports nothing entered."""
     arrival = line.arrivals[0]
     names, weights = _kinds(line, arrival)
-    c = next(c for c in line.catalog if c.name == names[int(np.argmax(weights))])
+    c = line.kind(names[int(np.argmax(weights))])
     return PartConfig(name=f"{c.name}_0", belt=arrival.belt, shape=c.shape, size=list(c.size),
                       offset=arrival.release, mass=c.mass, friction=c.friction)
 

@@ -396,5 +396,5 @@ def track_yaw(track) -> float:
 
 def kind_part(pick, kind: str) -> PartConfig:
     """A ``PartConfig`` of the catalog kind ``kind`` (its shape, size, mass and friction)."""
-    k = next(c for c in pick.line.catalog if c.name == kind)
+    k = pick.line.kind(kind)
     return PartConfig(name=k.name, shape=k.shape, size=list(k.size), mass=k.mass, friction=k.friction)

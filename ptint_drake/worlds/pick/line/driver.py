@@ -141,7 +141,7 @@ class LineDriver:
             belt = next(b for b in self.scenario.pick.belts if b.name == tr.belt)
             lateral = float(belt_frame(belt).inverse().multiply(np.asarray(tr.position))[1])
             yaw = float(np.degrees(np.arctan2(tr.axis[1], tr.axis[0])))  # world (``scene.part_start_pose``)
-            kind = next(c for c in self.line.catalog if c.name == tr.kind)  # (a camera's: as classified)
+            kind = self.line.kind(tr.kind)  # (a camera's: as classified)
             self._beliefs[tr.id] = (tr.s - tr.speed * t, lateral, yaw, kind.shape, list(kind.size))
             self._speeds[tr.belt] = tr.speed
 
@@ -233,7 +233,7 @@ class LineDriver:
         those of tasks ``keep``, ``grip.in_tray``), to the free slot its kind's ``fill`` takes
         (``slot_choice``: ``decision.slot`` set); None where no tf fits a phase (logged)."""
         track = next(tr for tr in tracks if tr.id == decision.track)
-        kind = next(c for c in self.line.catalog if c.name == track.kind)
+        kind = self.line.kind(track.kind)
         filled = in_tray(self.scenario.pick, keep)
         def cycle_of(slot):
             return self.cycles.phases(track, windows[track.id], decision.grasp, t, start, yaw, slot, filled)
@@ -282,7 +282,7 @@ class LineDriver:
         if replacing is not None and t >= tasks[replacing].start - 1e-9:
             begin = t  # its approach under way: restarted from the present state
         task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
-        mass = held_mass(self.scenario, next(c.mass for c in self.line.catalog if c.name == track.kind))
+        mass = held_mass(self.scenario, self.line.kind(track.kind).mass)
         self._vias = {}  # phase → the min tfs of its via's two legs (the decision log's ``via_tf``)
         why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
         for _ in range(DETOUR_PASSES):

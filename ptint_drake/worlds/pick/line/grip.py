@@ -81,7 +81,7 @@ def grips(part, part_yaw: float, tool_yaw: float, place_yaw: Optional[float] = N
 def slot_yaw(pick, kind: str) -> Optional[float]:
     """rad: the yaw of the first tray slot the catalog's ``kind`` goes to (``grips``' hint); None
     where it goes to a bin or an outgoing belt."""
-    slots = next(c for c in pick.line.catalog if c.name == kind).slots
+    slots = pick.line.kind(kind).slots
     return place_target(pick, PickTaskConfig(slot=slots[0]))[2] if slots else None
 
 

@@ -158,7 +158,7 @@ def keep(driver, run, context, t: float, k: int, kind: str, entry: dict) -> bool
     driver._believe(driver.view.tracks(context, t), t)
     old = run.built.plan
     run.replans[:] = [*unpinned(run.replans, k), pin_of(old, k)]
-    mass = held_mass(driver.scenario, next(c.mass for c in driver.line.catalog if c.name == kind))
+    mass = held_mass(driver.scenario, driver.line.kind(kind).mass)
     task, needs, why = refit(driver, run, k, mass)
     driver.scenario.pick.tasks[k] = task
     new = line_plan(driver.planning(), tuple(run.replans), driver.built.arm)
