@@ -65,3 +65,11 @@ def test_a_draw_that_releases_no_part_keeps_one_parked_and_a_closed_window_is_re
         arrival.start = closed.duration - arrival.until
     with pytest.raises(ScenarioError, match="pick.line.arrivals: no part arrives"):
         line_scenario(closed)
+
+
+def test_a_kind_is_read_by_its_name_and_an_unknown_name_is_named():
+    line = load_scenario("line_two_belts").pick.line
+    for kind in line.catalog:
+        assert line.kind(kind.name) is kind
+    with pytest.raises(KeyError, match="no kind named 'sphere'"):
+        line.kind("sphere")
