@@ -19,8 +19,17 @@ from pathlib import Path
 
 import pytest
 
+import ptint_drake
 from ptint_drake.simulation import simulate
 from ptint_drake.simulation.scenario import load_scenario, parse_with_overrides, scenario_text
+
+# The folder this test process imports ``ptint_drake`` from: the source tree for an editable
+# install, else the environment's site-packages (setup.sh's default, the README's test command).
+# A subprocess that must run the same package gets it first on PYTHONPATH, and so finds numba's
+# kernels where setup.sh compiled them; the tree itself, on a non-editable install, has none, and
+# each process importing it compiles them again (measured on Drake 1.51.1, .ci/run's oldest end:
+# 130 s of compiling in two processes).
+IMPORTED_FROM = Path(ptint_drake.__file__).resolve().parents[1]
 
 CURVES = ["curve_b025_tf15", "curve_b050_tf15", "curve_b075_tf15", "curve_b075_tf12",
           "curve_b075_tf19"]
@@ -275,12 +284,15 @@ def pytest_xdist_make_scheduler(config, log):
 
 
 def pytest_collection_modifyitems(config, items):
-    """Mark every test under tests/e2e as ``e2e``; order the units of work longest first (a stable
-    sort: a unit's tests keep their order)."""
+    """Mark every test under tests/e2e as ``e2e`` (a unit test marked ``slow`` is refused: the
+    oldest Drake end runs every unit test); order the units of work longest first (a stable sort: a
+    unit's tests keep their order)."""
     first = {}
     for k, item in enumerate(items):
         if "e2e" in item.path.parts:
             item.add_marker(pytest.mark.e2e)
+        elif item.get_closest_marker("slow") is not None:
+            raise pytest.UsageError(f"{item.nodeid}: only an e2e test may be marked slow")
         first.setdefault(work_unit(item.nodeid), k)
 
     def order(item) -> tuple:

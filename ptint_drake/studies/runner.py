@@ -63,7 +63,7 @@ import os
 from multiprocessing.connection import wait as wait_any
 
 from ptint_drake.controllers import plugin
-from ptint_drake.studies.workers import Worker, rss_mb, start_method
+from ptint_drake.studies.workers import Worker, rss_mb, start_forkserver, start_method
 
 MAX_TASKS_PER_CHILD = 50
 DASK_CONNECT_TIMEOUT_S = 5.0
@@ -195,7 +195,7 @@ class _LocalRun:
             # worker forked from it has it already: ~10 ms a worker instead of ~2 s
             inner = fn.args[0] if isinstance(fn, functools.partial) else fn  # _with_plugin_folders
             module = getattr(inner, "__module__", None)
-            self.ctx.set_forkserver_preload([__name__] + ([module] if module else []))
+            start_forkserver(self.ctx, [__name__] + ([module] if module else []))
         self.fn, self.tasks, self.max_tasks, self.stats = fn, tasks, max_tasks_per_child, stats
         self.results = [None] * len(tasks)
         self.rss = [0.0] * len(tasks)

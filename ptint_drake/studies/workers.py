@@ -32,10 +32,18 @@ def _stop_worker(signum, frame):
     os._exit(128 + signum)
 
 
+# set beside PYTHONSAFEPATH while ``start_forkserver`` starts the server: its workers unset both
+SAFE_PATH_MARK = "_PTINT_FORKSERVER_SAFE_PATH"
+
+
 def worker_main(conn, fn):
     """A local worker: tasks ``(index, args)`` in, ``(index, ok, value, rss_mb)`` out.
 
-    SIGINT is ignored (the parent handles Ctrl-C); SIGTERM is ``_stop_worker``."""
+    SIGINT is ignored (the parent handles Ctrl-C); SIGTERM is ``_stop_worker``.  A worker of a
+    forkserver ``start_forkserver`` started drops the server's ``PYTHONSAFEPATH`` from its
+    environment (the processes its task starts get the caller's usual path)."""
+    if os.environ.pop(SAFE_PATH_MARK, None):
+        os.environ.pop("PYTHONSAFEPATH", None)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     signal.signal(signal.SIGTERM, _stop_worker)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
@@ -135,3 +143,27 @@ def start_method(fn) -> str:
     if "fork" in methods and (fork_is_safe() or in_main):
         return "fork"
     return "forkserver" if "forkserver" in methods else "spawn"
+
+
+def start_forkserver(ctx, preload: list) -> None:
+    """Start this process's forkserver (once: later calls find it running) with ``preload``
+    imported from where this process imports it.  CPython starts the server as ``python -c`` in
+    this process's working folder and, up to 3.13 at least, does not apply the ``sys.path`` it
+    is given before importing the preload (``multiprocessing.forkserver.main``), so the working
+    folder comes first: inside a source tree the server imported the tree's ``ptint_drake``
+    rather than the installed one, and with it numba's cache of the tree, empty on a
+    non-editable install (measured: pytest-xdist on Drake 1.51.1, .ci/run's oldest end, compiled
+    every kernel again there).  ``PYTHONSAFEPATH`` (Python >= 3.11; ignored by 3.10) keeps the
+    working folder off the server's path; it is set only while the server starts."""
+    from multiprocessing import forkserver  # noqa: PLC0415
+
+    ctx.set_forkserver_preload(preload)
+    if "PYTHONSAFEPATH" in os.environ:
+        forkserver.ensure_running()
+        return
+    os.environ.update({"PYTHONSAFEPATH": "1", SAFE_PATH_MARK: "1"})
+    try:
+        forkserver.ensure_running()
+    finally:
+        os.environ.pop("PYTHONSAFEPATH", None)
+        os.environ.pop(SAFE_PATH_MARK, None)

@@ -16,6 +16,7 @@ from ptint_drake.robot.rvm1 import model_path
 ARMS = ("iiwa14", "panda", "ur5e")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("arm", ARMS)
 def test_curve_meets_prescribed_time(tmp_path, arm):
     """``ptint run curve_ARM`` exits 0; |e(tf)| ≤ 1 mm, not before tf/2, hold ≤ 3 mm; with the

@@ -36,6 +36,7 @@ def test_pose_meets_criteria(run, arm):
     assert _inside_limits(arm, np.asarray(result.series["q"]))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("arm", ARMS)
 def test_pick_places_every_yawed_part(run, arm):
     """``pick_ARM``: three parts, each turned, riding a belt at ≥ 0.1 m/s, grasped by the arm's

@@ -12,6 +12,7 @@ from ptint_drake.studies import benchmark
 _run = functools.lru_cache(maxsize=None)(benchmark._run)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["curve_b075_tf15", "assembly", "curve_iiwa14", "curve_ur5e"])
 def test_bundled_setting_is_within_tolerance_of_the_reference(name):
     """Every SPEC 5.3 metric (e0, e(tf/2), e(tf), ė(tf), hold max per segment, torque peaks)
@@ -71,6 +72,7 @@ def test_cli_bad_repeats_is_one_line(ptint_here):
     assert "Traceback" not in out.stderr and "--repeats: must be >= 1" in out.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("entry", [["scripts/benchmark.py"], ["-m", "ptint_drake", "bench"]])
 def test_entry_points_are_ptint_bench(entry):
     """``scripts/benchmark.py`` and ``python -m ptint_drake bench`` run ``ptint bench``:

@@ -22,6 +22,7 @@ def _run(*overrides):
     return simulate(LoadedScenario.load("catch_toss_iiwa14", list(overrides)).scenario)
 
 
+@pytest.mark.slow
 def test_the_arm_waits_for_the_throw_at_rest_at_its_start_pose():
     scenario = LoadedScenario.load("catch_toss_iiwa14").scenario
     snap, run = settled(scenario), CatchRun(scenario)
@@ -56,6 +57,7 @@ def test_a_throw_the_oracle_calls_too_fast_is_named_not_reachable_before_moving(
     assert np.abs(q - q[0]).max() < np.radians(0.5)  # the arm held its pose throughout
 
 
+@pytest.mark.slow
 def test_compare_puts_the_ct_quintic_baseline_with_the_same_planner_beside_ptsmc(tmp_path, ptint_here):
     """``ptint compare`` on the catch world (``CatchWorld.compare_scenario``/``compare_row``): both
     controllers aim at the same planner's moving catch target (ct_quintic with the position task,

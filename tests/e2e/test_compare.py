@@ -11,6 +11,7 @@ SEGMENT_KEYS = {"e0_norm", "e_half_norm", "e_tf_norm", "edot_tf_norm", "e_hold_m
                 "e_rot0_deg", "e_rot_half_deg", "e_rot_tf_deg", "e_rot_hold_max_deg", "edot_rot_tf_deg_s"}
 
 
+@pytest.mark.slow
 def test_compare_writes_the_table_and_the_paper_controller_is_ok(tmp_path, ptint_here):
     """``ptint compare`` in this process (test_plugin.py runs it as a real command)."""
     out = ptint_here("compare", "curve_b075_tf15", "--controllers", "ptsmc,pd,ct_quintic",

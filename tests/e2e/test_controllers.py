@@ -148,6 +148,7 @@ def test_model_free_controllers_never_evaluate_dynamics(controller, implementati
     assert calls == []
 
 
+@pytest.mark.slow
 def test_null_space_damping_keeps_a_redundant_arm_near_its_posture(tmp_path):
     """J⁺ leaves a redundant arm's self-motion free; the optional null-space term (off by
     default) damps it toward the start posture without changing the interception."""

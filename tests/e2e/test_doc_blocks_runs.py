@@ -22,6 +22,7 @@ def _metrics(name: str, overrides: str) -> dict:
     return run_cached(name, overrides).metrics
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("block", RUN_BLOCKS, ids=lambda b: b.name)
 def test_block_is_what_its_generator_writes_from_the_suites_runs(block):
     text = doc_blocks.render(block.name, runs=_metrics)

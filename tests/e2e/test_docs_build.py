@@ -12,6 +12,7 @@ import pytest
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(importlib.util.find_spec("sphinx") is None, reason="the docs extra is not installed")
 def test_the_docs_build_prints_no_configuration_dump(tmp_path):
     out = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-b", "html", str(DOCS),

@@ -46,6 +46,7 @@ CURVES = {"iiwa": ARM, "panda": "curve_panda"}  # the message set -> its arm's c
     ("panda", "position_and_torque", "position-torque", "0.001"),
     ("panda", "torque_only", "torque-gravity", "0.005"),
 ])
+@pytest.mark.slow
 def test_drive_against_drakes_blocks(tmp_path, messages, mode, driver_mode, period):
     curve, over = CURVES[messages], ("--messages", messages)
     out = run_plan([
@@ -86,6 +87,7 @@ def test_drakes_command_sender_to_ptint_hardware(tmp_path, mode, messages):
         assert "a position + torque command" in line and link["fault_time"] == 0.0, line
 
 
+@pytest.mark.slow
 def test_second_drive_named_by_its_address(tmp_path):
     """A second ``ptint drive`` started mid-run (once the hardware reports 10 %): the hardware
     names it by its source address (``link.SenderWatch``), not by a torque echo or a stamp."""

@@ -53,6 +53,7 @@ def relayed(clock):
     return run_relayed_pair(scenario, LinkSettings(period=1e-3, duration=0.6, lockstep=True), out, clock)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("clock, jumps, unset", [(epoch, 0, 0), (unset_first, 0, None),
                                                   (jump_forward, 1, 0), (jump_back, 1, 0)])
 def test_drive_follows_the_driver_clock(clock, jumps, unset):

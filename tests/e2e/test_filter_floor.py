@@ -41,6 +41,7 @@ def test_noiseless_camera_on_a_constant_velocity_belt_has_no_floor():
     assert noisy["segments"][0]["hold_max"] > 1e-4
 
 
+@pytest.mark.slow
 def test_less_noise_lowers_the_floor(curve_2mm):
     one_mm = floor.filter_floor(LOADED, [0.03], SEEDS, measurement={"noise_std": 0.001}, workers=1)
     assert one_mm["measurement"]["noise_std"] == 0.001

@@ -90,6 +90,7 @@ PICK_WIRE = {"IIWA_STATUS", "IIWA_COMMAND", "SCHUNK_WSG_STATUS", "SCHUNK_WSG_COM
 TRUTH_WORDS = r"PART|MOTION|TRUTH|TRUE|GROUND"  # a channel named for part motion or truth
 
 
+@pytest.mark.slow
 def test_pick_lockstep_places_like_one_process(tmp_path, run):
     """Acceptance, the pick world: lockstep across two processes (arm, gripper and the part
     tracker's reports over LCM; the targets, gripper sequence and grasp observer in the drive) =
@@ -129,6 +130,7 @@ def test_pick_lockstep_places_like_one_process(tmp_path, run):
     assert drive["subscribed_channels"] == ["IIWA_STATUS", "SCHUNK_WSG_STATUS", "TRACKED_POSES"]
 
 
+@pytest.mark.slow
 def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
     """Issue 43, the camera over LCM: conveyor_pick_place_rgbd across two processes in lockstep.
     The hardware sends the station's depth frames (Drake's ``lcmt_image_array``, lossless 32F, on
@@ -164,6 +166,7 @@ def test_camera_pick_lockstep_places_like_one_process(tmp_path, run):
     assert drive["perception"]["process"] == "own" and drive["perception"]["fit_ms"]["count"] >= 150
 
 
+@pytest.mark.slow
 def test_pick_replan_is_refused_in_one_line(tmp_path):
     """A grasp that is not confirmed would plan anew (a retry or an abort: a new diagram on both
     sides), which is not supported across processes: with a width tolerance of 0.2 mm the pads,
@@ -187,6 +190,7 @@ def test_pick_replan_is_refused_in_one_line(tmp_path):
     assert link["hold"]["speed_at_end"] < 0.05
 
 
+@pytest.mark.slow
 def test_drive_killed_holds_the_arm(tmp_path):
     """The drive SIGKILLed mid-run (real time, at 30 % of the run): the hardware holds the arm
     after exactly its silent periods without a command (here 100: a loaded CI machine stalls a
@@ -211,6 +215,7 @@ def test_drive_killed_holds_the_arm(tmp_path):
     assert link["hold"]["settled_s_after_fault"] <= 0.2 and link["hold"]["speed_at_end"] < 0.05
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGINT", 130)])
 def test_hardware_signal_holds_and_writes(tmp_path, sig, code):
     """SIGTERM / SIGINT to ``ptint hardware`` mid-run (real time): the arm held for the hold
@@ -233,6 +238,7 @@ def test_hardware_signal_holds_and_writes(tmp_path, sig, code):
     assert link["hold"]["held_until"] >= link["fault_time"] + 0.5 - 2 * PERIOD
 
 
+@pytest.mark.slow
 def test_hardware_killed_stops_the_drive(tmp_path):
     """The hardware SIGKILLed mid-run: the drive exits 1 with one line within its status timeout."""
     out = run_plan(
@@ -249,6 +255,7 @@ def test_hardware_killed_stops_the_drive(tmp_path):
     assert json.loads((tmp_path / "dr" / "drive.json").read_text())["fault"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mode, words", [("nan", "non-finite torque")])
 def test_bad_commands_rejected_and_held(tmp_path, mode, words):
     """A NaN torque: rejected, reported, the arm held (over-limit torques and a wrong size:
@@ -275,6 +282,7 @@ def test_bad_commands_rejected_and_held(tmp_path, mode, words):
     assert link["hold"]["speed_at_end"] < 0.05
 
 
+@pytest.mark.slow
 def test_second_sender_detected(tmp_path):
     """A second process answering the statuses too from t = 0.3 s: detected within 10 periods
     (the issue's bound), reported, the arm held."""
@@ -309,6 +317,7 @@ def test_second_sender_detected(tmp_path):
     assert link["hold"]["speed_at_end"] < 0.05
 
 
+@pytest.mark.slow
 def test_dropped_status_completes(tmp_path):
     """20 % of the status messages not sent: the lockstep run completes, the loss is reported."""
     out = run_plan(
@@ -348,6 +357,7 @@ def test_dropped_status_completes(tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_realtime_lost_gripper_status_does_not_end_the_run(tmp_path):
     """Issue 43: in real time nothing re-sends a companion; one lost gripper status (the hardware's
     test option --drop-companion: the tick at 1 s) costs that tick, not the run — the drive sees
@@ -417,6 +427,7 @@ def test_drive_without_hardware(tmp_path):
     assert "within the start-up timeout of 1 s" in one_line(out["drive"]["stderr"])
 
 
+@pytest.mark.slow
 def test_realtime_run_completes(tmp_path):
     """Real time: the run completes with its latency, lateness and late ticks reported."""
     out = run_plan(

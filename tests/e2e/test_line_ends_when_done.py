@@ -7,6 +7,7 @@ the metrics' duration and the timeline that end."""
 import json
 
 import numpy as np
+import pytest
 
 from ptint_drake.worlds.pick.line.truth import SETTLE
 from ptint_drake.worlds.pick.probe import PART_WIDTH
@@ -14,6 +15,7 @@ from ptint_drake.worlds.pick.probe import PART_WIDTH
 CAP = 16.0  # s: the run's duration
 
 
+@pytest.mark.slow
 def test_a_line_that_is_done_ends_early_and_is_judged_at_its_end(tmp_path, ptint_here):
     out = tmp_path / "out"
     steps = ", ".join(f"{{belt: conveyor{b}, t: 0.0, factor: 1.5}}" for b in (1, 2, 3))

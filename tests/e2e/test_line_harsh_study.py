@@ -20,6 +20,7 @@ import pytest
 from ptint_drake.config.pick import GripperConfig, PickTaskConfig
 
 
+@pytest.mark.slow
 def test_a_harsh_line_study_places_or_names_every_part(tmp_path, ptint_here):
     # seeds 6 to 8: a close 54 ms early (seed 6, part 0: before the grasp latch took the part's
     # velocity at the close command, a runaway into conveyor1), a 0.93 kg part at friction 0.06 that

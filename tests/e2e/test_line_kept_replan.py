@@ -9,6 +9,7 @@ now ends over where the part really is at the lift's start (the old plan, at the
 belief, put it 18.7 mm off; now 0.02 mm).  Before the fix no entry was ``replanned`` and no rebuild made."""
 
 import numpy as np
+import pytest
 
 from ptint_drake.robot.plant import nominal_plant
 from ptint_drake.simulation.scenario import parse_with_overrides, scenario_text
@@ -34,6 +35,7 @@ def _lift_end(planning, plan, k: int, arm) -> np.ndarray:
     return segment_target(nominal(planning, arm), plan, i, plan.schedule.segments[i].start)[0]
 
 
+@pytest.mark.slow
 def test_a_kept_drift_replans_the_carry_at_the_new_belief_and_the_approach_goes_on(monkeypatch):
     rebuilds = []
     replan, resume = world.PickRun.replan, world.PickRun.resume

@@ -33,6 +33,7 @@ def _resting_on(belt, series, k: int, height: float) -> tuple:
     return local[:, 0], on
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_every_part_that_entered_is_put_on_the_outgoing_belt_upright_and_a_pitch_apart(run, case):
     result = run("line_out_belt", CASES[case])

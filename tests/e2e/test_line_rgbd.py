@@ -21,6 +21,7 @@ def _line(out):
     return json.loads((out / "metrics.json").read_text())
 
 
+@pytest.mark.slow
 def test_a_short_rgbd_line_tracks_classifies_and_places_its_parts(tmp_path, ptint_here):
     out = tmp_path / "out"
     ptint_here("run", "line_two_belts_rgbd", "--quiet", "--no-replay", "--no-figures", "--out", out, *SHORT)
@@ -47,6 +48,7 @@ def test_a_short_rgbd_line_tracks_classifies_and_places_its_parts(tmp_path, ptin
         assert pick["saturated_fraction"] < 0.2
 
 
+@pytest.mark.slow
 def test_a_camera_that_sees_nothing_names_every_part_not_seen(tmp_path, ptint_here):
     out = tmp_path / "out"
     result = ptint_here("run", "line_two_belts_rgbd", "--quiet", "--no-replay", "--no-figures", "--out", out,

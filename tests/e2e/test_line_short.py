@@ -5,11 +5,14 @@ again from where it is, the torque continuous across the switch."""
 
 import json
 
+import pytest
+
 from ptint_drake.config.pick import PickTaskConfig
 
 REASONS = ("later deadline", "not reachable in time", "not in reach yet", "tray full")
 
 
+@pytest.mark.slow
 def test_short_line_places_what_it_decides_and_logs_every_decision(tmp_path, ptint_here):
     out = tmp_path / "out"
     # 28 s of line_short (seed 0): five cubes released at 3.7, 9.8, 10.5, 11.1 and 14.6 s; at 12.2 s,

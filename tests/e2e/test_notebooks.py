@@ -34,6 +34,7 @@ def same(a: float, b: float) -> bool:
     return a == b or f"{a:.{SIGNIFICANT - 1}e}" == f"{b:.{SIGNIFICANT - 1}e}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NOTEBOOKS)
 def test_notebook_runs_and_reproduces_its_tables(name):
     committed = nbformat.read(EXAMPLES / f"{name}.ipynb", as_version=4)

@@ -6,12 +6,15 @@ cycle estimate."""
 
 from pathlib import Path
 
+import pytest
+
 from ptint_drake.simulation.scenario import load_scenario
 from ptint_drake.worlds.pick.phase_time import MARGIN, capacity, task_cycles
 
 SCENARIO = str(Path(__file__).resolve().parents[1] / "min_tf_pick.yaml")
 
 
+@pytest.mark.slow
 def test_a_run_at_the_model_tfs_places_every_part_within_the_joint_limits(run):
     m = run(SCENARIO).metrics
     assert m["status"] == "ok", m["reasons"]

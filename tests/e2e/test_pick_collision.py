@@ -2,6 +2,8 @@
 issue 44: what the planning model sees in the way is gone around (``obstacles``), and what no via
 clears is warned before the run, naming the bodies, and named as a collision during it."""
 
+import pytest
+
 # a 4 × 4 cm bar ("gantry", a belt standing still) across the carry from the belt to the tray, its
 # underside 17 cm high: the approach and descend keep clear of it (so the clearance check passes);
 # the straight carry runs the hand into it
@@ -22,6 +24,7 @@ def test_a_bar_across_the_carry_is_gone_over_and_the_part_placed(run):
     assert pick["placed"] and not pick["collision"], pick
 
 
+@pytest.mark.slow
 def test_a_wall_no_via_clears_is_warned_and_the_collision_named(run):
     m = run("conveyor_pick_place", WALL).metrics
     assert any("carry passes" in w and "'belt gantry'" in w and "no via above clears it" in w

@@ -16,6 +16,7 @@ def _reasons(m: dict) -> list:
     return m["reasons"]
 
 
+@pytest.mark.slow
 def test_closed_on_nothing_is_empty_and_the_retry_picks_the_part(run):
     m = run("conveyor_pick_place", CLOSE_ON_AIR).metrics
     assert m["status"] == "ok", m["reasons"]
@@ -81,6 +82,7 @@ def test_the_lift_waits_for_holding_and_a_late_close_is_a_late_grasp(run):
     ("pick: {tasks: [{part: part, slot: 0, close_delay: -0.1}]}", "pick 0: early grasp"),
     ("criteria: {place_mm: 0.01}", "pick 0: not placed"),  # 0.16 mm is outside 0.01 mm
 ])
+@pytest.mark.slow
 def test_each_pick_reason_fails_the_verdict(run, override, reason):
     m = run("conveyor_pick_place", override).metrics
     assert m["status"] == "missed" and reason in m["reasons"], m["reasons"]

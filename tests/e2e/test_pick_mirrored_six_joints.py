@@ -10,12 +10,14 @@ docs/pick_place.md).  The plan's vias are tested in tests/unit/test_pick_route.p
 tests/e2e/test_pick_two_belts.py runs tests/two_belt_pick.yaml, whose rvm1_5dof plan has the same
 approach via, mirrored."""
 
+import pytest
 from pathlib import Path
 
 SCENARIO = str(Path(__file__).resolve().parents[1] / "two_belt_pick_mirrored.yaml")
 SIX = "robot: {model: rvm1_6dof, end_effector: tool, initial_q_deg: [22.7, 46.5, 20.0, 0.0, 21.5, 0.0]}"
 
 
+@pytest.mark.slow
 def test_the_mirrored_two_belt_scenario_places_both_parts_on_the_six_joint_arm(run):
     m = run(SCENARIO, SIX).metrics
     assert m["status"] == "ok", m["reasons"]

@@ -45,6 +45,7 @@ def test_the_routed_plan_goes_above_and_keeps_clear(planned):
         assert v.position[2] >= 0.19
 
 
+@pytest.mark.slow
 def test_the_re_routed_pick_places_both_parts(run):
     m = run(SCENARIO).metrics
     assert m["status"] == "ok", m["reasons"]

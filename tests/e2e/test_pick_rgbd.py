@@ -1,6 +1,7 @@
 """A pick and place that sees its part through a rendered RGB-D camera (issue 34)."""
 
 import numpy as np
+import pytest
 from conftest import run_cached
 
 from ptint_drake.simulation import simulate
@@ -17,6 +18,7 @@ def test_conveyor_pick_place_rgbd_places_a_randomly_placed_part_from_depth_image
     assert pick["estimate_error_mm"] <= 3.0 and pick["estimate_error_deg"] <= 3.0
 
 
+@pytest.mark.slow
 def test_a_part_never_seen_is_not_grasped():
     # the perception looks for parts on a belt 0.3 m beside the real one: nothing is ever fitted
     elsewhere = ("measurement: {camera: {belts: [{center: [0.6, 0.0, 0.135], direction: [0.0, 1.0, 0.0], "
@@ -50,6 +52,7 @@ def test_a_part_fitted_twice_is_not_grasped(monkeypatch):
     assert not pick["grasped"] and all(d["peak_grip_force_N"] == 0.0 for d in pick["attempt_details"])
 
 
+@pytest.mark.slow
 def test_a_fit_forced_wrong_makes_the_pick_fail(monkeypatch):
     real = part_pose_estimator.fit_parts
 

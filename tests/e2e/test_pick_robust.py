@@ -47,6 +47,7 @@ def test_harsh_part_mass_reaches_the_payload_less_the_hand():
     assert robust.RANGES["part_friction"][0] == 0.05 and robust.RANGES["belt_speed"] == (0.5, 2.0)
 
 
+@pytest.mark.slow
 def test_harsh_ranges_reach_a_named_failure_and_mild_passes():
     """Seed 6 of the harsh ranges closes 58 ms late on conveyor_pick_place: the verdict names the
     late grasp, the pick counts as failed although the part was placed; seed 7 passes.  The mild
@@ -117,6 +118,7 @@ def test_lateral_offset_moves_the_part_and_is_checked():
     assert x[0] == pytest.approx(scenario.pick.belts[0].center[0] - lateral, abs=1e-12)
 
 
+@pytest.mark.slow
 def test_floor_replays_the_runs_arm_trajectory_through_cpp_systems():
     """``ptint bench --floors``'s pick floor: the station driven by Drake's C++ systems alone
     (outside the station: no Python system), replaying the run's torques and PD on its [q; v],
@@ -152,6 +154,7 @@ def test_floor_replays_the_runs_arm_trajectory_through_cpp_systems():
     assert error[t_floor[same] > scenario.duration - 0.25].max() < 1e-4
 
 
+@pytest.mark.slow
 def test_cli_ranges_preset(tmp_path, capsys):
     """``ptint robust --ranges mild``: robust.json names the preset and its ranges, and its one
     sample (the mild preset's seed 0) places the part, no failure; an unknown preset is one

@@ -6,6 +6,8 @@ own part knocked by the open fingers included (``collisions.touched_before_close
 import re
 from pathlib import Path
 
+import pytest
+
 from ptint_drake.worlds.pick.runaway import SATURATED_FRACTION, SPEED_RUNAWAY, SPEED_RUNAWAY_S
 
 TWO_BELTS = str(Path(__file__).resolve().parents[1] / "two_belt_pick.yaml")
@@ -25,6 +27,7 @@ def _feasibility(metrics: dict) -> list:
     return [m.groups() for m in map(WARNING.match, _before(metrics)) if m]
 
 
+@pytest.mark.slow
 def test_a_too_short_approach_is_warned_before_the_run_and_its_runaway_named(run):
     m = run(TWO_BELTS, SHORT).metrics
     cut = [w for w in _feasibility(m) if w[0] == "pick.tasks[1].approach.tf"]

@@ -35,6 +35,7 @@ def test_a_pick_run_writes_its_timeline_with_the_events_of_its_metrics(run, tmp_
     assert line.seen <= line.scheduled < line.grasped < line.placed
 
 
+@pytest.mark.slow
 def test_a_camera_part_is_seen_at_its_tracks_first_fit_and_each_task_in_turn(run):
     result = run(TWO_PARTS, ())
     series, metrics = result.series, result.metrics

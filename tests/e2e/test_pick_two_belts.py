@@ -12,6 +12,7 @@ ARMS = {"rvm1_5dof": "", "rvm1_6dof": "robot: {model: rvm1_6dof, end_effector: t
                                       "[22.7, 46.5, 20.0, 0.0, 21.5, 0.0]}"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("arm", sorted(ARMS))
 def test_an_untuned_two_belt_scenario_places_both_parts(run, arm):
     m = run(SCENARIO, ARMS[arm]).metrics

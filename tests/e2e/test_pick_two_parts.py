@@ -26,6 +26,7 @@ def _no_runaway(m):
     assert all(p["saturated_fraction"] < 0.2 for p in m["picks"])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_two_parts_on_one_belt_go_each_to_its_own_slot(run, case):
     m = run(SCENARIO, CASES[case]).metrics
@@ -42,6 +43,7 @@ def test_two_parts_on_one_belt_go_each_to_its_own_slot(run, case):
     _no_runaway(m)
 
 
+@pytest.mark.slow
 def test_a_part_the_open_fingers_cannot_reach_beside_its_neighbour_is_blocked(run):
     # a 40 x 30 mm box turned 90°: its fingers close along the belt, and open (52 mm) their outer faces
     # reach 32 mm up the belt, where the cube 50 mm behind it begins: no grasp, the task backs off

@@ -13,7 +13,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from plugin_case import EXAMPLE, ROOT, SCENARIO, TYPE
+from conftest import IMPORTED_FROM
+from plugin_case import EXAMPLE, SCENARIO, TYPE
 
 from ptint_drake.simulation import simulate
 from ptint_drake.simulation.scenario import ScenarioError, parse_scenario
@@ -68,7 +69,7 @@ def user_folder(tmp_path: Path) -> Path:
 
 def ptint(*args, cwd) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | {
-        "PYTHONPATH": str(ROOT) if (ROOT / "ptint_drake").is_dir() else ""}
+        "PYTHONPATH": str(IMPORTED_FROM)}  # (the package this process runs: conftest)
     return subprocess.run([sys.executable, "-m", "ptint_drake", *args], capture_output=True, text=True,
                           cwd=cwd, env=env, timeout=600)
 
@@ -157,6 +158,7 @@ def test_tune_takes_a_plugin_parameter_with_its_range(user_folder, ptint_here, m
     assert not (user_folder / "t").exists()
 
 
+@pytest.mark.slow
 def test_dask_workers_find_the_plugin_beside_its_scenario_file(user_folder):
     """Dask worker processes start elsewhere: the runner hands them the scenario's folder."""
     distributed = pytest.importorskip("distributed", reason="install the [cluster] extra")

@@ -23,6 +23,7 @@ def short_yaw(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_the_angle_figure_is_written_and_listed(short_yaw):
     m = json.loads((short_yaw / "metrics.json").read_text())
     assert m["figures"] == ["axes.png", "errors.png", "joints.png", "paths3d.png", "angle.png"]

@@ -60,6 +60,7 @@ def test_interception_replay_loops_with_time_legend_and_floor(tmp_path):
     assert "conveyor belts" not in html[html.index('id="ptint-overlay"'):]  # no belts in this run
 
 
+@pytest.mark.slow
 def test_pick_replay_time_display_follows_the_animation_in_chromium(tmp_path):
     """The camera pick's page: the cloud, the estimate's outline and the floor explained; paused
     and sought to 1.0 s in headless Chromium, the time display reads 1.00 s."""

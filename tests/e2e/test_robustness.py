@@ -66,6 +66,7 @@ def test_payload_and_friction_reach_the_plant():
     assert loaded.metrics["torque_peak"][1] > base.metrics["torque_peak"][1] + 0.5
 
 
+@pytest.mark.slow
 def test_robust_study_and_exact_replay_of_worst_seed(tmp_path, ptint_here):
     """Both commands in this process (``ptint_here``)."""
     out = ptint_here("robust", "curve_b075_tf15", "--samples", "6", "--seed", "11", "--workers", "2",
@@ -146,6 +147,7 @@ def test_forced_divergence_is_reported_and_kept(tmp_path, ptint_here):
     assert (tmp_path / "errors.png").is_file()
 
 
+@pytest.mark.slow
 def test_sigint_leaves_no_half_written_files(tmp_path):
     out_dir = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "ptint_drake", "paper", "--out", str(out_dir)],
@@ -170,6 +172,7 @@ def test_sigint_leaves_no_half_written_files(tmp_path):
         assert (run / "series.npz").is_file() and (run / "replay.html").is_file()
 
 
+@pytest.mark.slow
 def test_second_run_does_not_mix_with_the_first(tmp_path, ptint_here):
     """The first run (0.6 s of it: its files are the point, not its length) writes a replay and
     figures as a real command (a replay drawn in this process would leave a Meshcat here)."""

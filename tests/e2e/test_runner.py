@@ -172,6 +172,7 @@ def test_a_worker_stopped_inside_a_c_callback_removes_its_folder_quietly(tmp_pat
     assert not _new_children(before)
 
 
+@pytest.mark.slow
 def test_robust_samples_identical_on_1_and_2_workers_and_on_dask():
     distributed = pytest.importorskip("distributed", reason="install the [cluster] extra")
     tasks = [(TEXT, NAME, 40 + i) for i in range(3)]
@@ -189,6 +190,7 @@ def test_robust_samples_identical_on_1_and_2_workers_and_on_dask():
     assert sorted(seen) == [0, 1, 2]
 
 
+@pytest.mark.slow
 def test_cli_dask_bad_address_is_one_line_exit_2(tmp_path):
     done = subprocess.run([sys.executable, "-m", "ptint_drake", "sweep", "curve_b075_tf15",
                            "--beta", "0.5", "--tf", "1.5", "--dask", "tcp://127.0.0.1:9",
@@ -200,6 +202,7 @@ def test_cli_dask_bad_address_is_one_line_exit_2(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_cli_ctrl_c_stops_robust_within_5_s(tmp_path):
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "ptint_drake.cli", "robust", "curve_b075_tf15",

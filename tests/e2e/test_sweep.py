@@ -43,6 +43,7 @@ def test_run_sweep_with_a_process_pool_keeps_grid_order():
     assert rows[1]["e_tf"] > rows[0]["e_tf"]
 
 
+@pytest.mark.slow
 def test_run_sweep_on_a_local_dask_cluster():
     distributed = pytest.importorskip("distributed", reason="install the [cluster] extra")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
@@ -55,6 +56,7 @@ def test_run_sweep_on_a_local_dask_cluster():
     assert rows[3]["e_tf"] == pytest.approx(direct["e_tf"], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_cli_sweep_writes_csv_and_heatmaps(tmp_path, ptint_here):
     """``ptint sweep`` in this process (test_runner.py runs it as a real command)."""
     done = ptint_here("sweep", "curve_b075_tf15", "--beta", "0.5,0.75", "--tf", "1.2,1.5", "--workers", "2",

@@ -6,6 +6,7 @@ averaged over 20 ms the torques agree within 0.075 N·m; 1,279 vs 27,030 integra
 """
 
 import numpy as np
+import pytest
 from conftest import assert_prescribed_time, run_cached
 
 
@@ -14,6 +15,7 @@ def _on_grid(t_grid, result, key):
                             for k in range(result.series[key].shape[1])])
 
 
+@pytest.mark.slow
 def test_boundary_layer_reproduces_sign():
     exact = run_cached("curve_b075_tf15", "controller: {switching: sign}")
     smooth = run_cached("curve_b075_tf15")

@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 from conftest import TOO_SHORT_TF
 from heavy_arm import heavy_arm_scenario, heavy_arm_urdf
 from test_cli import ptint
@@ -25,6 +26,7 @@ def _heavy(tmp_path):
     return scenario
 
 
+@pytest.mark.slow
 def test_tune_finds_gains_for_a_heavy_six_joint_arm(tmp_path):
     scenario = _heavy(tmp_path)
     text = scenario.read_text()
@@ -73,6 +75,7 @@ def test_tune_finds_gains_for_a_heavy_six_joint_arm(tmp_path):
     assert json.loads((elsewhere / "o" / "metrics.json").read_text())["status"] == "ok"
 
 
+@pytest.mark.slow
 def test_tune_on_the_paper_robot_says_how_it_compares(tmp_path):
     out = ptint("tune", "curve_b075_tf15", "--variants", "nominal,mass_x1.5", "--workers", "2",
                 "--out", str(tmp_path), "--quiet")
@@ -84,6 +87,7 @@ def test_tune_on_the_paper_robot_says_how_it_compares(tmp_path):
     assert simulate(tuned, check=False).metrics["status"] == "ok"
 
 
+@pytest.mark.slow
 def test_no_gain_can_save_a_too_short_tf(tmp_path):
     scenario = tmp_path / "short.yaml"
     scenario.write_text(TOO_SHORT_TF)

@@ -39,6 +39,7 @@ def _orange_pixels(png: Path) -> int:
     return int(np.sum((r > 0.75) & (g > 0.35) & (g < 0.7) & (b < 0.3)))
 
 
+@pytest.mark.slow
 def test_replay_renders_in_headless_chromium(paper_dir, tmp_path):
     from playwright.sync_api import sync_playwright
 
@@ -136,6 +137,7 @@ def test_uniform_derivatives_of_a_known_signal():
     np.testing.assert_allclose(j_u[inner, 1], -4 * np.cos(2 * t_u[inner]), atol=1e-3)
 
 
+@pytest.mark.slow
 def test_replay_floor_and_caught_object_are_visible(paper_dir, tmp_path):
     """The floor is a plate seen from above (not an edge-on band), and a caught object
     is drawn larger than the tool sphere, so it shows around the gripper."""
@@ -194,6 +196,7 @@ assert can_fork(), "the replay's Meshcat was made in a worker"
 """
 
 
+@pytest.mark.slow
 def test_views_in_workers_equal_views_drawn_here(tmp_path):
     """Figures drawn by forked workers are byte for byte those drawn in this process; the
     default is PNG only, ``svg=True`` adds the SVGs; the replay is written either way.  The
@@ -221,6 +224,7 @@ def test_views_in_workers_equal_views_drawn_here(tmp_path):
     assert (there / "replay.html").stat().st_size > 100_000
 
 
+@pytest.mark.slow
 def test_run_writes_svg_only_with_the_flag(tmp_path):
     """`ptint run` writes PNG figures; `--svg` adds an SVG beside each (SPEC 5.3 asks for PNG).
     Without the flag: no SVG, checked on test_cli.py's full run (test_run_writes_spec_outputs)."""

@@ -61,6 +61,7 @@ def test_sweep_is_refused_in_one_line(tmp_path):
     assert "the touch world has no β × tf grid to sweep" in (tmp_path / "s" / "sweep.csv").read_text()
 
 
+@pytest.mark.slow
 def test_hardware_and_drive_lockstep_match_one_process(tmp_path):
     """``ptint hardware`` + ``ptint drive`` on the plugin world in lockstep = ``ptint run`` with
     the same 1 ms control period and plant step: e(tf) within 1e-9 m."""
@@ -90,6 +91,7 @@ def test_hardware_and_drive_lockstep_match_one_process(tmp_path):
     ("touch_world", "world.type: expected 'module:Class'"),
     ("touch_world:TouchRun", "is not a ptint_drake.worlds.base.World subclass"),
 ])
+@pytest.mark.slow
 def test_a_bad_world_type_is_one_line(tmp_path, text, words):
     scenario = tmp_path / "bad.yaml"
     scenario.write_text((WORLDS / "touch.yaml").read_text().replace("touch_world:TouchWorld", text))

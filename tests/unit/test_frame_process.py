@@ -7,6 +7,7 @@ its fit; and a frame the worker cannot read is one line (``FrameError``)."""
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -101,3 +102,19 @@ def test_a_frame_fitted_in_the_worker_leaves_the_estimator_as_its_own_update():
     # handing the frame over is a copy, not the fit; the fit was back before it was due
     assert handed < summary["fit_ms"]["max"] * 1e-3, (handed, summary)
     assert summary["wait_ms"]["max"] < 1.0, summary
+
+
+@pytest.mark.skipif(sys.version_info < (3, 11), reason="PYTHONSAFEPATH is Python >= 3.11's")
+def test_the_worker_runs_this_package_from_a_folder_holding_another(tmp_path, monkeypatch):
+    """``python -m`` puts the working folder first: from a folder holding a ``ptint_drake`` (a source
+    tree beside a non-editable install) the worker imported that one (``FrameProcess.start``)."""
+    decoy = tmp_path / "ptint_drake"
+    decoy.mkdir()
+    (decoy / "__init__.py").write_text("raise ImportError('the decoy ptint_drake was imported')\n")
+    monkeypatch.chdir(tmp_path)
+    _, estimates = _estimator(load_scenario(RGBD_PICK), elsewhere=True)
+    frames = FrameProcess(estimates.estimator, estimates.config, 1e-3)
+    try:
+        frames.start(decoder=FRAME_DECODER)  # (a worker that imported the decoy never says ready)
+    finally:
+        frames.close()

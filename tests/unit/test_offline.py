@@ -20,6 +20,7 @@ import sys
 import tarfile
 from pathlib import Path
 
+from conftest import IMPORTED_FROM
 from lcm_link.netns import namespace_problem, run_in_netns
 from ptint_drake.simulation.scenario import bundled_scenarios
 
@@ -71,7 +72,7 @@ def test_every_bundled_model_and_scenario_builds_with_an_empty_download_cache(tm
     cache.mkdir()  # Drake takes XDG_CACHE_HOME only when the folder exists
     env = {k: v for k, v in os.environ.items() if k not in ("TEST_TMPDIR", "DRAKE_ALLOW_NETWORK")}
     env |= {"HOME": str(home), "XDG_CACHE_HOME": str(cache),
-            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+            "PYTHONPATH": os.pathsep.join([str(IMPORTED_FROM), os.environ.get("PYTHONPATH", "")])}
     argv = [sys.executable, str(ROOT / "tests" / "offline_build.py"), str(_canary(tmp_path)), *models]
     if namespace_problem() is None:  # no packet can leave, even if a model came to need drake_models
         result = run_in_netns(argv, timeout=600, env=env)

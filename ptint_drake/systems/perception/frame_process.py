@@ -123,7 +123,10 @@ class FrameProcess:
             return
         ours, theirs = socket.socketpair()
         ours.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)  # a frame never blocks
-        env = dict(os.environ)  # this package's tree first, whatever the caller's sys.path
+        # this package first, whatever the caller's sys.path; and not the working folder before it
+        # (``-m`` puts it first unless PYTHONSAFEPATH, Python >= 3.11): inside a source tree that
+        # would be the tree's package, and its numba cache, rather than this one
+        env = dict(os.environ, PYTHONSAFEPATH="1")
         env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[3]),
                                              env.get("PYTHONPATH", "")])
         self._process = subprocess.Popen([sys.executable, "-m", __name__, str(theirs.fileno())],
