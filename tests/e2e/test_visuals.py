@@ -232,7 +232,7 @@ def test_run_writes_svg_only_with_the_flag(tmp_path):
         done = subprocess.run([sys.executable, "-m", "ptint_drake", "run", "curve_b075_tf15", "--quiet",
                                "--no-replay", "--set", "duration=0.6", "--set", "interceptions[0].tf=0.5",
                                "--out", str(out), *flag],
-                              capture_output=True, text=True, timeout=300)
+                              capture_output=True, text=True, timeout=300, cwd=tmp_path)  # (not the tree)
         assert done.returncode in (0, 1), done.stderr
         for stem in ("axes", "errors", "joints", "paths3d"):
             assert (out / f"{stem}.png").stat().st_size > 10_000
