@@ -1,15 +1,17 @@
 """Issue 33: the arm's collision geometry, the floor, the collision report and the clearance check."""
 
 import numpy as np
+import pytest
 from pydrake.math import RigidTransform
 from pydrake.systems.analysis import Simulator
 
 from ptint_drake.cli import main
-from ptint_drake.simulation.scenario import load_scenario
+from ptint_drake.simulation.scenario import load_scenario, parse_with_overrides, scenario_text
 from ptint_drake.worlds.pick.collisions import collision_bodies
 from ptint_drake.worlds.pick.metrics import pick_reasons
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.station import MakePickStation
+from ptint_drake.worlds.pick.tasks import pick_plan
 
 # rvm1_5dof with the fingertip centre at (0.30, 0, 0.09), pointing down: the fingers inside the belt
 INTO_BELT_DEG = [0.0, 76.2, -5.9, 17.7, 0.0]
@@ -79,12 +81,32 @@ def test_a_start_pose_through_the_belt_is_rejected_before_the_run(tmp_path, caps
     assert not (tmp_path / "o" / "metrics.json").exists()
 
 
-def test_a_part_too_thin_for_the_pads_is_rejected_before_the_run(tmp_path, capsys):
-    """A 16 mm part puts the 20 mm pads (centred on the part's centre) 2 mm into its belt."""
+def test_a_part_shorter_than_the_fingers_allow_at_its_centre_is_gripped_above_it():
+    """A 16 mm part gripped at its centre would put the fingertips (10 mm past the fingertip centre)
+    2 mm into its belt: the plan grips it 7 mm higher, so that they keep 5 mm above the belt at the
+    grasp and above the tray at the place, and every target above the part or its slot rises by as
+    much; a 30 mm part is gripped at its centre, as before."""
+    for height, above in ((0.016, 0.007), (0.02, 0.005), (0.03, 0.0)):
+        s = parse_with_overrides(scenario_text("conveyor_pick_place")[1],
+                                 [f"pick.parts[0].size=[0.03,0.03,{height}]"])
+        plan = pick_plan(s.pick)
+        offsets = {seg.phase: seg.offset[2] for seg in plan.segments}
+        task = s.pick.tasks[0]
+        assert offsets["descend"] == pytest.approx(above) and offsets["place"] == pytest.approx(above)
+        assert offsets["approach"] == pytest.approx(task.clearance + above)
+        assert offsets["lift"] == pytest.approx(task.lift_height + above)
+        assert offsets["retreat"] == pytest.approx(task.clearance + above)
+        tips = height / 2 + above - 0.01  # the fingertips above the belt
+        assert tips == pytest.approx(max(0.005, height / 2 - 0.01)), height
+
+
+def test_a_part_too_short_to_hold_is_rejected_before_the_run(tmp_path, capsys):
+    """An 8 mm part: with the fingertips 5 mm above its belt the pads would hold 3 mm of it."""
     code = main(["run", "conveyor_pick_place", "--quiet", "--no-replay", "--no-figures", "--out",
-                 str(tmp_path / "o"), "--set", "pick.parts[0].size=[0.03,0.03,0.016]"])
+                 str(tmp_path / "o"), "--set", "pick.parts[0].size=[0.03,0.03,0.008]"])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and "pick.parts[0].size" in err and "belt" in err, err
+    assert code == 2 and "pick.parts[0].size" in err and "too short to hold" in err, err
+    assert len(err.splitlines()) == 1 and not (tmp_path / "o" / "metrics.json").exists()
 
 
 def test_strict_hydroelastic_reports_the_arm_in_a_belt_instead_of_failing():
@@ -124,3 +146,15 @@ def test_a_retry_is_the_tasks_own_window():
     logs = {"collisions": (t, flags)}
     assert pick_collisions(built, logs, 0) == []
     assert pick_collisions(built, logs, 1) == ["belt"]
+
+
+def test_a_line_part_placed_after_a_collision_is_warned_naming_the_bodies():
+    from ptint_drake.worlds.pick.line.metrics import placed_collision_warnings  # noqa: PLC0415
+
+    rows = [("a", True, 0), ("b", True, 1), ("c", False, 2), ("d", False, None)]
+    line = {"parts": [{"part": p, "placed": placed, "task": task} for p, placed, task in rows]}
+    picks = [{"collision": True, "collision_with": ["feed", "tray"]},
+             {"collision": False, "collision_with": []}, {"collision": True, "collision_with": ["feed"]}]
+    assert placed_collision_warnings({"line": line, "picks": picks}) == [
+        "a: placed, but its task's arm or gripper touched feed, tray"]
+    assert placed_collision_warnings({"picks": picks}) == []  # a task list: its pick's failure

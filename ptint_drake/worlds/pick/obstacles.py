@@ -7,7 +7,8 @@ at its nominal pose riding its belt (``ways.nominal``).  The hand is a vertical 
 the open fingers (radius half the opening plus a finger's thickness, from the pads' lower edge to
 the fingers' top: ``scene.finger_extent``, read from the gripper's collision geometry; a cylinder,
 so the tool's yaw does not matter) and, on a carry, the held part hangs in it (its centre at the
-tool point).  Each task's first approach and its carry are sampled along the planned way
+tool point, or below it where a short part is gripped above its centre: ``config.grip_height``).
+Each task's first approach and its carry are sampled along the planned way
 (``ways.segment_way``, the one tracer) at most ``STEP`` apart, and at each sample Drake's
 ``QueryObject.ComputeSignedDistancePairwiseClosestPoints`` gives the distance of the hand (and the
 held part) to every obstacle.  A sample nearer than ``HAND_MARGIN`` to an obstacle is a hit, named
@@ -33,21 +34,17 @@ The links above the hand are not in the planning model: their contacts are found
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 from pydrake.geometry import Box, Cylinder, ProximityProperties
 from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import SpatialInertia
 from pydrake.systems.framework import DiagramBuilder
 
-from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.config import grasp_width, grip_height
 from ptint_drake.worlds.pick.placement import nominal_parts
-from ptint_drake.worlds.pick.scene import (FINGER_JOINTS, belt_frame, bin_boxes, finger_extent, gripper_path,
-                                           slot_pose,
-                                           part_shape, tray_pose)
+from ptint_drake.worlds.pick.scene import belt_frame, bin_boxes, hand_size, part_shape, slot_pose, tray_pose
 from ptint_drake.worlds.pick.tasks import VIA_PART, VIA_SLOT, PickPlan, Via, aimed_yaw, pick_plan
 from ptint_drake.worlds.pick.ways import Nominal, down_posture, segment_way
 
@@ -90,6 +87,8 @@ class PlanningScene:
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         reach, top, thickness, stroke = _hand_size(scenario)
         names = [p.name for p in pick.parts]
+        # a held part's centre this far below the tool point (``config.grip_height``)
+        self.grip = [grip_height(p, reach) for p in pick.parts]
         self.radius = {}  # (task, phase) -> the hand's radius (m)
         for k, task in enumerate(pick.tasks):
             width = grasp_width(pick.parts[names.index(task.part)])
@@ -164,7 +163,7 @@ class PlanningScene:
         set_pose = self.plant.SetFreeBodyPose
         for i, body in enumerate(self.parts):
             p0, v = world.parts[i]
-            at = tool if i == held else p0 + v * t
+            at = tool - (0.0, 0.0, self.grip[i]) if i == held else p0 + v * t
             X = RigidTransform(RotationMatrix.MakeZRotation(world.part_yaws[i]), at)
             set_pose(self.plant_context, body, X)
         for body, X0, v in self.belts:
@@ -175,20 +174,7 @@ class PlanningScene:
 
 def _hand_size(scenario) -> tuple:
     """(reach, top, thickness, stroke) of the hand (m), from the gripper's model alone."""
-    return _gripper_size(scenario.pick.gripper.model)
-
-
-@lru_cache(maxsize=None)
-def _gripper_size(model: str) -> tuple:
-    """``_hand_size`` of the gripper ``model`` (``GripperConfig.model``), parsed once a process: the
-    planning scene of every replan and the slot warnings ask it of the same model."""
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-    (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(model)))
-    plant.Finalize()
-    stroke = sum(plant.GetJointByName(n, gripper).position_upper_limits()[0] for n in FINGER_JOINTS)
-    reach, top, thickness = finger_extent(plant, scene_graph, gripper)
-    return reach, top, thickness, stroke
+    return hand_size(scenario.pick.gripper.model)
 
 
 def way_hit(scene: PlanningScene, world: Nominal, plan: PickPlan, i: int) -> Hit | None:

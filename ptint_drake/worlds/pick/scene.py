@@ -31,6 +31,7 @@ corner spheres (``AddPointContactNubs``).  The friction of a pair is Drake's com
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -38,9 +39,10 @@ from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMate
                               AddRigidHydroelasticProperties, Box, Cylinder, ProximityProperties, Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelInstanceIndex,
                                     PdControllerGains, PrismaticJoint, SpatialInertia)
+from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.robot.rvm1 import model_path
@@ -164,6 +166,20 @@ def finger_extent(plant: MultibodyPlant, scene_graph, gripper: ModelInstanceInde
             reach, top = max(reach, corners[:, 2].max()), max(top, -corners[:, 2].min())
             thickness = max(thickness, np.abs(corners[:, 0]).max())
     return reach, top, thickness
+
+
+@lru_cache(maxsize=None)
+def hand_size(model: str) -> tuple:
+    """(reach, top, thickness, stroke) of the gripper ``model`` (``GripperConfig.model``; m):
+    ``finger_extent`` and ``gripper_stroke`` from its model alone, parsed once a process (the plan
+    of every task, the planning scene of every replan and the slot warnings ask it of the same
+    model)."""
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+    (gripper,) = Parser(plant, "gripper").AddModels(str(gripper_path(model)))
+    plant.Finalize()
+    reach, top, thickness = finger_extent(plant, scene_graph, gripper)
+    return float(reach), float(top), float(thickness), gripper_stroke(plant, gripper)
 
 
 def belt_frame(belt: BeltConfig) -> RigidTransform:

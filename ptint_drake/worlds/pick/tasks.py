@@ -33,6 +33,10 @@ its carry in two: first a segment of its own (phase ``via``) to a fixed point, t
 carry itself, the two together taking the segment's tf (so every later prescribed time stays
 where it was): the way around the arm's base when the straight way passes too near its waist axis.
 
+The tool grips a part at its centre, or ``config.grip_height`` above it where the fingertips would
+come too near its belt (or the tray at the place); then every target over the part, or over its
+place, rises by as much.
+
 Times: the approach starts at the task's ``start``; each later segment starts at the previous
 one's prescribed time, the lift and the retreat ``dwell`` later.  A task starts after the previous
 task's retreat (``start`` = 0: right after it).  ``pick_plan`` turns the block into the schedule,
@@ -49,7 +53,8 @@ from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.pick import PHASES, MoveConfig, PickConfig, PickTaskConfig  # noqa: F401
 from ptint_drake.systems.perception.part_fit import yaw_symmetry
 from ptint_drake.systems.task.schedule import Schedule, Segment
-from ptint_drake.worlds.pick.config import grasp_width
+from ptint_drake.worlds.pick.config import grasp_width, grip_height
+from ptint_drake.worlds.pick.scene import hand_size
 
 
 @dataclass(frozen=True)
@@ -162,12 +167,14 @@ def _up(h: float) -> tuple:
 
 
 def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start: float, replan: Replan,
-                   hold: float = 0.0, vias: tuple = (), ride: tuple = (0.0, 0.0, 0.0), grip: tuple = ()):
+                   hold: float = 0.0, vias: tuple = (), ride: tuple = (0.0, 0.0, 0.0), grip: tuple = (),
+                   above: float = 0.0):
     """The segments of task k, their plan entries, the attempts' (start, grasp) and the end;
     ``place``: (kind, index, yaw) of its place target (``place_target``); ``hold``: how long the
     first attempt waits at its pre-grasp pose before its descend (s); ``vias``: the task's ``Via``
     (at most one per phase); ``ride``: its place's velocity (m/s, an outgoing belt's); ``grip``:
-    every segment's ``PlanSegment.grip``."""
+    every segment's ``PlanSegment.grip``; ``above``: how far above the part's centre the tool grips
+    it (m, ``config.grip_height``): every offset from the part, and from its place, is raised by it."""
     segments, plans, attempts = [], [], []
     routes = {v.phase: v for v in vias if v.task == k}
 
@@ -191,27 +198,28 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start:
 
     t = start
     retries = replan.retries
+    high = _up(task.clearance + above)  # the pre-grasp pose, a backoff's and the retreat's
     for attempt in range(len(retries) + 1):
         if attempt:
-            t = add("backoff", "latched", part, _up(task.clearance), 0.0, retries[attempt - 1], attempt)
+            t = add("backoff", "latched", part, high, 0.0, retries[attempt - 1], attempt)
         approach = t
-        t = add("approach", "part", part, _up(task.clearance), 0.0, t, attempt)
+        t = add("approach", "part", part, high, 0.0, t, attempt)
         if attempt == 0:
             t += hold
         grasp = t + task.descend.tf  # prescribed, even where the descend is cut short
         last = replan.abort if replan.abort is not None else np.inf
         if attempt < len(retries) or last > t + 1e-9:  # an abort at the descend's start: none
-            t = add("descend", "part", part, _up(0.0), 0.0, t, attempt,
+            t = add("descend", "part", part, _up(above), 0.0, t, attempt,
                     retries[attempt] if attempt < len(retries) else last)
         attempts.append((approach, grasp))
     if replan.abort is not None:
-        t = add("backoff", "latched", part, _up(task.clearance), 0.0, replan.abort, len(retries))
+        t = add("backoff", "latched", part, high, 0.0, replan.abort, len(retries))
         t -= task.dwell  # the lift right after it
-    t = add("lift", "latched", part, _up(task.lift_height), 0.0, t + task.dwell + replan.lift_delay)
+    t = add("lift", "latched", part, _up(task.lift_height + above), 0.0, t + task.dwell + replan.lift_delay)
     kind, index, yaw = place
-    t = add("carry", kind, index, _up(task.lift_height), yaw, t)
-    t = add("place", kind, index, _up(0.0), yaw, t)
-    t = add("retreat", kind, index, _up(task.clearance), yaw, t + task.dwell)
+    t = add("carry", kind, index, _up(task.lift_height + above), yaw, t)
+    t = add("place", kind, index, _up(above), yaw, t)
+    t = add("retreat", kind, index, high, yaw, t + task.dwell)
     return segments, plans, attempts, t
 
 
@@ -220,6 +228,7 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
     retries and lift delays a run decided (``replans``: one ``Replan`` per task, none: the plan
     before the run) and the ways around the base (``vias``: ``Via``, ``route.routed_plan``)."""
     names = [p.name for p in pick.parts]
+    reach = hand_size(pick.gripper.model)[0] if pick.tasks else 0.0
     segments, plans, commands, closes, grasps, widths, attempts = [], [], [], [], [], [], []
     t = 0.0
     commands.append((0.0, pick.gripper.initial_opening))
@@ -232,7 +241,8 @@ def pick_plan(pick: PickConfig, replans: tuple = (), vias: tuple = ()) -> PickPl
         first_close, hold = _closed_on_nothing(pick, task, start)
         grip = () if task.grip_yaw is None else (float(task.grip_yaw), part_symmetry(pick.parts[part]))
         segs, plan, tries, t = _task_segments(k, task, part, place_target(pick, task), start, replan, hold,
-                                              vias, place_ride(pick, task), grip)
+                                              vias, place_ride(pick, task), grip,
+                                              grip_height(pick.parts[part], reach))
         widths.append((tries[0][0], width))
         task_attempts = []
         for j, (approach, grasp) in enumerate(tries):

@@ -51,7 +51,7 @@ from ptint_drake.worlds.pick.controller_side import pick_link_ports, plan_stands
 from ptint_drake.worlds.pick.grasp_gate import grasp_refusal
 from ptint_drake.worlds.pick.line.checks import check_line_scenario, line_plan, line_warnings
 from ptint_drake.worlds.pick.line.driver import LineDriver, NoLine, view_scenario
-from ptint_drake.worlds.pick.line.metrics import line_reasons
+from ptint_drake.worlds.pick.line.metrics import line_reasons, placed_collision_warnings
 from ptint_drake.worlds.pick.metrics import pick_metrics, pick_reasons, segment_rows
 from ptint_drake.worlds.pick.placement import bridging_warnings, check_placement
 from ptint_drake.worlds.pick.route import routed_plan
@@ -279,7 +279,7 @@ class PickRun(WorldRun):
                                  series["v"], built.limits)
         runaway_metrics(built, metrics, series)  # per pick: saturated, joint speed beyond limit
         self.line.add_metrics(metrics, series)  # a line's ``line`` (``line.metrics``)
-        return metrics, series, joint_limit_warnings(built.arm, series)
+        return metrics, series, joint_limit_warnings(built.arm, series) + placed_collision_warnings(metrics)
 
     def sim_info(self, integrator) -> dict:
         config = self.built.station.config

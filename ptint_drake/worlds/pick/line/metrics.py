@@ -195,3 +195,16 @@ def line_reasons(line: dict) -> list[Reason]:
     if line.get("idsw"):  # the camera's tracks: a part's fits went to another track (must be 0)
         reasons.append(Reason(None, "identity switch", f"tracking: {line['idsw']} identity switches"))
     return reasons
+
+
+def placed_collision_warnings(metrics: dict) -> list[str]:
+    """A line's warnings (none without a line): one per part placed although its task's arm or
+    gripper touched something on the way (``picks[*].collision_with``) — the line counts the part
+    placed, the warning names what was hit (a task list's collision is a failure of its pick)."""
+    out = []
+    for p in metrics["line"]["parts"] if "line" in metrics else []:
+        pick = metrics["picks"][p["task"]] if p["placed"] and p["task"] is not None else None
+        if pick is not None and pick["collision"]:
+            bodies = ", ".join(pick.get("collision_with") or []) or "a body not named"
+            out.append(f"{p['part']}: placed, but its task's arm or gripper touched {bodies}")
+    return out

@@ -17,7 +17,8 @@ tracker's report, each belt's known speed, each track's reach window — never t
   declares ``encoder: true``, else the declared ``speed`` — a speed step is unknown then, until
   a track's drift shows it: the speed the sensor reports for that track is learned for the belt
   (``learned``, set by ``driver``);
-- **the reach window** of a track (``window``): along its belt, at its lateral offset and height,
+- **the reach window** of a track (``window``): along its belt, at its lateral offset and the height
+  the tool grips it at (its centre's, or above it: ``config.grip_height``),
   the longest stretch where a top-down grasp and the lift above it are reachable (Drake's IK,
   ``robot.reachability.inverse_kinematics(down=True)``, every ``WINDOW_STEP``), cached per
   (belt, lateral, height) — for the process (``_WINDOWS``): a window depends on the arm's
@@ -36,7 +37,8 @@ from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.systems.perception.part_fit import reach
 from ptint_drake.worlds.pick.line.scheduler import Track
-from ptint_drake.worlds.pick.scene import belt_frame
+from ptint_drake.worlds.pick.config import grip_height
+from ptint_drake.worlds.pick.scene import belt_frame, hand_size
 
 VIEW_BEFORE = 0.05  # m, upstream of the release point: where the view begins
 WINDOW_STEP = 0.01  # m, of the reach window's scan
@@ -152,7 +154,8 @@ class LineView:
         """The reach window [s_in, s_out] (m along the belt) of ``track`` (module docstring)."""
         belt = {b.name: b for b in self.built.station.config.belts}[track.belt]
         local = belt_frame(belt).inverse().multiply(np.asarray(track.position))
-        return self.window_at(track.belt, float(local[1]), float(local[2]))
+        above = grip_height(self.line.kind(track.kind), hand_size(self.scenario.pick.gripper.model)[0])
+        return self.window_at(track.belt, float(local[1]), float(local[2]) + above)
 
     def _scan(self, X, belt, local) -> tuple:
         guess = np.radians(self.scenario.robot.initial_q_deg)
