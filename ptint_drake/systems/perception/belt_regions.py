@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ptint_drake.systems.perception.part_fit import BeltRegion, part_height
+from ptint_drake.config.part_shape import part_height
+from ptint_drake.systems.perception.part_fit import BeltRegion
 
 
 def belt_regions(configs) -> list[BeltRegion]:

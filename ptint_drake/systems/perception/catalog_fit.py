@@ -28,9 +28,10 @@ import math
 
 import numpy as np
 
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.systems.perception.part_fit import (MIN_POINTS, BeltRegion, PartFit, _hull, _split,
                                                      _top_face, clusters, fit_part, in_band,
-                                                     min_area_rectangle, nearest_belt, part_height)
+                                                     min_area_rectangle, nearest_belt)
 
 HEIGHT_TOLERANCE = 0.004  # m, measured (top face over its belt) vs the class's height
 FILL = {"box": 1.0, "cylinder": math.pi / 4.0}  # a top face's area over its smallest rectangle's

@@ -43,6 +43,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
+from ptint_drake.config.part_shape import part_height
+
 BELT_BAND = 0.004  # m, points this close to the belt plane are the belt (≈ 10 σ of the depth noise at 0.5 m)
 TOP_BAND = 0.004  # m, the top face: points within this of the cluster's highest
 CLUSTER_RADIUS = 0.006  # m, neighbours closer than this are one cluster (a few pixel footprints)
@@ -91,11 +93,6 @@ class PartFit:
         """R_WP: yaw about the fitted axis (vertical parts: about world z)."""
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def part_height(shape: str, size) -> float:
-    """m: a box's z size or a cylinder's height."""
-    return float(size[2] if shape == "box" else size[1])
 
 
 def _top_sides(shape: str, size) -> tuple[float, float]:

@@ -44,10 +44,10 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Outpu
 from pydrake.systems.primitives import ConstantValueSource
 from pydrake.systems.sensors import CameraInfo, PixelType
 
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.systems.perception.belt_regions import perception_belts
 from ptint_drake.systems.perception.catalog_fit import catalog_points, fit_catalog
-from ptint_drake.systems.perception.part_fit import (BELT_BAND, TOP_BAND, fit_parts, part_height,
-                                                     reach)
+from ptint_drake.systems.perception.part_fit import BELT_BAND, TOP_BAND, fit_parts, reach
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose, cloud_camera_info
 
 # m: the fits' noise the estimators assume when measurement.noise_std is 0 (the default): the

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ptint_drake.config.schema import Scenario
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.worlds.pick.config import DEFAULT_APPROXIMATION, PickWorldConfig
 from ptint_drake.worlds.pick.placement import placed_parts
 from ptint_drake.worlds.pick.scene import belt_frame, bin_drop, slot_pose
@@ -44,7 +45,7 @@ def place_point(config, kind: str, index: int, part, along: float = 0.0) -> np.n
     ``config``: a ``PickWorldConfig`` or a ``pick`` block."""
     if kind == "bin":
         return bin_drop(config.bins[index], part)
-    height = part.size[2] if part.shape == "box" else part.size[1]
+    height = part_height(part.shape, part.size)
     if kind == "belt":
         return belt_frame(config.belts[index]).multiply(np.array([along, 0.0, height / 2]))
     return slot_pose(config.tray, index).translation() + [0.0, 0.0, height / 2]

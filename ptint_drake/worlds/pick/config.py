@@ -13,8 +13,7 @@ the plant's settings (Drake's ``MultibodyPlantConfig`` fields that matter here).
 import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
-from ptint_drake.config.part_shape import TIP_CLEARANCE, check_part_shape
-from ptint_drake.config.part_shape import part_height as shape_height
+from ptint_drake.config.part_shape import TIP_CLEARANCE, check_part_shape, part_height
 from ptint_drake.config.pick import (  # noqa: F401
     BeltConfig,
     BinConfig,
@@ -42,17 +41,12 @@ def grasp_width(part: PartConfig) -> float:
     return float(part.size[0])
 
 
-def part_height(part: PartConfig) -> float:
-    """The part's (or a line's catalog kind's) height standing on its base (m)."""
-    return shape_height(part.shape, part.size)
-
-
 def grip_height(part: PartConfig, reach: float) -> float:
     """How far above the part's centre the fingertip centre grips it (m): 0 where the fingers,
     reaching ``reach`` m past the fingertip centre, keep ``config.part_shape.TIP_CLEARANCE`` above
     the part's base; higher on a part too short for that — gripped at its centre, a 20 mm part
     would have the fingertips of the bundled grippers on its belt and, at the place, on the tray."""
-    return max(0.0, reach + TIP_CLEARANCE - part_height(part) / 2)
+    return max(0.0, reach + TIP_CLEARANCE - part_height(part.shape, part.size) / 2)
 
 
 def _check_part(k: int, part: PartConfig, belts: dict) -> None:

@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.config.pick import PartConfig
 
 RANDOM = "random"
@@ -114,7 +115,7 @@ def bridging_warnings(pick) -> list[str]:
         lateral = part.lateral if isinstance(part.lateral, list) else [part.lateral, part.lateral]
         reach = _across_reach(part, v)
         low, high = float(lateral[0]) - reach, float(lateral[1]) + reach
-        height = float(part.size[2] if part.shape == "box" else part.size[1])
+        height = part_height(part.shape, part.size)
         for other in pick.belts:
             d = np.asarray(other.direction, float)
             if other.name == own.name or abs(abs(d @ u) - 1.0) > 1e-6:

@@ -24,6 +24,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, Saturation
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.config.schema import Scenario, default_simulator
 from ptint_drake.controllers import AddControllerTo, ControllerHandles
 from ptint_drake.robot.plant import actuator_effort_limits, nominal_plant
@@ -281,7 +282,7 @@ def _check_slots(scenario: Scenario, built: PickBuilt, frame, guesses: list, con
     the arm reaches from above (solved from each of ``guesses``: the start posture and the tasks'
     carries): at half the lowest part's height above the tray and ``lift_height`` above that."""
     tasks, used = scenario.pick.tasks, {t.slot for t in scenario.pick.tasks}
-    height = min(p.size[2] if p.shape == "box" else p.size[1] for p in built.station.config.parts)
+    height = min(part_height(p.shape, p.size) for p in built.station.config.parts)
     lift = max(t.lift_height for t in tasks)
     for j, slot in enumerate(built.station.slots):
         if j in used:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.systems.perception.track_system import ROW
 from ptint_drake.systems.perception.tracks import CONFIRM, MAX_TRACKS
 
@@ -90,7 +91,7 @@ def class_heights(scenario) -> list[float]:
     cylinder's length."""
     from ptint_drake.worlds.pick.part_tracks import catalog  # noqa: PLC0415
 
-    return [float(size[2] if shape == "box" else size[1]) for shape, size in catalog(scenario.pick)[0]]
+    return [part_height(shape, size) for shape, size in catalog(scenario.pick)[0]]
 
 
 def track_poses(tracks: list[TrackPath], heights: list[float], t: float) -> list[tuple]:

@@ -26,6 +26,7 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.line import check_line
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.config.pick import PickTaskConfig
 from ptint_drake.robot.plant import nominal_plant
 from ptint_drake.robot.reachability import inverse_kinematics
@@ -72,7 +73,7 @@ def check_line_scenario(scenario) -> None:
     guess = np.radians(scenario.robot.initial_q_deg)
     bins = {b.name: (j, b) for j, b in enumerate(pick.bins)}
     for k, kind in enumerate(pick.line.catalog):
-        height = kind.size[2] if kind.shape == "box" else kind.size[1]
+        height = part_height(kind.shape, kind.size)
         if kind.belt:
             _check_out_belt(arm, frame, guess, pick, k, height, task.lift_height)
         if kind.bin:

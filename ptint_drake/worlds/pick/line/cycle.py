@@ -56,6 +56,7 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.config.pick import MoveConfig, PartConfig, PickTaskConfig
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.phase_time import Cycle, NoTfFits, PhaseTimes, cycle_time, held_mass
 from ptint_drake.worlds.pick.line.grip import Grips, grip_axis, puts, slot_yaw
@@ -237,8 +238,7 @@ class LineCycles:
         cycle to it riding the belt); the point chosen: ``out_place``."""
         pick = self.scenario.pick
         belt = next(b for b in pick.belts if b.name == slot.belt)
-        height = kind.size[2] if kind.shape == "box" else kind.size[1]
-        window = self.window_at(slot.belt, 0.0, height / 2)
+        window = self.window_at(slot.belt, 0.0, part_height(kind.shape, kind.size) / 2)
         put = across_yaw(belt, grip)
         mass = held_mass(self.scenario, kind.mass)
         ride = track.speed * np.asarray(track.direction)
@@ -333,7 +333,7 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
             if arrival.mix and not arrival.mix.get(kind.name):
                 continue
             belt = belts[arrival.belt]
-            height = part.size[2] if part.shape == "box" else part.size[1]
+            height = part_height(part.shape, part.size)
             s_in, s_out = view(arrival.belt, 0.0, height / 2)
             x = belt_frame(belt).multiply(np.array([0.5 * (s_in + s_out), 0.0, height / 2]))
             ride = belt.speed * np.asarray(belt.direction) / np.linalg.norm(belt.direction)

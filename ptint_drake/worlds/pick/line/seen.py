@@ -34,8 +34,9 @@ from pydrake.math import RotationMatrix
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from ptint_drake.config.measurement import BeltRegionConfig
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.systems.perception.belt_regions import belt_regions
-from ptint_drake.systems.perception.part_fit import part_height, yaw_symmetry
+from ptint_drake.systems.perception.part_fit import yaw_symmetry
 from ptint_drake.systems.perception.part_pose_estimator import MakeRgbdPerception, PerceptionConfig
 from ptint_drake.systems.perception.rgbd_camera import camera_info, camera_pose
 from ptint_drake.systems.perception.track_system import TrackingPartPoseEstimator

@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from ptint_drake.config.pick import PickTaskConfig
+from ptint_drake.config.part_shape import part_height
 from ptint_drake.robot.reachability import inverse_kinematics
 from ptint_drake.systems.perception.part_fit import reach
 from ptint_drake.worlds.pick.line.scheduler import Track
@@ -117,7 +118,7 @@ class LineView:
             R = source.GetOutputPort(f"part_{k}_rotation").Eval(sc)[0:9].reshape(3, 3)
             belt = belts[part.belt]
             local = belt_frame(belt).inverse().multiply(pose[0:3])
-            height = part.size[2] if part.shape == "box" else part.size[1]
+            height = part_height(part.shape, part.size)
             if not (abs(local[1]) <= belt.width / 2 and abs(local[2] - height / 2) < 0.01
                     and view[belt.name] <= local[0] <= belt.length / 2):
                 continue
@@ -139,7 +140,7 @@ class LineView:
             belt, kind = belts[tr.belt], kinds[tr.kind]
             u = np.asarray(belt.direction, float) / np.linalg.norm(belt.direction)
             along = float(tr.x[2:4] @ u[0:2])
-            height = kind.size[2] if kind.shape == "box" else kind.size[1]
+            height = part_height(kind.shape, kind.size)
             p = np.array([tr.x[0], tr.x[1], belt.center[2] + height / 2]) + along * u * (t - tr.t)
             s = float(belt_frame(belt).inverse().multiply(p)[0])
             if belt.name not in line_belts or abs(s) > belt.length / 2:
