@@ -11,9 +11,10 @@ with no point in reach ``pick.line.catalog[k].belt``.
 
 ``line_warnings``: the arrival rate against the arm's capacity — the min-tf model's estimate
 (``line.cycle.estimate``, picks per minute): above it, a warning with the numbers, and the run goes
-on.  The estimate, not a measurement: a measured throughput belongs to one cell and one commit
-(the surplus line's is measured by ``scripts/line_capacity.py``, docs/pick_place.md "The line's
-capacity").  A tray slot where the open fingers come down beside a belt
+on; a cell where the model finds no cycle at a reach window's middle (``NoTfFits``), a warning
+naming why, and the run goes on.  The estimate, not a measurement: a measured throughput belongs
+to one cell and one commit (the surplus line's is measured by ``scripts/line_capacity.py``,
+docs/pick_place.md "The line's capacity").  A tray slot where the open fingers come down beside a belt
 (``obstacles.slot_warnings``): a warning naming the slot and the belt.  A camera that sees no
 point of the line's belts' centre lines (every
 ``VIEW_STEP``): a warning (every part will be ``not seen``), and the run goes on.
@@ -37,6 +38,7 @@ from ptint_drake.worlds.pick.line.cycle import estimate
 from ptint_drake.worlds.pick.line.driver import cycle_time
 from ptint_drake.worlds.pick.line.plan import line_plan
 from ptint_drake.worlds.pick.obstacles import slot_warnings
+from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.scene import (BIN_DROP_CLEARANCE, AddGripper, belt_frame, gripper_stroke,
                                           slot_pose)
 
@@ -128,7 +130,12 @@ def line_warnings(scenario, driver=None) -> list[str]:
     rate = 60.0 * sum(a.rate for a in scenario.pick.line.arrivals)
     fingers = slot_warnings(scenario, PickTaskConfig().margin)  # (obstacles: a slot beside a belt)
     if driver is not None and getattr(driver, "cycles", None) is not None:
-        capacity, cycle = estimate(driver.scenario, driver.view.window_at, driver.cycles.model)
+        try:
+            capacity, cycle = estimate(driver.scenario, driver.view.window_at, driver.cycles.model)
+        except NoTfFits as error:
+            return _blind(scenario) + fingers + [
+                f"pick.line: the arm's capacity could not be estimated ({error}, at the middle of a "
+                f"reach window, line.cycle.estimate); the run goes on"]
         how = (f"the feasibility model's estimate: 60 / a {cycle:.2f} s cycle at the min tfs, "
                f"line.cycle.estimate")
     else:

@@ -147,9 +147,15 @@ class LineDriver:
 
     def add_metrics(self, metrics: dict, series: dict) -> None:
         """metrics.json ``line`` (``metrics.line_metrics``) and the min-tf model's capacity estimate
-        (``line.cycle.estimate``: ``capacity_estimate``, picks per minute and the cycle, s)."""
+        (``line.cycle.estimate``: ``capacity_estimate``, picks per minute and the cycle, s; None
+        for both, and ``why_not``, where the model finds no cycle)."""
         metrics["line"] = line_metrics(self.scenario, self, metrics, series)
-        ppm, cycle = estimate(self.scenario, self.view.window_at, self.cycles.model)
+        try:
+            ppm, cycle = estimate(self.scenario, self.view.window_at, self.cycles.model)
+        except NoTfFits as error:  # (warned before the run, ``checks.line_warnings``)
+            metrics["line"]["capacity_estimate"] = {"picks_per_minute": None, "cycle_s": None,
+                                                    "why_not": str(error)}
+            return
         metrics["line"]["capacity_estimate"] = {"picks_per_minute": ppm, "cycle_s": cycle}
 
     def stops(self, duration: float) -> list[float]:
