@@ -17,7 +17,7 @@ from ptint_drake.worlds.pick.line.view import LineView
 from ptint_drake.worlds.pick.line.watch import AFTER, ahead
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 
-IIWA_LINE = str(Path(__file__).resolve().parents[1] / "line_iiwa14.yaml")
+LINE_BIN = str(Path(__file__).resolve().parents[1] / "line_bin.yaml")
 
 
 def test_a_cell_with_no_cycle_is_warned_and_the_run_goes_on(monkeypatch):
@@ -41,7 +41,7 @@ def test_a_kept_bin_tasks_phases_are_planned_again_at_the_yaw_it_grasped_at():
     """``watch.ahead`` on a task to a bin (no ``place_yaw``: the tool keeps its grip's yaw over a
     bin) plans its phases after the grasp again; before session 52 it raised a TypeError (the
     iiwa 14's line, tests/line_iiwa14.yaml, at its first drift)."""
-    scenario, _ = line_scenario(load_scenario(str(Path(IIWA_LINE).with_name("line_bin.yaml"))))
+    scenario, _ = line_scenario(load_scenario(LINE_BIN))
     scenario.pick.tasks = [PickTaskConfig(part="disc_0", bin="bin", grip_yaw=0.3, start=0.5)]
     driver = SimpleNamespace(scenario=scenario, cycles=LineCycles(scenario), straight={})
     disc = Track(0, "disc", "conveyor", (0.25, -0.05, 0.15), -0.05, (0.0, 1.0, 0.0), 0.1, (1.0, 0.0, 0.0),

@@ -85,7 +85,7 @@ class PlanningScene:
         self.parts_config = nominal_parts(pick.parts)
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-        reach, top, thickness, stroke = _hand_size(scenario)
+        reach, top, thickness, stroke = hand_size(pick.gripper.model)
         names = [p.name for p in pick.parts]
         # a held part's centre this far below the tool point (``config.grip_height``)
         self.grip = [grip_height(p, reach) for p in pick.parts]
@@ -170,11 +170,6 @@ class PlanningScene:
             set_pose(self.plant_context, body, RigidTransform(X0.rotation(), X0.translation() + v * t))
         for r, body in self.hands.items():
             set_pose(self.plant_context, body, RigidTransform(tool) if r == radius else self.PARKED)
-
-
-def _hand_size(scenario) -> tuple:
-    """(reach, top, thickness, stroke) of the hand (m), from the gripper's model alone."""
-    return hand_size(scenario.pick.gripper.model)
 
 
 def way_hit(scene: PlanningScene, world: Nominal, plan: PickPlan, i: int) -> Hit | None:
@@ -278,7 +273,7 @@ def slot_warnings(scenario, margin: float) -> list[str]:
     inner belt's edge at 0.195 m — the right finger 0.3 mm into the inner belt at the place and the
     retreat, `collision with inner` in 20 of 61 placed picks."""
     pick = scenario.pick
-    thickness = _hand_size(scenario)[2]
+    thickness = hand_size(pick.gripper.model)[2]
     out = []
     for kind in pick.line.catalog:
         radius = (kind.size[0] + margin) / 2 + thickness

@@ -113,11 +113,12 @@ def ahead(driver, t: float, k: int, track, tool: tuple) -> dict:
     pick = driver.scenario.pick
     kind = kind_part(pick, track.kind)
     place = destination_place(pick, task.bin or task.slot, kind)
-    # over a bin the tool keeps the yaw it grasped at (a bin task has no place_yaw: ``cycle.task_of``)
+    # over a bin the tool keeps the yaw it grasped at (a bin task has no place_yaw; a line's task
+    # always has its grip_yaw: ``cycle.task_of``)
     put = task.grip_yaw if task.place_yaw is None else task.place_yaw
     try:
         cycle = cycle_time(driver.cycles.model, track.at(max(t, task.start), t),
-                           track.speed * np.asarray(track.direction), place, 0.0 if put is None else put,
+                           track.speed * np.asarray(track.direction), place, put,
                            track_yaw(track), held_mass(driver.scenario, kind.mass),
                            task, *tool, grip=task.grip_yaw, put=put)
     except NoTfFits as error:
