@@ -286,6 +286,37 @@ def joint_terms_of(plant: MultibodyPlant, frame, postures: np.ndarray, motions: 
     return out
 
 
+def loop_inertia(plant: MultibodyPlant, frame, postures: np.ndarray, payload: float = 0.0, instance=None,
+                 rot_scale: float = 1.0, damping: float = 0.0) -> float:
+    """kg·m² (per unit of the weighed task): the largest, over ``postures``, of 1 / λ_min(J M⁻¹ J⁺)
+    — the controller's velocity loop τ = −K J⁺ s (eq. 18) on the arm of mass matrix M (the
+    station's plant, plus ``payload`` kg held at the tool) closes as ṡ ≈ −K J M⁻¹ J⁺ s, so its
+    slowest time constant is this over K.  J: the 6-D task Jacobian [ω; v] weighed by
+    ``rot_scale`` and inverted as the controller inverts it (``damping``: ``joint_terms_of``);
+    the eigenvalues of a direction J does not move (a 5-joint arm's sixth) are left out."""
+    context = plant.CreateDefaultContext()
+    nv = plant.num_velocities()
+    cols = (np.arange(nv) if instance is None
+            else plant.GetVelocitiesFromArray(instance, np.arange(nv, dtype=float)).astype(int))
+    world = plant.world_frame()
+    weight = np.r_[np.full(3, rot_scale), np.ones(3)]
+    worst = 0.0
+    for q in postures:
+        _set_positions(plant, context, instance, q)
+        M = plant.CalcMassMatrix(context)[np.ix_(cols, cols)]
+        J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3), world,
+                                              world)[:, cols]
+        if payload > 0.0:
+            M = M + payload * J[3:].T @ J[3:]
+        J = weight[:, None] * J
+        Jp = (np.linalg.pinv(J) if damping <= 0.0
+              else J.T @ np.linalg.inv(J @ J.T + damping ** 2 * np.eye(len(J))))
+        rates = np.linalg.eigvals(J @ np.linalg.solve(M, Jp)).real
+        rates = rates[rates > 1e-9 * rates.max()]
+        worst = max(worst, 1.0 / float(rates.min()))
+    return worst
+
+
 def _set_positions(plant: MultibodyPlant, context, instance, q: np.ndarray) -> None:
     if instance is None:
         plant.SetPositions(context, q)

@@ -42,6 +42,12 @@ docs/pick_place.md "The harsh study"): at the full limits the runaways were heav
 1.8 × briefly (0.5 % of the run at a limit) and the arm runs on.
 ``SPEED_SHARE`` = 1: a joint's speed |J⁺ẋ| is kinematic (no mass in it) — the runaways measured
 were torque-led, the speeds beyond their limits came after the torques saturated.
+``TRACKING`` = 10: a phase lasts at least that many time constants of the controller's velocity
+loop along its way (``run_warnings.loop_inertia`` / ``gain``, the payload held; before ``MARGIN``):
+the limits bound the planned motion, not the model-free feedback that follows it.  Measured on a
+line of each heavier arm (docs/pick_place.md "A phase the controller tracks"): at 10, every part
+placed on the Panda and the UR5e with commands within 0.57 of the limits; at 6 the Panda's commands
+reached 9.5 × a limit; with the limits alone (the RV-M1's 2.7 ms loop never sets a phase) none.
 
 ``cycle_time`` — one pick cycle from the min tfs: the approach from the last place's retreat point
 to ``clearance`` above a part riding its belt, the descend, the close dwell, the lift, the carry to
@@ -64,7 +70,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from ptint_drake.config.pick import PHASES, PickTaskConfig
 from ptint_drake.systems.hand.datasheets import RATED_PAYLOAD
 from ptint_drake.robot.plant import effort_limits, nominal_plant
-from ptint_drake.verdict.run_warnings import SPEED_SAMPLES, joint_demand, joint_terms_of
+from ptint_drake.verdict.run_warnings import SPEED_SAMPLES, joint_demand, joint_terms_of, loop_inertia
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.feasibility import Way, way_motion, way_postures, way_profile
 from ptint_drake.worlds.pick.route import nearest_branch, turn_ways
@@ -77,6 +83,7 @@ MARGIN = 1.15  # over the model's shortest tf (module docstring)
 TORQUE_SHARE = 2.0 / 3.0  # of each effort limit the model plans to (module docstring)
 SPEED_SHARE = 1.0  # of each joint-speed limit the model plans to (module docstring)
 SHORTEST = 0.05  # s: the floor of a way that asks nothing
+TRACKING = 10.0  # the controller's slowest velocity-loop time constants a phase lasts at least (docstring)
 TOLERANCE = 0.002  # s: a riding target's fixed point
 ITERATIONS = 5
 COARSE = 11  # samples of a profile, the coarser option (``PhaseTimes.samples``; default 21)
@@ -105,6 +112,7 @@ class PhaseTimes:
     rot_scale: float = 1.0
     damping: float = 0.0
     gripper_speed: float = 0.05  # m/s per jaw: a descend is at least the fingers' close (``cycle_time``)
+    gain: float = 50.0  # the controller's K (eq. 18): a phase lasts ``TRACKING`` of its loop's time constants
     samples: int = SPEED_SAMPLES  # of each profile (``COARSE``: fewer, faster)
     torque_share: float = TORQUE_SHARE  # of the effort limits planned to
     speed_share: float = SPEED_SHARE  # of the joint-speed limits planned to
@@ -124,7 +132,7 @@ class PhaseTimes:
                    plant.GetFrameByName(scenario.robot.end_effector, station.arm), station.arm,
                    np.radians(scenario.robot.initial_q_deg), plant.GetVelocityUpperLimits()[cols],
                    effort_limits(arm), scenario.controller.rot_scale, scenario.controller.pinv_damping,
-                   scenario.pick.gripper.speed)
+                   scenario.pick.gripper.speed, scenario.controller.K)
 
     def min_tf(self, start, target, velocity=None, payload: float = 0.0, beta: float = 0.75,
                yaws: tuple = (0.0, 0.0), q: Optional[np.ndarray] = None, margin: float = MARGIN) -> float:
@@ -240,7 +248,9 @@ class PhaseTimes:
                           for sign in (1, -1)]
         u = np.concatenate([np.ravel(r) for r in roots])
         u = u[np.isfinite(u) & (u > 0.0)]
-        return max(1.0 / float(np.min(u)), SHORTEST) if len(u) else SHORTEST
+        tracked = TRACKING * loop_inertia(self.plant, self.tool, postures, way.payload, self.instance,
+                                          self.rot_scale, self.damping) / self.gain
+        return max(1.0 / float(np.min(u)) if len(u) else 0.0, tracked, SHORTEST)
 
 
 def _way(start, target, velocity, payload: float, yaws: tuple) -> Way:

@@ -267,7 +267,6 @@ class LineCycles:
         yaws = {"grip_yaw": cycle.yaws[0], "place_yaw": cycle.yaws[1] if isinstance(slot, int) else None}
         return replace(self.task, part=part, start=begin, **destination(slot), **moves, **yaws)
 
-
     def detours(self, scenario, plan, k: int, mass: float) -> dict:
         """phase → (tf₁, tf₂, share): the min tfs (s) of the via's leg and of the rest of task
         ``k``'s phase split by a via in ``plan`` (the plan of ``scenario``; module docstring), and
@@ -301,7 +300,8 @@ def estimate(scenario, view, model: Optional[PhaseTimes] = None) -> tuple:
     pick = scenario.pick
     fresh = model is not None and not model.postures
     key = repr((scenario.robot, scenario.controller.rot_scale, scenario.controller.pinv_damping,
-                pick.gripper, pick.belts, pick.tray, pick.bins, pick.line.catalog, pick.line.arrivals,
+                scenario.controller.K, pick.gripper, pick.belts, pick.tray, pick.bins, pick.line.catalog,
+                pick.line.arrivals,
                 None if model is None else (model.torque_share, model.speed_share, model.samples,
                                             model.last)))
     if fresh and key in _ESTIMATES:
