@@ -201,6 +201,13 @@ class PhaseTimes:
             worst = max(worst, float(max(np.max(speeds / V), np.max(torques / L))))
         return worst
 
+    def initial_yaw(self) -> float:
+        """rad: the tool's yaw at the initial posture ``q0``."""
+        context = self.arm.CreateDefaultContext()
+        self.arm.SetPositions(context, self.q0)
+        R = self.frame.CalcPoseInWorld(context).rotation().matrix()
+        return float(np.arctan2(R[1, 0], R[0, 0]))
+
     def limits(self) -> tuple:
         """(joint speeds, rad/s; torques, N·m): the shares of the arm's limits the model plans to
         (``speed_share``, ``torque_share``; module docstring)."""
@@ -356,10 +363,7 @@ def task_cycles(scenario, model: Optional[PhaseTimes] = None) -> list:
     world = nominal(scenario, model.arm)
     pick = scenario.pick
     names = [p.name for p in pick.parts]
-    context = model.arm.CreateDefaultContext()
-    model.arm.SetPositions(context, model.q0)
-    R = model.frame.CalcPoseInWorld(context).rotation().matrix()
-    x, yaw, t, out = world.start, float(np.arctan2(R[1, 0], R[0, 0])), 0.0, []
+    x, yaw, t, out = world.start, model.initial_yaw(), 0.0, []
     for k, task in enumerate(pick.tasks):
         t = max(t, task.start)
         j = names.index(task.part)

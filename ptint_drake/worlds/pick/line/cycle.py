@@ -43,8 +43,9 @@ drift kept with its part out of reach at the approach's end (``driver``), not a 
 
 ``estimate`` — the line's capacity by the model: per kind of the catalog, one cycle from
 ``clearance`` above its first slot to a part at the middle of its reach window on its belt (no
-lateral offset, yaw 0) and back to that slot; 60 / the mean cycle, picks per minute (the arrival
-warning's number, and the surplus line's estimate, ``scripts/line_capacity.py``).
+lateral offset, yaw 0) and back to that slot, the tool on the slot's yaw branch (modulo π) nearest
+its yaw at the initial posture (the iiwa's is π: at 0 IK found no posture); 60 / the mean cycle,
+picks per minute (the arrival warning's number, the surplus line's, ``scripts/line_capacity.py``).
 """
 
 from __future__ import annotations
@@ -299,9 +300,8 @@ def estimate(scenario, view, model: Optional[PhaseTimes] = None) -> tuple:
     computation would: a sample's run does not depend on what its worker ran before."""
     pick = scenario.pick
     fresh = model is not None and not model.postures
-    key = repr((scenario.robot, scenario.controller.rot_scale, scenario.controller.pinv_damping,
-                scenario.controller.K, pick.gripper, pick.belts, pick.tray, pick.bins, pick.line.catalog,
-                pick.line.arrivals,
+    key = repr((scenario.robot, scenario.controller,  # (its K, rot_scale and pinv_damping)
+                pick.gripper, pick.belts, pick.tray, pick.bins, pick.line.catalog, pick.line.arrivals,
                 None if model is None else (model.torque_share, model.speed_share, model.samples,
                                             model.last)))
     if fresh and key in _ESTIMATES:
@@ -349,6 +349,7 @@ def _estimate(scenario, view, model: PhaseTimes) -> tuple:
             where = kind.bin or kind.slots[0]
             place = destination_place(pick, where, part)
             place_yaw = _place_yaw(pick, replace(task, **destination(where)), 0.0)
+            place_yaw = nearest_branch(model.initial_yaw(), place_yaw)
             cycle = cycle_time(model, x, ride, place, place_yaw, 0.0, held_mass(scenario, kind.mass), task)
             totals.append(cycle.total)
     mean = float(np.mean(totals))
@@ -378,8 +379,7 @@ def destination_place(pick, where, part) -> np.ndarray:
 
 def _lead_of(found: tuple) -> float:
     """s from the entry (or now) to the grasp of a ``_lead`` (approach, descend, wait, early, grip)."""
-    approach, descend, wait, early = found[:4]
-    return approach + descend + wait - early
+    return found[0] + found[1] + found[2] - found[3]  # approach + descend + wait − early
 
 
 def _key(track, window: tuple, start, yaw: float) -> tuple:
