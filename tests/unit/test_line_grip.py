@@ -116,7 +116,7 @@ def test_a_dropped_grip_gives_the_next_one(cycles):
 def test_a_turned_place_only_where_the_open_fingers_clear_the_trays_parts(cycles):
     """line_two_belts' tray: slots 50 mm apart in x, 40 mm in y.  A cube at slot 4 turned 90° from
     the slot (fingers along y) is offered while slot 1 (40 mm in −y) is empty, not once a part is
-    there; a disc's place at its grip's yaw likewise; the slot's own direction always."""
+    there; a disc's place at its grip's yaw likewise; the slot's own direction, which clears it."""
     pick = cycles.scenario.pick
     place, neighbour = (place_point(pick, "slot", j, CUBE) for j in (4, 1))
     finger, own = (0.006, 0.02), [pytest.approx(0.0)]

@@ -224,14 +224,15 @@ class LineCycles:
         place = destination_place(pick, slot, kind)
         options = [grip] if isinstance(slot, str) else puts(  # a bin: the tool keeps its grasp's yaw
             kind, place, _place_yaw(pick, task, grip), grip, list(filled), self.finger, task.margin)
-        for i, put in enumerate(options):
+        error = NoTfFits(f"no place yaw at slot {slot} keeps the open fingers clear of the tray's parts")
+        for put in options:
             try:
                 return cycle_time(self.model, track.at(begin, now), track.speed * np.asarray(track.direction),
                                   place, put, track_yaw(track), held_mass(self.scenario, kind.mass), task,
                                   start, yaw, grip=grip, put=put)
-            except NoTfFits:
-                if i == len(options) - 1:
-                    raise
+            except NoTfFits as e:
+                error = e
+        raise error
 
     def _riding(self, track, grasp: float, now: float, begin: float, start, yaw: float, slot, kind,
                 grip: float) -> Cycle:
@@ -249,9 +250,8 @@ class LineCycles:
             return cycle_time(self.model, track.at(begin, now), ride, place0, put, track_yaw(track), mass,
                               self.task, start, yaw, place_ride=ride_of(belt), begin=begin, grip=grip)
 
-        parts = {p.name: p for p in pick.parts}
-        self.out_place, cycle = choose(pick, slot.belt, window, grasp, cycle_of, kind,
-                                       placed_on(pick.tasks, slot.belt, parts), self.finger[1],
+        placed = placed_on(pick.tasks, slot.belt, {p.name: p for p in pick.parts})
+        self.out_place, cycle = choose(pick, slot.belt, window, grasp, cycle_of, kind, placed, self.finger[1],
                                        track.at(grasp, now))
         return cycle
 

@@ -33,11 +33,15 @@ The place (``puts``): first the slot's own yaw modulo π nearest the grip — th
 direction of the fingers, and the tool's yaw after each place kept where it was, so the wrist's
 roll does not wander cycle after cycle — then, for a cube, the slot's yaw turned 90°, for a
 cylinder the grip's yaw (no turn on the carry): each only where the open fingers there clear
-every part already in the tray (``grasp_gate.finger_clearance``, its ``FINGER_MARGIN``).  On
+every part already in the tray by ``grasp_gate.FINGER_MARGIN`` (``tray_clearance``: each finger a
+rectangle, a placed box its rectangle at the yaw it was put at, a cylinder its disc).  On
 line_two_belts' tray the slots are 50 mm apart in x and 40 mm in y: the open fingers reach 27 mm
-from a 30 mm cube's centre, a neighbour's half diagonal 21 mm — across y they would touch the
-neighbour, so a turned place is taken only where that neighbour is not there yet.  A bin keeps the
-yaw the part was gripped at (``tasks.place_target``).  ``LineCycles.phases`` keeps the first
+from a 30 mm cube's centre, the neighbour's face is 35 mm away along x (8 mm clear) and 25 mm
+across y — there they would touch, so a turned place is taken only where that neighbour is not
+there yet.  The slot's own yaw is checked too (session 53: an iiwa line of 40 mm boxes in slots 50
+mm apart along that side put the third box between two placed ones and pushed both 4 mm off);
+a slot with no yaw left has no cycle (``line.slot_choice`` asks the next nearest).  A bin keeps
+the yaw the part was gripped at (``tasks.place_target``).  ``LineCycles.phases`` keeps the first
 candidate whose cycle fits.
 """
 
@@ -49,7 +53,6 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.config.pick import PickTaskConfig
-from ptint_drake.systems.perception.part_fit import reach
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.config import grasp_width
 from ptint_drake.worlds.pick.grasp_gate import FINGER_MARGIN, finger_clearance
@@ -116,29 +119,77 @@ class Grips:
 def puts(part, place: np.ndarray, slot_yaw: float, grip: float, filled: list, finger: tuple,
          margin: float) -> list:
     """rad: the tool's yaws at a tray slot (its part's centre at ``place``, the slot's yaw
-    ``slot_yaw``) for ``part`` gripped at ``grip``, preferred first (module docstring); ``filled``:
-    [(centre, radius)] of the parts already in the tray; ``finger``: (thickness, width), m;
-    ``margin``: the open fingers' clearance around the part (m)."""
+    ``slot_yaw``) for ``part`` gripped at ``grip``, preferred first, each only where the open
+    fingers clear every part in the tray by ``FINGER_MARGIN`` (module docstring; none: the slot
+    cannot take the part now); ``filled``: the tray's parts' footprints (``in_tray``);
+    ``finger``: (thickness, width), m; ``margin``: the open fingers' clearance around the part (m)."""
     own = nearest_branch(grip, slot_yaw)
     symmetry = part_symmetry(part)
     others = ([grip] if symmetry <= 0.0 else
               [nearest_branch(grip, own + symmetry)] if symmetry < math.pi - 1e-9 else [])
     opening = grasp_width(part) + margin
-    out = [own]
-    for yaw in others:
-        axis = (math.cos(yaw), math.sin(yaw))
-        if abs(yaw - own) > 1e-9 and all(finger_clearance(place, axis, opening, finger, centre, radius)
-                                         >= FINGER_MARGIN for centre, radius in filled):
+    out = []
+    for yaw in [own] + [y for y in others if abs(y - own) > 1e-9]:
+        if all(tray_clearance(place, yaw, opening, finger, f) >= FINGER_MARGIN for f in filled):
             out.append(yaw)
     return out
 
 
 def in_tray(pick, keep: list) -> list:
-    """[(centre, radius)] of the parts the tasks ``keep`` (indices into ``pick.tasks``) put in the
-    tray (``puts``'s ``filled``): each slot's place point and its part's top-face radius."""
+    """The footprints (``tray_clearance``) of the parts the tasks ``keep`` (indices into
+    ``pick.tasks``) put in the tray: a box's rectangle, its x axis at the task's place yaw (the
+    axis its fingers closed along), a cylinder's disc."""
     parts = {p.name: p for p in pick.parts}
-    placed = [(pick.tasks[k].slot, parts[pick.tasks[k].part]) for k in keep if pick.tasks[k].slot is not None]
-    return [(place_point(pick, "slot", slot, part), reach(part.shape, part.size)) for slot, part in placed]
+    out = []
+    for k in keep:
+        task = pick.tasks[k]
+        if task.slot is None:
+            continue
+        part = parts[task.part]
+        centre = place_point(pick, "slot", task.slot, part)[:2]
+        if part.shape == "cylinder":
+            out.append((centre, 0.5 * float(part.size[0])))
+            continue
+        yaw = place_target(pick, task)[2] if task.place_yaw is None else task.place_yaw
+        out.append((centre, _rectangle(centre, yaw, 0.5 * float(part.size[0]), 0.5 * float(part.size[1]))))
+    return out
+
+
+def tray_clearance(place, yaw: float, opening: float, finger: tuple, footprint) -> float:
+    """m: the gap between the nearer open finger of the tool at ``place`` turned to ``yaw`` (each a
+    rectangle from half the ``opening`` outward by the finger's thickness, as wide as the finger:
+    ``grasp_gate``) and a tray part's ``footprint`` — (centre, radius) of a disc, or (centre,
+    corners) of a rectangle: there the largest separation along the two rectangles' edge normals,
+    never more than the true gap; negative where they overlap."""
+    centre, shape = footprint
+    axis = (math.cos(yaw), math.sin(yaw))
+    if np.isscalar(shape):
+        return finger_clearance(place, axis, opening, finger, centre, float(shape))
+    inner, outer, half = 0.5 * opening, 0.5 * opening + finger[0], 0.5 * finger[1]
+    gaps = []
+    for side in (1.0, -1.0):
+        mid = np.asarray(place, float)[:2] + side * 0.5 * (inner + outer) * np.array(axis)
+        own = _rectangle(mid, yaw, 0.5 * (outer - inner), half)
+        gaps.append(max(_separation(own, shape, n) for n in _normals(own) + _normals(shape)))
+    return min(gaps)
+
+
+def _rectangle(centre, yaw: float, half_x: float, half_y: float) -> np.ndarray:
+    """4 × 2: the corners of a rectangle centred at ``centre`` (xy), its x axis at ``yaw``."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = np.array([[half_x, half_y], [-half_x, half_y], [-half_x, -half_y], [half_x, -half_y]])
+    return np.asarray(centre, float)[:2] + local @ np.array([[c, s], [-s, c]])
+
+
+def _normals(corners: np.ndarray) -> list:
+    edges = np.diff(np.vstack([corners, corners[:1]]), axis=0)[:2]
+    return [np.array([-e[1], e[0]]) / np.linalg.norm(e) for e in edges]
+
+
+def _separation(a: np.ndarray, b: np.ndarray, n: np.ndarray) -> float:
+    """m: how far apart the projections of the convex corner sets ``a`` and ``b`` on ``n`` lie."""
+    pa, pb = a @ n, b @ n
+    return float(max(pb.min() - pa.max(), pa.min() - pb.max()))
 
 
 def grip_axis(yaw: float) -> tuple:
