@@ -142,6 +142,8 @@ class PickTaskConfig:
     part: str = ""  # the part's name (pick.parts[*].name)
     slot: Optional[int] = None  # index into pick.tray.slots
     bin: str = ""  # or the name of a bin (pick.bins[*].name): the part dropped into it
+    # m, (x, y): where over the bin's floor, from its centre (a line spreads its drops, ``scene.bin_spots``)
+    bin_at: List[float] = field(default_factory=lambda: [0.0, 0.0])
     belt: str = ""  # or an outgoing belt (pick.belts[*].name): the part put on it, riding it
     belt_at: float = 0.0  # m, the place point's coordinate along that belt at t = 0 (it rides on)
     start: float = 0.0  # s, the approach's start (0: right after the previous task)

@@ -288,6 +288,7 @@ def AddTray(plant: MultibodyPlant, tray: TrayConfig) -> list:
 
 
 BIN_DROP_CLEARANCE = 0.01  # m: a part's bottom above a bin's walls where the fingers let it go (assumption)
+BIN_GAP = 0.005  # m: between the drop points of a bin's grid, and from its walls (``bin_spots``)
 BIN_RGBA = [0.35, 0.5, 0.35, 1.0]
 
 
@@ -309,6 +310,18 @@ def bin_drop(box: BinConfig, part: PartConfig) -> np.ndarray:
     bottom ``BIN_DROP_CLEARANCE`` above the walls' top (the fingers open there, the part drops)."""
     _, height = part_shape(part)
     return np.asarray(box.center, dtype=float) + [0.0, 0.0, box.size[2] + BIN_DROP_CLEARANCE + height / 2]
+
+
+def bin_spots(box: BinConfig, part: PartConfig) -> list:
+    """[(x, y)] m from ``box``'s centre: the drop points of a grid over its inner floor for
+    ``part``, row by row — each a footprint (a cylinder's diameter, a box's top diagonal: any yaw)
+    plus ``BIN_GAP`` from the next and from the walls; the centre alone where one fits.  Parts let go
+    over one point stack (a Panda line of 25 mm pucks: the third rested above the 50 mm walls)."""
+    extent = float(part.size[0]) if part.shape == "cylinder" else float(np.hypot(part.size[0], part.size[1]))
+    pitch = extent + BIN_GAP
+    counts = [max(1, int((float(box.size[i]) - BIN_GAP) // pitch)) for i in (0, 1)]
+    axes = [[(j - (n - 1) / 2) * pitch for j in range(n)] for n in counts]
+    return [(x, y) for y in axes[1] for x in axes[0]]
 
 
 def in_bin(box: BinConfig, p: np.ndarray) -> bool:

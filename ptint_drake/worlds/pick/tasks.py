@@ -20,28 +20,23 @@ other, each a prescribed-time interception (SPEC 2.1) of its own target:
 6. ``retreat`` — ``clearance`` above the slot, starting ``dwell`` after the fingers opened.
 
 A task with a ``bin`` instead of a ``slot`` (``pick.bins``: an open box) carries the part to
-``lift_height`` above the bin's drop point (``scene.bin_drop``: over its centre, the part's bottom
-``scene.BIN_DROP_CLEARANCE`` above its walls), lowers it there, opens the fingers and retreats
-up; the tool keeps the yaw it grasped at (``place_target``).  A task with a ``belt`` (an
+``lift_height`` above the bin's drop point (``scene.bin_drop``: over its centre, or ``bin_at`` from
+it, the part's bottom ``scene.BIN_DROP_CLEARANCE`` above its walls), lowers it there, opens the
+fingers and retreats up; the tool keeps the yaw it grasped at (``place_target``).  A task with a ``belt`` (an
 outgoing belt of ``pick.belts``) puts the part on that belt at ``belt_at`` (its coordinate along
 the belt at t = 0): the carry, the place and the retreat aim at that point as it rides the belt at
 the belt's speed as the plan knows it (``PlanSegment.ride``), the part's closing axis across the
 belt (``place_target``); ``out_belt`` chooses the point.
 
-A *via* (``Via``: ``worlds.pick.route`` decides where one is needed) splits a task's first approach or
-its carry in two: first a segment of its own (phase ``via``) to a fixed point, then the approach or
-carry itself, the two together taking the segment's tf (so every later prescribed time stays
-where it was): the way around the arm's base when the straight way passes too near its waist axis.
-
+A *via* (``Via``, decided by ``worlds.pick.route``) splits a task's first approach or its carry in
+two — a segment of its own (phase ``via``) to a fixed point, then the approach or carry, together
+in the segment's tf: the way around the arm's base when the straight way passes its waist axis.
 The tool grips a part at its centre, or ``config.grip_height`` above it where the fingertips would
-come too near its belt (or the tray at the place); then every target over the part, or over its
-place, rises by as much.
-
-Times: the approach starts at the task's ``start``; each later segment starts at the previous
-one's prescribed time, the lift and the retreat ``dwell`` later.  A task starts after the previous
-task's retreat (``start`` = 0: right after it).  ``pick_plan`` turns the block into the schedule,
-one ``PlanSegment`` per segment (what ``pick.targets.PickTargets`` aims at) and the gripper's
-commands (``pick.targets.GripperSequence``).
+come too near its belt (or the tray at the place); every target over the part or its place rises
+by as much.  Times: the approach starts at the task's ``start`` (0: right after the previous
+task's retreat); each later segment at the previous one's prescribed time, the lift and the
+retreat ``dwell`` later.  ``pick_plan`` turns the block into the schedule, one ``PlanSegment`` per
+segment (what ``pick.targets.PickTargets`` aims at) and the gripper's commands.
 """
 
 from dataclasses import dataclass
@@ -217,9 +212,10 @@ def _task_segments(k: int, task: PickTaskConfig, part: int, place: tuple, start:
         t -= task.dwell  # the lift right after it
     t = add("lift", "latched", part, _up(task.lift_height + above), 0.0, t + task.dwell + replan.lift_delay)
     kind, index, yaw = place
-    t = add("carry", kind, index, _up(task.lift_height + above), yaw, t)
-    t = add("place", kind, index, _up(above), yaw, t)
-    t = add("retreat", kind, index, high, yaw, t + task.dwell)
+    dx, dy = (float(c) for c in task.bin_at) if kind == "bin" else (0.0, 0.0)  # (over the bin's floor)
+    t = add("carry", kind, index, (dx, dy, task.lift_height + above), yaw, t)
+    t = add("place", kind, index, (dx, dy, above), yaw, t)
+    t = add("retreat", kind, index, (dx, dy, high[2]), yaw, t + task.dwell)
     return segments, plans, attempts, t
 
 
@@ -354,6 +350,10 @@ def _check_place(pick: PickConfig, task: PickTaskConfig, where: str) -> None:
     if task.bin and task.bin not in [b.name for b in pick.bins]:
         raise ScenarioError(f"{where}.bin: no bin named {task.bin!r} (bins: "
                             f"{', '.join(b.name for b in pick.bins) or 'none'})")
+    size = next((b.size for b in pick.bins if b.name == task.bin), [])
+    if task.bin and not (len(task.bin_at) == 2 and all(abs(c) <= h / 2 for c, h in zip(task.bin_at, size))):
+        raise ScenarioError(f"{where}.bin_at: {list(task.bin_at)} m is not an (x, y) over the floor of "
+                            f"bin {task.bin!r} (from its centre, within half its inner size)")
     if task.slot is not None and not (isinstance(task.slot, int) and 0 <= task.slot < len(pick.tray.slots)):
         raise ScenarioError(f"{where}.slot: {task.slot} is not a slot of the tray "
                             f"({len(pick.tray.slots)} slots)")

@@ -41,6 +41,7 @@ from ptint_drake.worlds.pick.line.grip import grip_axis, in_tray, logged
 from ptint_drake.worlds.pick.line.metrics import line_metrics
 from ptint_drake.worlds.pick.line.no_line import NoLine
 from ptint_drake.worlds.pick.out_belt import OutPlace
+from ptint_drake.worlds.pick.scene import bin_spots
 from ptint_drake.worlds.pick.line.plan import IDLE_TF, line_plan, unpinned
 from ptint_drake.worlds.pick.line.scheduler import Timing, blocker, decide
 from ptint_drake.worlds.pick.line.truth import LineTruth
@@ -288,6 +289,10 @@ class LineDriver:
         if replacing is not None and t >= tasks[replacing].start - 1e-9:
             begin = t  # its approach under way: restarted from the present state
         task = self.cycles.task_of(name, decision.slot, decision.grasp, t, cycle, begin)
+        if task.bin:  # the grid's next spot over its bin's floor, by the tasks before it there
+            box = next(b for b in self.scenario.pick.bins if b.name == task.bin)
+            spots = bin_spots(box, next(p for p in self.scenario.pick.parts if p.name == name))
+            task = replace(task, bin_at=list(spots[sum(o.bin == task.bin for o in tasks[:k]) % len(spots)]))
         mass = held_mass(self.scenario, self.line.kind(track.kind).mass)
         self._vias = {}  # phase → the min tfs of its via's two legs (the decision log's ``via_tf``)
         why = f"the plan's vias still ask for more after {DETOUR_PASSES} passes"
