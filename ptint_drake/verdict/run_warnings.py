@@ -254,15 +254,7 @@ def joint_terms_of(plant: MultibodyPlant, frame, postures: np.ndarray, motions: 
     for k, q in enumerate(postures):
         _set_positions(plant, context, instance, q)
         plant.SetVelocities(context, np.zeros(nv))
-        if six:
-            J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3), world,
-                                                  world)[:, cols]
-        else:
-            J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3),
-                                                        world, world)[:, cols]
-        J = weight[:, None] * J
-        Jp = (np.linalg.pinv(J) if damping <= 0.0
-              else J.T @ np.linalg.inv(J @ J.T + damping ** 2 * np.eye(len(J))))
+        J, Jp = _task_jacobian(plant, context, frame, cols, weight, damping)
         for (velocity, acceleration), (speeds, torques) in zip(motions, out):
             xd, xdd = velocity[k], acceleration[k]
             v = np.zeros(nv)
@@ -298,23 +290,35 @@ def loop_inertia(plant: MultibodyPlant, frame, postures: np.ndarray, payload: fl
     nv = plant.num_velocities()
     cols = (np.arange(nv) if instance is None
             else plant.GetVelocitiesFromArray(instance, np.arange(nv, dtype=float)).astype(int))
-    world = plant.world_frame()
     weight = np.r_[np.full(3, rot_scale), np.ones(3)]
     worst = 0.0
     for q in postures:
         _set_positions(plant, context, instance, q)
         M = plant.CalcMassMatrix(context)[np.ix_(cols, cols)]
-        J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3), world,
-                                              world)[:, cols]
+        J, Jp = _task_jacobian(plant, context, frame, cols, weight, damping)
         if payload > 0.0:
-            M = M + payload * J[3:].T @ J[3:]
-        J = weight[:, None] * J
-        Jp = (np.linalg.pinv(J) if damping <= 0.0
-              else J.T @ np.linalg.inv(J @ J.T + damping ** 2 * np.eye(len(J))))
+            M = M + payload * J[3:].T @ J[3:]  # (the translational rows: weight 1)
         rates = np.linalg.eigvals(J @ np.linalg.solve(M, Jp)).real
         rates = rates[rates > 1e-9 * rates.max()]
         worst = max(worst, 1.0 / float(rates.min()))
     return worst
+
+
+def _task_jacobian(plant: MultibodyPlant, context, frame, cols, weight: np.ndarray, damping: float) -> tuple:
+    """(J, J⁺) at the context's posture: the task Jacobian of ``frame``'s origin — 6-D [ω; v] where
+    ``weight`` has 6 entries, else 3-D v — on the velocity columns ``cols``, its rows weighed by
+    ``weight``, and its pseudoinverse as the controller takes it (damped by ``damping`` > 0)."""
+    world = plant.world_frame()
+    if len(weight) == 6:
+        J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3), world,
+                                              world)[:, cols]
+    else:
+        J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frame, np.zeros(3),
+                                                    world, world)[:, cols]
+    J = weight[:, None] * J
+    Jp = (np.linalg.pinv(J) if damping <= 0.0
+          else J.T @ np.linalg.inv(J @ J.T + damping ** 2 * np.eye(len(J))))
+    return J, Jp
 
 
 def _set_positions(plant: MultibodyPlant, context, instance, q: np.ndarray) -> None:

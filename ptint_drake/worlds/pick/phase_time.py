@@ -70,6 +70,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from ptint_drake.config.pick import PHASES, PickTaskConfig
 from ptint_drake.systems.hand.datasheets import RATED_PAYLOAD
 from ptint_drake.robot.plant import effort_limits, nominal_plant
+from ptint_drake.systems.task.orientation import tool_yaw
 from ptint_drake.verdict.run_warnings import SPEED_SAMPLES, joint_demand, joint_terms_of, loop_inertia
 from ptint_drake.worlds.pick.cell import world_config
 from ptint_drake.worlds.pick.feasibility import Way, way_motion, way_postures, way_profile
@@ -205,8 +206,7 @@ class PhaseTimes:
         """rad: the tool's yaw at the initial posture ``q0``."""
         context = self.arm.CreateDefaultContext()
         self.arm.SetPositions(context, self.q0)
-        R = self.frame.CalcPoseInWorld(context).rotation().matrix()
-        return float(np.arctan2(R[1, 0], R[0, 0]))
+        return float(tool_yaw(self.frame.CalcPoseInWorld(context).rotation().matrix()))
 
     def limits(self) -> tuple:
         """(joint speeds, rad/s; torques, N·m): the shares of the arm's limits the model plans to

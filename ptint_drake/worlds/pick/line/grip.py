@@ -150,7 +150,7 @@ def in_tray(pick, keep: list) -> list:
         if part.shape == "cylinder":
             out.append((centre, 0.5 * float(part.size[0])))
             continue
-        yaw = place_target(pick, task)[2] if task.place_yaw is None else task.place_yaw
+        yaw = place_target(pick, task)[2]  # (a line's task: its place_yaw)
         out.append((centre, _rectangle(centre, yaw, 0.5 * float(part.size[0]), 0.5 * float(part.size[1]))))
     return out
 
