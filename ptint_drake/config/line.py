@@ -77,7 +77,9 @@ class ArrivalConfig:
     ``poisson``: gaps of ``min_gap`` + an exponential of mean 1/rate − ``min_gap`` (a Poisson
     process with a dead time: the mean rate kept); ``jittered``: gaps of 1/rate × (1 ± ``jitter``)
     (uniform), at least ``min_gap``.  ``min_gap``: no part is put where the previous one may still
-    be (the gap × the belt speed apart, centre to centre)."""
+    be (the gap × the belt speed apart, centre to centre).  Whatever the gap, a part is released
+    only once its belt has carried the one before it the two parts' footprint radii and 5 mm on
+    (``worlds.pick.line.arrivals.spaced``: on a slow belt ``min_gap`` alone is too short)."""
 
     belt: str = ""
     rate: float = 0.2  # parts/s

@@ -73,3 +73,50 @@ def test_a_kind_is_read_by_its_name_and_an_unknown_name_is_named():
         assert line.kind(kind.name) is kind
     with pytest.raises(KeyError, match="no kind named 'sphere'"):
         line.kind("sphere")
+
+
+def _slow_can_line():
+    """Session 53's new-user line: 40 mm cans on a 0.05 m/s belt at 0.12 parts/s (``min_gap``
+    0.6 s is 30 mm of belt there)."""
+    from ptint_drake.config.line import KindConfig, LineBeltConfig, LineConfig  # noqa: PLC0415
+
+    return LineConfig(belts=[LineBeltConfig(name="in")],
+                      catalog=[KindConfig(name="can", shape="cylinder", size=[0.04, 0.05], bin="tote")],
+                      arrivals=[ArrivalConfig(belt="in", rate=0.12, until=10.0, yaw_deg=[0.0, 0.0])],
+                      seed=0)
+
+
+def _travel(releases, speed_of):
+    """m of belt between consecutive releases (``speed_of(t)``: piecewise constant)."""
+    from scipy.integrate import quad  # noqa: PLC0415
+
+    times = [r.t for r in releases]
+    return [quad(speed_of, a, b, limit=200, points=[5.0])[0] for a, b in zip(times, times[1:])]
+
+
+def test_a_slow_belt_gets_no_part_onto_the_one_before_it():
+    from ptint_drake.worlds.pick.line.arrivals import SPACING, footprint_radius  # noqa: PLC0415
+
+    line, least = _slow_can_line(), 2 * footprint_radius("cylinder", [0.04, 0.05]) + SPACING
+    unspaced = line_pool(line, 200.0)[1]
+    # (the test can fail: the time gap alone put cans closer than their diameter)
+    assert min(_travel(unspaced, lambda t: 0.05)) < 0.04
+    parts, releases = line_pool(line, 200.0, {"in": 0.05})
+    gaps = _travel(releases, lambda t: 0.05)
+    assert min(gaps) >= least - 1e-9 and len(parts) == len(unspaced)
+    # a release that needed no delay is where the arrival process drew it
+    assert sum(abs(a.t - b.t) < 1e-12 for a, b in zip(unspaced, releases)) >= len(releases) // 3
+
+
+def test_the_spacing_follows_the_belts_speed_steps_and_a_stopped_belt_releases_nothing_more():
+    from ptint_drake.config.line import SpeedStepConfig  # noqa: PLC0415
+    from ptint_drake.worlds.pick.line.arrivals import SPACING, footprint_radius  # noqa: PLC0415
+
+    line, least = _slow_can_line(), 2 * footprint_radius("cylinder", [0.04, 0.05]) + SPACING
+    line.speed_steps = [SpeedStepConfig(belt="in", t=5.0, factor=0.5)]
+    parts, releases = line_pool(line, 200.0, {"in": 0.05})
+    assert min(_travel(releases, lambda t: 0.05 if t < 5.0 else 0.025)) >= least - 1e-9
+    line.speed_steps = [SpeedStepConfig(belt="in", t=20.0, factor=0.0)]
+    stopped_parts, stopped = line_pool(line, 200.0, {"in": 0.05})
+    assert len(stopped_parts) == len(parts)  # the pool's size does not depend on the speeds
+    assert stopped and stopped[-1].t < 20.0 and len(stopped) < len(releases)

@@ -15,7 +15,9 @@ The process (a choice the issue leaves open): ``poisson`` is a Poisson process w
 — gaps ``min_gap`` + Exp(1/rate − ``min_gap``), so the mean gap stays 1/rate while no two parts
 are put on the belt closer than ``min_gap`` × speed (a real feeder's singulation); ``jittered``
 is a period of 1/rate, each gap × (1 ± ``jitter``) uniformly, at least ``min_gap``.  Rates are per
-second, not spacings: a faster belt spreads the same parts farther apart.
+second, not spacings: a faster belt spreads the same parts farther apart.  On the truth side
+(``line_scenario``) a release is then delayed, where needed, until the belt has carried the part
+before it clear (``spaced``): ``min_gap`` is a time, and a slow belt covers little in it.
 """
 
 from __future__ import annotations
@@ -28,6 +30,8 @@ import numpy as np
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.line import ArrivalConfig, LineConfig, PoolTruthConfig
 from ptint_drake.config.pick import PartConfig
+
+SPACING = 0.005  # m: the least free belt between two parts as the feeder releases them (``spaced``)
 
 
 @dataclass(frozen=True)
@@ -67,8 +71,58 @@ def _kinds(line: LineConfig, arrival: ArrivalConfig) -> tuple[list, np.ndarray]:
     return names, weights / weights.sum()
 
 
-def line_pool(line: LineConfig, duration: float) -> tuple[list[PartConfig], list[Release]]:
-    """The pool of parts (release order) and their releases of ``line`` over ``duration``."""
+def footprint_radius(shape: str, size) -> float:
+    """m: the radius of a part's footprint on the belt at any yaw (a box's half diagonal of its
+    top, a cylinder's radius)."""
+    return 0.5 * float(np.hypot(size[0], size[1])) if shape == "box" else 0.5 * float(size[0])
+
+
+def belt_speed_at(belt: str, speed: float, steps: list, t: float) -> float:
+    """m/s: belt ``belt``'s speed at ``t`` on the truth side — ``speed`` (its declared) × the
+    factor of the last of ``steps`` (``line.speed_steps``) on it at or before ``t``."""
+    factor = 1.0
+    for step in sorted((s for s in steps if s.belt == belt), key=lambda s: s.t):
+        if step.t <= t:
+            factor = step.factor
+    return factor * speed
+
+
+def spaced(times: list[float], radii: list[float], belt: str, speed: float, steps: list) -> list[float]:
+    """The release times ``times`` (one belt's, in order) each delayed as little as needed so that
+    the belt has carried the part before it at least the two footprint radii (``radii``) and
+    ``SPACING`` farther (a feeder puts no part onto the one before it: ``min_gap`` is a time, and
+    on a slow belt it alone let two 40 mm parts be released 31 mm apart); the belt's travel
+    integrated over its speed steps.  A belt stopped at the end keeps a release waiting forever
+    (``inf``: never released)."""
+    out: list[float] = []
+    cuts = sorted({s.t for s in steps if s.belt == belt})
+    for k, t in enumerate(times):
+        if out:
+            need = radii[k - 1] + radii[k] + SPACING
+            t = max(t, _after_travel(out[-1], need, belt, speed, steps, cuts))
+        out.append(float(t))
+    return out
+
+
+def _after_travel(t0: float, distance: float, belt: str, speed: float, steps: list, cuts: list) -> float:
+    """s: when the belt has carried a point ``distance`` m from where it was at ``t0``."""
+    t, left = t0, distance
+    for cut in [c for c in cuts if c > t0] + [np.inf]:
+        v = belt_speed_at(belt, speed, steps, t)
+        if v > 0.0 and t + left / v <= cut:
+            return t + left / v
+        left -= v * (cut - t)
+        t = cut
+    return np.inf
+
+
+def line_pool(line: LineConfig, duration: float, speeds: dict[str, float] | None = None
+              ) -> tuple[list[PartConfig], list[Release]]:
+    """The pool of parts (release order) and their releases of ``line`` over ``duration``; with
+    ``speeds`` (belt name → its declared m/s) each belt's releases ``spaced`` along it.  A draw
+    delayed past its block's window (``until`` before the end) is not released: its part stays in
+    the pool, parked the whole run (as ``idle_part``), so the pool's size does not depend on the
+    speeds (the robust study draws per pool part before it draws the belts' speeds)."""
     drawn = []
     catalog = {c.name: c for c in line.catalog}
     for k, arrival in enumerate(line.arrivals):
@@ -79,6 +133,8 @@ def line_pool(line: LineConfig, duration: float) -> tuple[list[PartConfig], list
             lateral = float(rng.uniform(*arrival.lateral))
             yaw = float(rng.uniform(*arrival.yaw_deg))
             drawn.append((t, k, kind, lateral, yaw))
+    if speeds:
+        drawn = _spaced_draws(drawn, line, speeds)
     drawn.sort()
     parts, releases = [], []
     for n, (t, k, kind, lateral, yaw) in enumerate(drawn):
@@ -86,8 +142,21 @@ def line_pool(line: LineConfig, duration: float) -> tuple[list[PartConfig], list
         parts.append(PartConfig(name=f"{kind}_{n}", belt=arrival.belt, shape=c.shape, size=list(c.size),
                                 offset=arrival.release, lateral=lateral, yaw_deg=yaw, mass=c.mass,
                                 friction=c.friction))
-        releases.append(Release(n, t, arrival.belt, kind))
+        if t < duration - arrival.until:
+            releases.append(Release(n, t, arrival.belt, kind))
     return parts, releases
+
+
+def _spaced_draws(drawn: list, line: LineConfig, speeds: dict[str, float]) -> list:
+    """``drawn`` (time, block, kind, lateral, yaw) with each belt's times ``spaced``."""
+    radius = {c.name: footprint_radius(c.shape, c.size) for c in line.catalog}
+    out = []
+    for belt in sorted({line.arrivals[k].belt for _, k, _, _, _ in drawn}):
+        mine = sorted(d for d in drawn if line.arrivals[d[1]].belt == belt)
+        times = spaced([d[0] for d in mine], [radius[d[2]] for d in mine], belt, speeds[belt],
+                       line.speed_steps)
+        out += [(t, *d[1:]) for t, d in zip(times, mine)]
+    return out
 
 
 def idle_part(line: LineConfig) -> PartConfig:
@@ -131,7 +200,7 @@ def line_scenario(scenario):
     and the releases."""
     out = copy.deepcopy(scenario)
     line = scenario.pick.line
-    parts, releases = line_pool(line, scenario.duration)
+    parts, releases = line_pool(line, scenario.duration, {b.name: b.speed for b in scenario.pick.belts})
     if not parts:
         if all(a.start >= scenario.duration - a.until for a in line.arrivals):
             raise ScenarioError("pick.line.arrivals: no part arrives before the scenario's end (rate, "
