@@ -171,18 +171,21 @@ def pose(metrics: dict) -> str:
 
 
 def test_counts(collected: dict) -> str:
-    """docs/quickstart.md's counts: ``collected`` maps "all", "unit" and "slow" to pytest's counts."""
-    return (f"The suite has {collected['all']} tests, {collected['unit']} of them unit tests; "
-            f"{collected['slow']} e2e tests are marked slow, and the oldest Drake end runs the other "
-            f"{collected['all'] - collected['slow']} (`pytest --collect-only -q -m 'not slow'`; counted by "
+    """docs/quickstart.md's counts: ``collected`` maps "all", "unit" and "oldest" (the oldest
+    Drake end's selection) to pytest's counts."""
+    return (f"The suite has {collected['all']} tests, {collected['unit']} of them unit tests; the "
+            f"oldest Drake end runs {collected['oldest']}: the unit tests and the "
+            f"{collected['oldest'] - collected['unit']} e2e tests marked `both_ends` "
+            "(`pytest --collect-only -q -m 'not e2e or both_ends'`; counted by "
             "`scripts/doc_blocks.py`, checked by `tests/unit/test_doc_blocks.py`).")
 
 
 def collect_counts() -> dict:
-    """How many tests pytest collects in the whole suite, in tests/unit, and how many are marked
-    slow (one collection, the slow ones deselected)."""
+    """How many tests pytest collects in the whole suite, in tests/unit, and in the oldest Drake
+    end's selection (one collection, the others deselected)."""
     done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-n", "0",
-                           "-m", "not slow", "tests"], cwd=ROOT, capture_output=True, text=True, check=False)
+                           "-m", "not e2e or both_ends", "tests"], cwd=ROOT, capture_output=True, text=True,
+                          check=False)
     found = re.search(r"(\d+)/(\d+) tests? collected \((\d+) deselected\)|(\d+) tests? collected",
                       done.stdout)
     if found is None or done.returncode != 0:  # a collection error is not a count
@@ -190,7 +193,7 @@ def collect_counts() -> dict:
     kept, total = (int(found.group(1)), int(found.group(2))) if found.group(1) else (int(found.group(4)),) * 2
     ids = [line for line in done.stdout.splitlines() if "::" in line]
     assert len(ids) == kept, (len(ids), kept)
-    return {"all": total, "unit": sum(line.startswith("tests/unit/") for line in ids), "slow": total - kept}
+    return {"all": total, "unit": sum(line.startswith("tests/unit/") for line in ids), "oldest": kept}
 
 
 def rgbd_picks(data: dict) -> str:

@@ -17,6 +17,7 @@ def _velocity_error_converges(result):
         assert seg["edot_tf_norm"] < 0.03  # m/s
 
 
+@pytest.mark.both_ends
 @pytest.mark.parametrize("overrides", ["", "plant: {mass_scale: 1.5}"])
 def test_assembly_each_object_on_time(overrides):
     result = run_cached("assembly", overrides)

@@ -36,6 +36,7 @@ def caught():
     return _run("catch.throw=1", "measurement.seed=1")
 
 
+@pytest.mark.both_ends
 def test_a_real_throw_is_caught_and_still_held_half_a_second_later(caught):
     c = caught.metrics["catch"]
     assert c["outcome"] == "caught" and caught.metrics["status"] == "ok"

@@ -28,6 +28,7 @@ def test_list_names_every_paper_scenario(ptint_here):
     assert set(PAPER) <= set(names)
 
 
+@pytest.mark.both_ends
 def test_run_writes_spec_outputs(tmp_path):
     out = ptint("run", "curve_b075_tf15", "--out", str(tmp_path), "--quiet")
     assert out.returncode == 0, out.stderr

@@ -130,6 +130,7 @@ def test_plant_variants_scale_links_and_rotors():
             assert plant.get_joint_actuator(index).rotor_inertia(context) == pytest.approx(1.5 * rotor)
 
 
+@pytest.mark.both_ends
 @pytest.mark.parametrize("controller, implementation", [
     ("ptsmc", "fused"), ("ptsmc", "blocks"), ("pd", "fused"), ("smc", "fused")])
 def test_model_free_controllers_never_evaluate_dynamics(controller, implementation, dynamics_calls):

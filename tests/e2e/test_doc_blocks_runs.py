@@ -32,6 +32,7 @@ def test_block_is_what_its_generator_writes_from_the_suites_runs(block):
                            f"{block.name}):\n" + "\n".join(found))
 
 
+@pytest.mark.both_ends
 def test_the_own_diagram_page_snippet_runs_and_meets_the_object_at_tf():
     """docs/own_diagram.md's first code block, executed as it stands, then simulated to tf from
     the pose the page names: the tool within 1 mm of the object."""

@@ -69,6 +69,7 @@ def test_drive_against_drakes_blocks(tmp_path, messages, mode, driver_mode, peri
         assert seg["e_tf_norm"] is not None and drive["ticks_missing"] >= 4 * 399
 
 
+@pytest.mark.both_ends
 @pytest.mark.parametrize("messages", ["iiwa", "panda"])
 @pytest.mark.parametrize("mode", ["torque_only", "position_and_torque"])
 def test_drakes_command_sender_to_ptint_hardware(tmp_path, mode, messages):

@@ -56,6 +56,7 @@ def one_line(stderr: str) -> str:
     return lines[0]
 
 
+@pytest.mark.both_ends
 def test_lockstep_same_verdict_as_one_process(tmp_path, run):
     """Acceptance: lockstep across two processes (the drive started second) = ptint run with
     the control period and plant step at 1 ms: same verdict, e(tf) within 1e-9 m (measured:
@@ -392,6 +393,7 @@ def test_realtime_lost_gripper_status_does_not_end_the_run(tmp_path):
     assert out["hw"]["rc"] == 0 or (out["hw"]["rc"] == 1 and link["ticks_late"] > 1), out
 
 
+@pytest.mark.both_ends
 def test_in_memory_pair_matches_two_processes(tmp_path):
     """The fallback where no private namespace can be made: hardware and drive as two threads
     over one ``memq://`` LCM (``hardware.in_memory``), the same messages and checks; lockstep

@@ -44,6 +44,7 @@ def test_a_line_that_is_done_ends_early_and_is_judged_at_its_end(tmp_path, ptint
         assert pick["placed"] and pick["place_error_mm"] < 1.0
 
 
+@pytest.mark.both_ends
 def test_a_line_whose_draw_releases_no_part_runs_ends_at_once_and_says_so(tmp_path, ptint_here):
     """A Poisson line at a rate so low that its seed draws no part (a legal scenario, one seed in
     many at a low rate: line_two_belts' seed 4 of 0-36) runs — its pool one part parked the whole

@@ -19,6 +19,7 @@ def _assert_picked_and_placed(metrics: dict) -> None:
         assert pick["slip_mm"] <= 1.0 and pick["peak_grip_force_N"] > 5.0, pick
 
 
+@pytest.mark.both_ends
 def test_conveyor_pick_place_places_the_part(run):
     m = run("conveyor_pick_place").metrics
     _assert_picked_and_placed(m)

@@ -229,6 +229,7 @@ def test_conveyor_yaw_is_ok(run, overrides):
         assert seg["e_rot_hold_max_deg"] <= 5.0
 
 
+@pytest.mark.both_ends
 def test_curve_pose_is_ok(run):
     """The paper's curve with a tumbling object frame, task pose on the 6-joint rvm1_6dof with the
     paper's gains: 1 mm and 2° at tf, early in neither, holding."""

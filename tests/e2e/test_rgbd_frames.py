@@ -8,6 +8,7 @@ from PIL import Image
 from ptint_drake.worlds.interception.camera_frames import write_camera_frames
 
 
+@pytest.mark.both_ends
 def test_frames_show_the_belts_and_a_good_fit_at_every_instant(tmp_path):
     result = run_cached("conveyor_pair_rgbd")
     names = write_camera_frames(result.scenario, result.series, tmp_path)

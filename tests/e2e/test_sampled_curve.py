@@ -10,6 +10,7 @@ CASES = {"continuous plant": "controller: {control_period: 0.001}",
          "discrete 1 ms plant": "controller: {control_period: 0.001}\nmultibody: {time_step: 0.001}"}
 
 
+@pytest.mark.both_ends
 @pytest.mark.parametrize("plant", CASES)
 def test_1_khz_sampled_control_keeps_the_paper_curve_within_1_mm(plant):
     result = run_cached("curve_b075_tf15", CASES[plant])

@@ -29,6 +29,7 @@ def run(*args: str, cwd: Path):
     return subprocess.run(ptint(*args), capture_output=True, text=True, cwd=cwd, timeout=300)
 
 
+@pytest.mark.both_ends
 def test_run_touches_at_tf_and_not_before(tmp_path):
     """The plugin world's verdict is the segment criteria: within 1 mm at tf, not before tf/2
     (|e(tf/2)| ≥ |e0|/4; on the ideal surface |e0|/2), held within 3 mm after."""
