@@ -4,6 +4,8 @@ both get."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from ptint_drake.config.errors import ScenarioError
 
 SHAPE_SIZES = {"box": 3, "cylinder": 2}  # sizes per shape: box [x, y, z]; cylinder [diameter, height]
@@ -18,6 +20,12 @@ MIN_HELD = 0.005  # m: the least height of a part the pads hold above the finger
 def part_height(shape: str, size: list) -> float:
     """A part's height standing on its base (m): a box's z size, a cylinder's length."""
     return float(size[2] if shape == "box" else size[1])
+
+
+def footprint_radius(shape: str, size: list) -> float:
+    """m: the radius of a part's footprint standing on its base, at any yaw: a box's half diagonal
+    of its top, a cylinder's radius."""
+    return 0.5 * float(np.hypot(size[0], size[1])) if shape == "box" else 0.5 * float(size[0])
 
 
 def check_part_shape(where: str, shape: str, size: list, mass: float, friction: float) -> None:

@@ -95,7 +95,8 @@ def _travel(releases, speed_of):
 
 
 def test_a_slow_belt_gets_no_part_onto_the_one_before_it():
-    from ptint_drake.worlds.pick.line.arrivals import SPACING, footprint_radius  # noqa: PLC0415
+    from ptint_drake.config.part_shape import footprint_radius  # noqa: PLC0415
+    from ptint_drake.worlds.pick.line.arrivals import SPACING  # noqa: PLC0415
 
     line, least = _slow_can_line(), 2 * footprint_radius("cylinder", [0.04, 0.05]) + SPACING
     unspaced = line_pool(line, 200.0)[1]
@@ -110,7 +111,8 @@ def test_a_slow_belt_gets_no_part_onto_the_one_before_it():
 
 def test_the_spacing_follows_the_belts_speed_steps_and_a_stopped_belt_releases_nothing_more():
     from ptint_drake.config.line import SpeedStepConfig  # noqa: PLC0415
-    from ptint_drake.worlds.pick.line.arrivals import SPACING, footprint_radius  # noqa: PLC0415
+    from ptint_drake.config.part_shape import footprint_radius  # noqa: PLC0415
+    from ptint_drake.worlds.pick.line.arrivals import SPACING  # noqa: PLC0415
 
     line, least = _slow_can_line(), 2 * footprint_radius("cylinder", [0.04, 0.05]) + SPACING
     line.speed_steps = [SpeedStepConfig(belt="in", t=5.0, factor=0.5)]

@@ -38,7 +38,7 @@ from typing import Optional
 import numpy as np
 
 from ptint_drake.config.pick import PickTaskConfig
-from ptint_drake.config.part_shape import part_height
+from ptint_drake.config.part_shape import footprint_radius, part_height
 from ptint_drake.worlds.pick.cell import place_point
 from ptint_drake.worlds.pick.phase_time import NoTfFits
 from ptint_drake.worlds.pick.scene import belt_frame
@@ -142,6 +142,6 @@ def on_belt(belt, p, R, part) -> bool:
     local = belt_frame(belt).inverse().multiply(np.asarray(p, dtype=float))
     height = part_height(part.shape, part.size)
     tilt = float(np.degrees(np.arccos(np.clip(np.asarray(R)[2, 2], -1.0, 1.0))))
-    across = (float(np.hypot(part.size[0], part.size[1])) if part.shape == "box" else part.size[0]) / 2
+    across = footprint_radius(part.shape, part.size)
     return bool(abs(local[2] - height / 2) <= REST_TOL and abs(local[1]) + across <= belt.width / 2 + 1e-9
                 and abs(local[0]) <= belt.length / 2 and tilt <= UPRIGHT_DEG)

@@ -45,6 +45,7 @@ from pydrake.multibody.tree import (FixedOffsetFrame, JointActuatorIndex, ModelI
 from pydrake.systems.framework import DiagramBuilder
 
 from ptint_drake.config.errors import ScenarioError
+from ptint_drake.config.part_shape import footprint_radius
 from ptint_drake.robot.rvm1 import model_path
 from ptint_drake.worlds.pick.config import BeltConfig, BinConfig, GripperConfig, PartConfig, TrayConfig
 
@@ -317,8 +318,7 @@ def bin_spots(box: BinConfig, part: PartConfig) -> list:
     ``part``, row by row — each a footprint (a cylinder's diameter, a box's top diagonal: any yaw)
     plus ``BIN_GAP`` from the next and from the walls; the centre alone where one fits.  Parts let go
     over one point stack (a Panda line of 25 mm pucks: the third rested above the 50 mm walls)."""
-    extent = float(part.size[0]) if part.shape == "cylinder" else float(np.hypot(part.size[0], part.size[1]))
-    pitch = extent + BIN_GAP
+    pitch = 2.0 * footprint_radius(part.shape, part.size) + BIN_GAP
     counts = [max(1, int((float(box.size[i]) - BIN_GAP) // pitch)) for i in (0, 1)]
     axes = [[(j - (n - 1) / 2) * pitch for j in range(n)] for n in counts]
     return [(x, y) for y in axes[1] for x in axes[0]]

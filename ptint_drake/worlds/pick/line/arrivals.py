@@ -29,6 +29,7 @@ import numpy as np
 
 from ptint_drake.config.errors import ScenarioError
 from ptint_drake.config.line import ArrivalConfig, LineConfig, PoolTruthConfig
+from ptint_drake.config.part_shape import footprint_radius
 from ptint_drake.config.pick import PartConfig
 
 SPACING = 0.005  # m: the least free belt between two parts as the feeder releases them (``spaced``)
@@ -69,12 +70,6 @@ def _kinds(line: LineConfig, arrival: ArrivalConfig) -> tuple[list, np.ndarray]:
     if not weights.sum() > 0.0:
         raise ScenarioError("pick.line.arrivals: mix: the weights sum to 0")
     return names, weights / weights.sum()
-
-
-def footprint_radius(shape: str, size) -> float:
-    """m: the radius of a part's footprint on the belt at any yaw (a box's half diagonal of its
-    top, a cylinder's radius)."""
-    return 0.5 * float(np.hypot(size[0], size[1])) if shape == "box" else 0.5 * float(size[0])
 
 
 def belt_speed_at(belt: str, speed: float, steps: list, t: float) -> float:
