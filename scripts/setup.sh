@@ -15,6 +15,8 @@
 #   HEARTBEAT_S=6            seconds between the "still running" lines of a long step
 #   SYSTEM_TOOLS=0           leave the system tools alone (.ci/run: the other end's setup,
 #                            running beside this one, installs them; apt-get takes one lock)
+#   WARM_UP_WORKERS=1        compile the numba kernels in one process, not two (.ci/run: the
+#                            other end compiles beside this one; the step "compile" below)
 # An existing environment built on another Python version than the one chosen is rebuilt.
 #
 # Progress: every step prints what it does when it starts and how long it took when it ends
@@ -199,7 +201,7 @@ step_end
 # Drake 1.58); in one process 58-122 s at load averages of about 2.5 to 7 (2026-12-05) and 135 s /
 # 182 s in CI (2026-12-03, the two Drake ends, .ci/run); a warm cache a few seconds.
 step_begin "compile" "the controller's numba kernels, once (about 1 min when numba's cache is cold, seconds when warm)"
-(cd / && "$venv_abs/bin/python" -m ptint_drake.cli.warm_up)
+(cd / && "$venv_abs/bin/python" -m ptint_drake.cli.warm_up --workers "${WARM_UP_WORKERS:-2}")
 step_end
 info=$("$venv_abs/bin/python" -c 'import sys, importlib.metadata as m
 print("Python %s, Drake %s" % (sys.version.split()[0], m.version("drake")))')

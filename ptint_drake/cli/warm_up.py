@@ -16,6 +16,7 @@ run compiles them when it first needs them (``jit_notice``).
 
 from __future__ import annotations
 
+import argparse
 import multiprocessing
 import sys
 import time
@@ -141,8 +142,21 @@ def _report(line: str) -> None:
     print(f"warm-up: {line}", file=sys.stderr, flush=True)
 
 
-if __name__ == "__main__":
+def main(argv: list[str] | None = None) -> None:
+    """``python -m ptint_drake.cli.warm_up [--workers N]`` (``scripts/setup.sh``)."""
+    parser = argparse.ArgumentParser(prog="python -m ptint_drake.cli.warm_up",
+                                     description=__doc__.splitlines()[0])
+    parser.add_argument("--workers", type=int, choices=(1, 2), default=2,
+                        help="processes that compile side by side (2, the default: the two shares of "
+                             "the runs; 1: one after the other, where another compile shares the cores)")
+    workers = parser.parse_args(argv).workers
     runs = sum(run is not None for share in _RUNS for run in share)
+    where = "in two processes" if workers == 2 else "in one process"
     _report(f"compiling (or loading from numba's cache) the kernels of {runs} short runs and the rest, "
-            f"in two processes; a few seconds when the cache is warm")
-    print(f"warm-up: compiled kernels ready in {warm_up(report=_report):.1f} s", file=sys.stderr)
+            f"{where}; a few seconds when the cache is warm")
+    wall = warm_up(report=_report, workers=workers)
+    print(f"warm-up: compiled kernels ready in {wall:.1f} s", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

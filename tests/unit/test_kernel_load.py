@@ -72,3 +72,27 @@ def test_the_law_falls_back_to_the_general_kernels_at_a_singular_jacobian():
         np.testing.assert_array_equal(row, law.row(*args, path="general"))
     np.testing.assert_array_equal(law.rows(t, qv, sigma, captured),
                                   law.rows(t, qv, sigma, captured, path="general"))
+
+
+@pytest.mark.parametrize("name", ["curve_b075_tf15", "curve_pose"])
+def test_the_telemetry_passes_the_kernels_the_simulations_argument_types(name):
+    """``rows`` (the telemetry's batch kernel) hands the row kernel each sample as the simulation
+    hands it the ``loop`` input: read-only where the bindings' is (Drake 1.51), so numba compiles
+    the row kernel (and its general version) once, not once more for the telemetry's array."""
+    import numba
+    import numpy as np
+
+    _, text = scenario_text(name)
+    built = build(parse_with_overrides(text, [], name), log=False)
+    law = built.controller.system.law
+    simulator = make_simulator(built)
+    simulator.AdvanceTo(0.01)
+    context = law.GetMyContextFromRoot(simulator.get_context())
+    u_sim = law._loop_in.EvalBasicVector(context).value()  # what ``_calc_packed_output`` passes
+    calls = []
+    call = law._call
+    law._call = lambda kernel, *args, path="auto": calls.append(args) or call(kernel, *args, path=path)
+    qv, sigma, captured, _ = law.loop_values(context)
+    law.rows(np.array([0.01]), qv[None], sigma[None], captured[None])
+    (args,) = calls
+    assert numba.typeof(args[1][0]) == numba.typeof(u_sim)

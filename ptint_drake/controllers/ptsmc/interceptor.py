@@ -263,6 +263,7 @@ class InterceptorLaw(LeafSystem):
         if self._batch:
             parts = [qv, sigma, captured] + [p for p in (target, rotation) if p is not None]
             U = np.ascontiguousarray(np.hstack(parts), dtype=float)
+            U.flags.writeable = self._loop_writeable  # its rows the simulation's types (``row``)
             out = np.empty((k, self._size + 5 + self._n))
             self._call(self._rows_kernel, np.ascontiguousarray(t, dtype=float), U, self._static, out,
                        np.empty(self._nv + self._n), path=path)
