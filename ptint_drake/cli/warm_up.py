@@ -27,21 +27,25 @@ import numpy as np
 
 # scenario, ``--set`` overrides: each reaches kernels (or argument types) the others do not.  Two
 # shares, run side by side (``warm_up``), that compile disjoint kernels: the position task's fused
-# rows, the IMM and the baselines; the pose and top-down rows and the five blocks.  Measured on a
-# cold cache, 2 cores, nothing else running (2026-12-06, Python 3.13, Drake 1.58): in one process
-# the shares' runs took 38 s and 33 s (the first run of each 23 s: its fused rows); dealt to two
-# processes run by run, 67 s against 73 s in one, since the top-down rows were compiled in both.
+# rows, the baselines and the blocks (which call the baselines' solve); the pose and top-down rows,
+# the TBG, orientation and IMM kernels, then the camera runs (the IMM, and the position rows the
+# other share has compiled by then: a process finds in numba's cache what another wrote).  Each
+# share compiles what its runs need first, so neither compiles a kernel the other does.  Measured
+# on a cold cache, 2 cores, nothing else running (2026-12-07, Python 3.13, Drake 1.58): in one
+# process 148 CPU s; in two, shares dealt as before this order (the IMM in one share and a camera
+# run needing it in the other, the baselines' solve and the blocks likewise), 101 s wall and
+# 197 CPU s.
 _RUNS = (
     (("curve_b075_tf15", []),
      ("conveyor_pair", ["controller.switching=sat", "controller.pinv_damping=0.01"]),
-     ("conveyor_pair_camera", []),
-     ("throw_camera", []),
      ("curve_b075_tf15", ["controller.type=smc"]),
      ("curve_b075_tf15", ["controller.type=ct_quintic"]),  # pinv_solve (``ptint paper``'s comparisons)
-     None),  # the TBG, orientation and IMM kernels
-    (("curve_pose", []),
-     ("conveyor_yaw_camera", []),  # the top-down task from a filter, the orientation filter's output
      ("curve_b075_tf15", ["controller.implementation=blocks"])),
+    (("curve_pose", []),
+     None,  # the TBG, orientation and IMM kernels
+     ("conveyor_yaw_camera", []),  # the top-down task from a filter, the orientation filter's output
+     ("conveyor_pair_camera", []),
+     ("throw_camera", [])),
 )
 
 
