@@ -198,8 +198,9 @@ step_end
 # does not pay for it; the warm-up prints a line per run it compiles.  Two processes compile
 # disjoint kernels side by side (ptint_drake/cli/warm_up.py): a cold cache took 49 s, against 73 s
 # in one process, on a 2-core x86_64 machine with nothing else running (2026-12-06, Python 3.13,
-# Drake 1.58); in one process 58-122 s at load averages of about 2.5 to 7 (2026-12-05) and 135 s /
-# 182 s in CI (2026-12-03, the two Drake ends, .ci/run); a warm cache a few seconds.
+# Drake 1.58); on a slower 2-core AMD EPYC machine 97 s against 148 s (2026-12-07).  .ci/run sets
+# WARM_UP_WORKERS=1 for its two ends' setups side by side (162 s and 177 s there); a warm cache
+# takes a few seconds.
 step_begin "compile" "the controller's numba kernels, once (about 1 min when numba's cache is cold, seconds when warm)"
 (cd / && "$venv_abs/bin/python" -m ptint_drake.cli.warm_up --workers "${WARM_UP_WORKERS:-2}")
 step_end
