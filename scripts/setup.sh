@@ -171,26 +171,22 @@ step_begin "pip upgrade" "pip itself, in $VENV"
 "$VENV/bin/python" -m pip install -q --upgrade pip 2>&1 | quiet_pip
 step_end
 drake=${DRAKE:-drake}
-# --no-compile: pip writes no bytecode for the ~0.5 GB it installs; Python writes it on the first
-# import of each module, for those a program imports (the warm-up below imports most of them).  The
-# dependencies' install on a 2-core AMD EPYC machine, Python 3.13, wheels in pip's cache
-# (2026-12-07): 76.6 s wall and 72 CPU s with the bytecode, 32.8 s and 29 CPU s without.
 if [ "${PTINT_EDITABLE:-0}" = 1 ]; then
   step_begin "pip install" "ptint_drake (editable) with $drake, numba and the test, docs and cluster extras"
-  "$VENV/bin/python" -m pip install -q --no-compile -e ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
+  "$VENV/bin/python" -m pip install -q -e ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
   step_end
 else
   step_begin "pip install ptint_drake" "the package, from this tree"
-  "$VENV/bin/python" -m pip install -q --no-compile --force-reinstall --no-deps . 2>&1 | quiet_pip
+  "$VENV/bin/python" -m pip install -q --force-reinstall --no-deps . 2>&1 | quiet_pip
   step_end
   step_begin "pip install dependencies" "$drake, numba, the test, docs and cluster extras (a first install downloads ~0.5 GB)"
-  "$VENV/bin/python" -m pip install -q --no-compile ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
+  "$VENV/bin/python" -m pip install -q ".[test,docs,cluster]" "$drake" 2>&1 | quiet_pip
   step_end
 fi
 # without DRAKE=, bring an existing environment up to the newest Drake its Python admits
 if [ -z "${DRAKE:-}" ]; then
   step_begin "pip upgrade drake" "Drake up to the newest release this Python admits"
-  "$VENV/bin/python" -m pip install -q --no-compile --upgrade --upgrade-strategy only-if-needed "drake" 2>&1 | quiet_pip
+  "$VENV/bin/python" -m pip install -q --upgrade --upgrade-strategy only-if-needed "drake" 2>&1 | quiet_pip
   step_end
 fi
 # check the installed package (from outside the source tree) finds its bundled model
