@@ -29,8 +29,9 @@ import numpy as np
 # shares, run side by side (``warm_up``), that compile disjoint kernels: the position task's fused
 # rows, the baselines and the blocks (which call the baselines' solve); the pose and top-down rows,
 # the TBG, orientation and IMM kernels, then the camera runs (the IMM, and the position rows the
-# other share has compiled by then: a process finds in numba's cache what another wrote).  Each
-# share compiles what its runs need first, so neither compiles a kernel the other does.  Measured
+# other share has usually compiled by then: a process finds in numba's cache what another wrote;
+# if not, both compile them, which costs time, not correctness).  Each share compiles what its own
+# runs need first, so the two compile the same kernel only in that race.  Measured
 # on a cold cache, 2 cores, nothing else running (2026-12-07, Python 3.13, Drake 1.58): in one
 # process 148 CPU s; in two, shares dealt as before this order (the IMM in one share and a camera
 # run needing it in the other, the baselines' solve and the blocks likewise), 101 s wall and
